@@ -1,0 +1,10 @@
+"""imunoise: noise characterisation of inertial sensors.
+
+Allan deviation and its family with real confidence intervals, noise-model
+fitting, log readers for VectorNav VN-100 (ASCII and binary), CSV and ROS bags,
+plots and reports. Start with ``imunoise.adev(x, fs)``.
+"""
+
+from imunoise._core import __version__
+
+__all__ = ["__version__"]

@@ -1,0 +1,166 @@
+//! The Allan family over cumulative sums: estimates, noise identification and
+//! equivalent degrees of freedom for many channels and taus at once.
+
+pub mod edf;
+pub mod noise_id;
+pub mod phase;
+pub mod sum;
+pub mod variance;
+
+use rayon::prelude::*;
+
+use crate::error::{CoreError, CoreResult};
+pub use variance::{Estimate, Statistic};
+
+/// Results for `taus.len()` taus × `channels` channels, tau-major
+/// (`var[t * channels + c]`), the layout of a C-ordered `(taus, channels)` array.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Analysis {
+    pub channels: usize,
+    pub var: Vec<f64>,
+    /// Terms per tau (the same for every channel).
+    pub terms: Vec<usize>,
+    /// Noise type α used for the EDF at each tau and channel.
+    pub alpha: Vec<i32>,
+    /// Whether α was identified at that tau (false: taken from the nearest tau
+    /// where it was, or white FM, α = 0, when no tau could be identified).
+    pub alpha_identified: Vec<bool>,
+    pub edf: Vec<f64>,
+}
+
+/// Cumulative phases of several channels, computed in parallel. Each item yields
+/// one channel's samples and may be iterated twice.
+pub fn column_phases<I>(columns: Vec<I>) -> CoreResult<Vec<Vec<f64>>>
+where
+    I: Iterator<Item = f64> + Clone + Send,
+{
+    columns
+        .into_par_iter()
+        .enumerate()
+        .map(|(channel, col)| {
+            phase::cumulative_phase(col).map_err(|e| match e {
+                CoreError::InvalidArgument(msg) => {
+                    CoreError::InvalidArgument(format!("{msg} (channel {channel})"))
+                }
+                other => other,
+            })
+        })
+        .collect()
+}
+
+/// Estimates the statistic at every averaging factor in `ms` for every phase,
+/// identifies the noise type and computes the EDF. Work is spread over
+/// (channel, tau) pairs.
+pub fn analyse(phases: &[Vec<f64>], statistic: Statistic, ms: &[usize]) -> CoreResult<Analysis> {
+    let channels = phases.len();
+    if channels == 0 {
+        return Err(CoreError::InvalidArgument("x must have at least one channel".into()));
+    }
+    let n_phase = phases[0].len();
+    if phases.iter().any(|p| p.len() != n_phase) {
+        return Err(CoreError::InvalidArgument("all channels must have the same length".into()));
+    }
+    let terms: Vec<usize> = ms.iter().map(|&m| statistic.terms(n_phase, m)).collect();
+    if let Some(pos) = terms.iter().position(|&t| t == 0) {
+        return Err(CoreError::InvalidArgument(format!(
+            "tau of {} samples does not fit in {} samples for this statistic",
+            ms[pos],
+            n_phase.saturating_sub(1)
+        )));
+    }
+    let pairs: Vec<(usize, usize)> =
+        (0..ms.len()).flat_map(|t| (0..channels).map(move |c| (t, c))).collect();
+    let (dmax, estimator) = noise_model_of(statistic);
+    let per_pair: Vec<(f64, Option<i32>)> = pairs
+        .par_iter()
+        .map(|&(t, c)| {
+            let est = statistic.estimate(&phases[c], ms[t]);
+            (est.var, noise_id::identify_alpha(&phases[c], ms[t], dmax))
+        })
+        .collect();
+
+    let mut var = Vec::with_capacity(pairs.len());
+    let mut alpha = vec![0; pairs.len()];
+    let mut alpha_identified = vec![false; pairs.len()];
+    for (i, &(v, a)) in per_pair.iter().enumerate() {
+        var.push(v);
+        if let Some(a) = a {
+            alpha[i] = a;
+            alpha_identified[i] = true;
+        }
+    }
+    for c in 0..channels {
+        fill_from_nearest(&mut alpha, &alpha_identified, c, channels, ms.len());
+    }
+    let n_samples = n_phase - 1;
+    let edf = pairs
+        .iter()
+        .enumerate()
+        .map(|(i, &(t, _))| match estimator {
+            Some(est) => edf::greenhall_edf(alpha[i], est, ms[t], n_phase),
+            None => edf::totvar_edf(alpha[i], ms[t], n_samples),
+        })
+        .collect();
+    Ok(Analysis { channels, var, terms, alpha, alpha_identified, edf })
+}
+
+/// Maximum differencing for noise identification and the EDF estimator (None:
+/// the total variance's own EDF table).
+fn noise_model_of(statistic: Statistic) -> (u32, Option<edf::Estimator>) {
+    use edf::Estimator;
+    match statistic {
+        Statistic::Allan { overlapping } => (2, Some(Estimator { d: 2, overlapping, modified: false })),
+        Statistic::Modified => (2, Some(Estimator { d: 2, overlapping: true, modified: true })),
+        Statistic::Hadamard { overlapping } => (3, Some(Estimator { d: 3, overlapping, modified: false })),
+        Statistic::Total => (2, None),
+    }
+}
+
+/// Where a tau's series was too short to identify, use the nearest tau (in index)
+/// of the same channel that was identified; with none at all, white FM (α = 0).
+fn fill_from_nearest(alpha: &mut [i32], known: &[bool], c: usize, channels: usize, taus: usize) {
+    let idx = |t: usize| t * channels + c;
+    let identified: Vec<usize> = (0..taus).filter(|&t| known[idx(t)]).collect();
+    for t in 0..taus {
+        if known[idx(t)] {
+            continue;
+        }
+        alpha[idx(t)] = identified
+            .iter()
+            .min_by_key(|&&k| (k as isize - t as isize).unsigned_abs())
+            .map_or(0, |&k| alpha[idx(k)]);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn analysis_shapes_and_fallback() {
+        let y: Vec<f64> = (0..200).map(|k| ((k * 37) % 17) as f64).collect();
+        let phases = column_phases(vec![y.iter().copied(), y.iter().copied()]).unwrap();
+        let a = analyse(&phases, Statistic::Allan { overlapping: true }, &[1, 2, 16, 64]).unwrap();
+        assert_eq!(a.var.len(), 8);
+        assert_eq!(a.terms, vec![199, 197, 169, 73]);
+        // m = 16 leaves 13 decimated points: not identified, copied from m = 2.
+        assert!(!a.alpha_identified[4]);
+        assert_eq!(a.alpha[4], a.alpha[2]);
+        assert!(a.edf.iter().all(|e| *e > 0.0));
+    }
+
+    #[test]
+    fn tau_too_long_is_an_error() {
+        let phases = column_phases(vec![[1.0, 2.0, 4.0].iter().copied()]).unwrap();
+        let err = analyse(&phases, Statistic::Allan { overlapping: true }, &[2]).unwrap_err();
+        assert!(err.to_string().contains("does not fit"));
+    }
+
+    #[test]
+    fn non_finite_values_name_the_channel() {
+        let a = [1.0, 2.0];
+        let b = [1.0, f64::INFINITY];
+        let err = column_phases(vec![a.iter().copied(), b.iter().copied()]).unwrap_err();
+        assert!(err.to_string().contains("channel 1"), "{err}");
+    }
+}

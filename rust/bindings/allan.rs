@@ -1,0 +1,71 @@
+//! Bindings for the Allan family: one call computes variances, terms, noise
+//! identification and EDF for every tau and channel with the GIL released.
+
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+
+use crate::allan::{self, Statistic};
+
+fn parse_statistic(name: &str) -> PyResult<Statistic> {
+    Ok(match name {
+        "adev" => Statistic::Allan { overlapping: false },
+        "oadev" => Statistic::Allan { overlapping: true },
+        "mdev" => Statistic::Modified,
+        "hdev" => Statistic::Hadamard { overlapping: false },
+        "ohdev" => Statistic::Hadamard { overlapping: true },
+        "totdev" => Statistic::Total,
+        other => {
+            return Err(PyValueError::new_err(format!(
+                "statistic must be one of adev, oadev, mdev, hdev, ohdev, totdev; got {other:?}"
+            )))
+        }
+    })
+}
+
+type AnalysisArrays<'py> = (
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray1<u64>>,
+    Bound<'py, PyArray2<i32>>,
+    Bound<'py, PyArray2<bool>>,
+    Bound<'py, PyArray2<f64>>,
+);
+
+/// analyse(x, statistic, ms) -> (var, terms, alpha, alpha_identified, edf)
+///
+/// `x` is a float64 array (n, channels) in any memory order; `ms` the averaging
+/// factors. 2-D outputs have shape (len(ms), channels).
+#[pyfunction]
+fn analyse<'py>(
+    py: Python<'py>,
+    x: PyReadonlyArray2<'py, f64>,
+    statistic: &str,
+    ms: PyReadonlyArray1<'py, u64>,
+) -> PyResult<AnalysisArrays<'py>> {
+    let statistic = parse_statistic(statistic)?;
+    let view = x.as_array();
+    let ms: Vec<usize> = ms.as_array().iter().map(|&m| m as usize).collect();
+    let result = py.detach(|| {
+        let columns: Vec<_> = view.columns().into_iter().map(|c| c.into_iter().copied()).collect();
+        let phases = allan::column_phases(columns)?;
+        allan::analyse(&phases, statistic, &ms)
+    })?;
+    let shape = (ms.len(), result.channels);
+    let reshape_err = |e: numpy::ndarray::ShapeError| PyValueError::new_err(e.to_string());
+    let to2 = |v: Vec<f64>| numpy::ndarray::Array2::from_shape_vec(shape, v).map_err(reshape_err);
+    let var = to2(result.var)?.into_pyarray(py);
+    let edf = to2(result.edf)?.into_pyarray(py);
+    let alpha = numpy::ndarray::Array2::from_shape_vec(shape, result.alpha)
+        .map_err(reshape_err)?
+        .into_pyarray(py);
+    let identified = numpy::ndarray::Array2::from_shape_vec(shape, result.alpha_identified)
+        .map_err(reshape_err)?
+        .into_pyarray(py);
+    let terms: Vec<u64> = result.terms.iter().map(|&t| t as u64).collect();
+    Ok((var, terms.into_pyarray(py), alpha, identified, edf))
+}
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(analyse, m)?)?;
+    Ok(())
+}
