@@ -1,0 +1,5 @@
+"""Readers that turn logs into :class:`ImuLog` objects."""
+
+from imunoise.readers.log import CHANNELS, DEFAULT_FS, ISSUE_KINDS, ImuLog, ParseIssues
+
+__all__ = ["CHANNELS", "DEFAULT_FS", "ISSUE_KINDS", "ImuLog", "ParseIssues"]
