@@ -13,7 +13,10 @@ pub struct Estimate {
 }
 
 impl Estimate {
-    const EMPTY: Estimate = Estimate { var: f64::NAN, terms: 0 };
+    const EMPTY: Estimate = Estimate {
+        var: f64::NAN,
+        terms: 0,
+    };
 }
 
 /// Which statistic to compute.
@@ -37,8 +40,12 @@ impl Statistic {
             return 0;
         }
         match self {
-            Statistic::Allan { overlapping } => strided_count(n_phase, 2 * m, stride(overlapping, m)),
-            Statistic::Hadamard { overlapping } => strided_count(n_phase, 3 * m, stride(overlapping, m)),
+            Statistic::Allan { overlapping } => {
+                strided_count(n_phase, 2 * m, stride(overlapping, m))
+            }
+            Statistic::Hadamard { overlapping } => {
+                strided_count(n_phase, 3 * m, stride(overlapping, m))
+            }
             Statistic::Modified => (n_phase + 1).saturating_sub(3 * m),
             Statistic::Total => {
                 if m < n_phase && n_phase >= 3 {
@@ -153,7 +160,9 @@ mod tests {
     use crate::allan::phase::cumulative_phase;
 
     /// NIST SP 1065 NBS14 10-point frequency data.
-    const NBS14: [f64; 9] = [892.0, 809.0, 823.0, 798.0, 671.0, 644.0, 883.0, 903.0, 677.0];
+    const NBS14: [f64; 9] = [
+        892.0, 809.0, 823.0, 798.0, 671.0, 644.0, 883.0, 903.0, 677.0,
+    ];
 
     fn dev(stat: Statistic, m: usize) -> f64 {
         let c = cumulative_phase(NBS14.iter().copied()).unwrap();
