@@ -8,6 +8,7 @@ plots and reports. Start with ``imunoise.adev(x, fs)``.
 from imunoise._core import __version__
 from imunoise.allan import AllanResult, adev, hdev, mdev, tdev, totdev
 from imunoise.readers import ImuLog, ParseIssues
+from imunoise.stats import describe, distribution
 
 __all__ = [
     "__version__",
@@ -15,6 +16,8 @@ __all__ = [
     "ImuLog",
     "ParseIssues",
     "adev",
+    "describe",
+    "distribution",
     "hdev",
     "mdev",
     "tdev",

@@ -1,0 +1,397 @@
+"""The ``imunoise`` command line.
+
+Every error is one line on stderr, ``imunoise: error: ...``, with exit status 2;
+warnings are one line each, ``imunoise: warning: ...``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+__all__ = ["main"]
+
+SENSORS = ("gyro", "accel", "mag")
+KINDS = ("adev", "mdev", "hdev", "tdev", "totdev")
+_AXES = ("X", "Y", "Z")
+
+#: Noise of the simulated long log of ``imunoise demo``, in SI units: the VN-100
+#: datasheet's noise densities and in-run bias stabilities (gyro 0.0035 °/s/√Hz and
+#: 10 °/h; accelerometer 0.14 mg/√Hz and 0.04 mg); the datasheet gives no rate random
+#: walk, so K is a typical MEMS value (gyro 2e-6 rad/s/√s, accel 3e-5 m/s²/√s).
+DEMO_NOISE = {
+    "gyro": {"N": 0.0035 * np.pi / 180.0, "B": 10.0 * np.pi / 180.0 / 3600.0, "K": 2e-6},
+    "accel": {"N": 0.14e-3 * 9.80665, "B": 0.04e-3 * 9.80665, "K": 3e-5},
+}
+#: Still-sensor means of the simulated log: gravity on -Z, Earth rate ignored.
+DEMO_MEAN = {"gyro": (0.0, 0.0, 0.0), "accel": (0.0, 0.0, -9.80665)}
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse with one-line errors and exit status 2."""
+
+    def error(self, message: str):  # noqa: D401 - argparse API
+        _fail(message)
+
+
+class _Failure(Exception):
+    pass
+
+
+def _fail(message: str):
+    raise _Failure(message)
+
+
+def _version() -> str:
+    try:
+        from imunoise import __version__
+
+        return __version__
+    except ImportError:  # pragma: no cover
+        return "unknown"
+
+
+def _build_parser() -> argparse.ArgumentParser:
+    p = _Parser(
+        prog="imunoise",
+        description="Noise characterisation of inertial sensors: statistics, Allan "
+        "deviation, noise model, reports.",
+    )
+    p.add_argument("--version", action="version", version=f"imunoise {_version()}")
+    sub = p.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
+
+    r = sub.add_parser("report", help="write the full noise report (HTML, Markdown, figures)",
+                       description="Analyse a short log (statistics, distributions) and a long "
+                       "log (Allan deviation, noise model) and write report.html, report.md, "
+                       "figures/, noise.json and imu.yaml. With one log, both use it.")
+    r.add_argument("short_log", metavar="SHORT_LOG")
+    r.add_argument("long_log", metavar="LONG_LOG", nargs="?")
+    r.add_argument("-o", "--output", default="imunoise-report", metavar="DIR",
+                   help="output directory (default: %(default)s)")
+    r.add_argument("--spec", default="vn100",
+                   help="datasheet to compare with: a name or a TOML file (default: "
+                   "%(default)s); 'none' to skip")
+    _progress_args(r)
+
+    a = sub.add_parser("adev", help="print an Allan-family deviation table",
+                       description="Print tau, deviation, confidence interval and number of "
+                       "terms per axis.")
+    a.add_argument("log", metavar="LOG")
+    a.add_argument("--sensor", choices=SENSORS, default="gyro")
+    a.add_argument("--kind", choices=KINDS, default="adev")
+    a.add_argument("--taus", default="octave",
+                   help="octave, decade, all, or points per decade (default: %(default)s)")
+
+    f = sub.add_parser("fit", help="fit the noise model and print coefficients",
+                       description="Fit Q, N, B, K, R per axis to the Allan deviation and print "
+                       "them in datasheet units with uncertainties.")
+    f.add_argument("log", metavar="LOG")
+    f.add_argument("--sensor", choices=("gyro", "accel"), default=None,
+                   help="one sensor (default: gyro and accel)")
+
+    s = sub.add_parser("stats", help="print sample statistics and distribution fits",
+                       description="Per channel mean, std, variance, min, max, drift per hour; "
+                       "per axis normal fit and normality statistics.")
+    s.add_argument("log", metavar="LOG")
+
+    c = sub.add_parser("convert", help="convert a log to CSV, Parquet or NPZ",
+                       description="Write the log's channels to OUTPUT; the format follows the "
+                       "suffix: .csv, .parquet (needs pyarrow) or .npz.")
+    c.add_argument("log", metavar="LOG")
+    c.add_argument("-o", "--output", required=True, metavar="OUTPUT")
+
+    m = sub.add_parser("simulate", help="write the log of a simulated still VN-100",
+                       description="Write a VN-100 log with datasheet-level noise "
+                       "(imunoise.simulate_log).")
+    m.add_argument("-o", "--output", required=True, metavar="OUTPUT")
+    m.add_argument("--hours", type=_positive_float, default=1.0)
+    m.add_argument("--fs", type=_positive_float, default=40.0, help="sample rate in Hz")
+    m.add_argument("--format", choices=("vn-ascii", "vn-binary"), default="vn-ascii")
+    m.add_argument("--spec", default="vn100")
+    m.add_argument("--seed", type=int, default=None)
+
+    d = sub.add_parser("demo", help="run the report on bundled data",
+                       description="Report on a real 5-minute VN-100 log shipped with imunoise "
+                       "and a simulated 5-hour VN-100 log, then print where the report is.")
+    d.add_argument("-o", "--output", default="imunoise-demo", metavar="DIR")
+    d.add_argument("--hours", type=_positive_float, default=5.0,
+                   help="length of the simulated long log (default: %(default)s)")
+    d.add_argument("--seed", type=int, default=1)
+    _progress_args(d)
+    return p
+
+
+def _progress_args(p) -> None:
+    g = p.add_mutually_exclusive_group()
+    g.add_argument("--progress", dest="progress", action="store_true", default=None,
+                   help="always show progress bars on stderr")
+    g.add_argument("--no-progress", dest="progress", action="store_false",
+                   help="never show progress bars")
+
+
+def _positive_float(text: str) -> float:
+    try:
+        v = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a positive number; got {text!r}") from None
+    if not (np.isfinite(v) and v > 0):
+        raise argparse.ArgumentTypeError(f"expected a positive number; got {text!r}")
+    return v
+
+
+# --- dependencies, one function each -------------------------------------------------
+
+
+def _read(path: str):
+    from imunoise.report import _load, _Progress
+
+    return _load(path, "input", _Progress(False, 0))
+
+
+def _simulate(n: int, fs: float, seed: int | None, coeffs: dict) -> np.ndarray:
+    """(n, 3) noise with the given coefficients, from :func:`imunoise.simulate`."""
+    import imunoise
+
+    return np.asarray(imunoise.simulate(n, fs, channels=3, seed=seed, **coeffs))
+
+
+# --- commands ------------------------------------------------------------------------
+
+
+def _cmd_report(args) -> int:
+    from imunoise import report
+
+    spec = None if args.spec.lower() == "none" else args.spec
+    rep = report.build(args.short_log, args.long_log, args.output, spec=spec,
+                       progress=args.progress)
+    print(f"report written to {rep.html}")
+    return 0
+
+
+def _cmd_adev(args) -> int:
+    import imunoise
+
+    log = _read(args.log)
+    y = getattr(log, args.sensor)
+    if y is None:
+        _fail(f"{args.log}: the log has no {args.sensor} channel (has {', '.join(log.channels)})")
+    taus = int(args.taus) if args.taus.isdigit() else args.taus
+    r = getattr(imunoise, args.kind)(y, log.fs, taus=taus)
+    from imunoise.readers.log import CHANNELS
+
+    unit = CHANNELS[args.sensor][1]
+    head = ["tau[s]", "n"]
+    for a in _AXES:
+        head += [f"{a}[{unit}]", f"{a}_ci_low", f"{a}_ci_high"]
+    rows = []
+    for i, tau in enumerate(r.taus):
+        row = [f"{tau:.6g}", str(int(r.n[i]))]
+        for j in range(r.dev.shape[1]):
+            row += [f"{r.dev[i, j]:.6e}", f"{r.ci_low[i, j]:.6e}", f"{r.ci_high[i, j]:.6e}"]
+        rows.append(row)
+    print(f"# {args.kind} of {args.sensor}, {len(y)} samples at {log.fs:.6g} Hz, "
+          f"CI {r.confidence:.1%}")
+    _print_table(head, rows)
+    return 0
+
+
+def _cmd_fit(args) -> int:
+    import imunoise
+    from imunoise import report
+
+    if not hasattr(imunoise, "fit"):
+        _fail("the noise model (imunoise.fit) is not part of this installation")
+    log = _read(args.log)
+    sensors = [args.sensor] if args.sensor else [s for s in ("gyro", "accel")
+                                                  if getattr(log, s) is not None]
+    if not sensors or any(getattr(log, s) is None for s in sensors):
+        _fail(f"{args.log}: no {' or '.join(sensors or ['gyro/accel'])} channel in the log")
+    for s in sensors:
+        model = report._fit(report._allan(getattr(log, s), log.fs))
+        head, rows = report._datasheet_rows(model, s)
+        print(f"# {s}")
+        _print_table(head, rows)
+    return 0
+
+
+def _cmd_stats(args) -> int:
+    from imunoise import stats
+
+    log = _read(args.log)
+    desc = stats.describe(log)
+    print(f"# {log.source}: {len(log)} samples at {log.fs:.6g} Hz, parse issues: {log.issues}")
+    print(desc.table())
+    print()
+    head = ["channel", "step", "mu", "sigma", "KS_D", "KS_p", "AD_A2", "skew", "ex_kurt"]
+    rows = []
+    for sensor in SENSORS:
+        y = getattr(log, sensor)
+        if y is None:
+            continue
+        for j in range(y.shape[1]):
+            d = stats.distribution(y[:, j])
+            rows.append([f"{sensor} {_AXES[j]}", f"{d.step:.6g}" if d.step else "-"] + [
+                f"{v:.6g}" for v in (d.mu, d.sigma, d.ks_statistic, d.ks_pvalue,
+                                     d.ad_statistic, d.skewness, d.excess_kurtosis)
+            ])
+    _print_table(head, rows)
+    return 0
+
+
+def _columns(log) -> tuple[list[str], list[np.ndarray]]:
+    names, cols = [], []
+    if log.time is not None:
+        names.append("time")
+        cols.append(np.asarray(log.time))
+    from imunoise.readers.log import CHANNELS
+
+    for ch in CHANNELS:
+        arr = getattr(log, ch)
+        if arr is None:
+            continue
+        if arr.ndim == 1:
+            names.append(ch)
+            cols.append(arr)
+        else:
+            axes = ("w", "x", "y", "z") if ch == "quaternion" else ("x", "y", "z")
+            for j in range(arr.shape[1]):
+                names.append(f"{ch}_{axes[j]}")
+                cols.append(arr[:, j])
+    return names, cols
+
+
+def _cmd_convert(args) -> int:
+    out = Path(args.output)
+    suffix = out.suffix.lower()
+    if suffix not in (".csv", ".parquet", ".npz"):
+        _fail(f"--output must end in .csv, .parquet or .npz; got {str(out)!r}")
+    if suffix == ".parquet":
+        try:
+            import pyarrow  # noqa: F401
+        except ImportError:
+            _fail("Parquet output needs pyarrow (pip install pyarrow)")
+    log = _read(args.log)
+    names, cols = _columns(log)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    if suffix == ".csv":
+        np.savetxt(out, np.column_stack(cols), delimiter=",", header=",".join(names),
+                   comments="", fmt="%.10g")
+    elif suffix == ".parquet":
+        import pyarrow as pa
+        import pyarrow.parquet as pq
+
+        table = pa.table(dict(zip(names, cols, strict=True)))
+        table = table.replace_schema_metadata({"fs": str(log.fs), "source": log.source})
+        pq.write_table(table, out)
+    else:
+        np.savez(out, fs=log.fs, **dict(zip(names, cols, strict=True)))
+    print(f"wrote {len(log)} samples x {len(names)} columns to {out}")
+    return 0
+
+
+def _cmd_simulate(args) -> int:
+    import imunoise
+
+    simulate_log = getattr(imunoise, "simulate_log", None)
+    if simulate_log is None:
+        _fail("imunoise.simulate_log is not part of this installation")
+    path = simulate_log(args.output, args.hours, args.fs, format=args.format, spec=args.spec,
+                        seed=args.seed)
+    print(f"wrote {path or args.output}")
+    return 0
+
+
+def demo_long_log(hours: float, fs: float = 40.0, seed: int | None = 1):
+    """A simulated still VN-100 recording (:data:`DEMO_NOISE`) as an ImuLog."""
+    from imunoise.readers.log import ImuLog
+
+    n = int(round(hours * 3600 * fs))
+    chans = {}
+    for i, sensor in enumerate(("gyro", "accel")):
+        s = None if seed is None else seed + i
+        chans[sensor] = _simulate(n, fs, s, DEMO_NOISE[sensor]) + np.asarray(DEMO_MEAN[sensor])
+    return ImuLog.from_arrays(fs, source=f"<simulated VN-100, {hours:g} h>", **chans)
+
+
+def bundled_log() -> Path:
+    """Path of the real 5-minute VN-100 log shipped with imunoise."""
+    from importlib import resources
+
+    return Path(str(resources.files("imunoise") / "data" / "vn100_stationary_5min.txt"))
+
+
+def _cmd_demo(args) -> int:
+    import imunoise
+    from imunoise import report
+
+    short = bundled_log()
+    long = None
+    if hasattr(imunoise, "simulate"):
+        long = demo_long_log(args.hours, seed=args.seed)
+    else:
+        print("imunoise: note: imunoise.simulate is not part of this installation; the demo "
+              "analyses the bundled 5-minute log alone", file=sys.stderr)
+    rep = report.build(short, long, args.output, spec="vn100", progress=args.progress)
+    print(f"demo report: {rep.html.resolve()}")
+    print(f"             {rep.markdown.resolve()}")
+    return 0
+
+
+def _print_table(head, rows) -> None:
+    widths = [max(len(str(x)) for x in col) for col in zip(head, *rows, strict=True)]
+    for line in [head, *rows]:
+        print("  ".join(str(c).rjust(w) for c, w in zip(line, widths, strict=True)))
+
+
+_COMMANDS = {
+    "report": _cmd_report,
+    "adev": _cmd_adev,
+    "fit": _cmd_fit,
+    "stats": _cmd_stats,
+    "convert": _cmd_convert,
+    "simulate": _cmd_simulate,
+    "demo": _cmd_demo,
+}
+
+
+def _one_line(text: str) -> str:
+    return " ".join(str(text).split())
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the command line; returns the exit status (also used as the script's)."""
+
+    def _warn(message, category, filename, lineno, file=None, line=None):
+        print(f"imunoise: warning: {_one_line(message)}", file=sys.stderr)
+
+    parser = _build_parser()
+    old = warnings.showwarning
+    warnings.showwarning = _warn
+    try:
+        try:
+            args = parser.parse_args(argv)
+            if args.command is None:
+                parser.print_help(sys.stderr)
+                return 2
+            return _COMMANDS[args.command](args)
+        except _Failure as exc:
+            message = str(exc)
+        except (ValueError, OSError, TypeError) as exc:
+            message = str(exc) or type(exc).__name__
+            if isinstance(exc, OSError) and exc.filename and exc.strerror:
+                message = f"{exc.filename}: {exc.strerror}"
+        except KeyboardInterrupt:
+            print("imunoise: interrupted", file=sys.stderr)
+            return 130
+        print(f"imunoise: error: {_one_line(message)}", file=sys.stderr)
+        return 2
+    finally:
+        warnings.showwarning = old
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

@@ -1,0 +1,312 @@
+r"""Figures of a noise analysis, drawn with matplotlib's Agg backend (no display needed).
+
+Every function returns a :class:`matplotlib.figure.Figure`; :func:`save` writes it
+as PNG and SVG. One figure per sensor holds its three axes. Axis colours are the
+same in every figure (X blue, Y orange, Z green).
+
+Time series use min/max decimation: the samples are split into one bucket per
+pixel column and each bucket is drawn as a vertical stroke from its minimum to
+its maximum, so 10⁷ points draw in milliseconds and no spike disappears.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from contextlib import contextmanager
+from pathlib import Path
+
+import numpy as np
+
+__all__ = [
+    "AXIS_COLORS",
+    "allan",
+    "decimate_minmax",
+    "histograms",
+    "save",
+    "style",
+    "time_series",
+]
+
+AXIS_COLORS = ("#1f77b4", "#ff7f0e", "#2ca02c", "#9467bd")
+AXIS_NAMES = ("X", "Y", "Z", "W")
+TERM_STYLES = {
+    "Q": ("quantization Q", ":"),
+    "N": ("white noise N", "--"),
+    "B": ("bias instability B", "-."),
+    "K": ("rate random walk K", (0, (5, 1, 1, 1))),
+    "R": ("rate ramp R", (0, (1, 2))),
+}
+#: 2 ln2 / π, the bias-instability flat-floor factor of σ² (IEEE Std 952).
+_B_FACTOR = 2.0 * math.log(2.0) / math.pi
+
+_RC = {
+    "figure.dpi": 100,
+    "savefig.dpi": 110,
+    "font.size": 9,
+    "axes.titlesize": 10,
+    "axes.labelsize": 9,
+    "axes.grid": True,
+    "grid.alpha": 0.3,
+    "grid.linewidth": 0.6,
+    "axes.spines.top": False,
+    "axes.spines.right": False,
+    "legend.fontsize": 7.5,
+    "legend.frameon": False,
+    "lines.linewidth": 1.2,
+    "svg.fonttype": "none",
+}
+
+
+def _plt():
+    import matplotlib
+
+    matplotlib.use("Agg", force=False)
+    from matplotlib.figure import Figure
+
+    return Figure
+
+
+@contextmanager
+def style():
+    """Context manager applying the imunoise figure style."""
+    import matplotlib
+
+    with matplotlib.rc_context(_RC):
+        yield
+
+
+def _margins(fig, *, left=0.8, right=0.15, bottom=0.5, top=0.25, wspace=0.25, hspace=0.15,
+             title: bool = False) -> None:
+    """Fixed margins in inches (constrained layout costs more than the drawing)."""
+    w, h = fig.get_size_inches()
+    top += 0.3 if title else 0.0
+    fig.subplots_adjust(left=left / w, right=1 - right / w, bottom=bottom / h, top=1 - top / h,
+                        wspace=wspace, hspace=hspace)
+
+
+def decimate_minmax(y: np.ndarray, columns: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Per-column minimum and maximum of ``y``.
+
+    Parameters
+    ----------
+    y : ndarray, (n,)
+        Samples.
+    columns : int
+        Number of buckets (pixel columns).
+
+    Returns
+    -------
+    start, lo, hi : ndarray
+        Index of the first sample of each bucket and the bucket's min and max.
+        With ``n <= columns`` every sample is its own bucket.
+    """
+    y = np.asarray(y, dtype=np.float64)
+    n = len(y)
+    if columns < 1:
+        raise ValueError(f"columns must be >= 1; got {columns}")
+    if n <= columns:
+        idx = np.arange(n)
+        return idx, y.copy(), y.copy()
+    start = (np.arange(columns, dtype=np.int64) * n) // columns
+    start = np.unique(start)
+    return start, np.minimum.reduceat(y, start), np.maximum.reduceat(y, start)
+
+
+def _draw_series(ax, t0: float, fs: float, y: np.ndarray, color: str, columns: int) -> None:
+    start, lo, hi = decimate_minmax(y, columns)
+    t = t0 + start / fs
+    if len(y) <= columns:
+        ax.plot(t, y, color=color, linewidth=0.8)
+        return
+    # One vertical stroke per bucket, joined: a closed band from min to max.
+    ax.fill_between(t, lo, hi, color=color, linewidth=0.6, edgecolor=color, step="post")
+
+
+def time_series(
+    y: np.ndarray,
+    fs: float,
+    *,
+    title: str = "",
+    unit: str = "",
+    names: Sequence[str] | None = None,
+    columns: int = 1600,
+):
+    """Time series of a sensor's axes, one panel per axis, min/max decimated.
+
+    Parameters
+    ----------
+    y : ndarray, (n,) or (n, k)
+        Samples.
+    fs : float
+        Sample rate in Hz (the time axis is in seconds, minutes or hours by length).
+    title, unit : str
+        Figure title and y-axis unit.
+    names : sequence of str, optional
+        Axis names; default X, Y, Z.
+    columns : int
+        Buckets per panel (≈ pixel width of the saved figure).
+    """
+    Figure = _plt()
+    y = np.asarray(y, dtype=np.float64).reshape(len(y), -1)
+    k = y.shape[1]
+    names = list(names) if names is not None else list(AXIS_NAMES[:k])
+    duration = len(y) / fs
+    scale, tunit = (1.0, "s") if duration < 600 else (60.0, "min")
+    if duration >= 3 * 3600:
+        scale, tunit = 3600.0, "h"
+    with style():
+        fig = Figure(figsize=(9, 1.7 * k + 0.6))
+        axes = fig.subplots(k, 1, sharex=True, squeeze=False)[:, 0]
+        for j, ax in enumerate(axes):
+            _draw_series(ax, 0.0, fs * scale, y[:, j], AXIS_COLORS[j % 4], columns)
+            ax.set_ylabel(f"{names[j]} [{unit}]" if unit else names[j])
+            ax.margins(x=0)
+        axes[-1].set_xlabel(f"time [{tunit}]")
+        _margins(fig, left=0.95, bottom=0.45, title=bool(title))
+        if title:
+            fig.suptitle(title)
+    return fig
+
+
+def histograms(
+    dists: Sequence,
+    *,
+    title: str = "",
+    unit: str = "",
+    names: Sequence[str] | None = None,
+):
+    """Histograms (as densities) with the fitted normal pdf, one panel per axis.
+
+    Parameters
+    ----------
+    dists : sequence of :class:`imunoise.stats.Distribution`
+        One per axis.
+    """
+    Figure = _plt()
+    k = len(dists)
+    names = list(names) if names is not None else list(AXIS_NAMES[:k])
+    with style():
+        fig = Figure(figsize=(3.2 * k, 2.8))
+        axes = fig.subplots(1, k, squeeze=False)[0]
+        for j, (ax, d) in enumerate(zip(axes, dists, strict=True)):
+            color = AXIS_COLORS[j % 4]
+            ax.stairs(d.density(), d.edges, fill=True, color=color, alpha=0.45)
+            x = np.linspace(d.edges[0], d.edges[-1], 400)
+            if d.sigma > 0:
+                ax.plot(x, d.pdf(x), color="k", linewidth=1.1, label="normal fit")
+            ax.set_title(
+                f"{names[j]}: μ={d.mu:.4g}, σ={d.sigma:.3g}\n"
+                f"skew {d.skewness:.2f}, ex. kurt {d.excess_kurtosis:.2f}",
+                fontsize=8,
+            )
+            ax.set_xlabel(unit)
+            ax.grid(False)
+        axes[0].set_ylabel("density")
+        _margins(fig, left=0.6, bottom=0.45, top=0.55, wspace=0.3, title=bool(title))
+        if title:
+            fig.suptitle(title)
+    return fig
+
+
+def _curves(coeffs: Mapping[str, float], taus: np.ndarray) -> dict[str, np.ndarray]:
+    """Deviation of each noise term and the total at ``taus`` (IEEE Std 952 model)."""
+    t = np.asarray(taus, dtype=np.float64)
+    var = {
+        "Q": 3.0 * coeffs.get("Q", 0.0) ** 2 / t**2,
+        "N": coeffs.get("N", 0.0) ** 2 / t,
+        "B": _B_FACTOR * coeffs.get("B", 0.0) ** 2 * np.ones_like(t),
+        "K": coeffs.get("K", 0.0) ** 2 * t / 3.0,
+        "R": coeffs.get("R", 0.0) ** 2 * t**2 / 2.0,
+    }
+    out = {name: np.sqrt(v) for name, v in var.items()}
+    out["total"] = np.sqrt(sum(var.values()))
+    return out
+
+
+def allan(
+    result,
+    *,
+    coefficients: Sequence[Mapping[str, float]] | None = None,
+    title: str = "",
+    unit: str = "",
+    names: Sequence[str] | None = None,
+):
+    r"""Allan deviation of a sensor's axes on log-log axes, one panel per axis.
+
+    Parameters
+    ----------
+    result : AllanResult
+        1-D or 2-D result; the error bars are its ``ci_low``/``ci_high``.
+    coefficients : sequence of mapping, optional
+        Per axis, the fitted ``{"Q", "N", "B", "K", "R"}`` in the result's units.
+        When given, the model total and each non-zero term are drawn and the
+        read-off points are marked: N at τ = 1 s, K at τ = 3 s and
+        :math:`B\sqrt{2\ln2/\pi}` (the flat floor, ≈ 0.664 B) at the total's minimum.
+    """
+    Figure = _plt()
+    taus = np.asarray(result.taus, dtype=np.float64)
+    dev = np.asarray(result.dev, dtype=np.float64).reshape(len(taus), -1)
+    lo = np.asarray(result.ci_low, dtype=np.float64).reshape(dev.shape)
+    hi = np.asarray(result.ci_high, dtype=np.float64).reshape(dev.shape)
+    k = dev.shape[1]
+    names = list(names) if names is not None else list(AXIS_NAMES[:k])
+    kind = getattr(result, "kind", "adev").upper()
+    grid = np.geomspace(taus[0], taus[-1], 200)
+    with style():
+        fig = Figure(figsize=(3.6 * k, 3.4))
+        axes = fig.subplots(1, k, squeeze=False, sharey=True)[0]
+        for j, ax in enumerate(axes):
+            color = AXIS_COLORS[j % 4]
+            yerr = np.vstack([dev[:, j] - lo[:, j], hi[:, j] - dev[:, j]])
+            ax.errorbar(
+                taus, dev[:, j], yerr=yerr, fmt="o", ms=2.5, color=color,
+                elinewidth=0.8, capsize=1.5, label=f"{kind} ({result.confidence:.1%} CI)",
+            )
+            if coefficients is not None:
+                c = coefficients[j]
+                curves = _curves(c, grid)
+                ax.plot(grid, curves["total"], color="k", linewidth=1.2, label="model")
+                for term, (label, ls) in TERM_STYLES.items():
+                    if c.get(term, 0.0) > 0:
+                        ax.plot(grid, curves[term], color="0.45", linestyle=ls,
+                                linewidth=0.9, label=f"{label}")
+                if c.get("N", 0.0) > 0:
+                    ax.plot([1.0], [c["N"]], marker="s", color="crimson", ms=5,
+                            linestyle="none", label="N at τ=1 s")
+                if c.get("K", 0.0) > 0:
+                    ax.plot([3.0], [c["K"]], marker="^", color="purple", ms=5,
+                            linestyle="none", label="K at τ=3 s")
+                if c.get("B", 0.0) > 0:
+                    imin = int(np.argmin(curves["total"]))
+                    ax.plot([grid[imin]], [c["B"] * math.sqrt(_B_FACTOR)], marker="D",
+                            color="darkgreen", ms=5, linestyle="none",
+                            label="B·0.664 floor")
+            ax.set_xscale("log")
+            ax.set_yscale("log")
+            ax.set_xlabel("τ [s]")
+            ax.set_title(names[j])
+            ax.grid(True, which="both", alpha=0.25)
+            ymin = np.nanmin(np.where(lo[:, j] > 0, lo[:, j], np.nan))
+            ymax = np.nanmax(hi[:, j])
+            if np.isfinite(ymin) and np.isfinite(ymax):
+                ax.set_ylim(ymin / 2.0, ymax * 2.0)
+        axes[0].set_ylabel(f"σ(τ) [{unit}]" if unit else "σ(τ)")
+        axes[0].legend(loc="lower left")
+        _margins(fig, left=0.85, bottom=0.5, top=0.3, wspace=0.08, title=bool(title))
+        if title:
+            fig.suptitle(title)
+    return fig
+
+
+def save(fig, path, formats: Sequence[str] = ("png", "svg")) -> list[Path]:
+    """Save ``fig`` as ``path.<fmt>`` for each format; returns the paths written."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    written = []
+    with style():
+        for fmt in formats:
+            out = path.with_suffix(f".{fmt}")
+            fig.savefig(out, format=fmt)
+            written.append(out)
+    return written

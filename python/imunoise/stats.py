@@ -1,0 +1,440 @@
+r"""Sample statistics and distribution fits of still-IMU recordings.
+
+:func:`describe` gives, per channel, the moments and extremes of a recording and
+its linear drift; :func:`distribution` gives a histogram whose bins respect the
+sensor's quantization, a normal fit and goodness-of-fit statistics.
+
+Quantization-aware bins
+-----------------------
+Digital sensors (and logs printed with a fixed number of decimals) only produce
+values on a grid :math:`x_0 + k\,q`. Ordinary automatic bin edges fall between
+and on grid levels at random, so neighbouring bins hold 0, 1 or 2 levels and
+the histogram shows a comb that is not in the data (the usual workaround is to
+hand-pick 15, 30 or 100 bins per channel). :func:`quantization_step` estimates
+``q`` as the largest step of which every difference between sorted unique
+values is an integer multiple (a gcd over floats, tolerant of the rounding of
+decimal text), and :func:`distribution` then uses bins that are a whole number
+``k`` of steps wide with edges at :math:`x_0 + (j k - \tfrac12)\,q`: every level
+sits in the middle of exactly one bin and every bin holds ``k`` levels.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import stats as _sstats
+
+__all__ = [
+    "Description",
+    "Distribution",
+    "describe",
+    "distribution",
+    "quantization_step",
+    "SENSOR_CHANNELS",
+]
+
+#: ImuLog channels :func:`describe` reports, in this order.
+SENSOR_CHANNELS = ("gyro", "accel", "mag", "temperature", "pressure")
+_AXES = ("X", "Y", "Z", "W")
+
+#: Largest number of bins :func:`distribution` builds.
+MAX_BINS = 10_000
+
+
+@dataclass(frozen=True)
+class Description:
+    """Per-channel sample statistics (see :func:`describe`).
+
+    Every array has one entry per channel, in the order of ``names``.
+
+    Attributes
+    ----------
+    names : tuple of str
+        Channel names, e.g. ``"gyro X"``.
+    sensors, units : tuple of str
+        Sensor each channel belongs to and its unit.
+    n : int
+        Samples per channel.
+    fs : float or None
+        Sample rate in Hz (None when unknown: then ``drift_per_hour`` is NaN).
+    mean, std, var, min, max : ndarray
+        ``std``/``var`` with ``ddof=1``.
+    drift_per_hour : ndarray
+        Least-squares slope of the channel against time, in unit per hour.
+    """
+
+    names: tuple[str, ...]
+    sensors: tuple[str, ...]
+    units: tuple[str, ...]
+    n: int
+    fs: float | None
+    mean: np.ndarray
+    std: np.ndarray
+    var: np.ndarray
+    min: np.ndarray
+    max: np.ndarray
+    drift_per_hour: np.ndarray
+
+    def __post_init__(self) -> None:
+        for name in ("mean", "std", "var", "min", "max", "drift_per_hour"):
+            getattr(self, name).flags.writeable = False
+
+    def rows(self) -> list[dict]:
+        """One dict per channel: name, unit, mean, std, var, min, max, drift_per_hour."""
+        return [
+            {
+                "name": self.names[i],
+                "unit": self.units[i],
+                "mean": float(self.mean[i]),
+                "std": float(self.std[i]),
+                "var": float(self.var[i]),
+                "min": float(self.min[i]),
+                "max": float(self.max[i]),
+                "drift_per_hour": float(self.drift_per_hour[i]),
+            }
+            for i in range(len(self.names))
+        ]
+
+    def table(self) -> str:
+        """A fixed-width text table, one line per channel."""
+        head = ("channel", "unit", "mean", "std", "var", "min", "max", "drift/h")
+        lines = [head] + [
+            (
+                r["name"],
+                r["unit"],
+                *(
+                    _fmt(r[k])
+                    for k in ("mean", "std", "var", "min", "max", "drift_per_hour")
+                ),
+            )
+            for r in self.rows()
+        ]
+        widths = [max(len(line[j]) for line in lines) for j in range(len(head))]
+        out = []
+        for line in lines:
+            cells = [line[0].ljust(widths[0]), line[1].ljust(widths[1])]
+            cells += [c.rjust(w) for c, w in zip(line[2:], widths[2:], strict=True)]
+            out.append("  ".join(cells).rstrip())
+        return "\n".join(out)
+
+    def __str__(self) -> str:
+        return self.table()
+
+
+def _fmt(v: float) -> str:
+    return "—" if not np.isfinite(v) else f"{v:.6g}"
+
+
+def describe(log_or_array, fs: float | None = None) -> Description:
+    r"""Per-channel mean, standard deviation, variance, extremes and linear drift.
+
+    Parameters
+    ----------
+    log_or_array : ImuLog or array_like, shape (n,) or (n, k)
+        An :class:`imunoise.ImuLog` (its gyro, accel, mag, temperature and
+        pressure channels are described, axes named X/Y/Z), or rate samples.
+    fs : float, optional
+        Sample rate in Hz; defaults to ``log.fs`` for a log. For arrays without
+        ``fs`` the drift is NaN.
+
+    Returns
+    -------
+    Description
+
+    Notes
+    -----
+    ``std`` and ``var`` use ``ddof=1``. The drift is the ordinary least-squares
+    slope of :math:`x_i` against :math:`t_i = i/f_s`,
+    :math:`\hat b = \sum (t_i-\bar t)(x_i-\bar x) / \sum (t_i-\bar t)^2`,
+    times 3600 (unit per hour).
+    """
+    from imunoise.readers.log import CHANNELS, ImuLog
+
+    if isinstance(log_or_array, ImuLog):
+        log = log_or_array
+        fs = log.fs if fs is None else fs
+        blocks, names, sensors, units = [], [], [], []
+        for sensor in SENSOR_CHANNELS:
+            arr = getattr(log, sensor)
+            if arr is None:
+                continue
+            arr = arr.reshape(len(arr), -1)
+            blocks.append(arr)
+            unit = CHANNELS[sensor][1]
+            for j in range(arr.shape[1]):
+                names.append(sensor if arr.shape[1] == 1 else f"{sensor} {_AXES[j]}")
+                sensors.append(sensor)
+                units.append(unit)
+        if not blocks:
+            raise ValueError(
+                f"log_or_array has none of the channels {SENSOR_CHANNELS}; "
+                f"got channels {log.channels}"
+            )
+        x = np.hstack(blocks) if len(blocks) > 1 else blocks[0]
+    else:
+        x = _as_samples(log_or_array, "log_or_array")
+        x = x.reshape(len(x), -1)
+        k = x.shape[1]
+        names = [f"ch{j}" for j in range(k)] if k > 1 else ["x"]
+        sensors = ["-"] * k
+        units = [""] * k
+    if fs is not None:
+        fs = float(fs)
+        if not (np.isfinite(fs) and fs > 0):
+            raise ValueError(f"fs must be a positive finite number of Hz; got {fs!r}")
+    n = x.shape[0]
+    if n < 2:
+        raise ValueError(f"log_or_array needs at least 2 samples; got {n}")
+    if not np.all(np.isfinite(x)):
+        raise ValueError("log_or_array must be finite; it contains NaN or inf")
+    mean = x.mean(axis=0)
+    var = x.var(axis=0, ddof=1)
+    if fs is None:
+        drift = np.full(x.shape[1], np.nan)
+    else:
+        t = np.arange(n, dtype=np.float64) / fs
+        tc = t - t.mean()
+        drift = (tc @ (x - mean)) / (tc @ tc) * 3600.0
+    return Description(
+        names=tuple(names),
+        sensors=tuple(sensors),
+        units=tuple(units),
+        n=int(n),
+        fs=fs,
+        mean=mean,
+        std=np.sqrt(var),
+        var=var,
+        min=x.min(axis=0),
+        max=x.max(axis=0),
+        drift_per_hour=np.asarray(drift, dtype=np.float64),
+    )
+
+
+def _as_samples(x, name: str) -> np.ndarray:
+    arr = np.asarray(x)
+    if arr.dtype.kind not in "biuf":
+        raise TypeError(f"{name} must hold real numbers; got dtype {arr.dtype}")
+    arr = arr.astype(np.float64, copy=False)
+    if arr.ndim not in (1, 2):
+        raise ValueError(f"{name} must be 1-D (n,) or 2-D (n, k); got shape {arr.shape}")
+    return arr
+
+
+def quantization_step(x, *, rtol: float = 1e-3) -> float | None:
+    """The least significant step of quantized data, or None if there is none.
+
+    Parameters
+    ----------
+    x : array_like
+        Samples.
+    rtol : float
+        How far (as a fraction of the step) a difference may be from a whole
+        multiple of the step; absorbs the rounding of decimal text to float.
+
+    Returns
+    -------
+    float or None
+        The largest ``q`` such that every difference between consecutive sorted
+        unique values is a whole multiple of ``q`` (within ``rtol``), found
+        among ``d_min / k`` for k = 1…10 and refined as the mean of
+        ``d / round(d / q)``; None for constant data or data with no such grid
+        (continuous values).
+    """
+    v = np.unique(np.asarray(x, dtype=np.float64).ravel())
+    v = v[np.isfinite(v)]
+    if len(v) < 2:
+        return None
+    d = np.diff(v)
+    scale = max(abs(v[0]), abs(v[-1]))
+    # Differences at the level of float rounding are not steps of the data.
+    d = d[d > 64 * np.finfo(np.float64).eps * scale]
+    if len(d) == 0:
+        return None
+    dmin = d.min()
+    for k in range(1, 11):
+        q = dmin / k
+        r = d / q
+        if np.all(np.abs(r - np.round(r)) <= rtol):
+            return float(np.mean(d / np.round(r)))
+    return None
+
+
+@dataclass(frozen=True)
+class Distribution:
+    """Histogram, normal fit and normality statistics (see :func:`distribution`).
+
+    Attributes
+    ----------
+    n : int
+        Number of samples.
+    counts : ndarray of int, (B,)
+    edges : ndarray, (B + 1,)
+        Histogram bin edges.
+    step : float or None
+        Detected quantization step (None: continuous data, ordinary bins).
+    mu, sigma : float
+        Maximum-likelihood normal fit (``scipy.stats.norm.fit``; sigma has ddof=0).
+    ks_statistic, ks_pvalue : float
+        Kolmogorov–Smirnov test against N(mu, sigma).
+    ad_statistic : float
+        Anderson–Darling statistic for normality.
+    ad_critical_values, ad_significance_levels : ndarray
+        Critical values (of ``ad_statistic``) at significance levels in percent.
+    skewness, excess_kurtosis : float
+        Sample skewness and Fisher (excess) kurtosis, biased estimators.
+    qq_theoretical, qq_sample : ndarray
+        Q–Q data: standard normal quantiles and the matching sample quantiles.
+    """
+
+    n: int
+    counts: np.ndarray
+    edges: np.ndarray
+    step: float | None
+    mu: float
+    sigma: float
+    ks_statistic: float
+    ks_pvalue: float
+    ad_statistic: float
+    ad_critical_values: np.ndarray
+    ad_significance_levels: np.ndarray
+    skewness: float
+    excess_kurtosis: float
+    qq_theoretical: np.ndarray
+    qq_sample: np.ndarray
+
+    def __post_init__(self) -> None:
+        for name in (
+            "counts",
+            "edges",
+            "ad_critical_values",
+            "ad_significance_levels",
+            "qq_theoretical",
+            "qq_sample",
+        ):
+            getattr(self, name).flags.writeable = False
+
+    def pdf(self, x) -> np.ndarray:
+        """Density of the fitted normal at ``x``."""
+        return _sstats.norm.pdf(np.asarray(x, dtype=np.float64), self.mu, self.sigma)
+
+    def density(self) -> np.ndarray:
+        """Histogram normalised to a density (integrates to 1), comparable to :meth:`pdf`."""
+        widths = np.diff(self.edges)
+        return self.counts / (self.counts.sum() * widths)
+
+
+def distribution(x, bins="auto", *, qq_points: int = 1001) -> Distribution:
+    r"""Histogram with quantization-aware bins, normal fit and normality tests.
+
+    Parameters
+    ----------
+    x : array_like, 1-D
+        Samples of one channel.
+    bins : "auto", str, int or array_like
+        ``"auto"`` (or any rule of :func:`numpy.histogram_bin_edges`) gives that
+        rule's bin width, rounded up to a whole number of quantization steps
+        when the data are quantized (see the module notes); an int asks for
+        about that many bins (also aligned to the step); an array gives the
+        edges as they are.
+    qq_points : int
+        Number of Q–Q points (sample quantiles at probabilities
+        :math:`p_i = (i + 0.5)/m`), so plots stay light for 10⁷ samples.
+
+    Returns
+    -------
+    Distribution
+
+    Notes
+    -----
+    The KS test uses the parameters fitted from the same data, so its p-value
+    is optimistic (Lilliefors); on quantized data ties inflate the statistic
+    too. With 10⁴–10⁶ samples any real sensor fails a normality test: read the
+    statistics, skewness and kurtosis as effect sizes, not verdicts. The
+    Anderson–Darling statistic and its critical values are those of
+    ``scipy.stats.anderson(x, "norm")`` (Stephens 1974).
+    """
+    arr = np.asarray(x)
+    if arr.dtype.kind not in "biuf":
+        raise TypeError(f"x must hold real numbers; got dtype {arr.dtype}")
+    arr = arr.astype(np.float64, copy=False)
+    if arr.ndim != 1:
+        raise ValueError(f"x must be 1-D; got shape {arr.shape}")
+    if len(arr) < 3:
+        raise ValueError(f"x needs at least 3 samples; got {len(arr)}")
+    if not np.all(np.isfinite(arr)):
+        raise ValueError("x must be finite; it contains NaN or inf")
+    if not (isinstance(qq_points, int | np.integer) and qq_points >= 2):
+        raise ValueError(f"qq_points must be an integer >= 2; got {qq_points!r}")
+
+    step = quantization_step(arr)
+    edges = _edges(arr, bins, step)
+    counts, edges = np.histogram(arr, bins=edges)
+    mu, sigma = _sstats.norm.fit(arr)
+    if sigma > 0:
+        ks = _sstats.kstest(arr, "norm", args=(mu, sigma))
+        ks_stat, ks_p = float(ks.statistic), float(ks.pvalue)
+        ad = _anderson(arr)
+        skew = float(_sstats.skew(arr))
+        kurt = float(_sstats.kurtosis(arr, fisher=True))
+    else:
+        ks_stat = ks_p = skew = kurt = float("nan")
+        ad = (float("nan"), np.full(5, np.nan), np.array([15.0, 10.0, 5.0, 2.5, 1.0]))
+    p = (np.arange(qq_points) + 0.5) / qq_points
+    return Distribution(
+        n=len(arr),
+        counts=counts.astype(np.int64),
+        edges=edges,
+        step=step,
+        mu=float(mu),
+        sigma=float(sigma),
+        ks_statistic=ks_stat,
+        ks_pvalue=ks_p,
+        ad_statistic=float(ad[0]),
+        ad_critical_values=np.asarray(ad[1], dtype=np.float64),
+        ad_significance_levels=np.asarray(ad[2], dtype=np.float64),
+        skewness=skew,
+        excess_kurtosis=kurt,
+        qq_theoretical=_sstats.norm.ppf(p),
+        qq_sample=np.quantile(arr, p),
+    )
+
+
+def _anderson(x: np.ndarray):
+    import warnings
+
+    with warnings.catch_warnings():
+        # Newer scipy warns about a future change of the p-value method.
+        warnings.simplefilter("ignore", FutureWarning)
+        warnings.simplefilter("ignore", DeprecationWarning)
+        res = _sstats.anderson(x, "norm")
+    return res.statistic, res.critical_values, res.significance_level
+
+
+def _edges(x: np.ndarray, bins, step: float | None) -> np.ndarray:
+    lo, hi = float(x.min()), float(x.max())
+    if not isinstance(bins, str) and np.ndim(bins) == 1:
+        edges = np.asarray(bins, dtype=np.float64)
+        if len(edges) < 2 or np.any(np.diff(edges) <= 0):
+            raise ValueError("bins as an array must be at least 2 increasing edges")
+        return edges
+    if isinstance(bins, str):
+        try:
+            rule = np.histogram_bin_edges(x, bins=bins)
+        except ValueError as exc:
+            raise ValueError(
+                f"bins must be a numpy bin rule, an int or edges; got {bins!r}"
+            ) from exc
+        width = float(rule[1] - rule[0]) if len(rule) > 1 else 0.0
+    elif isinstance(bins, int | np.integer) and not isinstance(bins, bool) and bins >= 1:
+        width = (hi - lo) / int(bins)
+    else:
+        raise ValueError(f"bins must be a numpy bin rule, a positive int or edges; got {bins!r}")
+    if step is None or hi == lo:
+        nb = 1 if width <= 0 else int(min(MAX_BINS, max(1, np.ceil((hi - lo) / width))))
+        return np.histogram_bin_edges(x, bins=nb)
+    k = max(1, int(np.ceil(width / step * (1 - 1e-9))))
+    levels = int(round((hi - lo) / step)) + 1
+    k = max(k, int(np.ceil(levels / MAX_BINS)))
+    nb = int(np.ceil(levels / k))
+    return lo + (np.arange(nb + 1) * k - 0.5) * step

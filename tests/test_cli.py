@@ -1,0 +1,128 @@
+"""The imunoise command line: exit codes and one-line errors, never a traceback."""
+
+import subprocess
+import sys
+
+import imunoise
+import numpy as np
+import pytest
+from imunoise.cli import main
+
+needs_read = pytest.mark.skipif(not hasattr(imunoise, "read"),
+                                reason="imunoise.read has not landed")
+
+
+def _run(argv, capsys):
+    code = main(argv)
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def _one_line_error(err):
+    lines = err.strip().splitlines()
+    assert len(lines) == 1, err
+    assert lines[0].startswith("imunoise: error: ")
+    assert "Traceback" not in err
+    return lines[0]
+
+
+@pytest.mark.parametrize("cmd", ["stats", "adev", "fit", "convert", "report"])
+def test_missing_file(cmd, tmp_path, capsys):
+    argv = [cmd, str(tmp_path / "missing.txt")]
+    if cmd == "convert":
+        argv += ["-o", str(tmp_path / "x.csv")]
+    if cmd == "fit" and not hasattr(imunoise, "fit"):
+        pytest.skip("imunoise.fit has not landed")
+    code, _, err = _run(argv, capsys)
+    assert code == 2
+    assert "missing.txt" in _one_line_error(err)
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        [],
+        ["nonsense"],
+        ["adev", "x.txt", "--kind", "bogus"],
+        ["adev"],
+        ["report", "a", "b", "c"],
+        ["demo", "--hours", "-1"],
+        ["simulate", "-o", "x.txt", "--fs", "abc"],
+        ["stats", "--no-such-option", "x"],
+    ],
+)
+def test_bad_options(argv, capsys):
+    code, _, err = _run(argv, capsys)
+    assert code == 2
+    if argv:
+        _one_line_error(err)
+
+
+def test_convert_rejects_unknown_suffix(tmp_path, capsys):
+    f = tmp_path / "log.txt"
+    f.write_text("x")
+    code, _, err = _run(["convert", str(f), "-o", str(tmp_path / "out.xlsx")], capsys)
+    assert code == 2 and ".xlsx" in _one_line_error(err)
+
+
+@pytest.mark.parametrize("cmd", ["report", "adev", "fit", "stats", "convert", "simulate", "demo"])
+def test_help(cmd, capsys):
+    with pytest.raises(SystemExit) as exc:
+        main([cmd, "--help"])
+    assert exc.value.code == 0
+    assert "usage: imunoise " + cmd in capsys.readouterr().out
+
+
+def test_version(capsys):
+    with pytest.raises(SystemExit) as exc:
+        main(["--version"])
+    assert exc.value.code == 0
+    assert capsys.readouterr().out.strip() == f"imunoise {imunoise.__version__}"
+
+
+def test_subprocess_no_traceback(tmp_path):
+    proc = subprocess.run(
+        [sys.executable, "-c", "import sys; from imunoise.cli import main; sys.exit(main())",
+         "stats", str(tmp_path / "nope.bin")],
+        capture_output=True, text=True, timeout=60,
+    )
+    assert proc.returncode == 2
+    assert proc.stdout == ""
+    _one_line_error(proc.stderr)
+
+
+@needs_read
+def test_unreadable_and_empty_logs(tmp_path, capsys):
+    garbage = tmp_path / "garbage.bin"
+    garbage.write_bytes(bytes(range(256)) * 20)
+    code, _, err = _run(["stats", str(garbage)], capsys)
+    assert code == 2
+    _one_line_error(err)
+    empty = tmp_path / "empty.txt"
+    empty.write_text("")
+    code, _, err = _run(["adev", str(empty)], capsys)
+    assert code == 2
+    _one_line_error(err)
+
+
+@needs_read
+def test_stats_adev_convert_on_bundled_log(tmp_path, capsys):
+    from imunoise.cli import bundled_log
+
+    log = imunoise.read(bundled_log())
+    code, out, _ = _run(["stats", str(bundled_log())], capsys)
+    assert code == 0 and "gyro X" in out
+    code, out, _ = _run(["adev", str(bundled_log()), "--sensor", "gyro"], capsys)
+    assert code == 0
+    rows = [line.split() for line in out.splitlines()[2:]]
+    r = imunoise.adev(log.gyro, log.fs)
+    np.testing.assert_allclose([float(x[0]) for x in rows], r.taus, rtol=1e-5)
+    np.testing.assert_allclose([float(x[2]) for x in rows], r.dev[:, 0], rtol=1e-6)
+    for suffix in (".csv", ".npz", ".parquet"):
+        out_file = tmp_path / f"log{suffix}"
+        code, _, _ = _run(["convert", str(bundled_log()), "-o", str(out_file)], capsys)
+        assert code == 0 and out_file.is_file()
+    z = np.load(tmp_path / "log.npz")
+    np.testing.assert_array_equal(z["gyro_x"], log.gyro[:, 0])
+    csv = np.loadtxt(tmp_path / "log.csv", delimiter=",", skiprows=1)
+    assert csv.shape[0] == len(log)
