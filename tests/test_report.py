@@ -87,15 +87,17 @@ def test_distribution_table_matches_api(built):
     rep, short, _ = built
     rows = _md_table(rep.markdown.read_text(), "Distribution fits (short log)")
     header = rows[0]
-    assert header[:6] == ["channel", "unit", "quantization step", "bins", "μ", "σ"]
+    assert header[:7] == ["channel", "unit", "quantization step", "level spacing", "bins", "μ",
+                          "σ"]
     by_name = {r[0]: r for r in rows[1:]}
     for sensor, step in (("gyro", 1e-6), ("accel", 1e-3), ("mag", 1e-4)):
         for j, axis in enumerate("XYZ"):
             r = by_name[f"{sensor} {axis}"]
             d = distribution(getattr(short, sensor)[:, j])
             assert float(r[2]) == pytest.approx(step, rel=1e-4)
-            assert int(r[3]) == len(d.counts)
-            got = [float(v) for v in (r[4], r[5], r[6], r[8], r[9], r[10])]
+            assert float(r[3]) == pytest.approx(d.level_spacing, rel=1e-5)
+            assert int(r[4]) == len(d.counts)
+            got = [float(v) for v in (r[5], r[6], r[7], r[9], r[10], r[11])]
             want = [d.mu, d.sigma, d.ks_statistic, d.ad_statistic, d.skewness,
                     d.excess_kurtosis]
             np.testing.assert_allclose(got, want, rtol=5e-6)

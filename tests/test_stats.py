@@ -134,3 +134,20 @@ def test_distribution_int_bins_and_errors():
         imunoise.distribution(x, bins="nonsense")
     with pytest.raises(ValueError, match="finite"):
         imunoise.distribution([1.0, 2.0, np.inf])
+
+
+def test_sparse_levels_use_the_level_spacing():
+    # A magnetometer-like LSB of 0.92e-3 printed with four decimals: values on the 1e-4
+    # grid, but only every ninth or tenth grid point occupied.
+    rng = np.random.default_rng(9)
+    lsb = 0.92e-3
+    x = np.round(np.round(rng.normal(0.0466, 0.0013, 13000) / lsb) * lsb, 4)
+    d = imunoise.distribution(x)
+    assert d.step == pytest.approx(1e-4, rel=1e-6)
+    assert d.level_spacing == pytest.approx(lsb, rel=0.02)
+    # every sensor level in its own bin, no empty bins between occupied ones
+    levels = np.unique(x)
+    which = np.searchsorted(d.edges, levels, side="right") - 1
+    assert len(np.unique(which)) == len(levels)
+    inner = d.counts[np.flatnonzero(d.counts)[0]: np.flatnonzero(d.counts)[-1] + 1]
+    assert np.count_nonzero(inner == 0) <= 0.05 * len(inner)

@@ -226,7 +226,7 @@ def _cmd_stats(args) -> int:
     print(f"# {log.source}: {len(log)} samples at {log.fs:.6g} Hz, parse issues: {log.issues}")
     print(desc.table())
     print()
-    head = ["channel", "step", "mu", "sigma", "KS_D", "KS_p", "AD_A2", "skew", "ex_kurt"]
+    head = ["channel", "step", "spacing", "mu", "sigma", "KS_D", "KS_p", "AD_A2", "skew", "ex_kurt"]
     rows = []
     for sensor in SENSORS:
         y = getattr(log, sensor)
@@ -234,7 +234,11 @@ def _cmd_stats(args) -> int:
             continue
         for j in range(y.shape[1]):
             d = stats.distribution(y[:, j])
-            rows.append([f"{sensor} {_AXES[j]}", f"{d.step:.6g}" if d.step else "-"] + [
+            rows.append([
+                f"{sensor} {_AXES[j]}",
+                f"{d.step:.6g}" if d.step else "-",
+                f"{d.level_spacing:.6g}" if d.level_spacing else "-",
+            ] + [
                 f"{v:.6g}" for v in (d.mu, d.sigma, d.ks_statistic, d.ks_pvalue,
                                      d.ad_statistic, d.skewness, d.excess_kurtosis)
             ])

@@ -420,7 +420,8 @@ def _build(short, long, out: Path, spec, bar: _Progress) -> Report:
     bar.step("distributions")
     doc.h(2, "3. Distribution fits")
     doc.p("Normal fit by maximum likelihood; histogram bins are whole multiples of the "
-          "detected quantization step, centred on the levels. With this many samples any "
+          "detected quantization step (or of the level spacing, where the sensor uses only "
+          "some of the printed grid), centred on the levels. With this many samples any "
           "real sensor fails a normality test: read KS D, A², skewness and excess kurtosis "
           "as sizes of the departure from normal.")
     dists: dict[str, object] = {}
@@ -436,7 +437,8 @@ def _build(short, long, out: Path, spec, bar: _Progress) -> Report:
             dists[name] = d
             per_axis.append(d)
             drows.append([
-                name, CHANNELS[sensor][1], _num(d.step) if d.step else "—", str(len(d.counts)),
+                name, CHANNELS[sensor][1], _num(d.step) if d.step else "—",
+                _num(d.level_spacing) if d.level_spacing else "—", str(len(d.counts)),
                 _num(d.mu), _num(d.sigma), _num(d.ks_statistic), _num(d.ks_pvalue),
                 _num(d.ad_statistic), _num(d.skewness), _num(d.excess_kurtosis),
             ])
@@ -446,8 +448,8 @@ def _build(short, long, out: Path, spec, bar: _Progress) -> Report:
         doc.figure(figdir / f"hist_{sensor}.png",
                    f"Histogram of {sensor} with the fitted normal density")
     doc.table(
-        ["channel", "unit", "quantization step", "bins", "μ", "σ", "KS D", "KS p", "AD A²",
-         "skewness", "excess kurtosis"],
+        ["channel", "unit", "quantization step", "level spacing", "bins", "μ", "σ", "KS D",
+         "KS p", "AD A²", "skewness", "excess kurtosis"],
         drows,
         caption="Distribution fits (short log)",
     )

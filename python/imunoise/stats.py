@@ -16,6 +16,13 @@ values is an integer multiple (a gcd over floats, tolerant of the rounding of
 decimal text), and :func:`distribution` then uses bins that are a whole number
 ``k`` of steps wide with edges at :math:`x_0 + (j k - \tfrac12)\,q`: every level
 sits in the middle of exactly one bin and every bin holds ``k`` levels.
+
+Some sensors have a step that is not a decimal (a magnetometer LSB of 0.92 mGauss
+printed with four decimals): the values then lie on the 0.1 mGauss print grid
+but only every ninth or tenth grid point is used, and 1-step bins show a comb
+of empty bins. :func:`distribution` measures the mean spacing of the levels in
+the central 98 % of the data; when it is at least 1.5 steps it becomes the bin
+unit (``level_spacing``), so each sensor level still sits in one bin.
 """
 
 from __future__ import annotations
@@ -273,6 +280,10 @@ class Distribution:
         Histogram bin edges.
     step : float or None
         Detected quantization step (None: continuous data, ordinary bins).
+    level_spacing : float or None
+        Mean spacing of the occupied levels in the central 98 % of the data,
+        the unit of the bins; equals ``step`` unless the sensor skips grid
+        points (see the module notes).
     mu, sigma : float
         Maximum-likelihood normal fit (``scipy.stats.norm.fit``; sigma has ddof=0).
     ks_statistic, ks_pvalue : float
@@ -291,6 +302,7 @@ class Distribution:
     counts: np.ndarray
     edges: np.ndarray
     step: float | None
+    level_spacing: float | None
     mu: float
     sigma: float
     ks_statistic: float
@@ -368,7 +380,8 @@ def distribution(x, bins="auto", *, qq_points: int = 1001) -> Distribution:
         raise ValueError(f"qq_points must be an integer >= 2; got {qq_points!r}")
 
     step = quantization_step(arr)
-    edges = _edges(arr, bins, step)
+    spacing = None if step is None else _level_spacing(arr, step)
+    edges = _edges(arr, bins, spacing)
     counts, edges = np.histogram(arr, bins=edges)
     mu, sigma = _sstats.norm.fit(arr)
     if sigma > 0:
@@ -386,6 +399,7 @@ def distribution(x, bins="auto", *, qq_points: int = 1001) -> Distribution:
         counts=counts.astype(np.int64),
         edges=edges,
         step=step,
+        level_spacing=spacing,
         mu=float(mu),
         sigma=float(sigma),
         ks_statistic=ks_stat,
@@ -409,6 +423,18 @@ def _anderson(x: np.ndarray):
         warnings.simplefilter("ignore", DeprecationWarning)
         res = _sstats.anderson(x, "norm")
     return res.statistic, res.critical_values, res.significance_level
+
+
+def _level_spacing(x: np.ndarray, step: float) -> float:
+    """Mean spacing of the occupied levels in the central 98 % of ``x`` (see module notes)."""
+    lo, hi = np.quantile(x, [0.01, 0.99])
+    v = np.unique(x[(x >= lo) & (x <= hi)])
+    if len(v) < 3:
+        return step
+    gaps = np.diff(v)
+    if np.median(gaps) < 1.5 * step:
+        return step
+    return float((v[-1] - v[0]) / (len(v) - 1))
 
 
 def _edges(x: np.ndarray, bins, step: float | None) -> np.ndarray:
