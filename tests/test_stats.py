@@ -151,3 +151,19 @@ def test_sparse_levels_use_the_level_spacing():
     assert len(np.unique(which)) == len(levels)
     inner = d.counts[np.flatnonzero(d.counts)[0]: np.flatnonzero(d.counts)[-1] + 1]
     assert np.count_nonzero(inner == 0) <= 0.05 * len(inner)
+
+
+def test_real_vn100_magnetometer_has_no_comb():
+    from importlib import resources
+
+    text = (resources.files("imunoise") / "data" / "vn100_stationary_5min.txt").read_text()
+    mag = np.array([[float(v) for v in line.split(",")[4:7]] for line in text.splitlines()])
+    for j in range(3):
+        d = imunoise.distribution(mag[:, j])
+        assert d.step == pytest.approx(1e-4, rel=1e-6)
+        assert 6e-4 < d.level_spacing < 1.3e-3
+        nz = np.flatnonzero(d.counts)
+        inner = d.counts[nz[0]: nz[-1] + 1]
+        # the 1e-4 grid would leave most bins empty; level-spacing bins leave almost none
+        assert np.count_nonzero(inner == 0) <= 0.1 * len(inner)
+        assert d.counts.sum() == len(mag)

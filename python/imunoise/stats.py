@@ -20,9 +20,13 @@ sits in the middle of exactly one bin and every bin holds ``k`` levels.
 Some sensors have a step that is not a decimal (a magnetometer LSB of 0.92 mGauss
 printed with four decimals): the values then lie on the 0.1 mGauss print grid
 but only every ninth or tenth grid point is used, and 1-step bins show a comb
-of empty bins. :func:`distribution` measures the mean spacing of the levels in
-the central 98 % of the data; when it is at least 1.5 steps it becomes the bin
-unit (``level_spacing``), so each sensor level still sits in one bin.
+of empty bins (real VN-100 magnetometer logs show clusters of two to five
+adjacent print values about nine steps apart). :func:`distribution` finds such
+regularly spaced clusters in the central 98 % of the data and uses their mean
+spacing as the bin unit (``level_spacing``); inner edges that would cut a
+cluster move to the middle of the nearest gap between occupied values, so every
+sensor level sits in one bin (bin widths may then differ slightly; the density
+accounts for it).
 """
 
 from __future__ import annotations
@@ -381,7 +385,7 @@ def distribution(x, bins="auto", *, qq_points: int = 1001) -> Distribution:
 
     step = quantization_step(arr)
     spacing = None if step is None else _level_spacing(arr, step)
-    edges = _edges(arr, bins, spacing)
+    edges = _edges(arr, bins, None) if step is None else _quantized_edges(arr, bins, step, spacing)
     counts, edges = np.histogram(arr, bins=edges)
     mu, sigma = _sstats.norm.fit(arr)
     if sigma > 0:
@@ -426,15 +430,44 @@ def _anderson(x: np.ndarray):
 
 
 def _level_spacing(x: np.ndarray, step: float) -> float:
-    """Mean spacing of the occupied levels in the central 98 % of ``x`` (see module notes)."""
+    """Spacing of the sensor's levels in the central 98 % of ``x`` (see module notes).
+
+    Occupied print-grid values are grouped into clusters (runs separated by gaps
+    of more than 1.5 steps). When the cluster starts are regularly spaced (spacing
+    with a coefficient of variation below 0.3, at least 5 clusters) their mean
+    spacing is returned; otherwise (dense levels, or gaps that are just random
+    sparsity) ``step``.
+    """
     lo, hi = np.quantile(x, [0.01, 0.99])
     v = np.unique(x[(x >= lo) & (x <= hi)])
     if len(v) < 3:
         return step
     gaps = np.diff(v)
-    if np.median(gaps) < 1.5 * step:
+    starts = v[1:][gaps > 1.5 * step]
+    if len(starts) < 5:
         return step
-    return float((v[-1] - v[0]) / (len(v) - 1))
+    spacing = np.diff(starts)
+    mean = float(spacing.mean())
+    if mean < 1.5 * step or spacing.std() > 0.3 * mean:
+        return step
+    return mean
+
+
+def _snap(edges: np.ndarray, x: np.ndarray, step: float) -> np.ndarray:
+    """Move inner edges that sit within half a step of a level into the nearest gap."""
+    v = np.unique(x)
+    if len(v) < 2 or len(edges) < 3:
+        return edges
+    inner = edges[1:-1].copy()
+    i = np.clip(np.searchsorted(v, inner), 1, len(v) - 1)
+    near = np.minimum(np.abs(inner - v[i - 1]), np.abs(v[i] - inner))
+    bad = near < 0.5 * step * (1 - 1e-6)
+    if np.any(bad):
+        mids = 0.5 * (v[:-1] + v[1:])
+        j = np.clip(np.searchsorted(mids, inner[bad]), 1, len(mids) - 1)
+        left, right = mids[j - 1], mids[j]
+        inner[bad] = np.where(inner[bad] - left <= right - inner[bad], left, right)
+    return np.unique(np.concatenate([edges[:1], inner, edges[-1:]]))
 
 
 def _edges(x: np.ndarray, bins, step: float | None) -> np.ndarray:
@@ -464,3 +497,11 @@ def _edges(x: np.ndarray, bins, step: float | None) -> np.ndarray:
     k = max(k, int(np.ceil(levels / MAX_BINS)))
     nb = int(np.ceil(levels / k))
     return lo + (np.arange(nb + 1) * k - 0.5) * step
+
+
+def _quantized_edges(x: np.ndarray, bins, step: float, spacing: float) -> np.ndarray:
+    """Regular edges in units of ``spacing``, inner edges moved off the levels."""
+    edges = _edges(x, bins, spacing)
+    if isinstance(bins, str) or np.ndim(bins) == 0:
+        edges = _snap(edges, x, step)
+    return edges
