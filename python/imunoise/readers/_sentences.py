@@ -124,6 +124,11 @@ def sentence_rows(
         if match and 1 <= int(match.group(1)) <= len(line_loc):
             loc = line_loc[int(match.group(1)) - 1]
             raise ValueError(f"{source}: {where} {loc}: {exc}") from exc
+        for k, c in enumerate(clean):  # the message names no line: find the item
+            try:
+                parse_sentences(c + b"\n", strict=True, source=source)
+            except ValueError as item_exc:
+                raise ValueError(f"{source}: {where} {line_loc[k]}: {item_exc}") from exc
         raise ValueError(f"{source}: {exc}") from exc
 
     # move the parser's issues from lines of `data` to container locations
