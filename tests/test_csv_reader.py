@@ -7,13 +7,14 @@ import math
 import warnings
 from pathlib import Path
 
+import _fake_vn
 import numpy as np
 import pytest
 import vn_helpers
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from imunoise.readers.csv_reader import read_csv
-from vn_helpers import ymr_fields
+from vn_helpers import ymr, ymr_fields
 
 DATA = Path(__file__).parent / "data"
 VN_CSV = DATA / "vn100-csv" / "stationary_data_5min_0.csv"
@@ -250,3 +251,20 @@ def test_random_rows_are_all_accounted_for(rows, crlf):
         assert "line" in str(exc) and log.issues.total > 0
     else:
         assert len(strict) == len(log) and log.issues.total == 0
+
+
+def test_strict_error_located_when_parser_names_no_line(monkeypatch):
+    import imunoise.readers._sentences as sentences
+
+    def terse(data, *, strict, source):
+        if strict and b"*00" in data:
+            raise ValueError("checksum mismatch")  # names no line
+        return _fake_vn.parse_vn_sentences(data, strict=False, fs=1.0, source=source)
+
+    monkeypatch.setattr(sentences, "parse_sentences", terse)
+    good = [ymr([k] * 12) for k in range(4)]
+    bad = good[2].rsplit("*", 1)[0] + "*00"
+    rows = [f'{k * 0.025},"{s}"' for k, s in enumerate([good[0], good[1], bad, good[3]])]
+    data = ("t,raw\n" + "\n".join(rows) + "\n").encode()
+    with pytest.raises(ValueError, match=r"line 4: checksum mismatch"):
+        read_csv(data, strict=True)

@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import vn_helpers
+from imunoise.readers import rosbag_reader
 from imunoise.readers.rosbag_reader import read_rosbag
 from rosbags.highlevel import AnyReader
 from rosbags.rosbag2 import StoragePlugin, Writer
@@ -187,7 +188,9 @@ def test_imu_bag_round_trip(tmp_path, plugin):
         },
         plugin,
     )
-    log = read_rosbag(tmp_path / "bag")
+    calls = []
+    log = read_rosbag(tmp_path / "bag", progress=lambda d, t: calls.append((d, t)))
+    assert calls[-1][0] == calls[-1][1] > 0
     assert len(log) == n and log.issues.total == 0
     np.testing.assert_array_equal(log.gyro, gyro)
     np.testing.assert_array_equal(log.accel, accel)
@@ -230,7 +233,9 @@ def test_imu_without_orientation_and_topic_errors(tmp_path):
         read_rosbag(tmp_path / "missing.bag")
 
 
-def test_custom_vn_message_bad_sentences(tmp_path, vn_parser):
+@pytest.mark.parametrize("batch", [20_000, 7])
+def test_custom_vn_message_bad_sentences(tmp_path, vn_parser, batch, monkeypatch):
+    monkeypatch.setattr(rosbag_reader, "_BATCH", batch)
     store = _store()
     Raw = store.types["lab/msg/Raw"]
     rng = np.random.default_rng(1)

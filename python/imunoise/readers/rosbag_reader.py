@@ -42,6 +42,7 @@ __all__ = ["read_rosbag"]
 IMU = "sensor_msgs/msg/Imu"
 MAG = "sensor_msgs/msg/MagneticField"
 TESLA_TO_GAUSS = 1e4
+_BATCH = 20_000  # messages per call of the VN parser
 
 _MAGIC = {b"#ROSBAG": ".bag", b"\x89MCAP": ".mcap", b"SQLite format 3": ".db3"}
 
@@ -286,6 +287,22 @@ def _read(reader, name, total, strict, fs, progress, topic) -> ImuLog:
         time_ns = stamps
     else:
         items, stamps, locs = [], [], []
+        parts: list[dict[str, np.ndarray]] = []
+        kept_ns: list[np.ndarray] = []
+
+        def flush():
+            # sentences are decoded in batches so that no Python object per message
+            # outlives its batch
+            rows = sentence_rows(items, locs, tally, strict=strict, source=name, where="message")
+            if rows.channels:
+                parts.append(rows.channels)
+                kept_ns.append(np.asarray(stamps, dtype=np.int64)[rows.kept])
+            for key, count in rows.messages.items():
+                messages[key] = messages.get(key, 0) + count
+            items.clear()
+            stamps.clear()
+            locs.clear()
+
         msgtype = topics[chosen][0].msgtype
         for number, (_conn, t, raw) in enumerate(
             reader.messages(connections=topics[chosen]), start=1
@@ -299,6 +316,7 @@ def _read(reader, name, total, strict, fs, progress, topic) -> ImuLog:
                     msg = reader.deserialize(raw, msgtype)
                 except Exception as exc:
                     if strict:
+                        flush()  # a bad sentence in an earlier message is reported first
                         raise ValueError(
                             f"{name}: message {number}: does not decode: {exc}"
                         ) from exc
@@ -310,6 +328,9 @@ def _read(reader, name, total, strict, fs, progress, topic) -> ImuLog:
                 items.append(value.encode("latin-1", "replace") if isinstance(value, str) else b"")
                 stamps.append(_stamp(msg) or t)
             locs.append(number)
+            if len(items) >= _BATCH:
+                flush()
+        flush()
         if kind == "vn-bytes":
             warnings.warn(
                 f"{name}: topic {chosen!r} has type {msgtype!r} with no definition in the bag; "
@@ -317,10 +338,9 @@ def _read(reader, name, total, strict, fs, progress, topic) -> ImuLog:
                 "used (pass msg_defs= to use the message header stamps)",
                 stacklevel=3,
             )
-        rows = sentence_rows(items, locs, tally, strict=strict, source=name, where="message")
-        channels.update(rows.channels)
-        messages.update(rows.messages)
-        time_ns = np.asarray(stamps, dtype=np.int64)[rows.kept]
+        for ch in parts[0] if parts else ():
+            channels[ch] = np.concatenate([p[ch] for p in parts])
+        time_ns = np.concatenate(kept_ns) if kept_ns else np.zeros(0, dtype=np.int64)
 
     for tp, conns in topics.items():
         if tp != chosen and tp != merged_mag:
