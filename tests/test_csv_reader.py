@@ -13,6 +13,7 @@ import pytest
 import vn_helpers
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from imunoise.readers import csv_reader
 from imunoise.readers.csv_reader import read_csv
 from vn_helpers import ymr, ymr_fields
 
@@ -213,7 +214,9 @@ def test_malformed_rows_counted_with_line_numbers():
         read_csv(text.replace("0.01;1;2\n", "").encode(), strict=True)
 
 
-def test_corrupted_real_csv_every_line_accounted():
+@pytest.mark.parametrize("chunk", [1 << 22, 997])
+def test_corrupted_real_csv_every_line_accounted(chunk, monkeypatch):
+    monkeypatch.setattr(csv_reader, "_CHUNK_BYTES", chunk)  # lines cut across chunks
     lines = VN_CSV.read_text().splitlines()
     rng = np.random.default_rng(3)
     bad = sorted(rng.choice(np.arange(1, len(lines)), size=25, replace=False))
@@ -225,6 +228,9 @@ def test_corrupted_real_csv_every_line_accounted():
     assert len(log) == len(lines) - 1 - 25
     assert log.issues.counts["malformed_field"] == 25
     assert log.issues.first["malformed_field"] == tuple(int(i) + 1 for i in bad[:10])
+    good = [ln.split(",") for k, ln in enumerate(lines) if k and k not in set(bad)]
+    np.testing.assert_array_equal(log.gyro, [[float(v) for v in g[2:5]] for g in good])
+    np.testing.assert_array_equal(log.time, [float(g[1]) for g in good])
 
 
 _token = st.one_of(

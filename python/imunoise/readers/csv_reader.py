@@ -314,6 +314,7 @@ def read_csv(
     with fh:
         chunks = _lines(fh, total, progress)
         state = _Reader(name, strict, columns, units, delimiter, tally)
+        state.total = total
         for first_line, lines in chunks:
             state.feed(first_line, lines)
     return state.finish(fs)
@@ -332,7 +333,8 @@ class _Reader:
         self.layout_done = False
         self.numeric: dict[str, list[int]] = {}
         self.raw_col: int | None = None
-        self.parts: list[np.ndarray] = []  # (rows, used numeric columns) per chunk
+        self.buf: np.ndarray | None = None  # (capacity, used numeric columns), grown as needed
+        self.total = 0
         self.raw_items: list[bytes] = []  # VN fields of the current chunk
         self.raw_lines: list[int] = []
         self.vn_parts: list[dict[str, np.ndarray]] = []
@@ -477,8 +479,7 @@ class _Reader:
         arr = arr[:, self.used]
         if not np.isfinite(arr).all():
             return False
-        self.parts.append(arr)
-        self.rows += len(arr)
+        self._append(arr, len(text))
         return True
 
     def _slow(self, first_line: int, lines: list[str], start: int) -> None:
@@ -527,19 +528,30 @@ class _Reader:
             self.vn_time.append(rows.time)
             for key, count in rows.messages.items():
                 self.messages[key] = self.messages.get(key, 0) + count
-        self.parts.append(out)
-        self.rows += len(out)
+        self._append(out, sum(len(ln) + 1 for ln in lines))
 
     # -- result ---------------------------------------------------------------------
+    def _append(self, rows: np.ndarray, chunk_chars: int) -> None:
+        """Copy a chunk's rows into one buffer sized from the file size (memory ~ output)."""
+        need = self.rows + len(rows)
+        if self.buf is None or need > len(self.buf):
+            per_char = max(len(rows), 1) / max(chunk_chars, 1)
+            estimate = int(per_char * self.total * 1.02) + 16
+            cap = max(need, estimate if self.buf is None else int(len(self.buf) * 1.5))
+            buf = np.empty((cap, len(self.used)), dtype=np.float64)
+            if self.buf is not None:
+                buf[: self.rows] = self.buf[: self.rows]
+            self.buf = buf
+        self.buf[self.rows : need] = rows
+        self.rows = need
+
     def finish(self, fs: float | None) -> ImuLog:
         if not self.layout_done:
             raise ValueError(f"{self.name}: no data lines")
-        data = (
-            np.concatenate(self.parts)
-            if self.parts
-            else np.zeros((0, len(self.used)), dtype=np.float64)
-        )
-        self.parts = []
+        data = self.buf[: self.rows] if self.buf is not None else np.zeros((0, len(self.used)))
+        if self.buf is not None and len(self.buf) > 1.1 * self.rows + 16:
+            data = data.copy()  # do not keep a much larger buffer alive through views
+        self.buf = None
         channels: dict[str, np.ndarray] = {}
         messages: dict[str, int] = dict(self.messages)
         time = None
@@ -555,7 +567,11 @@ class _Reader:
         else:
             messages["csv"] = len(data)
         for ch, idx in self.numeric.items():
-            values = data[:, [self.pos[i] for i in idx]]
+            pos = [self.pos[i] for i in idx]
+            if pos == list(range(pos[0], pos[0] + len(pos))):
+                values = data[:, pos[0] : pos[0] + len(pos)]  # a view: no copy
+            else:
+                values = data[:, pos]
             conv = self.conv[ch]
             if ch == "time":
                 t = values[:, 0]
