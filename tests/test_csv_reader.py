@@ -22,6 +22,7 @@ VN_CSV = DATA / "vn100-csv" / "stationary_data_5min_0.csv"
 SHARED = Path("/work/shared/data")
 IG500N = SHARED / "other-imu" / "ig500n_static.txt"
 G = 9.80665
+VN_RTOL = vn_helpers.VN_RTOL
 vn_parser = vn_helpers.vn_parser  # fixture: stand-in VN parser, then the real one
 
 
@@ -45,10 +46,10 @@ def test_vn_csv_raw_column_wins(vn_parser):
     raw = header.index("raw")
     for row, i in ((first, 0), (last, -1)):
         v = ymr_fields(row[raw])
-        np.testing.assert_array_equal(log.ypr[i], v[0:3])
-        np.testing.assert_array_equal(log.mag[i], v[3:6])
-        np.testing.assert_array_equal(log.accel[i], v[6:9])
-        np.testing.assert_array_equal(log.gyro[i], v[9:12])
+        np.testing.assert_allclose(log.ypr[i], v[0:3], rtol=VN_RTOL)
+        np.testing.assert_allclose(log.mag[i], v[3:6], rtol=VN_RTOL)
+        np.testing.assert_allclose(log.accel[i], v[6:9], rtol=VN_RTOL)
+        np.testing.assert_allclose(log.gyro[i], v[9:12], rtol=VN_RTOL)
         assert log.time[i] == pytest.approx(float(row[header.index("ros_t")]), abs=1e-6)
     # the recording driver's own columns are mis-scaled and axis-swapped: not used
     assert log.gyro[0, 0] != float(first[header.index("gyro_x")])
@@ -71,7 +72,7 @@ def test_vn_csv_bad_sentences_counted_at_their_lines(vn_parser):
     # samples stay with their own row's timestamp after the dropped ones
     row = list(csv.reader([text[5]]))[0]
     assert log.time[3] == pytest.approx(float(row[1]), abs=1e-6)
-    np.testing.assert_array_equal(log.gyro[3], ymr_fields(row[-1])[9:12])
+    np.testing.assert_allclose(log.gyro[3], ymr_fields(row[-1])[9:12], rtol=VN_RTOL)
     with pytest.raises(ValueError, match=r"line 5\b"):
         read_csv(data, strict=True)
 

@@ -20,6 +20,7 @@ MCAP = DATA / "vn100-ros" / "11sec_motion_0.mcap"
 SHARED = Path("/work/shared/data/vn100-ros")
 ROS1 = SHARED / "ros1_stationary.bag"
 DB3 = SHARED / "ros2_circle_0.db3"
+VN_RTOL = vn_helpers.VN_RTOL
 vn_parser = vn_helpers.vn_parser  # fixture: stand-in VN parser, then the real one
 
 # The lab driver's message in ros2_circle_0.db3, read off its serialized bytes (the
@@ -46,10 +47,10 @@ def _oracle(path, topic, field, **kw):
 def _check_ends(log, sentences, times):
     for i in (0, -1):
         v = ymr_fields(sentences[i])
-        np.testing.assert_array_equal(log.ypr[i], v[0:3])
-        np.testing.assert_array_equal(log.mag[i], v[3:6])
-        np.testing.assert_array_equal(log.accel[i], v[6:9])
-        np.testing.assert_array_equal(log.gyro[i], v[9:12])
+        np.testing.assert_allclose(log.ypr[i], v[0:3], rtol=VN_RTOL)
+        np.testing.assert_allclose(log.mag[i], v[3:6], rtol=VN_RTOL)
+        np.testing.assert_allclose(log.accel[i], v[6:9], rtol=VN_RTOL)
+        np.testing.assert_allclose(log.gyro[i], v[9:12], rtol=VN_RTOL)
         assert log.time[i] == pytest.approx(times[i], abs=1e-6)
 
 
@@ -67,7 +68,7 @@ def test_mcap_lab_driver_schema_from_bag(vn_parser):
     _check_ends(log, sentences, stamps)
     assert log.time[-1] - log.time[0] == pytest.approx(10.3, abs=0.05)
     # the driver's own parsed Imu fields disagree with the sentence: the sentence wins
-    assert log.gyro[0, 0] == -0.355773
+    assert log.gyro[0, 0] == pytest.approx(-0.355773, rel=VN_RTOL)
     assert read_rosbag(MCAP.read_bytes()).source == "<bytes>"
 
 
@@ -264,7 +265,7 @@ def test_custom_vn_message_bad_sentences(tmp_path, vn_parser, batch, monkeypatch
     assert log.issues.first["bad_checksum"] == (5, 18)
     assert log.issues.counts["malformed_field"] == 1
     assert log.issues.first["malformed_field"] == (10,)
-    np.testing.assert_array_equal(log.gyro, values[keep, 9:12])
+    np.testing.assert_allclose(log.gyro, values[keep, 9:12], rtol=VN_RTOL)
     np.testing.assert_allclose(log.time, np.array(ns)[keep] * 1e-9, atol=5e-7, rtol=0)
     with pytest.raises(ValueError, match=r"message 5\b"):
         read_rosbag(tmp_path / "vn", strict=True)

@@ -8,6 +8,10 @@ from functools import reduce
 import _fake_vn
 import pytest
 
+#: Decoded sentence values may differ from Python's correctly rounded float() by an ulp
+#: or two when a fast decimal parser is used.
+VN_RTOL = 1e-15
+
 
 def have_real_vn() -> bool:
     try:
