@@ -154,16 +154,41 @@ def test_single_log_does_both(tmp_path):
 
 @pytest.mark.skipif(not report.model_available(), reason="noise model (imunoise.fit, "
                     "compare, export) has not landed in this build")
-def test_model_files_match_fit(built):
+def test_model_files_and_tables_match_fit(built):
+    from imunoise import export
+
     rep, _, long = built
+    md = rep.markdown.read_text()
     data = json.loads((rep.out_dir / "noise.json").read_text())
-    assert data
-    yaml_text = (rep.out_dir / "imu.yaml").read_text()
+    kalibr = {}
+    for line in (rep.out_dir / "imu.yaml").read_text().splitlines():
+        if ":" in line and not line.startswith("#"):
+            key, value = line.split("#")[0].split(":", 1)
+            kalibr[key.strip()] = value.strip()
+    for sensor in ("gyro", "accel"):
+        model = imunoise.fit(imunoise.adev(getattr(long, sensor), long.fs,
+                                           taus=report.TAUS_PER_DECADE))
+        for term in "QNBKR":
+            np.testing.assert_allclose(data[sensor][term]["value"], model.value(term),
+                                       rtol=1e-12)
+        rows = _md_table(md, f"{sensor} noise coefficients per axis")
+        for want, got in zip(model.table(sensor), rows[1:], strict=True):
+            assert got[1] == want["term"]
+            for j, axis in enumerate("XYZ"):
+                if not want[f"{axis}_supported"]:
+                    assert got[3 + j] == "not resolved"
+                    continue
+                value, std = (float(v) for v in got[3 + j].split(" ± "))
+                assert value == pytest.approx(want[axis], rel=5e-6)
+                assert std == pytest.approx(want[f"{axis}_std"], rel=5e-6)
+    want = export.kalibr_dict(gyro=rep.models["gyro"], accel=rep.models["accel"],
+                              update_rate=long.fs)
     for key in ("gyroscope_noise_density", "accelerometer_noise_density",
                 "gyroscope_random_walk", "accelerometer_random_walk", "update_rate"):
-        assert key in yaml_text
-    model = imunoise.fit(imunoise.adev(long.gyro, long.fs, taus=report.TAUS_PER_DECADE))
-    np.testing.assert_allclose(np.ravel(rep.models["gyro"].N), np.ravel(model.N))
+        assert float(kalibr[key]) == pytest.approx(want[key], rel=1e-5)
+    cmp = _md_table(md, "Measured vs datasheet (vn100)")
+    assert len(cmp) - 1 == len(imunoise.compare(rep.models, "vn100").rows)
+    assert {r[-1] for r in cmp[1:]} <= {"pass", "fail", "unresolved"}
 
 
 @pytest.mark.skipif(not hasattr(imunoise, "read"), reason="imunoise.read has not landed")

@@ -71,7 +71,12 @@ def _allan(x: np.ndarray, fs: float):
 
 def model_available() -> bool:
     """Whether the noise model (fit, compare, export) is part of this installation."""
-    return all(hasattr(imunoise, name) for name in ("fit", "compare", "export"))
+    import importlib.util
+
+    return (
+        all(hasattr(imunoise, name) for name in ("fit", "compare"))
+        and importlib.util.find_spec("imunoise.export") is not None
+    )
 
 
 def _fit(result):
@@ -81,21 +86,39 @@ def _fit(result):
 
 def _coefficients(model) -> list[dict[str, float]]:
     """Per channel ``{"Q", "N", "B", "K", "R"}`` in the input's units (for plots)."""
-    out = []
-    for j in range(np.size(model.N)):
-        out.append({t: float(np.ravel(getattr(model, t))[j]) for t in "QNBKR"})
-    return out
+    values = {t: np.atleast_1d(model.value(t)) for t in "QNBKR"}
+    return [{t: float(values[t][j]) for t in "QNBKR"} for j in range(len(values["N"]))]
 
 
 def _datasheet_rows(model, sensor: str) -> tuple[list[str], list[list[str]]]:
-    """Noise coefficients per axis in datasheet units with uncertainties."""
-    table = model.in_units(sensor).table()
-    return _rows_of(table)
+    """Noise coefficients per axis in datasheet units: ``value ± std`` cells."""
+    rows = model.table(sensor)
+    axes = [a for a in _AXES if rows and a in rows[0]]
+    header = ["quantity", "term", "unit", *axes]
+    out = []
+    for r in rows:
+        cells = [r["quantity"], r["term"], r["unit"]]
+        for a in axes:
+            if not r[f"{a}_supported"]:
+                cells.append("not resolved")
+            else:
+                cells.append(f"{_num(r[a])} ± {_num(r[f'{a}_std'])}")
+        out.append(cells)
+    return header, out
 
 
 def _compare_rows(models: dict, spec: str) -> tuple[list[str], list[list[str]]]:
     """Measured vs datasheet table from :func:`imunoise.compare`."""
-    return _rows_of(imunoise.compare(models, spec))
+    cmp = imunoise.compare(models, spec)
+    header = ["sensor", "quantity", "axis", "unit", "measured", "spec", "ratio", "verdict"]
+    out = []
+    for r in cmp.rows:
+        bound = "<" if r["limit"] == "max" else "typ."
+        out.append([
+            r["sensor"], f"{r['quantity']} ({r['term']})", r["axis"], r["unit"],
+            _num(r["measured"]), f"{bound} {_num(r['spec'])}", _num(r["ratio"]), r["verdict"],
+        ])
+    return header, out
 
 
 def _write_model_files(models: dict, out_dir: Path, fs: float) -> list[Path]:
@@ -103,27 +126,10 @@ def _write_model_files(models: dict, out_dir: Path, fs: float) -> list[Path]:
     from imunoise import export
 
     json_path, yaml_path = out_dir / "noise.json", out_dir / "imu.yaml"
-    export.to_json(models, json_path)
-    export.to_kalibr(models, yaml_path, update_rate=fs)
+    export.write_json(json_path, **models)
+    export.write_kalibr(yaml_path, gyro=models.get("gyro"), accel=models.get("accel"),
+                        update_rate=fs)
     return [json_path, yaml_path]
-
-
-def _rows_of(table) -> tuple[list[str], list[list[str]]]:
-    """Header and string rows of a table object (rows of dicts, or a .rows() provider)."""
-    rows = table.rows() if hasattr(table, "rows") else table
-    rows = list(rows)
-    if not rows:
-        return [], []
-    header = list(rows[0].keys())
-    return header, [[_cell(r[h]) for h in header] for r in rows]
-
-
-def _cell(v) -> str:
-    if isinstance(v, bool | np.bool_):
-        return "pass" if v else "FAIL"
-    if isinstance(v, float | np.floating):
-        return _num(float(v))
-    return str(v)
 
 
 # ---------------------------------------------------------------------------
