@@ -12,7 +12,7 @@ needs_read = pytest.mark.skipif(not hasattr(imunoise, "read"),
                                 reason="imunoise.read has not landed")
 
 
-def _standin_read(path, progress=None):
+def _standin_read(path, fs=None, progress=None):
     """Test-only stand-in for imunoise.read until the readers land: $VNYMR lines only."""
     rows = []
     with open(path) as f:
@@ -22,7 +22,7 @@ def _standin_read(path, progress=None):
     if not rows:
         raise ValueError(f"{path}: no usable records")
     a = np.array(rows)
-    return imunoise.ImuLog(fs=40.0, source=str(path), format="vn-ascii",
+    return imunoise.ImuLog(fs=fs or 40.0, source=str(path), format="vn-ascii",
                            issues=imunoise.ParseIssues.none(), ypr=a[:, 0:3], mag=a[:, 3:6],
                            accel=a[:, 6:9], gyro=a[:, 9:12])
 
@@ -159,3 +159,13 @@ def test_report_command_on_bundled_log(tmp_path, capsys, read):
     assert out.strip() == f"report written to {tmp_path / 'r' / 'report.html'}"
     md = (tmp_path / "r" / "report.md").read_text()
     assert "| short | vn100_stationary_5min.txt |" in md
+
+
+@pytest.mark.skipif(not hasattr(imunoise, "simulate"), reason="imunoise.simulate has not landed")
+def test_demo(tmp_path, capsys, read):
+    code, out, err = _run(["demo", "-o", str(tmp_path / "demo"), "--hours", "0.2",
+                           "--no-progress"], capsys)
+    assert code == 0, err
+    assert str((tmp_path / "demo" / "report.html").resolve()) in out
+    md = (tmp_path / "demo" / "report.md").read_text()
+    assert "| long | <simulated VN-100, 0.2 h> |" in md

@@ -75,12 +75,14 @@ def _build_parser() -> argparse.ArgumentParser:
     r.add_argument("--spec", default="vn100",
                    help="datasheet to compare with: a name or a TOML file (default: "
                    "%(default)s); 'none' to skip")
+    _fs_arg(r)
     _progress_args(r)
 
     a = sub.add_parser("adev", help="print an Allan-family deviation table",
                        description="Print tau, deviation, confidence interval and number of "
                        "terms per axis.")
     a.add_argument("log", metavar="LOG")
+    _fs_arg(a)
     a.add_argument("--sensor", choices=SENSORS, default="gyro")
     a.add_argument("--kind", choices=KINDS, default="adev")
     a.add_argument("--taus", default="octave",
@@ -90,6 +92,7 @@ def _build_parser() -> argparse.ArgumentParser:
                        description="Fit Q, N, B, K, R per axis to the Allan deviation and print "
                        "them in datasheet units with uncertainties.")
     f.add_argument("log", metavar="LOG")
+    _fs_arg(f)
     f.add_argument("--sensor", choices=("gyro", "accel"), default=None,
                    help="one sensor (default: gyro and accel)")
 
@@ -97,11 +100,13 @@ def _build_parser() -> argparse.ArgumentParser:
                        description="Per channel mean, std, variance, min, max, drift per hour; "
                        "per axis normal fit and normality statistics.")
     s.add_argument("log", metavar="LOG")
+    _fs_arg(s)
 
     c = sub.add_parser("convert", help="convert a log to CSV, Parquet or NPZ",
                        description="Write the log's channels to OUTPUT; the format follows the "
                        "suffix: .csv, .parquet (needs pyarrow) or .npz.")
     c.add_argument("log", metavar="LOG")
+    _fs_arg(c)
     c.add_argument("-o", "--output", required=True, metavar="OUTPUT")
 
     m = sub.add_parser("simulate", help="write the log of a simulated still VN-100",
@@ -125,6 +130,12 @@ def _build_parser() -> argparse.ArgumentParser:
     return p
 
 
+def _fs_arg(p) -> None:
+    p.add_argument("--fs", type=_positive_float, default=None, metavar="HZ",
+                   help="sample rate of logs without timestamps (VN ASCII: the rate the "
+                   "sensor was set to; default 40 Hz with a warning)")
+
+
 def _progress_args(p) -> None:
     g = p.add_mutually_exclusive_group()
     g.add_argument("--progress", dest="progress", action="store_true", default=None,
@@ -146,10 +157,10 @@ def _positive_float(text: str) -> float:
 # --- dependencies, one function each -------------------------------------------------
 
 
-def _read(path: str):
+def _read(args):
     from imunoise.report import _load, _Progress
 
-    return _load(path, "input", _Progress(False, 0))
+    return _load(args.log, "input", _Progress(False, 0), args.fs)
 
 
 def _simulate(n: int, fs: float, seed: int | None, coeffs: dict) -> np.ndarray:
@@ -166,7 +177,7 @@ def _cmd_report(args) -> int:
     from imunoise import report
 
     spec = None if args.spec.lower() == "none" else args.spec
-    rep = report.build(args.short_log, args.long_log, args.output, spec=spec,
+    rep = report.build(args.short_log, args.long_log, args.output, spec=spec, fs=args.fs,
                        progress=args.progress)
     print(f"report written to {rep.html}")
     return 0
@@ -175,7 +186,7 @@ def _cmd_report(args) -> int:
 def _cmd_adev(args) -> int:
     import imunoise
 
-    log = _read(args.log)
+    log = _read(args)
     y = getattr(log, args.sensor)
     if y is None:
         _fail(f"{args.log}: the log has no {args.sensor} channel (has {', '.join(log.channels)})")
@@ -205,7 +216,7 @@ def _cmd_fit(args) -> int:
 
     if not hasattr(imunoise, "fit"):
         _fail("the noise model (imunoise.fit) is not part of this installation")
-    log = _read(args.log)
+    log = _read(args)
     sensors = [args.sensor] if args.sensor else [s for s in ("gyro", "accel")
                                                   if getattr(log, s) is not None]
     if not sensors or any(getattr(log, s) is None for s in sensors):
@@ -221,7 +232,7 @@ def _cmd_fit(args) -> int:
 def _cmd_stats(args) -> int:
     from imunoise import stats
 
-    log = _read(args.log)
+    log = _read(args)
     desc = stats.describe(log)
     print(f"# {log.source}: {len(log)} samples at {log.fs:.6g} Hz, parse issues: {log.issues}")
     print(desc.table())
@@ -278,7 +289,7 @@ def _cmd_convert(args) -> int:
             import pyarrow  # noqa: F401
         except ImportError:
             _fail("Parquet output needs pyarrow (pip install pyarrow)")
-    log = _read(args.log)
+    log = _read(args)
     names, cols = _columns(log)
     out.parent.mkdir(parents=True, exist_ok=True)
     if suffix == ".csv":
@@ -339,7 +350,8 @@ def _cmd_demo(args) -> int:
     else:
         print("imunoise: note: imunoise.simulate is not part of this installation; the demo "
               "analyses the bundled 5-minute log alone", file=sys.stderr)
-    rep = report.build(short, long, args.output, spec="vn100", progress=args.progress)
+    # The bundled log is VN ASCII without timestamps, recorded at 40 Hz.
+    rep = report.build(short, long, args.output, spec="vn100", fs=40.0, progress=args.progress)
     print(f"demo report: {rep.html.resolve()}")
     print(f"             {rep.markdown.resolve()}")
     return 0

@@ -54,14 +54,14 @@ _AXES = ("X", "Y", "Z")
 # ---------------------------------------------------------------------------
 
 
-def _read_log(path, progress: Callable[[int, int], None] | None = None) -> ImuLog:
+def _read_log(
+    path, fs: float | None = None, progress: Callable[[int, int], None] | None = None
+) -> ImuLog:
     """Read a log file with :func:`imunoise.read`."""
     read = getattr(imunoise, "read", None)
     if read is None:
         raise ValueError("reading log files needs imunoise.read, which this build lacks")
-    if progress is None:
-        return read(path)
-    return read(path, progress=progress)
+    return read(path, fs=fs, progress=progress)
 
 
 def _allan(x: np.ndarray, fs: float):
@@ -325,13 +325,13 @@ class _Progress:
             self.bar.close()
 
 
-def _load(source, label: str, progress: _Progress) -> ImuLog:
+def _load(source, label: str, progress: _Progress, fs: float | None = None) -> ImuLog:
     if isinstance(source, ImuLog):
         return source
     path = Path(source)
-    if not path.is_file():
-        raise OSError(f"{label} log {str(path)!r} does not exist or is not a file")
-    log = _read_log(path, progress.reader(f"reading {path.name}"))
+    if not path.exists():
+        raise OSError(f"{label} log {str(path)!r} does not exist")
+    log = _read_log(path, fs, progress.reader(f"reading {path.name}"))
     if len(log) == 0:
         raise ValueError(f"{label} log {str(path)!r}: no usable records ({log.issues})")
     return log
@@ -343,6 +343,7 @@ def build(
     out_dir="imunoise-report",
     *,
     spec: str | None = "vn100",
+    fs: float | None = None,
     progress: bool | None = None,
 ) -> Report:
     """Analyse the logs and write the report directory.
@@ -358,20 +359,22 @@ def build(
     spec : str or None
         Datasheet to compare against (name or file, see :func:`imunoise.compare`);
         None skips the comparison.
+    fs : float, optional
+        Sample rate in Hz for logs without timestamps (VN ASCII); passed to the reader.
     progress : bool or None
         Progress bars on stderr; None shows them when stderr is a terminal.
     """
     out = Path(out_dir)
     bar = _Progress(progress, total=6)
     try:
-        return _build(short, long, out, spec, bar)
+        return _build(short, long, out, spec, fs, bar)
     finally:
         bar.close()
 
 
-def _build(short, long, out: Path, spec, bar: _Progress) -> Report:
-    short_log = _load(short, "short", bar)
-    long_log = short_log if long is None else _load(long, "long", bar)
+def _build(short, long, out: Path, spec, fs, bar: _Progress) -> Report:
+    short_log = _load(short, "short", bar, fs)
+    long_log = short_log if long is None else _load(long, "long", bar, fs)
     bar.step("statistics")
     figdir = out / "figures"
     figdir.mkdir(parents=True, exist_ok=True)
