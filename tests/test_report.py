@@ -213,3 +213,14 @@ def test_figures_listed(built):
     rep, _, _ = built
     assert all(Path(p).is_file() for p in rep.figures)
     assert len(rep.figures) == 22
+
+
+def test_progress_bar_only_when_asked(capsys):
+    bar = report._Progress(True, total=2)
+    bar.step("one")
+    bar.close()
+    assert "one" in capsys.readouterr().err
+    quiet = report._Progress(None, total=2)  # stderr is not a terminal under pytest
+    quiet.step("two")
+    quiet.close()
+    assert capsys.readouterr().err == ""
