@@ -69,6 +69,7 @@ def test_distribution_matches_scipy():
     assert d.excess_kurtosis > 0.3  # t(8) has excess kurtosis 1.5
     assert d.step is None
     assert d.counts.sum() == len(x)
+    np.testing.assert_array_equal(d.counts, np.histogram(x, d.edges)[0])
     np.testing.assert_allclose(d.edges, np.histogram_bin_edges(x, bins=len(d.counts)))
     np.testing.assert_allclose(np.sum(d.density() * np.diff(d.edges)), 1.0)
     assert np.all(np.diff(d.qq_sample) >= 0)
@@ -112,6 +113,7 @@ def test_quantized_bins_hold_each_level_once():
     pos = (levels - d.edges[0]) / step
     np.testing.assert_allclose(pos - 0.5, np.round(pos - 0.5), atol=1e-6)
     assert d.counts.sum() == len(x)
+    np.testing.assert_array_equal(d.counts, np.histogram(x, d.edges)[0])
     # Each bin holds the same number of levels: counts of a 1-step histogram summed by k.
     one = imunoise.distribution(x, bins=np.arange(x.min() - step / 2, x.max() + step, step))
     kk = int(k[0])
@@ -119,6 +121,14 @@ def test_quantized_bins_hold_each_level_once():
     grouped = np.add.reduceat(np.concatenate([one.counts, np.zeros(pad, int)]),
                               np.arange(0, len(one.counts) + pad, kk))
     np.testing.assert_array_equal(grouped[: len(d.counts)], d.counts)
+
+
+def test_large_sample_ks_is_asymptotic():
+    x = np.random.default_rng(4).normal(size=50_000) + 0.002 * np.arange(50_000) ** 0.5
+    d = imunoise.distribution(x)
+    ks = sstats.kstest(x, "norm", args=sstats.norm.fit(x), method="asymp")
+    assert d.ks_statistic == pytest.approx(ks.statistic, rel=1e-12)
+    assert d.ks_pvalue == pytest.approx(ks.pvalue, rel=1e-9, abs=1e-300)
 
 
 def test_distribution_int_bins_and_errors():
