@@ -169,3 +169,15 @@ def test_demo(tmp_path, capsys, read):
     assert str((tmp_path / "demo" / "report.html").resolve()) in out
     md = (tmp_path / "demo" / "report.md").read_text()
     assert "| long | <simulated VN-100, 0.2 h> |" in md
+
+
+@pytest.mark.skipif(not all(hasattr(imunoise, f) for f in ("simulate", "write_vn_ascii", "read")),
+                    reason="imunoise.simulate, the VN writers or imunoise.read have not landed")
+def test_simulate_writes_a_readable_vn_log(tmp_path, capsys):
+    out = tmp_path / "still.txt"
+    code, _, err = _run(["simulate", "-o", str(out), "--hours", "0.01", "--seed", "3"], capsys)
+    assert code == 0, err
+    log = imunoise.read(out, fs=40.0)
+    assert len(log) == 1440 and log.issues.total == 0
+    assert log.accel[:, 2].mean() == pytest.approx(-9.80665, abs=0.01)
+    assert log.gyro.std(axis=0) == pytest.approx([6.1e-5 * np.sqrt(40)] * 3, rel=0.1)

@@ -110,13 +110,13 @@ def _build_parser() -> argparse.ArgumentParser:
     c.add_argument("-o", "--output", required=True, metavar="OUTPUT")
 
     m = sub.add_parser("simulate", help="write the log of a simulated still VN-100",
-                       description="Write a VN-100 log with datasheet-level noise "
-                       "(imunoise.simulate_log).")
+                       description="Write the log of a still VN-100 (gravity on -Z, a constant "
+                       "magnetic field and attitude) with the datasheet's noise densities and "
+                       "bias instabilities plus a typical rate random walk.")
     m.add_argument("-o", "--output", required=True, metavar="OUTPUT")
     m.add_argument("--hours", type=_positive_float, default=1.0)
     m.add_argument("--fs", type=_positive_float, default=40.0, help="sample rate in Hz")
     m.add_argument("--format", choices=("vn-ascii", "vn-binary"), default="vn-ascii")
-    m.add_argument("--spec", default="vn100")
     m.add_argument("--seed", type=int, default=None)
 
     d = sub.add_parser("demo", help="run the report on bundled data",
@@ -167,7 +167,21 @@ def _simulate(n: int, fs: float, seed: int | None, coeffs: dict) -> np.ndarray:
     """(n, 3) noise with the given coefficients, from :func:`imunoise.simulate`."""
     import imunoise
 
+    if not hasattr(imunoise, "simulate"):
+        _fail("imunoise.simulate is not part of this installation")
     return np.asarray(imunoise.simulate(n, fs, channels=3, seed=seed, **coeffs))
+
+
+def _write_log(log, path: Path, fmt: str) -> None:
+    """Write an ImuLog as VN ASCII ($VNYMR) or VN binary with the readers' writers."""
+    import imunoise
+
+    if not hasattr(imunoise, "write_vn_ascii"):
+        _fail("the VN writers (imunoise.write_vn_ascii) are not part of this installation")
+    if fmt == "vn-ascii":
+        imunoise.write_vn_ascii(log, "VNYMR", path=path)
+    else:
+        imunoise.write_vn_binary(log, path=path)
 
 
 # --- commands ------------------------------------------------------------------------
@@ -309,26 +323,33 @@ def _cmd_convert(args) -> int:
 
 
 def _cmd_simulate(args) -> int:
-    import imunoise
-
-    simulate_log = getattr(imunoise, "simulate_log", None)
-    if simulate_log is None:
-        _fail("imunoise.simulate_log is not part of this installation")
-    path = simulate_log(args.output, args.hours, args.fs, format=args.format, spec=args.spec,
-                        seed=args.seed)
-    print(f"wrote {path or args.output}")
+    out = Path(args.output)
+    log = demo_long_log(args.hours, args.fs, seed=args.seed, full=True)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    _write_log(log, out, args.format)
+    print(f"wrote {len(log)} samples ({args.hours:g} h at {args.fs:g} Hz, {args.format}) "
+          f"to {out}")
     return 0
 
 
-def demo_long_log(hours: float, fs: float = 40.0, seed: int | None = 1):
-    """A simulated still VN-100 recording (:data:`DEMO_NOISE`) as an ImuLog."""
+def demo_long_log(hours: float, fs: float = 40.0, seed: int | None = 1, full: bool = False):
+    """A simulated still VN-100 recording (:data:`DEMO_NOISE`) as an ImuLog.
+
+    ``full=True`` adds a constant attitude and magnetic field (what a ``$VNYMR``
+    sentence carries besides the inertial channels).
+    """
     from imunoise.readers.log import ImuLog
 
     n = int(round(hours * 3600 * fs))
+    if n < 2:
+        _fail(f"--hours {hours:g} at {fs:g} Hz gives fewer than 2 samples")
     chans = {}
     for i, sensor in enumerate(("gyro", "accel")):
         s = None if seed is None else seed + i
         chans[sensor] = _simulate(n, fs, s, DEMO_NOISE[sensor]) + np.asarray(DEMO_MEAN[sensor])
+    if full:
+        chans["ypr"] = np.broadcast_to(np.array([-77.7, -1.3, 0.15]), (n, 3))
+        chans["mag"] = np.broadcast_to(np.array([0.045, 0.247, -0.338]), (n, 3))
     return ImuLog.from_arrays(fs, source=f"<simulated VN-100, {hours:g} h>", **chans)
 
 
