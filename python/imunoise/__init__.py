@@ -5,6 +5,10 @@ fitting, log readers for VectorNav VN-100 (ASCII and binary), CSV and ROS bags,
 plots and reports. Start with ``imunoise.adev(x, fs)``.
 """
 
+from imunoise import units
 from imunoise._core import __version__
+from imunoise.datasheet import compare
+from imunoise.noise import NoiseModel, fit
+from imunoise.simulate import simulate
 
-__all__ = ["__version__"]
+__all__ = ["__version__", "NoiseModel", "compare", "fit", "simulate", "units"]
