@@ -7,12 +7,10 @@ test_simulate.py), and the closed forms of the model for the slope read-off.
 
 from __future__ import annotations
 
-
+import imunoise
 import numpy as np
 import pytest
 from _allan_helper import StandInResult, allan
-
-import imunoise
 from imunoise.noise import FLICKER, model_variance
 
 FS = 40.0
@@ -21,9 +19,11 @@ HOURS5 = int(5 * 3600 * FS)
 
 def _exact_result(taus, edf=1000.0, **coef):
     var = model_variance(taus, **coef)
-    return StandInResult(kind="adev", overlapping=True, taus=np.asarray(taus), dev=np.sqrt(var),
-                         var=var, n=np.ones(len(taus), dtype=int), edf=np.full(len(taus), edf),
-                         alpha=np.zeros(len(taus), dtype=int), fs=FS)
+    taus = np.asarray(taus)
+    n = 10**9 - 2 * np.rint(taus * FS).astype(int)
+    return StandInResult(kind="adev", overlapping=True, taus=taus, dev=np.sqrt(var), var=var,
+                         n=n, edf=np.full(len(taus), edf), alpha=np.zeros(len(taus), dtype=int),
+                         fs=FS)
 
 
 @pytest.fixture(scope="module")
@@ -78,7 +78,8 @@ def test_all_terms_together(vn_like):
     nbk = imunoise.fit(result, terms=("N", "B", "K"))
     assert np.all(nbk.supported["K"])
     assert np.median(np.abs(nbk.K / truth["K"] - 1)) < 0.4
-    assert np.all(np.abs(nbk.K - truth["K"]) < 4 * nbk.K_std)
+    # uncertainties assume independent taus; overlapping octaves correlate (docs/noise.md)
+    assert np.all(np.abs(nbk.K - truth["K"]) < 5 * nbk.K_std)
 
 
 def test_tau_ranges_follow_the_slopes(vn_like):

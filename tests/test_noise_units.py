@@ -6,13 +6,12 @@ import json
 import math
 import re
 
+import imunoise
 import numpy as np
 import pytest
 from _allan_helper import allan
 from hypothesis import given
 from hypothesis import strategies as st
-
-import imunoise
 from imunoise import export, units
 
 DEG = math.pi / 180
@@ -165,7 +164,8 @@ def test_kalibr_round_trip(tmp_path, gyro_model, accel_model):
     mg, _, _ = gyro_model
     ma, _ = accel_model
     path = tmp_path / "imu.yaml"
-    text = mg.to_kalibr(accel=ma, path=path, rostopic="/vn100/imu")
+    with pytest.warns(RuntimeWarning, match="no resolved K"):
+        text = mg.to_kalibr(accel=ma, path=path, rostopic="/vn100/imu")
     assert path.read_text(encoding="utf-8") == text
     assert [p.name for p in tmp_path.iterdir()] == ["imu.yaml"]  # no temp file left
     v = _yaml_scalars(text)
@@ -175,7 +175,8 @@ def test_kalibr_round_trip(tmp_path, gyro_model, accel_model):
     assert v["rostopic"] == "/vn100/imu"
     # Random walk of a white-noise-only accel is unresolved -> 0 with a warning
     assert float(v["accelerometer_random_walk"]) == 0.0
-    rms = export.kalibr_dict(mg, ma, combine="rms")
+    with pytest.warns(RuntimeWarning, match="no resolved K"):
+        rms = export.kalibr_dict(mg, ma, combine="rms")
     assert rms["gyroscope_noise_density"] == pytest.approx(np.sqrt(np.mean(mg.N**2)))
     assert rms["gyroscope_noise_density"] <= np.max(mg.N)
 
@@ -183,7 +184,8 @@ def test_kalibr_round_trip(tmp_path, gyro_model, accel_model):
 def test_openvins_and_json(tmp_path, gyro_model, accel_model):
     mg, _, _ = gyro_model
     ma, _ = accel_model
-    p = export.write_openvins(tmp_path / "kalibr_imu_chain.yaml", mg, ma)
+    with pytest.warns(RuntimeWarning, match="no resolved K"):
+        p = export.write_openvins(tmp_path / "kalibr_imu_chain.yaml", mg, ma)
     text = p.read_text(encoding="utf-8")
     assert text.startswith("%YAML:1.0") and "\nimu0:\n" in text and "T_i_b" in text
     v = _yaml_scalars(text)
@@ -202,3 +204,5 @@ def test_export_errors(gyro_model):
         export.kalibr_dict()
     with pytest.raises(ValueError, match="combine"):
         export.kalibr_dict(mg, combine="mean")
+    with pytest.raises(ValueError, match="inflate"):
+        export.kalibr_dict(mg, inflate=-1.0)

@@ -9,10 +9,9 @@ from __future__ import annotations
 import math
 
 import allantools
+import imunoise
 import numpy as np
 import pytest
-
-import imunoise
 from imunoise.noise import model_variance
 
 FS = 40.0

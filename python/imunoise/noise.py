@@ -400,7 +400,37 @@ def _extract(result, tau_range):
                 f"tau_range {tau_range!r} contains none of result.taus "
                 f"({taus.min():.3g} s .. {taus.max():.3g} s)"
             )
+    cap = _edf_cap(result, taus)
+    if cap is not None:
+        edf = np.minimum(edf, cap[:, None])
     return taus[keep], var[keep], edf[keep], one
+
+
+def _edf_cap(result, taus):
+    """Largest EDF an IMU rate-noise type can give at each tau (white rate noise).
+
+    For the noise types the model describes at mid and long τ (white, flicker
+    and random-walk rate noise, α ≤ 0) the EDF of the Allan variance is largest
+    for white rate noise (α = 0). Capping the result's EDF there keeps a noise
+    type misidentified as phase noise (α = 2, whose EDF is ≈ N/2 at every τ) from
+    dominating the weights. Overlapping: Riley, NIST SP 1065, Table 11 (white
+    FM): edf = (3(N−1)/(2m) − 2(N−2)/N)·4m²/(4m² + 5), N phase points;
+    non-overlapping: the number of terms.
+    """
+    n_terms = getattr(result, "n", None)
+    if n_terms is None:
+        return None
+    n_terms = np.asarray(n_terms, dtype=float)
+    if n_terms.shape != taus.shape:
+        return None
+    m = np.maximum(np.rint(taus * float(result.fs)), 1.0)
+    if not getattr(result, "overlapping", True):
+        return np.maximum(n_terms, 1.0)
+    n_phase = n_terms + 2 * m  # overlapping ADEV has N - 2m terms over N phase points
+    with np.errstate(divide="ignore", invalid="ignore"):
+        cap = (3 * (n_phase - 1) / (2 * m) - 2 * (n_phase - 2) / n_phase) * 4 * m**2 / (
+            4 * m**2 + 5)
+    return np.where(np.isfinite(cap) & (cap > 1.0), cap, 1.0)
 
 
 def _terms_mask(terms) -> np.ndarray:
@@ -443,6 +473,8 @@ def fit(result, method: str = "wls", terms: Sequence[str] = TERMS, tau_range=Non
 
     Notes
     -----
+    The EDF of the result is capped at its white-rate-noise value (the largest
+    for the α ≤ 0 noise types of an IMU) before weighting, see ``_edf_cap``.
     The weights w = edf/(2σ⁴) treat the Allan variances at different taus as
     independent; overlapping estimates at neighbouring octaves are mildly
     correlated, so the uncertainties are approximate (they are inflated by
