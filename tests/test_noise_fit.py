@@ -177,3 +177,16 @@ def test_slopes_matches_matlab_rule_by_hand():
     j = np.argmin(np.abs(s - 0.5))
     by_hand_k = 10 ** (logd[j] - 0.5 * logt[j] + 0.5 * np.log10(3.0))
     assert float(model.K) == pytest.approx(by_hand_k, rel=1e-12)
+
+
+def test_wls_agrees_with_allan_variance_on_an_exact_curve():
+    """Peer cross-check: on an exact model curve both NNLS fits return the truth."""
+    allan_variance = pytest.importorskip("allan_variance")
+    coef = {"Q": 3e-6, "N": 6e-5, "B": 2.4e-5, "K": 1e-6, "R": 1e-8}
+    r = _exact_result(TAUS, **coef)
+    ours = imunoise.fit(r)
+    params, _ = allan_variance.estimate_parameters(r.taus, r.var)
+    names = {"Q": "quantization", "N": "white", "B": "flicker", "K": "walk", "R": "ramp"}
+    for k, v in coef.items():
+        assert float(getattr(ours, k)) == pytest.approx(v, rel=1e-6), k
+        assert float(getattr(ours, k)) == pytest.approx(params[names[k]], rel=1e-4), k
