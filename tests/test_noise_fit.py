@@ -134,6 +134,8 @@ def test_model_is_frozen(vn_like):
     model = imunoise.fit(result)
     with pytest.raises(AttributeError):
         model.N = 0
+    with pytest.raises(ValueError):
+        model.N[0] = 1.0
 
 
 # -- slope read-off ----------------------------------------------------------

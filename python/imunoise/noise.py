@@ -108,6 +108,8 @@ class Prediction:
 class NoiseModel:
     """Fitted noise coefficients, per channel, in the input's units.
 
+    All arrays are read-only.
+
     Attributes
     ----------
     Q, N, B, K, R : ndarray
@@ -517,7 +519,9 @@ def fit(result, method: str = "wls", terms: Sequence[str] = TERMS, tau_range=Non
     std[~sup] = np.nan
 
     def shaped(a):
-        return a[0] if one else a
+        out = np.array(a[0] if one else a)
+        out.setflags(write=False)
+        return out
 
     values = {k: shaped(coef[:, i]) for i, k in enumerate(TERMS)}
     stds = {k + "_std": shaped(std[:, i]) for i, k in enumerate(TERMS)}
@@ -530,10 +534,16 @@ def fit(result, method: str = "wls", terms: Sequence[str] = TERMS, tau_range=Non
         kind=result.kind,
         fs=float(result.fs),
         overlapping=bool(getattr(result, "overlapping", True)),
-        taus=taus,
+        taus=_readonly(taus),
         chi2=shaped(chi2),
         dof=shaped(dof),
     )
+
+
+def _readonly(a):
+    out = np.array(a)
+    out.setflags(write=False)
+    return out
 
 
 def _fit_wls(t, v, e, mask, min_share, min_z):
