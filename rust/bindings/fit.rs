@@ -19,6 +19,7 @@ type FitArrays<'py> = (
 ///
 /// `coef` holds (Q², N², B², K², R²), `cov` their 5 × 5 covariance.
 #[pyfunction]
+#[allow(clippy::too_many_arguments)] // mirrors the Python keyword arguments
 #[pyo3(signature = (taus, var, edf, terms, reweight=3, min_share=0.25, min_z=2.0))]
 fn fit_wls<'py>(
     py: Python<'py>,
