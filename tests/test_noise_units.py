@@ -127,6 +127,21 @@ def test_compare_verdicts(gyro_model, accel_model):
     assert only.passed and {r["sensor"] for r in only.rows} == {"gyro"}
 
 
+def test_marginal_verdict(gyro_model, tmp_path):
+    """Above the spec by less than 2 standard uncertainties: marginal, not fail."""
+    mg, _, _ = gyro_model
+    n_deg_h = float(mg.N[0]) / DEG * 60
+    u = float(mg.N_std[0]) / DEG * 60
+    spec = tmp_path / "edge.toml"
+    spec.write_text(
+        f'[[gyro]]\nterm = "N"\nvalue = {n_deg_h - u}\nunit = "deg/sqrt(h)"\n'
+        f'[[gyro]]\nterm = "N"\nvalue = {n_deg_h - 3 * u}\nunit = "deg/sqrt(h)"\n',
+        encoding="utf-8",
+    )
+    rows = [r for r in imunoise.compare(mg, spec).rows if r["axis"] == "X"]
+    assert [r["verdict"] for r in rows] == ["marginal", "fail"]
+
+
 def test_compare_with_user_spec(tmp_path, gyro_model):
     mg, n, _ = gyro_model
     spec = tmp_path / "mine.toml"

@@ -121,8 +121,10 @@ class Comparison:
 
     Each row is a dict: ``sensor, term, quantity, unit, limit, spec, axis,
     measured, std, ratio, verdict`` where ``ratio = measured/spec`` and
-    ``verdict`` is ``"pass"`` (measured ≤ spec), ``"fail"`` or ``"unresolved"``
-    (the data do not resolve that term, e.g. too short a log for B).
+    ``verdict`` is ``"pass"`` (measured ≤ spec), ``"marginal"`` (above the spec
+    but within two standard uncertainties of it), ``"fail"``, or
+    ``"unresolved"`` (the data do not resolve that term, e.g. too short a log
+    for B).
     """
 
     spec: Spec
@@ -130,7 +132,7 @@ class Comparison:
 
     @property
     def passed(self) -> bool:
-        """True when no row fails (unresolved rows do not fail)."""
+        """True when no row fails (marginal and unresolved rows do not fail)."""
         return all(r["verdict"] != "fail" for r in self.rows)
 
     def text(self) -> str:
@@ -154,6 +156,16 @@ class Comparison:
             lines.append("  ".join(c.ljust(w) for c, w in zip(row, widths, strict=True)).rstrip())
         lines.insert(2, "  ".join("-" * w for w in widths))
         return "\n".join(lines)
+
+
+def _verdict(resolved: bool, measured: float, std: float, spec: float) -> str:
+    if not resolved:
+        return "unresolved"
+    if measured <= spec:
+        return "pass"
+    if np.isfinite(std) and measured - 2.0 * std <= spec:
+        return "marginal"
+    return "fail"
 
 
 def compare(models, spec="vn100", *, sensor: str = "gyro", input_units: dict | None = None,
@@ -225,7 +237,7 @@ def compare(models, spec="vn100", *, sensor: str = "gyro", input_units: dict | N
                 "measured": measured if ok else math.nan,
                 "std": float(stds[i]) if ok else math.nan,
                 "ratio": ratio,
-                "verdict": "unresolved" if not ok else ("pass" if ratio <= 1.0 else "fail"),
+                "verdict": _verdict(ok, measured, float(stds[i]), item.value),
             })
     if not rows:
         raise ValueError(

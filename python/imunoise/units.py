@@ -19,7 +19,7 @@ Examples
 >>> from imunoise import units
 >>> round(units.convert(1e-4, "N", "deg/sqrt(h)", sensor="gyro"), 6)  # rad/√s
 0.343775
->>> units.convert(1.0, "B", "mg", sensor="accel", input_unit="g")
+>>> round(units.convert(1.0, "B", "mg", sensor="accel", input_unit="g"), 9)
 1000.0
 """
 
