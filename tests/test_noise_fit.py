@@ -11,6 +11,8 @@ import imunoise
 import numpy as np
 import pytest
 from _allan_helper import StandInResult, allan
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from imunoise.noise import FLICKER, model_variance
 
 FS = 40.0
@@ -192,3 +194,24 @@ def test_wls_agrees_with_allan_variance_on_an_exact_curve():
     for k, v in coef.items():
         assert float(getattr(ours, k)) == pytest.approx(v, rel=1e-6), k
         assert float(getattr(ours, k)) == pytest.approx(params[names[k]], rel=1e-4), k
+
+
+@pytest.fixture(scope="module")
+def vn_like_small():
+    x = imunoise.simulate(200_000, FS, N=2e-4, B=3e-5, K=4e-6, channels=2, seed=2)
+    return allan(x, FS)
+
+
+@settings(max_examples=15, deadline=None)
+@given(st.floats(1e-6, 1e6), st.sampled_from(["wls", "slopes"]))
+def test_fit_is_scale_equivariant(vn_like_small, scale, method):
+    """Scaling the data by c scales every coefficient and uncertainty by c."""
+    r = vn_like_small
+    scaled = StandInResult(kind="adev", overlapping=True, taus=r.taus, dev=r.dev * scale,
+                           var=r.var * scale**2, n=r.n, edf=r.edf, alpha=r.alpha, fs=r.fs)
+    a = imunoise.fit(r, method=method)
+    b = imunoise.fit(scaled, method=method)
+    for k in "QNBKR":
+        np.testing.assert_array_equal(a.supported[k], b.supported[k])
+        np.testing.assert_allclose(b.value(k), scale * a.value(k), rtol=1e-6)
+        np.testing.assert_allclose(b.std(k), scale * a.std(k), rtol=1e-5)
