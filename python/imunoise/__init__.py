@@ -5,21 +5,30 @@ fitting, log readers for VectorNav VN-100 (ASCII and binary), CSV and ROS bags,
 plots and reports. Start with ``imunoise.adev(x, fs)``.
 """
 
+from imunoise import units
 from imunoise._core import __version__
 from imunoise.allan import AllanResult, adev, hdev, mdev, tdev, totdev
+from imunoise.datasheet import compare
+from imunoise.noise import NoiseModel, fit
 from imunoise.readers import ImuLog, ParseIssues
+from imunoise.simulate import simulate
 from imunoise.stats import describe, distribution
 
 __all__ = [
     "__version__",
     "AllanResult",
     "ImuLog",
+    "NoiseModel",
     "ParseIssues",
     "adev",
+    "compare",
     "describe",
     "distribution",
+    "fit",
     "hdev",
     "mdev",
+    "simulate",
     "tdev",
     "totdev",
+    "units",
 ]
