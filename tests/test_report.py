@@ -188,7 +188,7 @@ def test_model_files_and_tables_match_fit(built):
         assert float(kalibr[key]) == pytest.approx(want[key], rel=1e-5)
     cmp = _md_table(md, "Measured vs datasheet (vn100)")
     assert len(cmp) - 1 == len(imunoise.compare(rep.models, "vn100").rows)
-    assert {r[-1] for r in cmp[1:]} <= {"pass", "fail", "unresolved"}
+    assert {r[-1] for r in cmp[1:]} <= {"pass", "marginal", "fail", "unresolved"}
 
 
 @pytest.mark.skipif(not hasattr(imunoise, "read"), reason="imunoise.read has not landed")

@@ -245,6 +245,8 @@ def allan(
         :math:`B\sqrt{2\ln2/\pi}` (the flat floor, ≈ 0.664 B) at the total's minimum.
     """
     Figure = _plt()
+    from matplotlib.ticker import NullFormatter
+
     taus = np.asarray(result.taus, dtype=np.float64)
     dev = np.asarray(result.dev, dtype=np.float64).reshape(len(taus), -1)
     lo = np.asarray(result.ci_low, dtype=np.float64).reshape(dev.shape)
@@ -254,8 +256,9 @@ def allan(
     kind = getattr(result, "kind", "adev").upper()
     grid = np.geomspace(taus[0], taus[-1], 200)
     with style():
-        fig = Figure(figsize=(3.6 * k, 3.4))
+        fig = Figure(figsize=(3.6 * k, 3.9))
         axes = fig.subplots(1, k, squeeze=False, sharey=True)[0]
+        lims: list[tuple[float, float]] = []
         for j, ax in enumerate(axes):
             color = AXIS_COLORS[j % 4]
             yerr = np.vstack([dev[:, j] - lo[:, j], hi[:, j] - dev[:, j]])
@@ -289,11 +292,30 @@ def allan(
             ax.grid(True, which="both", alpha=0.25)
             ymin = np.nanmin(np.where(lo[:, j] > 0, lo[:, j], np.nan))
             ymax = np.nanmax(hi[:, j])
-            if np.isfinite(ymin) and np.isfinite(ymax):
-                ax.set_ylim(ymin / 2.0, ymax * 2.0)
+            if coefficients is not None:
+                # keep the read-off points (N at 1 s, K at 3 s) inside the axes
+                marks = [coefficients[j].get(t, 0.0) for t in ("N", "K")]
+                marks = [v for v in marks if v > 0]
+                if marks:
+                    ymin = min(ymin, min(marks) / 1.5)
+                    ymax = max(ymax, max(marks) * 1.5)
+            ax.yaxis.set_minor_formatter(NullFormatter())
+            lims.append((ymin, ymax))
+        ymin = np.nanmin([a for a, _ in lims])
+        ymax = np.nanmax([b for _, b in lims])
+        if np.isfinite(ymin) and np.isfinite(ymax) and ymin > 0:
+            axes[0].set_ylim(ymin / 1.5, ymax * 1.5)  # shared by all panels
         axes[0].set_ylabel(f"σ(τ) [{unit}]" if unit else "σ(τ)")
-        axes[0].legend(loc="lower left")
-        _margins(fig, left=0.85, bottom=0.5, top=0.3, wspace=0.08, title=bool(title))
+        seen: dict[str, object] = {}
+        for ax in axes:
+            for h, lab in zip(*ax.get_legend_handles_labels(), strict=True):
+                seen.setdefault(lab, h)
+        labels, handles = list(seen), list(seen.values())
+        fig.legend(handles, labels, loc="lower center", ncol=min(len(labels), 5),
+                   bbox_to_anchor=(0.5, 0.0))
+        rows = -(-len(labels) // 5)
+        _margins(fig, left=0.85, bottom=0.55 + 0.22 * rows, top=0.3, wspace=0.08,
+                 title=bool(title))
         if title:
             fig.suptitle(title)
     return fig
