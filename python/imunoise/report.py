@@ -27,6 +27,7 @@ import datetime as _dt
 import html as _html
 import math
 import sys
+import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -331,9 +332,13 @@ def _load(source, label: str, progress: _Progress, fs: float | None = None) -> I
     path = Path(source)
     if not path.exists():
         raise OSError(f"{label} log {str(path)!r} does not exist")
-    log = _read_log(path, fs, progress.reader(f"reading {path.name}"))
-    if len(log) == 0:
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        log = _read_log(path, fs, progress.reader(f"reading {path.name}"))
+    if len(log) == 0:  # the error says it all; drop warnings such as the assumed rate
         raise ValueError(f"{label} log {str(path)!r}: no usable records ({log.issues})")
+    for w in caught:
+        warnings.warn(w.message, w.category, stacklevel=2)
     return log
 
 
