@@ -158,7 +158,7 @@ def test_report_command_on_bundled_log(tmp_path, capsys, read):
     assert code == 0, err
     assert out.strip() == f"report written to {tmp_path / 'r' / 'report.html'}"
     md = (tmp_path / "r" / "report.md").read_text()
-    assert "| short | vn100_stationary_5min.txt |" in md
+    assert "| both | vn100_stationary_5min.txt |" in md
 
 
 @pytest.mark.skipif(not hasattr(imunoise, "simulate"), reason="imunoise.simulate has not landed")

@@ -392,7 +392,7 @@ def _build(short, long, out: Path, spec, fs, bar: _Progress) -> Report:
 
     # 1. Recording summary
     doc.h(2, "1. Recording summary")
-    logs = [("short", short_log)] if long is None else [("short", short_log), ("long", long_log)]
+    logs = [("both", short_log)] if long is None else [("short", short_log), ("long", long_log)]
     rows = []
     for label, log in logs:
         rows.append([
@@ -413,10 +413,11 @@ def _build(short, long, out: Path, spec, fs, bar: _Progress) -> Report:
             if y is None:
                 continue
             unit = CHANNELS[sensor][1]
-            fig = _plot.time_series(y, log.fs, title=f"{sensor} ({label} log)", unit=unit)
+            which = "the log" if label == "both" else f"the {label} log"
+            fig = _plot.time_series(y, log.fs, title=f"{sensor} ({which})", unit=unit)
             figures += _plot.save(fig, figdir / f"timeseries_{label}_{sensor}")
             doc.figure(figdir / f"timeseries_{label}_{sensor}.png",
-                       f"Time series of the {label} log: {sensor} [{unit}] (min/max per pixel)")
+                       f"Time series of {which}: {sensor} [{unit}] (min/max per pixel)")
 
     # 2. Sample statistics
     doc.h(2, "2. Sample statistics")
