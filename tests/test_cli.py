@@ -181,3 +181,19 @@ def test_simulate_writes_a_readable_vn_log(tmp_path, capsys):
     assert len(log) == 1440 and log.issues.total == 0
     assert log.accel[:, 2].mean() == pytest.approx(-9.80665, abs=0.01)
     assert log.gyro.std(axis=0) == pytest.approx([6.1e-5 * np.sqrt(40)] * 3, rel=0.1)
+
+
+@pytest.mark.skipif(not hasattr(imunoise, "fit"), reason="imunoise.fit has not landed")
+def test_fit_prints_datasheet_table(capsys, read):
+    from imunoise import report
+    from imunoise.cli import bundled_log
+
+    code, out, err = _run(["fit", str(bundled_log()), "--sensor", "gyro", "--fs", "40"], capsys)
+    assert code == 0, err
+    log = read(bundled_log(), fs=40.0)
+    model = imunoise.fit(imunoise.adev(log.gyro, log.fs, taus=report.TAUS_PER_DECADE))
+    lines = out.splitlines()
+    assert lines[0] == "# gyro"
+    n_row = next(line for line in lines if " N " in f" {line} " and "deg/sqrt(h)" in line)
+    want = next(r for r in model.table("gyro") if r["term"] == "N")
+    assert f"{want['X']:.6g}" in n_row
