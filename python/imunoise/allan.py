@@ -16,7 +16,7 @@ tau, with compensated summation. With :math:`\tau = m/f_s` and N = n + 1:
 
 Confidence intervals: the noise type α is identified at each tau by the lag-1
 autocorrelation method (Riley & Greenhall 2004) — where the decimated series is
-too short (< 30 points) α is taken from the nearest identified tau — then the
+too short (< 30 points) α is the median of the three nearest identified taus — then the
 equivalent degrees of freedom follow Greenhall's algorithm (TOTVAR: SP 1065
 Table 7), and the bounds are the χ² quantiles
 :math:`\sigma^2\,\nu/\chi^2_{\nu}(1-p/2) \le \sigma^2 \le \sigma^2\,\nu/\chi^2_{\nu}(p/2)`.
@@ -76,7 +76,8 @@ class AllanResult:
         Power-law noise type used for the EDF: rate PSD ∝ f^α (2 white PM,
         1 flicker PM, 0 white FM / white rate noise, −1 flicker FM, −2 random walk FM).
     alpha_identified : ndarray of bool
-        False where α was borrowed from the nearest identified tau.
+        False where α was taken from the nearest identified taus (the median of
+        up to three) because the series was too short to identify it there.
     fs : float
         Sample rate in Hz.
     confidence : float
