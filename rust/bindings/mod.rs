@@ -8,6 +8,7 @@ use pyo3::prelude::*;
 use crate::error::CoreError;
 
 mod allan;
+mod vn;
 
 impl From<CoreError> for PyErr {
     fn from(err: CoreError) -> PyErr {
@@ -22,5 +23,6 @@ impl From<CoreError> for PyErr {
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     allan::register(m)?;
+    vn::register(m)?;
     Ok(())
 }
