@@ -6,5 +6,17 @@ plots and reports. Start with ``imunoise.adev(x, fs)``.
 """
 
 from imunoise._core import __version__
+from imunoise.allan import AllanResult, adev, hdev, mdev, tdev, totdev
+from imunoise.readers import ImuLog, ParseIssues
 
-__all__ = ["__version__"]
+__all__ = [
+    "__version__",
+    "AllanResult",
+    "ImuLog",
+    "ParseIssues",
+    "adev",
+    "hdev",
+    "mdev",
+    "tdev",
+    "totdev",
+]

@@ -43,7 +43,8 @@ pub fn greenhall_edf(alpha: i32, est: Estimator, m: usize, n_phase: usize) -> f6
 
     let inv_edf = if est.modified {
         if j <= J_MAX {
-            basic_sum(j, big_m, s, Some(1.0), alpha, d) / (sz(0.0, Some(1.0), alpha, d).powi(2) * big_m)
+            basic_sum(j, big_m, s, Some(1.0), alpha, d)
+                / (sz(0.0, Some(1.0), alpha, d).powi(2) * big_m)
         } else if r > df + 1.0 {
             let (a0, a1) = table1(alpha, d);
             (a0 - a1 / r) / r
@@ -54,14 +55,19 @@ pub fn greenhall_edf(alpha: i32, est: Estimator, m: usize, n_phase: usize) -> f6
         }
     } else if alpha <= 0 {
         if j <= J_MAX {
-            let f_prime = if mf * (df + 1.0) <= J_MAX { Some(mf) } else { None };
+            let f_prime = if mf * (df + 1.0) <= J_MAX {
+                Some(mf)
+            } else {
+                None
+            };
             basic_sum(j, big_m, s, f_prime, alpha, d) / (sz(0.0, f_prime, alpha, d).powi(2) * big_m)
         } else if r > df + 1.0 {
             let (a0, a1) = table2(alpha, d);
             (a0 - a1 / r) / r
         } else {
             let m_prime = J_MAX / r;
-            basic_sum(J_MAX, J_MAX, m_prime, None, alpha, d) / (sz(0.0, None, alpha, d).powi(2) * J_MAX)
+            basic_sum(J_MAX, J_MAX, m_prime, None, alpha, d)
+                / (sz(0.0, None, alpha, d).powi(2) * J_MAX)
         }
     } else if alpha == 1 {
         let (b0, b1) = table3(d);
@@ -72,7 +78,8 @@ pub fn greenhall_edf(alpha: i32, est: Estimator, m: usize, n_phase: usize) -> f6
             (a0 - a1 / r) / ((b0 + b1 * mf.ln()).powi(2) * r)
         } else {
             let m_prime = J_MAX / r;
-            basic_sum(J_MAX, J_MAX, m_prime, Some(m_prime), 1, d) / ((b0 + b1 * mf.ln()).powi(2) * J_MAX)
+            basic_sum(J_MAX, J_MAX, m_prime, Some(m_prime), 1, d)
+                / ((b0 + b1 * mf.ln()).powi(2) * J_MAX)
         }
     } else {
         // α = 2, unmodified.
@@ -100,7 +107,11 @@ pub fn totvar_edf(alpha: i32, m: usize, n_samples: usize) -> f64 {
         -2 => 0.93 * ratio - 0.36,
         _ => greenhall_edf(
             alpha,
-            Estimator { d: 2, overlapping: true, modified: false },
+            Estimator {
+                d: 2,
+                overlapping: true,
+                modified: false,
+            },
             m,
             n_samples + 1,
         ),
@@ -163,7 +174,11 @@ fn binomial(n: u32, k: u32) -> f64 {
 /// Greenhall Table 1 (modified variances): (a0, a1) by α (rows 2..−4) and d.
 fn table1(alpha: i32, d: u32) -> (f64, f64) {
     const T: [[(f64, f64); 3]; 7] = [
-        [(2.0 / 3.0, 1.0 / 3.0), (7.0 / 9.0, 0.5), (22.0 / 25.0, 2.0 / 3.0)],
+        [
+            (2.0 / 3.0, 1.0 / 3.0),
+            (7.0 / 9.0, 0.5),
+            (22.0 / 25.0, 2.0 / 3.0),
+        ],
         [(0.840, 0.345), (0.997, 0.616), (1.141, 0.843)],
         [(1.079, 0.368), (1.033, 0.607), (1.184, 0.848)],
         [(f64::NAN, f64::NAN), (1.048, 0.534), (1.180, 0.816)],
@@ -179,7 +194,11 @@ fn table2(alpha: i32, d: u32) -> (f64, f64) {
     const T: [[(f64, f64); 3]; 7] = [
         [(1.5, 0.5), (35.0 / 18.0, 1.0), (231.0 / 100.0, 1.5)],
         [(78.6, 25.2), (790.0, 410.0), (9950.0, 6520.0)],
-        [(2.0 / 3.0, 1.0 / 6.0), (2.0 / 3.0, 1.0 / 3.0), (7.0 / 9.0, 0.5)],
+        [
+            (2.0 / 3.0, 1.0 / 6.0),
+            (2.0 / 3.0, 1.0 / 3.0),
+            (7.0 / 9.0, 0.5),
+        ],
         [(f64::NAN, f64::NAN), (0.852, 0.375), (0.997, 0.617)],
         [(f64::NAN, f64::NAN), (1.079, 0.368), (1.033, 0.607)],
         [(f64::NAN, f64::NAN), (f64::NAN, f64::NAN), (1.053, 0.553)],
@@ -197,8 +216,16 @@ fn table3(d: u32) -> (f64, f64) {
 mod tests {
     use super::*;
 
-    const OADEV: Estimator = Estimator { d: 2, overlapping: true, modified: false };
-    const ADEV: Estimator = Estimator { d: 2, overlapping: false, modified: false };
+    const OADEV: Estimator = Estimator {
+        d: 2,
+        overlapping: true,
+        modified: false,
+    };
+    const ADEV: Estimator = Estimator {
+        d: 2,
+        overlapping: false,
+        modified: false,
+    };
 
     #[test]
     fn non_overlapping_white_fm_edf_is_close_to_terms_count() {
@@ -208,7 +235,10 @@ mod tests {
         let m = 10;
         let edf = greenhall_edf(0, ADEV, m, n);
         let terms = (n - 1) / m - 1;
-        assert!(edf > 0.5 * terms as f64 && edf < terms as f64, "{edf} {terms}");
+        assert!(
+            edf > 0.5 * terms as f64 && edf < terms as f64,
+            "{edf} {terms}"
+        );
     }
 
     #[test]
@@ -229,7 +259,10 @@ mod tests {
 
     #[test]
     fn out_of_range_alpha_is_clamped() {
-        assert_eq!(greenhall_edf(-4, OADEV, 8, 1000), greenhall_edf(-2, OADEV, 8, 1000));
+        assert_eq!(
+            greenhall_edf(-4, OADEV, 8, 1000),
+            greenhall_edf(-2, OADEV, 8, 1000)
+        );
     }
 
     #[test]

@@ -34,12 +34,13 @@ pub fn column_phases<I>(columns: Vec<I>) -> CoreResult<Vec<Vec<f64>>>
 where
     I: Iterator<Item = f64> + Clone + Send,
 {
+    let several = columns.len() > 1;
     columns
         .into_par_iter()
         .enumerate()
         .map(|(channel, col)| {
             phase::cumulative_phase(col).map_err(|e| match e {
-                CoreError::InvalidArgument(msg) => {
+                CoreError::InvalidArgument(msg) if several => {
                     CoreError::InvalidArgument(format!("{msg} (channel {channel})"))
                 }
                 other => other,
@@ -54,11 +55,15 @@ where
 pub fn analyse(phases: &[Vec<f64>], statistic: Statistic, ms: &[usize]) -> CoreResult<Analysis> {
     let channels = phases.len();
     if channels == 0 {
-        return Err(CoreError::InvalidArgument("x must have at least one channel".into()));
+        return Err(CoreError::InvalidArgument(
+            "x must have at least one channel".into(),
+        ));
     }
     let n_phase = phases[0].len();
     if phases.iter().any(|p| p.len() != n_phase) {
-        return Err(CoreError::InvalidArgument("all channels must have the same length".into()));
+        return Err(CoreError::InvalidArgument(
+            "all channels must have the same length".into(),
+        ));
     }
     let terms: Vec<usize> = ms.iter().map(|&m| statistic.terms(n_phase, m)).collect();
     if let Some(pos) = terms.iter().position(|&t| t == 0) {
@@ -68,8 +73,9 @@ pub fn analyse(phases: &[Vec<f64>], statistic: Statistic, ms: &[usize]) -> CoreR
             n_phase.saturating_sub(1)
         )));
     }
-    let pairs: Vec<(usize, usize)> =
-        (0..ms.len()).flat_map(|t| (0..channels).map(move |c| (t, c))).collect();
+    let pairs: Vec<(usize, usize)> = (0..ms.len())
+        .flat_map(|t| (0..channels).map(move |c| (t, c)))
+        .collect();
     let (dmax, estimator) = noise_model_of(statistic);
     let per_pair: Vec<(f64, Option<i32>)> = pairs
         .par_iter()
@@ -101,7 +107,14 @@ pub fn analyse(phases: &[Vec<f64>], statistic: Statistic, ms: &[usize]) -> CoreR
             None => edf::totvar_edf(alpha[i], ms[t], n_samples),
         })
         .collect();
-    Ok(Analysis { channels, var, terms, alpha, alpha_identified, edf })
+    Ok(Analysis {
+        channels,
+        var,
+        terms,
+        alpha,
+        alpha_identified,
+        edf,
+    })
 }
 
 /// Maximum differencing for noise identification and the EDF estimator (None:
@@ -109,9 +122,30 @@ pub fn analyse(phases: &[Vec<f64>], statistic: Statistic, ms: &[usize]) -> CoreR
 fn noise_model_of(statistic: Statistic) -> (u32, Option<edf::Estimator>) {
     use edf::Estimator;
     match statistic {
-        Statistic::Allan { overlapping } => (2, Some(Estimator { d: 2, overlapping, modified: false })),
-        Statistic::Modified => (2, Some(Estimator { d: 2, overlapping: true, modified: true })),
-        Statistic::Hadamard { overlapping } => (3, Some(Estimator { d: 3, overlapping, modified: false })),
+        Statistic::Allan { overlapping } => (
+            2,
+            Some(Estimator {
+                d: 2,
+                overlapping,
+                modified: false,
+            }),
+        ),
+        Statistic::Modified => (
+            2,
+            Some(Estimator {
+                d: 2,
+                overlapping: true,
+                modified: true,
+            }),
+        ),
+        Statistic::Hadamard { overlapping } => (
+            3,
+            Some(Estimator {
+                d: 3,
+                overlapping,
+                modified: false,
+            }),
+        ),
         Statistic::Total => (2, None),
     }
 }
@@ -140,7 +174,12 @@ mod tests {
     fn analysis_shapes_and_fallback() {
         let y: Vec<f64> = (0..200).map(|k| ((k * 37) % 17) as f64).collect();
         let phases = column_phases(vec![y.iter().copied(), y.iter().copied()]).unwrap();
-        let a = analyse(&phases, Statistic::Allan { overlapping: true }, &[1, 2, 16, 64]).unwrap();
+        let a = analyse(
+            &phases,
+            Statistic::Allan { overlapping: true },
+            &[1, 2, 16, 64],
+        )
+        .unwrap();
         assert_eq!(a.var.len(), 8);
         assert_eq!(a.terms, vec![199, 197, 169, 73]);
         // m = 16 leaves 13 decimated points: not identified, copied from m = 2.

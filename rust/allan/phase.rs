@@ -59,7 +59,9 @@ mod tests {
 
     #[test]
     fn large_offset_costs_no_digits() {
-        let base: Vec<f64> = (0..1000).map(|k| ((k * 7919) % 101) as f64 * 1e-4).collect();
+        let base: Vec<f64> = (0..1000)
+            .map(|k| ((k * 7919) % 101) as f64 * 1e-4)
+            .collect();
         let shifted: Vec<f64> = base.iter().map(|v| v + 9.81).collect();
         let a = cumulative_phase(base.iter().copied()).unwrap();
         let b = cumulative_phase(shifted.iter().copied()).unwrap();

@@ -63,6 +63,43 @@ pub fn sum_of_squares(count: usize, mut term: impl FnMut(usize) -> f64) -> f64 {
     total.value()
 }
 
+/// Σ_i (Σ_s w_s·x_s[i])² over `S` equally long streams: the overlapping
+/// estimators' sum of squared differences, c[i+2m] − 2c[i+m] + c[i] and the like.
+/// Slices of fixed-size chunks let the compiler drop bounds checks and vectorise;
+/// blocks of 256 squares are summed plainly and then added with compensation.
+pub fn sum_of_squared_combinations<const S: usize>(streams: [&[f64]; S], weights: [f64; S]) -> f64 {
+    const BLOCK: usize = 256;
+    let len = streams.iter().map(|s| s.len()).min().unwrap_or(0);
+    let mut total = Neumaier::new();
+    let mut start = 0;
+    while start < len {
+        let end = (start + BLOCK).min(len);
+        let blocks: [&[f64]; S] = std::array::from_fn(|s| &streams[s][start..end]);
+        let chunked: [(&[[f64; 8]], &[f64]); S] =
+            std::array::from_fn(|s| blocks[s].as_chunks::<8>());
+        let mut lanes = [0.0f64; 8];
+        for k in 0..chunked[0].0.len() {
+            let mut v = [0.0f64; 8];
+            for s in 0..S {
+                let chunk = &chunked[s].0[k];
+                for lane in 0..8 {
+                    v[lane] += weights[s] * chunk[lane];
+                }
+            }
+            for lane in 0..8 {
+                lanes[lane] += v[lane] * v[lane];
+            }
+        }
+        for r in 0..chunked[0].1.len() {
+            let v: f64 = (0..S).map(|s| weights[s] * chunked[s].1[r]).sum();
+            lanes[0] += v * v;
+        }
+        total.add(lanes.iter().sum());
+        start = end;
+    }
+    total.value()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -82,6 +119,21 @@ mod tests {
         let n = 1000usize;
         let s = sum_of_squares(n, |k| (k + 1) as f64);
         assert_eq!(s, (n * (n + 1) * (2 * n + 1) / 6) as f64);
+    }
+
+    #[test]
+    fn combinations_match_the_closure_form() {
+        let c: Vec<f64> = (0..1000)
+            .map(|k| ((k * 7919) % 113) as f64 - 50.0)
+            .collect();
+        let m = 7;
+        let terms = c.len() - 2 * m;
+        let fast = sum_of_squared_combinations(
+            [&c[2 * m..2 * m + terms], &c[m..m + terms], &c[..terms]],
+            [1.0, -2.0, 1.0],
+        );
+        let slow = sum_of_squares(terms, |k| c[k + 2 * m] - 2.0 * c[k + m] + c[k]);
+        assert_eq!(fast, slow);
     }
 
     #[test]

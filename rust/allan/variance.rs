@@ -3,7 +3,7 @@
 //! τ = m·τ0 together with the number of terms in its sum, counted as Stable32
 //! and allantools count them. References: NIST SP 1065 (Riley 2008), eqs. 6–25.
 
-use super::sum::{sum_of_squares, Neumaier};
+use super::sum::{sum_of_squared_combinations, sum_of_squares, Neumaier};
 
 /// A variance estimate and the number of terms it averages.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -13,7 +13,10 @@ pub struct Estimate {
 }
 
 impl Estimate {
-    const EMPTY: Estimate = Estimate { var: f64::NAN, terms: 0 };
+    const EMPTY: Estimate = Estimate {
+        var: f64::NAN,
+        terms: 0,
+    };
 }
 
 /// Which statistic to compute.
@@ -37,8 +40,12 @@ impl Statistic {
             return 0;
         }
         match self {
-            Statistic::Allan { overlapping } => strided_count(n_phase, 2 * m, stride(overlapping, m)),
-            Statistic::Hadamard { overlapping } => strided_count(n_phase, 3 * m, stride(overlapping, m)),
+            Statistic::Allan { overlapping } => {
+                strided_count(n_phase, 2 * m, stride(overlapping, m))
+            }
+            Statistic::Hadamard { overlapping } => {
+                strided_count(n_phase, 3 * m, stride(overlapping, m))
+            }
             Statistic::Modified => (n_phase + 1).saturating_sub(3 * m),
             Statistic::Total => {
                 if m < n_phase && n_phase >= 3 {
@@ -58,6 +65,25 @@ impl Statistic {
         }
         let mf = m as f64;
         let var = match self {
+            Statistic::Allan { overlapping: true } => {
+                let ss = sum_of_squared_combinations(
+                    [&c[2 * m..2 * m + terms], &c[m..m + terms], &c[..terms]],
+                    [1.0, -2.0, 1.0],
+                );
+                ss / (2.0 * mf * mf * terms as f64)
+            }
+            Statistic::Hadamard { overlapping: true } => {
+                let ss = sum_of_squared_combinations(
+                    [
+                        &c[3 * m..3 * m + terms],
+                        &c[2 * m..2 * m + terms],
+                        &c[m..m + terms],
+                        &c[..terms],
+                    ],
+                    [1.0, -3.0, 3.0, -1.0],
+                );
+                ss / (6.0 * mf * mf * terms as f64)
+            }
             Statistic::Allan { overlapping } => {
                 let s = stride(overlapping, m);
                 let ss = sum_of_squares(terms, |j| {
@@ -127,6 +153,8 @@ fn modified_sum(c: &[f64], m: usize, terms: usize) -> f64 {
 
 /// Σ_{i=1}^{N−2} (x*_{i−m} − 2x*_i + x*_{i+m})² with x* the phase reflected about
 /// both end points: x*_{−j} = 2x_0 − x_j and x*_{N−1+j} = 2x_{N−1} − x_{N−1−j}.
+/// Where both neighbours lie inside the data (m ≤ i ≤ N−1−m) the sum is the plain
+/// overlapping one; only the two ends need the reflection.
 fn total_sum(c: &[f64], m: usize) -> f64 {
     let n = c.len();
     let last = n - 1;
@@ -141,10 +169,28 @@ fn total_sum(c: &[f64], m: usize) -> f64 {
         }
     };
     let mi = m as isize;
-    sum_of_squares(n - 2, |j| {
-        let i = j as isize + 1;
+    let term = |i: usize| {
+        let i = i as isize;
         reflected(i - mi) - 2.0 * c[i as usize] + reflected(i + mi)
-    })
+    };
+    // i runs over 1..=N−2; the straight middle is max(1, m)..=min(N−2, N−1−m).
+    let lo = m.max(1);
+    let hi = (n - 2).min(last.saturating_sub(m));
+    if lo > hi {
+        return sum_of_squares(n - 2, |j| term(j + 1));
+    }
+    let middle_terms = hi - lo + 1;
+    let middle = sum_of_squared_combinations(
+        [
+            &c[lo - m..lo - m + middle_terms],
+            &c[lo..lo + middle_terms],
+            &c[lo + m..lo + m + middle_terms],
+        ],
+        [1.0, -2.0, 1.0],
+    );
+    let left = sum_of_squares(lo - 1, |j| term(j + 1));
+    let right = sum_of_squares(n - 2 - hi, |j| term(hi + 1 + j));
+    left + middle + right
 }
 
 #[cfg(test)]
@@ -153,7 +199,9 @@ mod tests {
     use crate::allan::phase::cumulative_phase;
 
     /// NIST SP 1065 NBS14 10-point frequency data.
-    const NBS14: [f64; 9] = [892.0, 809.0, 823.0, 798.0, 671.0, 644.0, 883.0, 903.0, 677.0];
+    const NBS14: [f64; 9] = [
+        892.0, 809.0, 823.0, 798.0, 671.0, 644.0, 883.0, 903.0, 677.0,
+    ];
 
     fn dev(stat: Statistic, m: usize) -> f64 {
         let c = cumulative_phase(NBS14.iter().copied()).unwrap();

@@ -46,7 +46,11 @@ fn analyse<'py>(
     let view = x.as_array();
     let ms: Vec<usize> = ms.as_array().iter().map(|&m| m as usize).collect();
     let result = py.detach(|| {
-        let columns: Vec<_> = view.columns().into_iter().map(|c| c.into_iter().copied()).collect();
+        let columns: Vec<_> = view
+            .columns()
+            .into_iter()
+            .map(|c| c.into_iter().copied())
+            .collect();
         let phases = allan::column_phases(columns)?;
         allan::analyse(&phases, statistic, &ms)
     })?;
@@ -65,7 +69,25 @@ fn analyse<'py>(
     Ok((var, terms.into_pyarray(py), alpha, identified, edf))
 }
 
+/// estimator_terms(statistic, n_phase, ms) -> terms per averaging factor (0: does not fit)
+#[pyfunction]
+fn estimator_terms<'py>(
+    py: Python<'py>,
+    statistic: &str,
+    n_phase: usize,
+    ms: PyReadonlyArray1<'py, u64>,
+) -> PyResult<Bound<'py, PyArray1<u64>>> {
+    let statistic = parse_statistic(statistic)?;
+    let terms: Vec<u64> = ms
+        .as_array()
+        .iter()
+        .map(|&m| statistic.terms(n_phase, m as usize) as u64)
+        .collect();
+    Ok(terms.into_pyarray(py))
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(analyse, m)?)?;
+    m.add_function(wrap_pyfunction!(estimator_terms, m)?)?;
     Ok(())
 }

@@ -1,0 +1,284 @@
+r"""The Allan-variance family with confidence intervals.
+
+All statistics take rate samples :math:`y_0 … y_{n-1}` (gyro rate, acceleration,
+fractional frequency, …) at a uniform sample rate ``fs`` and work on the
+cumulative sum of the mean-removed data, :math:`c_k = \sum_{i<k}(y_i - \bar y)`
+(n + 1 points; the phase is :math:`x = c/f_s`), in Rust, one streaming pass per
+tau, with compensated summation. With :math:`\tau = m/f_s` and N = n + 1:
+
+- overlapping Allan variance
+  :math:`\sigma^2_y(\tau) = \frac{1}{2m^2(N-2m)}\sum_{k=0}^{N-2m-1}(c_{k+2m}-2c_{k+m}+c_k)^2`
+  (non-overlapping: k in steps of m);
+- modified Allan variance, SP 1065 eq. 14; time variance
+  :math:`\sigma_x^2 = \tau^2\,\mathrm{Mod}\,\sigma_y^2/3`;
+- Hadamard variance (third differences, divisor 6), overlapping by default;
+- total variance, SP 1065 eq. 25 (phase reflected about both ends).
+
+Confidence intervals: the noise type α is identified at each tau by the lag-1
+autocorrelation method (Riley & Greenhall 2004) — where the decimated series is
+too short (< 30 points) α is taken from the nearest identified tau — then the
+equivalent degrees of freedom follow Greenhall's algorithm (TOTVAR: SP 1065
+Table 7), and the bounds are the χ² quantiles
+:math:`\sigma^2\,\nu/\chi^2_{\nu}(1-p/2) \le \sigma^2 \le \sigma^2\,\nu/\chi^2_{\nu}(p/2)`.
+
+References
+----------
+W. J. Riley, *Handbook of Frequency Stability Analysis*, NIST SP 1065 (2008).
+C. A. Greenhall and W. J. Riley, "Uncertainty of stability variances based on
+finite differences", Proc. 35th PTTI (2003).
+W. J. Riley and C. A. Greenhall, "Power law noise identification using the lag 1
+autocorrelation", Proc. 18th EFTF (2004).
+"""
+
+from __future__ import annotations
+
+import numbers
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import stats as _stats
+
+from imunoise import _core
+from imunoise.taus import averaging_factors, keep_estimable
+
+#: One-sigma confidence, erf(1/√2).
+ONE_SIGMA = 0.6826894921370859
+
+__all__ = ["AllanResult", "adev", "mdev", "hdev", "tdev", "totdev", "ONE_SIGMA"]
+
+
+@dataclass(frozen=True)
+class AllanResult:
+    """A deviation evaluated at a set of taus.
+
+    Arrays of per-tau values have shape ``(T,)`` for 1-D input and
+    ``(T, channels)`` for 2-D input ``(n, channels)``. All arrays are read-only.
+
+    Attributes
+    ----------
+    kind : str
+        ``"adev"``, ``"mdev"``, ``"hdev"``, ``"tdev"`` or ``"totdev"``.
+    overlapping : bool
+        Whether the estimator uses every start sample (stride 1) or stride m.
+    taus : ndarray, (T,)
+        Averaging times in seconds, ``m / fs``.
+    m : ndarray of int, (T,)
+        Averaging factors.
+    dev, var : ndarray
+        The deviation and its square, in the input's units (TDEV: units × s).
+    n : ndarray of int, (T,)
+        Number of terms in each estimate (Stable32's N).
+    edf : ndarray
+        Equivalent degrees of freedom.
+    ci_low, ci_high : ndarray
+        Bounds of the ``confidence`` interval on ``dev``.
+    alpha : ndarray of int
+        Power-law noise type used for the EDF: rate PSD ∝ f^α (2 white PM,
+        1 flicker PM, 0 white FM / white rate noise, −1 flicker FM, −2 random walk FM).
+    alpha_identified : ndarray of bool
+        False where α was borrowed from the nearest identified tau.
+    fs : float
+        Sample rate in Hz.
+    confidence : float
+        Two-sided confidence level of ``ci_low``/``ci_high``.
+    """
+
+    kind: str
+    overlapping: bool
+    taus: np.ndarray
+    m: np.ndarray
+    dev: np.ndarray
+    var: np.ndarray
+    n: np.ndarray
+    edf: np.ndarray
+    ci_low: np.ndarray
+    ci_high: np.ndarray
+    alpha: np.ndarray
+    alpha_identified: np.ndarray
+    fs: float
+    confidence: float
+
+    def __post_init__(self) -> None:
+        for name in (
+            "taus",
+            "m",
+            "dev",
+            "var",
+            "n",
+            "edf",
+            "ci_low",
+            "ci_high",
+            "alpha",
+            "alpha_identified",
+        ):
+            getattr(self, name).flags.writeable = False
+
+    @property
+    def channels(self) -> int:
+        """Number of channels (1 for 1-D input)."""
+        return 1 if self.dev.ndim == 1 else self.dev.shape[1]
+
+    def __len__(self) -> int:
+        return len(self.taus)
+
+
+def adev(x, fs, taus="octave", *, overlapping: bool = True, confidence: float = ONE_SIGMA):
+    """Allan deviation, overlapping by default.
+
+    Parameters
+    ----------
+    x : array_like, shape (n,) or (n, channels)
+        Rate samples (any real dtype, any memory order).
+    fs : float
+        Sample rate in Hz.
+    taus : {"octave", "decade", "all"}, int or array_like, optional
+        Tau grid; see :func:`imunoise.taus.averaging_factors`. Taus whose
+        estimator would have fewer than two terms are dropped.
+    overlapping : bool, optional
+        Overlapping estimator (stride 1, the default and the better one) or the
+        classic non-overlapping one (stride m).
+    confidence : float, optional
+        Two-sided confidence level of the interval, default one sigma (68.3 %).
+
+    Returns
+    -------
+    AllanResult
+
+    Examples
+    --------
+    >>> import numpy as np, imunoise
+    >>> y = np.random.default_rng(0).normal(size=100_000)
+    >>> r = imunoise.adev(y, fs=100.0)
+    >>> bool(abs(r.dev[0] - 1.0) < 0.01)
+    True
+    """
+    _check_bool("overlapping", overlapping)
+    return _deviation(
+        "adev", "oadev" if overlapping else "adev", x, fs, taus, confidence, overlapping
+    )
+
+
+def mdev(x, fs, taus="octave", *, confidence: float = ONE_SIGMA):
+    """Modified Allan deviation (SP 1065 eq. 14); see :func:`adev` for the parameters."""
+    return _deviation("mdev", "mdev", x, fs, taus, confidence, True)
+
+
+def tdev(x, fs, taus="octave", *, confidence: float = ONE_SIGMA):
+    """Time deviation, τ·MDEV/√3 (SP 1065 eq. 16), in input units × seconds;
+    see :func:`adev` for the parameters."""
+    return _deviation("tdev", "mdev", x, fs, taus, confidence, True)
+
+
+def hdev(x, fs, taus="octave", *, overlapping: bool = True, confidence: float = ONE_SIGMA):
+    """Hadamard deviation (SP 1065 eqs. 17–20), overlapping by default; insensitive
+    to a linear drift of the rate. See :func:`adev` for the parameters."""
+    _check_bool("overlapping", overlapping)
+    return _deviation(
+        "hdev", "ohdev" if overlapping else "hdev", x, fs, taus, confidence, overlapping
+    )
+
+
+def totdev(x, fs, taus="octave", *, confidence: float = ONE_SIGMA):
+    """Total deviation (SP 1065 eq. 25): the overlapping Allan deviation of the
+    phase extended by reflection at both ends, better confidence at long taus.
+    No bias correction is applied (it is small for white and flicker FM).
+    See :func:`adev` for the parameters."""
+    return _deviation("totdev", "totdev", x, fs, taus, confidence, True)
+
+
+def _deviation(kind, statistic, x, fs, taus, confidence, overlapping) -> AllanResult:
+    data, one_d = _as_samples(x)
+    fs = _check_fs(fs)
+    confidence = _check_confidence(confidence)
+    n = data.shape[0]
+    m, user_given = averaging_factors(taus, fs, n)
+    m = m.astype(np.uint64)
+    terms = _core.estimator_terms(statistic, n + 1, m)
+    m = keep_estimable(m.astype(np.int64), terms.astype(np.int64), fs, user_given, kind)
+    if m.size == 0:
+        raise ValueError(
+            f"x has {n} samples, too few for any tau of {kind} "
+            f"(the shortest tau needs at least {_minimum_samples(statistic)})"
+        )
+    var, terms, alpha, identified, edf = _core.analyse(data, statistic, m.astype(np.uint64))
+    tau = m / fs
+    if kind == "tdev":
+        var = var * (tau**2 / 3.0)[:, None]
+    dev = np.sqrt(var)
+    ci_low, ci_high = chi2_interval(dev, edf, confidence)
+    squeeze = (lambda a: a[:, 0]) if one_d else (lambda a: a)
+    return AllanResult(
+        kind=kind,
+        overlapping=overlapping,
+        taus=tau,
+        m=m,
+        dev=squeeze(dev),
+        var=squeeze(var),
+        n=terms.astype(np.int64),
+        edf=squeeze(edf),
+        ci_low=squeeze(ci_low),
+        ci_high=squeeze(ci_high),
+        alpha=squeeze(alpha).astype(np.int64),
+        alpha_identified=squeeze(identified),
+        fs=fs,
+        confidence=confidence,
+    )
+
+
+def chi2_interval(dev, edf, confidence):
+    """Two-sided χ² interval on a deviation with ``edf`` degrees of freedom
+    (SP 1065 eq. 45): σ·√(ν/χ²(1 − p/2, ν)) ≤ σ ≤ σ·√(ν/χ²(p/2, ν)), p = 1 − confidence."""
+    tail = (1.0 - confidence) / 2.0
+    with np.errstate(invalid="ignore", divide="ignore"):
+        low = dev * np.sqrt(edf / _stats.chi2.ppf(1.0 - tail, edf))
+        high = dev * np.sqrt(edf / _stats.chi2.ppf(tail, edf))
+    return low, high
+
+
+def _minimum_samples(statistic: str) -> int:
+    for n in range(1, 16):
+        if _core.estimator_terms(statistic, n + 1, np.array([1], dtype=np.uint64))[0] > 1:
+            return n
+    return 16
+
+
+def _as_samples(x) -> tuple[np.ndarray, bool]:
+    """float64 (n, channels) view or copy of x, and whether x was 1-D."""
+    arr = x if isinstance(x, np.ndarray) else np.asarray(x)
+    if arr.dtype.kind not in "iuf":
+        raise TypeError(f"x must be an array of real numbers; got dtype {arr.dtype}")
+    if arr.ndim not in (1, 2):
+        raise ValueError(
+            f"x must be 1-D (n,) or 2-D (n, channels); got {arr.ndim}-D shape {arr.shape}"
+        )
+    if arr.shape[0] == 0:
+        raise ValueError("x must not be empty; got 0 samples")
+    if arr.ndim == 2 and arr.shape[1] == 0:
+        raise ValueError(f"x must have at least one channel; got shape {arr.shape}")
+    data = arr.astype(np.float64, copy=False)
+    if data.ndim == 1:
+        return data[:, None], True
+    return data, False
+
+
+def _check_fs(fs) -> float:
+    if isinstance(fs, bool) or not isinstance(fs, numbers.Real):
+        raise TypeError(f"fs must be a real number of Hz; got {type(fs).__name__} {fs!r}")
+    fs = float(fs)
+    if not (np.isfinite(fs) and fs > 0):
+        raise ValueError(f"fs must be positive and finite (Hz); got {fs!r}")
+    return fs
+
+
+def _check_confidence(confidence) -> float:
+    if isinstance(confidence, bool) or not isinstance(confidence, numbers.Real):
+        raise TypeError(f"confidence must be a number in (0, 1); got {confidence!r}")
+    confidence = float(confidence)
+    if not 0.0 < confidence < 1.0:
+        raise ValueError(f"confidence must be in (0, 1); got {confidence!r}")
+    return confidence
+
+
+def _check_bool(name, value) -> None:
+    if not isinstance(value, (bool, np.bool_)):
+        raise TypeError(f"{name} must be True or False; got {value!r}")
