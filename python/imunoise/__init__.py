@@ -8,6 +8,8 @@ plots and reports. Start with ``imunoise.adev(x, fs)``.
 from imunoise._core import __version__
 from imunoise.allan import AllanResult, adev, hdev, mdev, tdev, totdev
 from imunoise.readers import ImuLog, ParseIssues
+from imunoise.readers.read import read
+from imunoise.readers.vn_write import write_vn_ascii, write_vn_binary
 
 __all__ = [
     "__version__",
@@ -19,4 +21,7 @@ __all__ = [
     "mdev",
     "tdev",
     "totdev",
+    "read",
+    "write_vn_ascii",
+    "write_vn_binary",
 ]

@@ -487,7 +487,7 @@ mod tests {
         let p = hex("FA 01 09 00 | 70 05 00 03 0A 00 00 00 | 48 0E 2C 42 08 4C 37 C1 10 38 8B C2 | D4 CB");
         let (_, names, v, t) = decode(&p);
         assert_eq!(names, ["common.time_startup", "common.yaw", "common.pitch", "common.roll"]);
-        assert_eq!(t, Some(43.000006));
+        assert!(close(t.unwrap(), 43.000006, 1e-9));
         assert!(close(v[1], 43.013947, 1e-6) && close(v[2], -11.456062, 1e-6));
         assert!(close(v[3], -69.609497, 1e-5));
     }

@@ -36,6 +36,8 @@ const PARALLEL_MIN: usize = 1 << 20;
 pub const CHUNK: usize = 8 << 20;
 /// Layouts remembered per reader (distinct binary configurations).
 const MAX_LAYOUTS: usize = 16;
+/// CRC failures remembered before their configuration is confirmed.
+const MAX_PENDING: usize = 64;
 
 enum Ascii {
     /// More input is needed to decide.
@@ -183,6 +185,9 @@ pub struct Parser {
     layouts: Vec<(Layout, String)>,
     /// Indices into `layouts` of configurations that framed a good packet.
     good_layouts: Vec<usize>,
+    /// CRC failures of configurations not (yet) seen in a good packet: counted as
+    /// `bad_checksum` once the configuration frames a good packet.
+    pending: Vec<(usize, Location)>,
     /// First damaged record in strict mode: kind, location, reason.
     pub fail: Option<(IssueKind, Location, String)>,
 }
@@ -198,6 +203,7 @@ impl Parser {
             skip_end: u64::MAX,
             layouts: Vec::new(),
             good_layouts: Vec::new(),
+            pending: Vec::new(),
             fail: None,
         }
     }
@@ -316,6 +322,7 @@ impl Parser {
                         }
                     }
                     self.layouts = kept;
+                    self.pending.clear();
                     self.good_layouts = (0..self.layouts.len()).collect();
                 }
                 let name = layout.table_name();
@@ -419,12 +426,26 @@ impl Parser {
                 let reason = "binary packet CRC mismatch";
                 // The record is counted; its bytes are re-scanned (resync one byte).
                 self.issue(buf, i, IssueKind::BadChecksum, reason);
+            } else if self.pending.len() < MAX_PENDING {
+                let loc = self.location(buf, i);
+                self.pending.push((k, loc));
             }
             self.skip(buf, i, 1);
             return Some(i + 1);
         }
         if !self.good_layouts.contains(&k) {
             self.good_layouts.push(k);
+            let kind = IssueKind::BadChecksum;
+            for (_, loc) in self.pending.iter().filter(|(p, _)| *p == k) {
+                if self.data.issues.wants_location(kind) {
+                    self.data.issues.first[kind as usize].push(*loc);
+                }
+                self.data.issues.counts[kind as usize] += 1;
+                if self.strict && self.fail.is_none() {
+                    self.fail = Some((kind, *loc, "binary packet CRC mismatch".to_string()));
+                }
+            }
+            self.pending.retain(|(p, _)| *p != k);
         }
         let (layout, name) = &self.layouts[k];
         let table = match self.data.tables.get_mut(name) {
@@ -589,4 +610,159 @@ pub fn parse_file(
         .map_err(|e| CoreError::Io(format!("cannot open {}: {e}", path.display())))?;
     let total = file.metadata().map(|m| m.len()).unwrap_or(0);
     parse_reader(file, total, strict, progress)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    const A1: &[u8] = b"$VNYMR,+100.949,-007.330,+000.715,-00.0049,-00.2449,+00.5397,-01.258,-00.100,-09.701,-00.000018,+00.001122,-00.000551*69\r\n";
+    const B1: [u8; 26] = [
+        0xFA, 0x01, 0x09, 0x00, 0x70, 0x05, 0x00, 0x03, 0x0A, 0x00, 0x00, 0x00, 0x48, 0x0E, 0x2C,
+        0x42, 0x08, 0x4C, 0x37, 0xC1, 0x10, 0x38, 0x8B, 0xC2, 0xD4, 0xCB,
+    ];
+
+    fn accounted(d: &VnData, n: usize) -> bool {
+        d.bytes_total == n as u64
+            && d.bytes_parsed + d.bytes_in_bad_records + d.bytes_skipped == n as u64
+            && d.issues.count(IssueKind::BytesSkipped) == d.bytes_skipped
+    }
+
+    #[test]
+    fn spec_sentences() {
+        let text = b"$VNYPR,+010.071,+000.278,-002.026*60\r\n\
+$VNYPR,+010.071,+000.278,-002.026,T1162704*2F\r\n\
+$VNYPR,+010.071,+000.278,-002.026,S0000*1F\n\
+$VNRRG,27,+006.380,+000.023,-001.953,+1.0640,-0.2531,+3.0614,+00.005,+00.344,-09.758,-0.001222,-0.000450,-0.001218*4F\r\n\
+$VNERR,03*72\r\n$VNWNV*57\r\n$VNRRG,15*92EA\r\n\
+$VNQMR,-0.017057,-0.000767,+0.056534,+0.998255,+1.0670,-0.2568,+3.0696,-00.019,+00.320,-09.802,-0.002801,-0.001186,-0.001582*65\r\n\
+$VNERR,12*72\r\n";
+        let d = parse_bytes(text, false).unwrap();
+        assert!(accounted(&d, text.len()));
+        let ypr = &d.tables["VNYPR"];
+        assert_eq!(ypr.len, 3);
+        assert_eq!(ypr.columns[0], vec![10.071; 3]);
+        let t = &ypr.extra.iter().find(|(n, _)| n == "serial_count").unwrap().1;
+        assert!(t[0].is_nan() && t[1] == 1162704.0 && t[2].is_nan());
+        assert_eq!(d.tables["VNYMR"].columns[0], vec![6.380]);
+        assert_eq!(d.issues.count(IssueKind::DeviceError), 1);
+        assert_eq!(d.issues.count(IssueKind::BadChecksum), 1);
+        assert_eq!(d.issues.count(IssueKind::MalformedField), 1);
+        assert_eq!(d.messages["VNWNV"], 1);
+        assert_eq!(d.messages["VNRRG"], 1);
+        assert_eq!(d.issues.first[IssueKind::BadChecksum as usize][0].line, 8);
+        let err = parse_bytes(text, true).unwrap_err();
+        assert!(err.to_string().starts_with("line 8 "), "{err}");
+    }
+
+    #[test]
+    fn interleaved_and_truncated() {
+        let mut s = Vec::new();
+        s.extend_from_slice(b"noise");
+        s.extend_from_slice(&B1);
+        s.extend_from_slice(A1);
+        s.extend_from_slice(&B1);
+        s.extend_from_slice(&A1[..50]);
+        s.extend_from_slice(&B1);
+        s.extend_from_slice(&B1[..20]);
+        let d = parse_bytes(&s, false).unwrap();
+        assert!(accounted(&d, s.len()));
+        assert_eq!(d.binary_records, 3);
+        assert_eq!(d.ascii_records, 1);
+        assert_eq!(d.issues.count(IssueKind::TruncatedRecord), 2);
+        assert_eq!(d.issues.count(IssueKind::BytesSkipped), 5);
+        // Corrupt the CRC of the second packet: counted, neighbours kept.
+        let mut bad = s.clone();
+        bad[5 + 26 + A1.len() + 25] ^= 1;
+        let d = parse_bytes(&bad, false).unwrap();
+        assert_eq!(d.binary_records, 2);
+        assert_eq!(d.issues.count(IssueKind::BadChecksum), 1);
+        assert!(accounted(&d, s.len()));
+    }
+
+    #[test]
+    fn chunked_reader_equals_whole() {
+        let mut s = Vec::new();
+        for k in 0..5000 {
+            if k % 7 == 0 {
+                s.extend_from_slice(&B1);
+            }
+            s.extend_from_slice(A1);
+        }
+        let whole = parse_bytes(&s, false).unwrap();
+        struct Slow<'a>(&'a [u8], usize);
+        impl std::io::Read for Slow<'_> {
+            fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+                let n = buf.len().min(self.1).min(self.0.len());
+                buf[..n].copy_from_slice(&self.0[..n]);
+                self.0 = &self.0[n..];
+                Ok(n)
+            }
+        }
+        let mut calls = 0;
+        let chunked =
+            parse_reader(Slow(&s, 977), s.len() as u64, false, &mut |_, _| {
+                calls += 1;
+                Ok(())
+            })
+            .unwrap();
+        assert_eq!(whole, chunked);
+        assert_eq!(whole.tables["VNYMR"].len, 5000);
+        assert!(calls >= 1);
+    }
+
+    #[test]
+    fn parallel_equals_sequential() {
+        let mut s = Vec::new();
+        for k in 0..40_000u32 {
+            if k % 1000 == 3 {
+                s.extend_from_slice(&A1[..60]);
+                s.push(b'\n');
+            }
+            s.extend_from_slice(A1);
+        }
+        let par = parse_bytes(&s, false).unwrap();
+        let mut p = Parser::new(false);
+        p.feed(&s, true);
+        let seq = p.finish().unwrap();
+        assert_eq!(par, seq);
+        assert_eq!(par.tables["VNYMR"].len, 40_000);
+        assert_eq!(par.issues.count(IssueKind::TruncatedRecord), 40);
+        let err = parse_bytes(&s, true).unwrap_err().to_string();
+        assert!(err.starts_with("line 4 "), "{err}");
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 300, ..ProptestConfig::default() })]
+
+        #[test]
+        fn random_bytes_are_accounted(data in proptest::collection::vec(any::<u8>(), 0..3000)) {
+            let d = parse_bytes(&data, false).unwrap();
+            prop_assert!(accounted(&d, data.len()));
+        }
+
+        #[test]
+        fn mutated_streams_are_accounted(
+            edits in proptest::collection::vec((any::<u16>(), any::<u8>(), 0u8..3), 0..20)
+        ) {
+            let mut s = Vec::new();
+            for _ in 0..10 {
+                s.extend_from_slice(A1);
+                s.extend_from_slice(&B1);
+            }
+            for (pos, byte, op) in edits {
+                let i = pos as usize % (s.len() + 1);
+                match op {
+                    0 => s.insert(i, byte),
+                    1 if i < s.len() => { s.remove(i); }
+                    _ if i < s.len() => s[i] = byte,
+                    _ => {}
+                }
+            }
+            let d = parse_bytes(&s, false).unwrap();
+            prop_assert!(accounted(&d, s.len()));
+            let _ = parse_bytes(&s, true);
+        }
+    }
 }

@@ -16,19 +16,20 @@ pub enum AsciiCheck {
     Crc16,
 }
 
-/// Default decimals for a field, as a VN-100 prints it (spec §2.6 examples).
-pub fn default_decimals(field: &str) -> usize {
+/// Default (integer digits, decimals) of a field, as a VN-100 prints it (spec
+/// §7.1 examples: `+100.949`, `-00.0049`, `-01.258`, `-00.000018`, `+0.021375`).
+pub fn default_format(field: &str) -> (usize, usize) {
     match field {
-        "yaw" | "pitch" | "roll" => 3,
-        "qx" | "qy" | "qz" | "qw" => 6,
-        "temperature" => 1,
-        "pressure" => 3,
-        "delta_time" => 6,
-        _ if field.starts_with("mag") => 4,
-        _ if field.starts_with("accel") || field.starts_with("lin_accel") => 3,
-        _ if field.starts_with("inertial_accel") => 3,
-        _ if field.starts_with("delta_theta") || field.starts_with("delta_vel") => 3,
-        _ => 6,
+        "yaw" | "pitch" | "roll" => (3, 3),
+        "qx" | "qy" | "qz" | "qw" => (1, 6),
+        "temperature" => (2, 1),
+        "pressure" => (3, 3),
+        "delta_time" => (1, 6),
+        _ if field.starts_with("mag") => (2, 4),
+        _ if field.starts_with("accel") || field.starts_with("lin_accel") => (2, 3),
+        _ if field.starts_with("inertial_accel") => (2, 3),
+        _ if field.starts_with("delta_theta") || field.starts_with("delta_vel") => (3, 3),
+        _ => (2, 6),
     }
 }
 
@@ -76,6 +77,7 @@ pub fn write_ascii(
     if let Some(s) = status {
         check_len("status", s.len(), n)?;
     }
+    let defaults: Vec<(usize, usize)> = spec.fields.iter().map(|f| default_format(f)).collect();
     let dec: Vec<usize> = match decimals {
         Some(d) if d.len() == nf => d.iter().map(|&x| x.min(15)).collect(),
         Some(d) => {
@@ -84,7 +86,7 @@ pub fn write_ascii(
                 d.len()
             )))
         }
-        None => spec.fields.iter().map(|f| default_decimals(f)).collect(),
+        None => defaults.iter().map(|&(_, d)| d).collect(),
     };
     let mut out = Vec::with_capacity(n * (8 + 11 * nf));
     let mut line: Vec<u8> = Vec::with_capacity(256);
@@ -101,7 +103,7 @@ pub fn write_ascii(
             }
             let p = dec[k];
             // Zero-padded with an explicit sign, like the sensor: +000.715.
-            let width = p + if p > 0 { 1 } else { 0 } + 4;
+            let width = defaults[k].0 + p + if p > 0 { 2 } else { 1 };
             let _ = write!(line, ",{v:+0width$.p$}");
         }
         if let Some(s) = status {
@@ -209,7 +211,7 @@ pub fn write_binary(layout: &Layout, columns: &[&[f64]]) -> CoreResult<Vec<u8>> 
         out.push(0xFA);
         out.extend_from_slice(&layout.header);
         let mut col = 0usize;
-        let mut next = |col: &mut usize| -> f64 {
+        let next = |col: &mut usize| -> f64 {
             let v = columns[*col][r];
             *col += 1;
             v

@@ -33,6 +33,9 @@ for _ch, _names in {
 _FROM_CHANNEL["temperature"] = ("temperature", None)
 _FROM_CHANNEL["pressure"] = ("pressure", None)
 
+#: Common-group fields written when no selection is given.
+DEFAULT_BINARY_FIELDS = ("TimeStartup", "YawPitchRoll", "AngularRate", "Accel", "MagPres")
+
 #: Binary fields that default to zero when not given (status words, counters).
 _ZERO_DEFAULT = ("vpe_status", "imu_status", "sens_sat", "syncin_count", "syncout_count")
 
@@ -152,9 +155,7 @@ def binary_columns(fields) -> list[str]:
 
 def write_vn_binary(
     data: ImuLog | Mapping[str, np.ndarray],
-    fields: Mapping[str, Sequence[str]] | Sequence[tuple[int, int]] = (
-        ("common", ("TimeStartup", "YawPitchRoll", "AngularRate", "Accel", "MagPres"))
-    ),
+    fields: Mapping[str, Sequence[str]] | Sequence[tuple[int, int]] | None = None,
     *,
     path: str | os.PathLike | None = None,
 ) -> bytes:
@@ -168,6 +169,7 @@ def write_vn_binary(
         counters default to 0; any other field must be given.
     fields : mapping or sequence
         Selection as ``{"common": ["TimeStartup", "AngularRate"], "imu": [...]}``
+        (default: Common TimeStartup, YawPitchRoll, AngularRate, Accel, MagPres)
         (field names of the spec's §5.3 tables) or ``[(group index, field mask)]``.
     path : path, optional
         Also write the bytes to this file.
@@ -176,8 +178,8 @@ def write_vn_binary(
     -------
     bytes
     """
-    if isinstance(fields, tuple) and len(fields) == 2 and isinstance(fields[0], str):
-        fields = {fields[0]: fields[1]}
+    if fields is None:
+        fields = {"common": DEFAULT_BINARY_FIELDS}
     selection = _selection(fields)
     names, _ = _core.vn_binary_columns(selection)
     n = _length(data)
