@@ -5,7 +5,7 @@ from __future__ import annotations
 import re
 from functools import reduce
 
-SENTENCE = re.compile(rb"\$(VN[A-Z]{3}[ -)+-~]*?)\*([0-9A-F]{2})(?=\r?\n|$)")
+SENTENCE = re.compile(rb"\$(VN[A-Z]{3}[ -)+-~]*?)\*([0-9A-F]{2})(?![0-9A-Fa-f])")
 
 
 def xor8(body: bytes) -> int:

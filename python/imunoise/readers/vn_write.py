@@ -33,8 +33,28 @@ for _ch, _names in {
 _FROM_CHANNEL["temperature"] = ("temperature", None)
 _FROM_CHANNEL["pressure"] = ("pressure", None)
 
-#: Common-group fields written when no selection is given.
-DEFAULT_BINARY_FIELDS = ("TimeStartup", "YawPitchRoll", "AngularRate", "Accel", "MagPres")
+#: Common-group field -> channels it needs; the default selection takes every field
+#: whose channels the data has (plus TimeStartup).
+_COMMON_DEFAULT = (
+    ("YawPitchRoll", ("ypr",)),
+    ("Quaternion", ("quaternion",)),
+    ("AngularRate", ("gyro",)),
+    ("Accel", ("accel",)),
+    ("MagPres", ("mag", "temperature", "pressure")),
+)
+
+
+def _default_fields(data) -> dict[str, list[str]]:
+    def has(ch: str) -> bool:
+        if isinstance(data, Mapping):
+            return ch in data
+        return getattr(data, ch, None) is not None
+
+    fields = ["TimeStartup"] + [f for f, chans in _COMMON_DEFAULT if all(map(has, chans))]
+    out = {"common": fields}
+    if has("mag") and not has("pressure"):
+        out["imu"] = ["Mag"]
+    return out
 
 #: Binary fields that default to zero when not given (status words, counters).
 _ZERO_DEFAULT = ("vpe_status", "imu_status", "sens_sat", "syncin_count", "syncout_count")
@@ -169,7 +189,8 @@ def write_vn_binary(
         counters default to 0; any other field must be given.
     fields : mapping or sequence
         Selection as ``{"common": ["TimeStartup", "AngularRate"], "imu": [...]}``
-        (default: Common TimeStartup, YawPitchRoll, AngularRate, Accel, MagPres)
+        (default: Common TimeStartup plus YawPitchRoll, Quaternion, AngularRate,
+        Accel, MagPres for the channels present; IMU Mag if mag has no pressure)
         (field names of the spec's §5.3 tables) or ``[(group index, field mask)]``.
     path : path, optional
         Also write the bytes to this file.
@@ -179,7 +200,7 @@ def write_vn_binary(
     bytes
     """
     if fields is None:
-        fields = {"common": DEFAULT_BINARY_FIELDS}
+        fields = _default_fields(data)
     selection = _selection(fields)
     names, _ = _core.vn_binary_columns(selection)
     n = _length(data)
