@@ -5,6 +5,7 @@ from __future__ import annotations
 import re
 from functools import reduce
 
+NUMBER = re.compile(rb"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?")
 SENTENCE = re.compile(rb"\$(VN[A-Z]{3}[ -)+-~]*?)\*([0-9A-F]{2})(?![0-9A-Fa-f])")
 
 
@@ -18,5 +19,7 @@ def good_sentences(data: bytes, header: bytes = b"VNYMR") -> list[list[float]]:
     for m in SENTENCE.finditer(data):
         body, check = m.group(1), int(m.group(2), 16)
         if xor8(body) == check and body.startswith(header + b","):
-            rows.append([float(v) for v in body.split(b",")[1:]])
+            fields = body.split(b",")[1:]
+            if all(NUMBER.fullmatch(v) for v in fields):
+                rows.append([float(v) for v in fields])
     return rows

@@ -70,8 +70,13 @@ fn scan_ascii(buf: &[u8], i: usize, fin: bool) -> Ascii {
         }
         if c == b'$' || !(0x20..=0x7E).contains(&c) {
             return if is_vn {
+                // A line end that cuts the sentence belongs to it.
+                let end = if c == b'\r' || c == b'\n' { eat_eol(buf, j) } else { j };
+                if !fin && end == n {
+                    return Ascii::Need;
+                }
                 Ascii::Record {
-                    end: j,
+                    end,
                     outcome: Outcome::Issue(
                         IssueKind::TruncatedRecord,
                         format!("sentence cut short by byte 0x{c:02X} before its checksum"),

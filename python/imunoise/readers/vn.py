@@ -24,6 +24,7 @@ packet carries it; ASCII sentences carry no timestamps.
 
 from __future__ import annotations
 
+import errno
 import os
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
@@ -94,7 +95,10 @@ def _source_arg(source) -> bytes | str:
     if isinstance(source, (bytes, bytearray, memoryview)):
         return bytes(source)
     if isinstance(source, (str, os.PathLike)):
-        return os.fspath(source)
+        path = os.fspath(source)
+        if not os.path.exists(path):
+            raise FileNotFoundError(errno.ENOENT, "no such file", path)
+        return path
     raise TypeError(f"source must be a path or bytes; got {type(source).__name__}")
 
 
