@@ -1,3 +1,4 @@
+# ruff: noqa: E501  (protocol test vectors are quoted verbatim)
 """The VN-100 protocol spec's test vectors (vn100-protocol.md §7)."""
 
 import imunoise

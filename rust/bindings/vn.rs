@@ -37,8 +37,10 @@ fn to_dict<'py>(py: Python<'py>, data: VnData) -> PyResult<Bound<'py, PyDict>> {
     let first = PyDict::new(py);
     for kind in IssueKind::ALL {
         counts.set_item(kind.name(), data.issues.counts[kind as usize])?;
-        let locs: Vec<(u64, u64)> =
-            data.issues.first[kind as usize].iter().map(|l| (l.offset, l.line)).collect();
+        let locs: Vec<(u64, u64)> = data.issues.first[kind as usize]
+            .iter()
+            .map(|l| (l.offset, l.line))
+            .collect();
         first.set_item(kind.name(), locs)?;
     }
     out.set_item("issues", counts)?;
@@ -73,7 +75,11 @@ fn parse_vn<'py>(
         let path: PathBuf = source.extract().map_err(|_| {
             PyValueError::new_err(format!(
                 "source must be bytes or a path; got {}",
-                source.get_type().name().map(|n| n.to_string()).unwrap_or_default()
+                source
+                    .get_type()
+                    .name()
+                    .map(|n| n.to_string())
+                    .unwrap_or_default()
             ))
         })?;
         let mut cb_err: Option<PyErr> = None;
@@ -124,12 +130,27 @@ fn write_vn_ascii<'py>(
     crc: bool,
     eol: Vec<u8>,
 ) -> PyResult<Bound<'py, PyBytes>> {
-    let cols: Vec<&[f64]> = columns.iter().map(|c| c.as_slice()).collect::<Result<_, _>>()?;
+    let cols: Vec<&[f64]> = columns
+        .iter()
+        .map(|c| c.as_slice())
+        .collect::<Result<_, _>>()?;
     let count = count.as_ref().map(|c| c.as_slice()).transpose()?;
     let status = status.as_ref().map(|c| c.as_slice()).transpose()?;
-    let check = if crc { AsciiCheck::Crc16 } else { AsciiCheck::Xor8 };
+    let check = if crc {
+        AsciiCheck::Crc16
+    } else {
+        AsciiCheck::Xor8
+    };
     let out = py.detach(|| {
-        write::write_ascii(message, &cols, decimals.as_deref(), count, status, check, &eol)
+        write::write_ascii(
+            message,
+            &cols,
+            decimals.as_deref(),
+            count,
+            status,
+            check,
+            &eol,
+        )
     })?;
     Ok(PyBytes::new(py, &out))
 }
@@ -161,7 +182,10 @@ fn write_vn_binary<'py>(
         })?;
         arrays.push(item.extract()?);
     }
-    let cols: Vec<&[f64]> = arrays.iter().map(|c| c.as_slice()).collect::<Result<_, _>>()?;
+    let cols: Vec<&[f64]> = arrays
+        .iter()
+        .map(|c| c.as_slice())
+        .collect::<Result<_, _>>()?;
     let out = py.detach(|| write::write_binary(&layout, &cols))?;
     Ok(PyBytes::new(py, &out))
 }

@@ -49,22 +49,29 @@ const MAR: [&str; 9] = cat(MA, GYR);
 const YMR: [&str; 12] = cat(YPR, MAR);
 const QMR: [&str; 13] = cat(QUAT, MAR);
 const YBA: [&str; 9] = cat(cat::<3, 3, 6>(YPR, xyz!("lin_accel")), GYR);
-const YIA: [&str; 9] =
-    cat(cat::<3, 3, 6>(YPR, ["lin_accel_n", "lin_accel_e", "lin_accel_d"]), GYR);
+const YIA: [&str; 9] = cat(
+    cat::<3, 3, 6>(YPR, ["lin_accel_n", "lin_accel_e", "lin_accel_d"]),
+    GYR,
+);
 const IMU: [&str; 11] = cat(MAR, ["temperature", "pressure"]);
-const DTV: [&str; 7] =
-    cat(cat::<1, 3, 4>(["delta_time"], xyz!("delta_theta")), xyz!("delta_vel"));
+const DTV: [&str; 7] = cat(
+    cat::<1, 3, 4>(["delta_time"], xyz!("delta_theta")),
+    xyz!("delta_vel"),
+);
 const HVE: [&str; 3] = ["heave", "heave_rate", "delayed_heave"];
 const QTM: [&str; 7] = cat(QUAT, MAG);
 const QTA: [&str; 7] = cat(QUAT, ACC);
 const QTR: [&str; 7] = cat(QUAT, GYR);
 const QMA: [&str; 10] = cat(QUAT, MA);
 const QAR: [&str; 10] = cat(QUAT, cat::<3, 3, 6>(ACC, GYR));
-const DCM: [&str; 9] =
-    ["dcm_0", "dcm_1", "dcm_2", "dcm_3", "dcm_4", "dcm_5", "dcm_6", "dcm_7", "dcm_8"];
+const DCM: [&str; 9] = [
+    "dcm_0", "dcm_1", "dcm_2", "dcm_3", "dcm_4", "dcm_5", "dcm_6", "dcm_7", "dcm_8",
+];
 const YCM: [&str; 13] = cat(YMR, ["temperature"]);
-const ICM: [&str; 12] =
-    cat(cat::<3, 3, 6>(YPR, MAG), cat::<3, 3, 6>(xyz!("inertial_accel"), GYR));
+const ICM: [&str; 12] = cat(
+    cat::<3, 3, 6>(YPR, MAG),
+    cat::<3, 3, 6>(xyz!("inertial_accel"), GYR),
+);
 const RAW: [&str; 10] = cat(
     cat::<3, 3, 6>(xyz!("mag_volt"), xyz!("accel_volt")),
     cat::<3, 1, 4>(xyz!("gyro_volt"), ["temperature_volt"]),
@@ -75,38 +82,163 @@ const COV: [&str; 6] = cat(xyz!("att_var"), xyz!("gyro_bias_var"));
 
 /// Every decoded message type: spec tables 3.1 (current firmware) and 3.2 (legacy).
 pub static MESSAGES: &[MsgSpec] = &[
-    MsgSpec { id: "VNYPR", register: 8, ador: 1, fields: &YPR },
-    MsgSpec { id: "VNQTN", register: 9, ador: 2, fields: &QUAT },
-    MsgSpec { id: "VNQMR", register: 15, ador: 8, fields: &QMR },
-    MsgSpec { id: "VNMAG", register: 17, ador: 10, fields: &MAG },
-    MsgSpec { id: "VNACC", register: 18, ador: 11, fields: &ACC },
-    MsgSpec { id: "VNGYR", register: 19, ador: 12, fields: &GYR },
-    MsgSpec { id: "VNMAR", register: 20, ador: 13, fields: &MAR },
-    MsgSpec { id: "VNYMR", register: 27, ador: 14, fields: &YMR },
-    MsgSpec { id: "VNYBA", register: 239, ador: 16, fields: &YBA },
-    MsgSpec { id: "VNYIA", register: 240, ador: 17, fields: &YIA },
-    MsgSpec { id: "VNIMU", register: 54, ador: 19, fields: &IMU },
-    MsgSpec { id: "VNDTV", register: 80, ador: 30, fields: &DTV },
-    MsgSpec { id: "VNHVE", register: 115, ador: 34, fields: &HVE },
+    MsgSpec {
+        id: "VNYPR",
+        register: 8,
+        ador: 1,
+        fields: &YPR,
+    },
+    MsgSpec {
+        id: "VNQTN",
+        register: 9,
+        ador: 2,
+        fields: &QUAT,
+    },
+    MsgSpec {
+        id: "VNQMR",
+        register: 15,
+        ador: 8,
+        fields: &QMR,
+    },
+    MsgSpec {
+        id: "VNMAG",
+        register: 17,
+        ador: 10,
+        fields: &MAG,
+    },
+    MsgSpec {
+        id: "VNACC",
+        register: 18,
+        ador: 11,
+        fields: &ACC,
+    },
+    MsgSpec {
+        id: "VNGYR",
+        register: 19,
+        ador: 12,
+        fields: &GYR,
+    },
+    MsgSpec {
+        id: "VNMAR",
+        register: 20,
+        ador: 13,
+        fields: &MAR,
+    },
+    MsgSpec {
+        id: "VNYMR",
+        register: 27,
+        ador: 14,
+        fields: &YMR,
+    },
+    MsgSpec {
+        id: "VNYBA",
+        register: 239,
+        ador: 16,
+        fields: &YBA,
+    },
+    MsgSpec {
+        id: "VNYIA",
+        register: 240,
+        ador: 17,
+        fields: &YIA,
+    },
+    MsgSpec {
+        id: "VNIMU",
+        register: 54,
+        ador: 19,
+        fields: &IMU,
+    },
+    MsgSpec {
+        id: "VNDTV",
+        register: 80,
+        ador: 30,
+        fields: &DTV,
+    },
+    MsgSpec {
+        id: "VNHVE",
+        register: 115,
+        ador: 34,
+        fields: &HVE,
+    },
     // Legacy / internal types (spec §3.2).
-    MsgSpec { id: "VNQTM", register: 0, ador: 3, fields: &QTM },
-    MsgSpec { id: "VNQTA", register: 0, ador: 4, fields: &QTA },
-    MsgSpec { id: "VNQTR", register: 0, ador: 5, fields: &QTR },
-    MsgSpec { id: "VNQMA", register: 0, ador: 6, fields: &QMA },
-    MsgSpec { id: "VNQAR", register: 0, ador: 7, fields: &QAR },
-    MsgSpec { id: "VNDCM", register: 0, ador: 9, fields: &DCM },
-    MsgSpec { id: "VNYCM", register: 0, ador: 15, fields: &YCM },
-    MsgSpec { id: "VNICM", register: 0, ador: 18, fields: &ICM },
-    MsgSpec { id: "VNRAW", register: 0, ador: 252, fields: &RAW },
-    MsgSpec { id: "VNCMV", register: 0, ador: 253, fields: &CMV },
-    MsgSpec { id: "VNSTV", register: 0, ador: 254, fields: &STV },
-    MsgSpec { id: "VNCOV", register: 0, ador: 255, fields: &COV },
+    MsgSpec {
+        id: "VNQTM",
+        register: 0,
+        ador: 3,
+        fields: &QTM,
+    },
+    MsgSpec {
+        id: "VNQTA",
+        register: 0,
+        ador: 4,
+        fields: &QTA,
+    },
+    MsgSpec {
+        id: "VNQTR",
+        register: 0,
+        ador: 5,
+        fields: &QTR,
+    },
+    MsgSpec {
+        id: "VNQMA",
+        register: 0,
+        ador: 6,
+        fields: &QMA,
+    },
+    MsgSpec {
+        id: "VNQAR",
+        register: 0,
+        ador: 7,
+        fields: &QAR,
+    },
+    MsgSpec {
+        id: "VNDCM",
+        register: 0,
+        ador: 9,
+        fields: &DCM,
+    },
+    MsgSpec {
+        id: "VNYCM",
+        register: 0,
+        ador: 15,
+        fields: &YCM,
+    },
+    MsgSpec {
+        id: "VNICM",
+        register: 0,
+        ador: 18,
+        fields: &ICM,
+    },
+    MsgSpec {
+        id: "VNRAW",
+        register: 0,
+        ador: 252,
+        fields: &RAW,
+    },
+    MsgSpec {
+        id: "VNCMV",
+        register: 0,
+        ador: 253,
+        fields: &CMV,
+    },
+    MsgSpec {
+        id: "VNSTV",
+        register: 0,
+        ador: 254,
+        fields: &STV,
+    },
+    MsgSpec {
+        id: "VNCOV",
+        register: 0,
+        ador: 255,
+        fields: &COV,
+    },
 ];
 
 /// Commands and their responses: well-formed, decoded as "seen" without a table.
 const COMMANDS: &[&[u8]] = &[
-    b"RRG", b"WRG", b"WNV", b"RFS", b"RST", b"TAR", b"KMD", b"KAD", b"SGB", b"ASY", b"BOM",
-    b"FWU", b"CMD",
+    b"RRG", b"WRG", b"WNV", b"RFS", b"RST", b"TAR", b"KMD", b"KAD", b"SGB", b"ASY", b"BOM", b"FWU",
+    b"CMD",
 ];
 
 /// `$VNERR` codes defined by the manual (spec §4).
@@ -119,7 +251,9 @@ pub fn spec_by_id(id: &[u8]) -> Option<&'static MsgSpec> {
 }
 
 fn spec_by_register(reg: u16) -> Option<&'static MsgSpec> {
-    MESSAGES.iter().find(|m| m.register == reg && m.register != 0)
+    MESSAGES
+        .iter()
+        .find(|m| m.register == reg && m.register != 0)
 }
 
 /// Most fields any message has (13) plus slack.
@@ -195,7 +329,9 @@ pub fn parse_f64(s: &[u8]) -> Option<f64> {
         return Some(if neg { -v } else { v });
     }
     let text = std::str::from_utf8(s).ok()?;
-    let first_ok = text.bytes().all(|c| c.is_ascii_digit() || b"+-.eE".contains(&c));
+    let first_ok = text
+        .bytes()
+        .all(|c| c.is_ascii_digit() || b"+-.eE".contains(&c));
     if !first_ok {
         return None;
     }
@@ -330,7 +466,12 @@ pub fn decode(body: &[u8]) -> Decoded {
     if k < n {
         return Decoded::Malformed(format!("{} has {} fields; expected {}", spec.id, k, n));
     }
-    Decoded::Data { spec, values, count, status }
+    Decoded::Data {
+        spec,
+        values,
+        count,
+        status,
+    }
 }
 
 #[cfg(test)]
@@ -339,9 +480,12 @@ mod tests {
 
     fn data(body: &str) -> (&'static str, Vec<f64>, Option<f64>, Option<f64>) {
         match decode(body.as_bytes()) {
-            Decoded::Data { spec, values, count, status } => {
-                (spec.id, values[..spec.fields.len()].to_vec(), count, status)
-            }
+            Decoded::Data {
+                spec,
+                values,
+                count,
+                status,
+            } => (spec.id, values[..spec.fields.len()].to_vec(), count, status),
             other => panic!("{body}: {other:?}"),
         }
     }
@@ -375,7 +519,11 @@ mod tests {
             ("VNCOV", 6),
         ];
         for (id, n) in expect {
-            assert_eq!(spec_by_id(id.as_bytes()).map(|s| s.fields.len()), Some(n), "{id}");
+            assert_eq!(
+                spec_by_id(id.as_bytes()).map(|s| s.fields.len()),
+                Some(n),
+                "{id}"
+            );
         }
     }
 
@@ -407,12 +555,23 @@ mod tests {
         assert!(matches!(decode(b"VNYPR,+1,+2"), Decoded::Malformed(_)));
         assert!(matches!(decode(b"VNYPR,+1,+2,3,4"), Decoded::Malformed(_)));
         assert!(matches!(decode(b"VNYPR,+1,+2,x"), Decoded::Malformed(_)));
-        assert!(matches!(decode(b"VNMAR,1,2,3,4,5,6,-0.0.000840,1,2"), Decoded::Malformed(_)));
+        assert!(matches!(
+            decode(b"VNMAR,1,2,3,4,5,6,-0.0.000840,1,2"),
+            Decoded::Malformed(_)
+        ));
     }
 
     #[test]
     fn floats_match_std() {
-        for s in ["+100.949", "-00.000018", "0", "-0.0", "+084.322", "1e3", "12345678901234567.5"] {
+        for s in [
+            "+100.949",
+            "-00.000018",
+            "0",
+            "-0.0",
+            "+084.322",
+            "1e3",
+            "12345678901234567.5",
+        ] {
             let want: f64 = s.parse().unwrap();
             assert_eq!(parse_f64(s.as_bytes()), Some(want), "{s}");
         }

@@ -50,11 +50,21 @@ const fn f(
     kind: Kind,
     columns: &'static [&'static str],
 ) -> Option<FieldSpec> {
-    Some(FieldSpec { name, size, kind, columns })
+    Some(FieldSpec {
+        name,
+        size,
+        kind,
+        columns,
+    })
 }
 
 const fn opaque(size: usize) -> Option<FieldSpec> {
-    Some(FieldSpec { name: "reserved", size, kind: Kind::Opaque, columns: &[] })
+    Some(FieldSpec {
+        name: "reserved",
+        size,
+        kind: Kind::Opaque,
+        columns: &[],
+    })
 }
 
 use Kind::*;
@@ -86,7 +96,12 @@ pub static COMMON: [Option<FieldSpec>; 15] = [
             "uncomp_gyro_z",
         ],
     ),
-    f("MagPres", 20, F32(5), &["mag_x", "mag_y", "mag_z", "temperature", "pressure"]),
+    f(
+        "MagPres",
+        20,
+        F32(5),
+        &["mag_x", "mag_y", "mag_z", "temperature", "pressure"],
+    ),
     f(
         "DeltaThetaVel",
         28,
@@ -118,7 +133,15 @@ pub static TIME: [Option<FieldSpec>; 10] = [
         "TimeUtc",
         8,
         TimeUtc,
-        &["utc_year", "utc_month", "utc_day", "utc_hour", "utc_minute", "utc_second", "utc_ms"],
+        &[
+            "utc_year",
+            "utc_month",
+            "utc_day",
+            "utc_hour",
+            "utc_minute",
+            "utc_second",
+            "utc_ms",
+        ],
     ),
     f("SyncInCnt", 4, U32, &["syncin_count"]),
     f("SyncOutCnt", 4, U32, &["syncout_count"]),
@@ -128,18 +151,43 @@ pub static TIME: [Option<FieldSpec>; 10] = [
 /// IMU group (group bit 2).
 pub static IMU: [Option<FieldSpec>; 13] = [
     f("ImuStatus", 2, U16, &["imu_status"]),
-    f("UncompMag", 12, F32(3), &["uncomp_mag_x", "uncomp_mag_y", "uncomp_mag_z"]),
-    f("UncompAccel", 12, F32(3), &["uncomp_accel_x", "uncomp_accel_y", "uncomp_accel_z"]),
-    f("UncompGyro", 12, F32(3), &["uncomp_gyro_x", "uncomp_gyro_y", "uncomp_gyro_z"]),
+    f(
+        "UncompMag",
+        12,
+        F32(3),
+        &["uncomp_mag_x", "uncomp_mag_y", "uncomp_mag_z"],
+    ),
+    f(
+        "UncompAccel",
+        12,
+        F32(3),
+        &["uncomp_accel_x", "uncomp_accel_y", "uncomp_accel_z"],
+    ),
+    f(
+        "UncompGyro",
+        12,
+        F32(3),
+        &["uncomp_gyro_x", "uncomp_gyro_y", "uncomp_gyro_z"],
+    ),
     f("Temp", 4, F32(1), &["temperature"]),
     f("Pres", 4, F32(1), &["pressure"]),
     f(
         "DeltaTheta",
         16,
         F32(4),
-        &["delta_time", "delta_theta_x", "delta_theta_y", "delta_theta_z"],
+        &[
+            "delta_time",
+            "delta_theta_x",
+            "delta_theta_y",
+            "delta_theta_z",
+        ],
     ),
-    f("DeltaVel", 12, F32(3), &["delta_vel_x", "delta_vel_y", "delta_vel_z"]),
+    f(
+        "DeltaVel",
+        12,
+        F32(3),
+        &["delta_vel_x", "delta_vel_y", "delta_vel_z"],
+    ),
     f("Mag", 12, F32(3), &["mag_x", "mag_y", "mag_z"]),
     f("Accel", 12, F32(3), &["accel_x", "accel_y", "accel_z"]),
     f("AngularRate", 12, F32(3), &["gyro_x", "gyro_y", "gyro_z"]),
@@ -156,17 +204,34 @@ pub static ATTITUDE: [Option<FieldSpec>; 14] = [
         "DCM",
         36,
         F32(9),
-        &["dcm_0", "dcm_1", "dcm_2", "dcm_3", "dcm_4", "dcm_5", "dcm_6", "dcm_7", "dcm_8"],
+        &[
+            "dcm_0", "dcm_1", "dcm_2", "dcm_3", "dcm_4", "dcm_5", "dcm_6", "dcm_7", "dcm_8",
+        ],
     ),
     f("MagNed", 12, F32(3), &["mag_n", "mag_e", "mag_d"]),
     f("AccelNed", 12, F32(3), &["accel_n", "accel_e", "accel_d"]),
-    f("LinearAccelBody", 12, F32(3), &["lin_accel_x", "lin_accel_y", "lin_accel_z"]),
-    f("LinearAccelNed", 12, F32(3), &["lin_accel_n", "lin_accel_e", "lin_accel_d"]),
+    f(
+        "LinearAccelBody",
+        12,
+        F32(3),
+        &["lin_accel_x", "lin_accel_y", "lin_accel_z"],
+    ),
+    f(
+        "LinearAccelNed",
+        12,
+        F32(3),
+        &["lin_accel_n", "lin_accel_e", "lin_accel_d"],
+    ),
     f("YprU", 12, F32(3), &["yaw_u", "pitch_u", "roll_u"]),
     opaque(12),
     opaque(28),
     opaque(24),
-    f("Heave", 12, F32(3), &["heave", "heave_rate", "delayed_heave"]),
+    f(
+        "Heave",
+        12,
+        F32(3),
+        &["heave", "heave_rate", "delayed_heave"],
+    ),
     f("AttU", 4, F32(1), &["att_u"]),
 ];
 
@@ -187,9 +252,19 @@ static GNSS: [Option<FieldSpec>; 19] = [
     opaque(4),
     opaque(2),
     opaque(28),
-    Some(FieldSpec { name: "SatInfo", size: 2, kind: SatInfo, columns: &[] }),
+    Some(FieldSpec {
+        name: "SatInfo",
+        size: 2,
+        kind: SatInfo,
+        columns: &[],
+    }),
     None,
-    Some(FieldSpec { name: "RawMeas", size: 12, kind: RawMeas, columns: &[] }),
+    Some(FieldSpec {
+        name: "RawMeas",
+        size: 12,
+        kind: RawMeas,
+        columns: &[],
+    }),
     opaque(2),
     opaque(8),
 ];
@@ -291,7 +366,9 @@ pub fn parse_header(buf: &[u8]) -> HeaderScan {
     let mut j = 1;
     let mut groups: Vec<u8> = Vec::with_capacity(1);
     loop {
-        let Some(&g) = buf.get(j) else { return HeaderScan::Incomplete };
+        let Some(&g) = buf.get(j) else {
+            return HeaderScan::Incomplete;
+        };
         groups.push(g);
         j += 1;
         if g & 0x80 == 0 {
@@ -342,7 +419,11 @@ pub fn parse_header(buf: &[u8]) -> HeaderScan {
             }
         }
     }
-    HeaderScan::Ok(Layout { header: buf[1..j].to_vec(), fields, fixed_payload: fixed })
+    HeaderScan::Ok(Layout {
+        header: buf[1..j].to_vec(),
+        fields,
+        fixed_payload: fixed,
+    })
 }
 
 /// Payload size of `layout` for the payload starting at `payload` (which may be
@@ -350,7 +431,11 @@ pub fn parse_header(buf: &[u8]) -> HeaderScan {
 /// `Err(false)` if the size exceeds [`MAX_PACKET`].
 pub fn payload_size(layout: &Layout, payload: &[u8]) -> Result<usize, bool> {
     if let Some(s) = layout.fixed_payload {
-        return if s + layout.header.len() + 3 > MAX_PACKET { Err(false) } else { Ok(s) };
+        return if s + layout.header.len() + 3 > MAX_PACKET {
+            Err(false)
+        } else {
+            Ok(s)
+        };
     }
     let mut off = 0usize;
     for &(g, k) in &layout.fields {
@@ -395,7 +480,9 @@ pub fn decode_into(layout: &Layout, payload: &[u8], out: &mut [Vec<f64>]) -> Opt
         *col += 1;
     };
     for &(g, k) in &layout.fields {
-        let Some(spec) = field_spec(g, k) else { continue };
+        let Some(spec) = field_spec(g, k) else {
+            continue;
+        };
         let p = payload.get(off..).unwrap_or(&[]);
         let size = match spec.kind {
             F32(n) => {
@@ -415,8 +502,10 @@ pub fn decode_into(layout: &Layout, payload: &[u8], out: &mut [Vec<f64>]) -> Opt
                 spec.size
             }
             Nanos => {
-                let ns =
-                    p.get(..8).and_then(|b| b.try_into().ok()).map_or(0, u64::from_le_bytes);
+                let ns = p
+                    .get(..8)
+                    .and_then(|b| b.try_into().ok())
+                    .map_or(0, u64::from_le_bytes);
                 let s = ns as f64 * 1e-9;
                 if spec.name == "TimeStartup" && time.is_none() {
                     time = Some(s);
@@ -425,12 +514,18 @@ pub fn decode_into(layout: &Layout, payload: &[u8], out: &mut [Vec<f64>]) -> Opt
                 spec.size
             }
             U32 => {
-                let v = p.get(..4).and_then(|b| b.try_into().ok()).map_or(0, u32::from_le_bytes);
+                let v = p
+                    .get(..4)
+                    .and_then(|b| b.try_into().ok())
+                    .map_or(0, u32::from_le_bytes);
                 push(&mut col, v as f64);
                 spec.size
             }
             U16 => {
-                let v = p.get(..2).and_then(|b| b.try_into().ok()).map_or(0, u16::from_le_bytes);
+                let v = p
+                    .get(..2)
+                    .and_then(|b| b.try_into().ok())
+                    .map_or(0, u16::from_le_bytes);
                 push(&mut col, v as f64);
                 spec.size
             }
@@ -461,12 +556,20 @@ mod tests {
     use super::*;
 
     fn hex(s: &str) -> Vec<u8> {
-        let s: String = s.chars().filter(|c| !c.is_whitespace() && *c != '|').collect();
-        (0..s.len()).step_by(2).map(|i| u8::from_str_radix(&s[i..i + 2], 16).unwrap()).collect()
+        let s: String = s
+            .chars()
+            .filter(|c| !c.is_whitespace() && *c != '|')
+            .collect();
+        (0..s.len())
+            .step_by(2)
+            .map(|i| u8::from_str_radix(&s[i..i + 2], 16).unwrap())
+            .collect()
     }
 
     fn decode(bytes: &[u8]) -> (Layout, Vec<String>, Vec<f64>, Option<f64>) {
-        let HeaderScan::Ok(layout) = parse_header(bytes) else { panic!("header") };
+        let HeaderScan::Ok(layout) = parse_header(bytes) else {
+            panic!("header")
+        };
         let hl = 1 + layout.header.len();
         let size = payload_size(&layout, &bytes[hl..]).unwrap();
         assert_eq!(hl + size + 2, bytes.len());
@@ -484,9 +587,19 @@ mod tests {
 
     #[test]
     fn b1() {
-        let p = hex("FA 01 09 00 | 70 05 00 03 0A 00 00 00 | 48 0E 2C 42 08 4C 37 C1 10 38 8B C2 | D4 CB");
+        let p = hex(
+            "FA 01 09 00 | 70 05 00 03 0A 00 00 00 | 48 0E 2C 42 08 4C 37 C1 10 38 8B C2 | D4 CB",
+        );
         let (_, names, v, t) = decode(&p);
-        assert_eq!(names, ["common.time_startup", "common.yaw", "common.pitch", "common.roll"]);
+        assert_eq!(
+            names,
+            [
+                "common.time_startup",
+                "common.yaw",
+                "common.pitch",
+                "common.roll"
+            ]
+        );
         assert!(close(t.unwrap(), 43.000006, 1e-9));
         assert!(close(v[1], 43.013947, 1e-6) && close(v[2], -11.456062, 1e-6));
         assert!(close(v[3], -69.609497, 1e-5));
@@ -504,12 +617,27 @@ mod tests {
         // Synthetic B: Time group.
         let b = hex("fa 02 81 01 00 f2 05 2a 01 00 00 00 11 00 00 00 03 00 00 00 83 71");
         let (_, names, v, t) = decode(&b);
-        assert_eq!(names, ["time.time_startup", "time.syncin_count", "time.syncout_count"]);
+        assert_eq!(
+            names,
+            [
+                "time.time_startup",
+                "time.syncin_count",
+                "time.syncout_count"
+            ]
+        );
         assert_eq!((t, v[1], v[2]), (Some(5.0), 17.0, 3.0));
         // B4 corrected.
         let b4 = hex("FA 05 08 00 10 00 A4 15 02 42 4D DF EB 3F F6 1A 36 BE BF 2D A4 41 AF 1A");
         let (_, names, v, _) = decode(&b4);
-        assert_eq!(names, ["common.yaw", "common.pitch", "common.roll", "imu.temperature"]);
+        assert_eq!(
+            names,
+            [
+                "common.yaw",
+                "common.pitch",
+                "common.roll",
+                "imu.temperature"
+            ]
+        );
         assert!(close(v[3], 20.522337, 1e-5));
     }
 

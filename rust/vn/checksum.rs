@@ -35,7 +35,11 @@ const fn make_tables() -> [[u16; 256]; 8] {
         let mut crc = (i as u16) << 8;
         let mut k = 0;
         while k < 8 {
-            crc = if crc & 0x8000 != 0 { (crc << 1) ^ 0x1021 } else { crc << 1 };
+            crc = if crc & 0x8000 != 0 {
+                (crc << 1) ^ 0x1021
+            } else {
+                crc << 1
+            };
             k += 1;
         }
         t[0][i] = crc;
@@ -92,7 +96,11 @@ pub fn crc16_bitwise(bytes: &[u8]) -> u16 {
     for &b in bytes {
         crc ^= (b as u16) << 8;
         for _ in 0..8 {
-            crc = if crc & 0x8000 != 0 { (crc << 1) ^ 0x1021 } else { crc << 1 };
+            crc = if crc & 0x8000 != 0 {
+                (crc << 1) ^ 0x1021
+            } else {
+                crc << 1
+            };
         }
     }
     crc
@@ -154,7 +162,9 @@ mod tests {
 
     #[test]
     fn table_matches_bitwise() {
-        let data: Vec<u8> = (0..1000u32).map(|i| (i.wrapping_mul(2654435761) >> 13) as u8).collect();
+        let data: Vec<u8> = (0..1000u32)
+            .map(|i| (i.wrapping_mul(2654435761) >> 13) as u8)
+            .collect();
         for len in 0..200 {
             for start in [0usize, 1, 3, 7] {
                 let s = &data[start..start + len];

@@ -92,7 +92,10 @@ impl Issues {
             self.counts[k] += other.counts[k];
             for loc in &other.first[k] {
                 if self.first[k].len() < FIRST_KEEP {
-                    self.first[k].push(Location { offset: loc.offset, line: loc.line + line_shift });
+                    self.first[k].push(Location {
+                        offset: loc.offset,
+                        line: loc.line + line_shift,
+                    });
                 }
             }
         }
@@ -115,7 +118,12 @@ pub struct Table {
 impl Table {
     pub fn new(names: Vec<String>) -> Table {
         let columns = names.iter().map(|_| Vec::new()).collect();
-        Table { names, columns, extra: Vec::new(), len: 0 }
+        Table {
+            names,
+            columns,
+            extra: Vec::new(),
+            len: 0,
+        }
     }
 
     /// Set an extra column's value for the last pushed row.

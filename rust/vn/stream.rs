@@ -39,6 +39,9 @@ const MAX_LAYOUTS: usize = 16;
 /// CRC failures remembered before their configuration is confirmed.
 const MAX_PENDING: usize = 64;
 
+/// A strict-mode failure: kind, location, reason.
+pub type Failure = (IssueKind, Location, String);
+
 enum Ascii {
     /// More input is needed to decide.
     Need,
@@ -71,7 +74,11 @@ fn scan_ascii(buf: &[u8], i: usize, fin: bool) -> Ascii {
         if c == b'$' || !(0x20..=0x7E).contains(&c) {
             return if is_vn {
                 // A line end that cuts the sentence belongs to it.
-                let end = if c == b'\r' || c == b'\n' { eat_eol(buf, j) } else { j };
+                let end = if c == b'\r' || c == b'\n' {
+                    eat_eol(buf, j)
+                } else {
+                    j
+                };
                 if !fin && end == n {
                     return Ascii::Need;
                 }
@@ -148,7 +155,11 @@ fn scan_ascii(buf: &[u8], i: usize, fin: bool) -> Ascii {
         if !is_vn {
             return Ascii::Noise;
         }
-        let field = if digits.len() >= 4 { &digits[..4] } else { &digits[..digits.len().min(2)] };
+        let field = if digits.len() >= 4 {
+            &digits[..4]
+        } else {
+            &digits[..digits.len().min(2)]
+        };
         let reason = match field.len() {
             2 | 4 if field != b"XX" && field != b"XXXX" => format!(
                 "checksum mismatch: field {} but XOR-8 is {:02X} and CRC-16 is {:04X}",
@@ -156,13 +167,24 @@ fn scan_ascii(buf: &[u8], i: usize, fin: bool) -> Ascii {
                 checksum::xor8(body),
                 checksum::crc16(body)
             ),
-            _ => format!("check field {:?} is not 2 or 4 hex digits", String::from_utf8_lossy(field)),
+            _ => format!(
+                "check field {:?} is not 2 or 4 hex digits",
+                String::from_utf8_lossy(field)
+            ),
         };
         let end = star + 1 + field.len();
-        return Ascii::Record { end: eat_eol(buf, end), outcome: Outcome::Issue(IssueKind::BadChecksum, reason) };
+        return Ascii::Record {
+            end: eat_eol(buf, end),
+            outcome: Outcome::Issue(IssueKind::BadChecksum, reason),
+        };
     };
     let end = eat_eol(buf, star + 1 + used);
-    Ascii::Record { end, outcome: Outcome::Good { body: (i + 1, star) } }
+    Ascii::Record {
+        end,
+        outcome: Outcome::Good {
+            body: (i + 1, star),
+        },
+    }
 }
 
 fn eat_eol(buf: &[u8], mut end: usize) -> usize {
@@ -194,7 +216,7 @@ pub struct Parser {
     /// `bad_checksum` once the configuration frames a good packet.
     pending: Vec<(usize, Location)>,
     /// First damaged record in strict mode: kind, location, reason.
-    pub fail: Option<(IssueKind, Location, String)>,
+    pub fail: Option<Failure>,
 }
 
 impl Parser {
@@ -221,7 +243,10 @@ impl Parser {
             self.lines += buf[from..i].iter().filter(|&&c| c == b'\n').count() as u64;
             self.line_pos = abs;
         }
-        Location { offset: abs, line: self.lines + 1 }
+        Location {
+            offset: abs,
+            line: self.lines + 1,
+        }
     }
 
     fn issue(&mut self, buf: &[u8], i: usize, kind: IssueKind, reason: &str) {
@@ -255,12 +280,19 @@ impl Parser {
 
     fn push_ascii(&mut self, decoded: Decoded, buf: &[u8], i: usize, len: usize) {
         match decoded {
-            Decoded::Data { spec, values, count, status } => {
+            Decoded::Data {
+                spec,
+                values,
+                count,
+                status,
+            } => {
                 let table = self
                     .data
                     .tables
                     .entry(spec.id.to_string())
-                    .or_insert_with(|| Table::new(spec.fields.iter().map(|s| s.to_string()).collect()));
+                    .or_insert_with(|| {
+                        Table::new(spec.fields.iter().map(|s| s.to_string()).collect())
+                    });
                 for (col, v) in table.columns.iter_mut().zip(values.iter()) {
                     col.push(*v);
                 }
@@ -292,7 +324,12 @@ impl Parser {
                 self.data.bytes_in_bad_records += len as u64;
             }
             Decoded::Unknown => {
-                self.issue(buf, i, IssueKind::UnknownMessage, "message type not decoded");
+                self.issue(
+                    buf,
+                    i,
+                    IssueKind::UnknownMessage,
+                    "message type not decoded",
+                );
                 self.data.bytes_in_bad_records += len as u64;
             }
             Decoded::Malformed(reason) => {
@@ -419,7 +456,12 @@ impl Parser {
                 return None;
             }
             if self.good_layouts.contains(&k) {
-                self.issue(buf, i, IssueKind::TruncatedRecord, "input ends inside a binary packet");
+                self.issue(
+                    buf,
+                    i,
+                    IssueKind::TruncatedRecord,
+                    "input ends inside a binary packet",
+                );
                 self.data.bytes_in_bad_records += (n - i) as u64;
                 return Some(n);
             }
@@ -456,7 +498,9 @@ impl Parser {
         let table = match self.data.tables.get_mut(name) {
             Some(t) => t,
             None => {
-                self.data.tables.insert(name.clone(), Table::new(layout.column_names()));
+                self.data
+                    .tables
+                    .insert(name.clone(), Table::new(layout.column_names()));
                 self.data.tables.get_mut(name)?
             }
         };
@@ -490,7 +534,7 @@ impl Parser {
         let last = *cuts.last().unwrap_or(&0);
         let inner: Vec<(usize, usize)> = cuts.windows(2).map(|w| (w[0], w[1])).collect();
         let strict = self.strict;
-        let results: Vec<(VnData, Option<(IssueKind, Location, String)>, u64)> = inner
+        let results: Vec<(VnData, Option<Failure>, u64)> = inner
             .par_iter()
             .map(|&(a, b)| {
                 let piece = &buf[a..b];
@@ -511,7 +555,10 @@ impl Parser {
             }
             self.data.merge(data, line_shift);
             if let Some((kind, loc, reason)) = fail {
-                let loc = Location { offset: loc.offset + shift_offset, line: loc.line + line_shift };
+                let loc = Location {
+                    offset: loc.offset + shift_offset,
+                    line: loc.line + line_shift,
+                };
                 self.fail = Some((kind, loc, reason));
                 return buf.len();
             }
@@ -648,7 +695,12 @@ $VNERR,12*72\r\n";
         let ypr = &d.tables["VNYPR"];
         assert_eq!(ypr.len, 3);
         assert_eq!(ypr.columns[0], vec![10.071; 3]);
-        let t = &ypr.extra.iter().find(|(n, _)| n == "serial_count").unwrap().1;
+        let t = &ypr
+            .extra
+            .iter()
+            .find(|(n, _)| n == "serial_count")
+            .unwrap()
+            .1;
         assert!(t[0].is_nan() && t[1] == 1162704.0 && t[2].is_nan());
         assert_eq!(d.tables["VNYMR"].columns[0], vec![6.380]);
         assert_eq!(d.issues.count(IssueKind::DeviceError), 1);
@@ -706,12 +758,11 @@ $VNERR,12*72\r\n";
             }
         }
         let mut calls = 0;
-        let chunked =
-            parse_reader(Slow(&s, 977), s.len() as u64, false, &mut |_, _| {
-                calls += 1;
-                Ok(())
-            })
-            .unwrap();
+        let chunked = parse_reader(Slow(&s, 977), s.len() as u64, false, &mut |_, _| {
+            calls += 1;
+            Ok(())
+        })
+        .unwrap();
         assert_eq!(whole, chunked);
         assert_eq!(whole.tables["VNYMR"].len, 5000);
         assert!(calls >= 1);

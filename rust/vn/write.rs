@@ -142,18 +142,25 @@ pub fn binary_layout(selection: &[(usize, u32)]) -> CoreResult<Layout> {
     let mut sel: Vec<(usize, u32)> = selection.iter().copied().filter(|&(_, m)| m != 0).collect();
     sel.sort_by_key(|&(g, _)| g);
     if sel.is_empty() {
-        return Err(CoreError::InvalidArgument("selection must select at least one field".into()));
+        return Err(CoreError::InvalidArgument(
+            "selection must select at least one field".into(),
+        ));
     }
     let mut groups = [0u8; 3];
     let mut nbytes = 0;
     for w in sel.windows(2) {
         if w[0].0 == w[1].0 {
-            return Err(CoreError::InvalidArgument(format!("group {} selected twice", w[0].0)));
+            return Err(CoreError::InvalidArgument(format!(
+                "group {} selected twice",
+                w[0].0
+            )));
         }
     }
     for &(g, mask) in &sel {
         if g % 8 == 7 || g >= 24 {
-            return Err(CoreError::InvalidArgument(format!("group index {g} is not a group")));
+            return Err(CoreError::InvalidArgument(format!(
+                "group index {g} is not a group"
+            )));
         }
         if mask & 0x8000 != 0 || mask >> 31 != 0 {
             return Err(CoreError::InvalidArgument(format!(
@@ -185,6 +192,7 @@ pub fn binary_layout(selection: &[(usize, u32)]) -> CoreResult<Layout> {
     }
 }
 
+#[allow(clippy::needless_range_loop)] // one packet per record index across columns
 /// Write `n` binary packets for `layout` from columns in
 /// [`Layout::column_names`] order. Opaque fields are written as zeros (variable
 /// GNSS fields with a count of 0); times are given in seconds.
@@ -217,7 +225,9 @@ pub fn write_binary(layout: &Layout, columns: &[&[f64]]) -> CoreResult<Vec<u8>> 
             v
         };
         for &(g, k) in &layout.fields {
-            let Some(spec) = field_spec(g, k) else { continue };
+            let Some(spec) = field_spec(g, k) else {
+                continue;
+            };
             match spec.kind {
                 Kind::F32(m) => {
                     for _ in 0..m {
@@ -282,7 +292,8 @@ mod tests {
             out,
             b"$VNYMR,+100.949,-007.330,+000.715,-00.0049,-00.2449,+00.5397,-01.258,-00.100,-09.701,-00.000018,+00.001122,-00.000551*69\r\n"
         );
-        let out = write_ascii("VNYMR", &refs, None, None, None, AsciiCheck::Crc16, b"\r\n").unwrap();
+        let out =
+            write_ascii("VNYMR", &refs, None, None, None, AsciiCheck::Crc16, b"\r\n").unwrap();
         assert!(out.ends_with(b"*C251\r\n"));
     }
 
