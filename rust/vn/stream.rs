@@ -187,6 +187,16 @@ fn scan_ascii(buf: &[u8], i: usize, fin: bool) -> Ascii {
     }
 }
 
+/// Count one record of `key` without allocating once the key exists.
+fn bump(map: &mut std::collections::BTreeMap<String, u64>, key: &str) {
+    match map.get_mut(key) {
+        Some(n) => *n += 1,
+        None => {
+            map.insert(key.to_string(), 1);
+        }
+    }
+}
+
 fn eat_eol(buf: &[u8], mut end: usize) -> usize {
     if buf.get(end) == Some(&b'\r') {
         end += 1;
@@ -286,13 +296,15 @@ impl Parser {
                 count,
                 status,
             } => {
-                let table = self
-                    .data
-                    .tables
-                    .entry(spec.id.to_string())
-                    .or_insert_with(|| {
-                        Table::new(spec.fields.iter().map(|s| s.to_string()).collect())
-                    });
+                if !self.data.tables.contains_key(spec.id) {
+                    let names = spec.fields.iter().map(|s| s.to_string()).collect();
+                    self.data
+                        .tables
+                        .insert(spec.id.to_string(), Table::new(names));
+                }
+                let Some(table) = self.data.tables.get_mut(spec.id) else {
+                    return;
+                };
                 for (col, v) in table.columns.iter_mut().zip(values.iter()) {
                     col.push(*v);
                 }
@@ -303,12 +315,12 @@ impl Parser {
                 if let Some(s) = status {
                     table.set_extra("status", s);
                 }
-                *self.data.messages.entry(spec.id.to_string()).or_insert(0) += 1;
+                bump(&mut self.data.messages, spec.id);
                 self.data.bytes_parsed += len as u64;
                 self.data.ascii_records += 1;
             }
             Decoded::Command(id) => {
-                *self.data.messages.entry(id.to_string()).or_insert(0) += 1;
+                bump(&mut self.data.messages, id);
                 self.data.bytes_parsed += len as u64;
                 self.data.ascii_records += 1;
             }
@@ -506,7 +518,7 @@ impl Parser {
         };
         binary::decode_into(layout, &buf[i + hl..i + hl + size], &mut table.columns);
         table.len += 1;
-        *self.data.messages.entry(name.clone()).or_insert(0) += 1;
+        bump(&mut self.data.messages, name);
         self.data.bytes_parsed += (end - i) as u64;
         self.data.binary_records += 1;
         Some(end)
