@@ -65,7 +65,17 @@ fn scan_ascii(buf: &[u8], i: usize, fin: bool) -> Ascii {
     let n = buf.len();
     let is_vn = buf.get(i + 1) == Some(&b'V') && buf.get(i + 2) == Some(&b'N');
     let limit = (i + MAX_SENTENCE).min(n);
+    // Common case first: find '*' and check the bytes before it in one
+    // branch-free pass; fall back to the byte loop to locate a bad byte.
     let mut j = i + 1;
+    if let Some(p) = buf[i + 1..limit].iter().position(|&c| c == b'*') {
+        let bad = buf[i + 1..i + 1 + p].iter().fold(false, |acc, &c| {
+            acc | (c == b'$') | !(0x20..=0x7E).contains(&c)
+        });
+        if !bad {
+            j = i + 1 + p;
+        }
+    }
     while j < limit {
         let c = buf[j];
         if c == b'*' {
@@ -219,7 +229,9 @@ pub struct Parser {
     line_pos: u64,
     /// End (absolute) of the current run of skipped bytes, to record each run once.
     skip_end: u64,
-    layouts: Vec<(Layout, String)>,
+    /// Binary configurations seen: layout, table name, decoded rows (moved to
+    /// `data.tables` by `finish`).
+    layouts: Vec<(Layout, String, Table)>,
     /// Indices into `layouts` of configurations that framed a good packet.
     good_layouts: Vec<usize>,
     /// CRC failures of configurations not (yet) seen in a good packet: counted as
@@ -315,7 +327,6 @@ impl Parser {
                 if let Some(s) = status {
                     table.set_extra("status", s);
                 }
-                bump(&mut self.data.messages, spec.id);
                 self.data.bytes_parsed += len as u64;
                 self.data.ascii_records += 1;
             }
@@ -353,7 +364,7 @@ impl Parser {
 
     fn layout_index(&mut self, buf: &[u8], i: usize) -> Result<usize, bool> {
         // Fast path: a known header.
-        for (k, (l, _)) in self.layouts.iter().enumerate() {
+        for (k, (l, _, _)) in self.layouts.iter().enumerate() {
             let h = &l.header;
             if buf.get(i + 1..i + 1 + h.len()) == Some(h.as_slice()) {
                 return Ok(k);
@@ -380,7 +391,7 @@ impl Parser {
                     self.good_layouts = (0..self.layouts.len()).collect();
                 }
                 let name = layout.table_name();
-                self.layouts.push((layout, name));
+                self.layouts.push((layout, name, Table::default()));
                 Ok(self.layouts.len() - 1)
             }
         }
@@ -506,19 +517,12 @@ impl Parser {
             }
             self.pending.retain(|(p, _)| *p != k);
         }
-        let (layout, name) = &self.layouts[k];
-        let table = match self.data.tables.get_mut(name) {
-            Some(t) => t,
-            None => {
-                self.data
-                    .tables
-                    .insert(name.clone(), Table::new(layout.column_names()));
-                self.data.tables.get_mut(name)?
-            }
-        };
+        let (layout, _, table) = &mut self.layouts[k];
+        if table.names.is_empty() {
+            *table = Table::new(layout.column_names());
+        }
         binary::decode_into(layout, &buf[i + hl..i + hl + size], &mut table.columns);
         table.len += 1;
-        bump(&mut self.data.messages, name);
         self.data.bytes_parsed += (end - i) as u64;
         self.data.binary_records += 1;
         Some(end)
@@ -595,8 +599,16 @@ impl Parser {
                 reason
             )));
         }
-        for t in self.data.tables.values_mut() {
+        for (_, name, table) in self.layouts.drain(..) {
+            if table.len > 0 {
+                self.data.tables.insert(name, table);
+            }
+        }
+        for (name, t) in self.data.tables.iter_mut() {
             t.finish();
+            if name != "VNERR" {
+                self.data.messages.insert(name.clone(), t.len as u64);
+            }
         }
         Ok(self.data)
     }
