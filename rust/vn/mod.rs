@@ -126,6 +126,16 @@ impl Table {
         }
     }
 
+    /// Make room for `rows` more rows in every column.
+    pub fn reserve(&mut self, rows: usize) {
+        let want = self.len + rows;
+        for c in &mut self.columns {
+            if c.capacity() < want {
+                c.reserve(want - c.len());
+            }
+        }
+    }
+
     /// Set an extra column's value for the last pushed row.
     pub(crate) fn set_extra(&mut self, name: &str, value: f64) {
         let len = self.len;
@@ -146,6 +156,15 @@ impl Table {
         let len = self.len;
         for (_, col) in &mut self.extra {
             col.resize(len, f64::NAN);
+        }
+    }
+
+    /// Give back capacity reserved beyond the rows decoded.
+    pub fn shrink(&mut self) {
+        for c in &mut self.columns {
+            if c.capacity() > c.len() + c.len() / 8 + 64 {
+                c.shrink_to_fit();
+            }
         }
     }
 

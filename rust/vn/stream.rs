@@ -221,6 +221,7 @@ fn eat_eol(buf: &[u8], mut end: usize) -> usize {
 /// `base` is the absolute offset of the block start.
 pub struct Parser {
     strict: bool,
+    size_hint: u64,
     pub data: VnData,
     /// Absolute offset of the current block's first byte.
     base: u64,
@@ -243,7 +244,14 @@ pub struct Parser {
 
 impl Parser {
     pub fn new(strict: bool) -> Parser {
+        Parser::with_size_hint(strict, 0)
+    }
+
+    /// A parser for a stream of about `size_hint` bytes: tables reserve their
+    /// rows once (untouched capacity costs address space, not memory).
+    pub fn with_size_hint(strict: bool, size_hint: u64) -> Parser {
         Parser {
+            size_hint,
             strict,
             data: VnData::default(),
             base: 0,
@@ -255,6 +263,12 @@ impl Parser {
             pending: Vec::new(),
             fail: None,
         }
+    }
+
+    /// Rows to reserve for a table whose records are `len` bytes long.
+    fn rows_hint(&self, len: usize) -> usize {
+        let left = self.size_hint.saturating_sub(self.base);
+        (left / len.max(1) as u64).min(1 << 32) as usize
     }
 
     fn location(&mut self, buf: &[u8], i: usize) -> Location {
@@ -309,10 +323,9 @@ impl Parser {
                 status,
             } => {
                 if !self.data.tables.contains_key(spec.id) {
-                    let names = spec.fields.iter().map(|s| s.to_string()).collect();
-                    self.data
-                        .tables
-                        .insert(spec.id.to_string(), Table::new(names));
+                    let mut table = Table::new(spec.fields.iter().map(|s| s.to_string()).collect());
+                    table.reserve(self.rows_hint(len));
+                    self.data.tables.insert(spec.id.to_string(), table);
                 }
                 let Some(table) = self.data.tables.get_mut(spec.id) else {
                     return;
@@ -520,6 +533,9 @@ impl Parser {
         let (layout, _, table) = &mut self.layouts[k];
         if table.names.is_empty() {
             *table = Table::new(layout.column_names());
+            let rows = (self.size_hint.saturating_sub(self.base + i as u64) / (end - i) as u64)
+                .min(1 << 32) as usize;
+            table.reserve(rows);
         }
         binary::decode_into(layout, &buf[i + hl..i + hl + size], &mut table.columns);
         table.len += 1;
@@ -554,7 +570,7 @@ impl Parser {
             .par_iter()
             .map(|&(a, b)| {
                 let piece = &buf[a..b];
-                let mut p = Parser::new(strict);
+                let mut p = Parser::with_size_hint(strict, piece.len() as u64);
                 p.feed(piece, true);
                 let nl = piece.iter().filter(|&&c| c == b'\n').count() as u64;
                 (p.data, p.fail, nl)
@@ -562,14 +578,23 @@ impl Parser {
             .collect();
         // Lines before the block (kept current by `feed`).
         let mut line_shift = self.lines;
-        for ((a, _b), (mut data, fail, nl)) in inner.iter().zip(results) {
+        for ((a, b), (mut data, fail, nl)) in inner.iter().zip(results) {
             let shift_offset = self.base + *a as u64;
             for locs in data.issues.first.iter_mut() {
                 for l in locs.iter_mut() {
                     l.offset += shift_offset;
                 }
             }
+            let first_merge = self.data.tables.is_empty();
             self.data.merge(data, line_shift);
+            if first_merge && self.size_hint > 0 {
+                // Extrapolate rows from the first piece and reserve once.
+                let done = (self.base + *b as u64).max(1) as f64;
+                let scale = self.size_hint as f64 / done;
+                for t in self.data.tables.values_mut() {
+                    t.reserve(((t.len as f64) * scale * 1.01) as usize);
+                }
+            }
             if let Some((kind, loc, reason)) = fail {
                 let loc = Location {
                     offset: loc.offset + shift_offset,
@@ -606,6 +631,7 @@ impl Parser {
         }
         for (name, t) in self.data.tables.iter_mut() {
             t.finish();
+            t.shrink();
             if name != "VNERR" {
                 self.data.messages.insert(name.clone(), t.len as u64);
             }
@@ -616,7 +642,7 @@ impl Parser {
 
 /// Parse a whole in-memory stream.
 pub fn parse_bytes(data: &[u8], strict: bool) -> CoreResult<VnData> {
-    let mut p = Parser::new(strict);
+    let mut p = Parser::with_size_hint(strict, data.len() as u64);
     let mut pos = 0usize;
     while pos < data.len() {
         let end = (pos + CHUNK).min(data.len());
@@ -648,7 +674,7 @@ pub fn parse_reader<R: Read>(
     strict: bool,
     progress: &mut dyn FnMut(u64, u64) -> CoreResult<()>,
 ) -> CoreResult<VnData> {
-    let mut p = Parser::new(strict);
+    let mut p = Parser::with_size_hint(strict, total);
     let mut buf: Vec<u8> = Vec::with_capacity(CHUNK + binary::MAX_PACKET);
     let mut done: u64 = 0;
     let mut eof = false;
