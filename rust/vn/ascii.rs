@@ -297,36 +297,31 @@ pub fn parse_f64(s: &[u8]) -> Option<f64> {
         Some(b'+') => (false, &s[1..]),
         _ => (false, s),
     };
-    let mut mant: u64 = 0;
-    let mut frac: usize = 0;
-    let mut seen_dot = false;
-    let mut ndigits = 0usize;
-    let mut fast = !digits.is_empty();
-    for &c in digits {
-        match c {
-            b'0'..=b'9' => {
-                if ndigits >= 15 {
-                    fast = false;
-                    break;
-                }
-                mant = mant * 10 + (c - b'0') as u64;
-                if mant != 0 {
-                    ndigits += 1;
-                }
-                if seen_dot {
-                    frac += 1;
-                }
-            }
-            b'.' if !seen_dot => seen_dot = true,
-            _ => {
-                fast = false;
-                break;
-            }
+    let n = digits.len();
+    // At most 19 digits cannot overflow u64; exactness is checked below.
+    if n <= 20 {
+        let mut mant: u64 = 0;
+        let mut k = 0usize;
+        while k < n && digits[k].is_ascii_digit() {
+            mant = mant * 10 + (digits[k] - b'0') as u64;
+            k += 1;
         }
-    }
-    if fast && frac < POW10.len() && digits != b"." {
-        let v = mant as f64 / POW10[frac];
-        return Some(if neg { -v } else { v });
+        let int_digits = k;
+        let mut frac = 0usize;
+        if k < n && digits[k] == b'.' {
+            k += 1;
+            let from = k;
+            while k < n && digits[k].is_ascii_digit() {
+                mant = mant * 10 + (digits[k] - b'0') as u64;
+                k += 1;
+            }
+            frac = k - from;
+        }
+        if k == n && int_digits + frac > 0 && mant <= (1u64 << 53) && frac < POW10.len() {
+            // Exact integer / exact power of ten: one correctly rounded division.
+            let v = mant as f64 / POW10[frac];
+            return Some(if neg { -v } else { v });
+        }
     }
     let text = std::str::from_utf8(s).ok()?;
     let first_ok = text
