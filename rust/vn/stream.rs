@@ -549,20 +549,25 @@ impl Parser {
         if buf.len() < PARALLEL_MIN || self.fail.is_some() || buf.contains(&0xFA) {
             return self.feed(buf, fin);
         }
+        // Everything up to the last newline is split into pieces at newlines and
+        // parsed in parallel; only the tail after it (part of one line, which may
+        // continue in the next block) is parsed sequentially and carried over.
+        let Some(end_nl) = buf.iter().rposition(|&c| c == b'\n').map(|p| p + 1) else {
+            return self.feed(buf, fin);
+        };
         let pieces = (rayon::current_num_threads() * 4).max(2);
-        let step = buf.len() / pieces;
+        let step = end_nl / pieces;
         let mut cuts = vec![0usize];
         for p in 1..pieces {
             let from = (p * step).max(*cuts.last().unwrap_or(&0));
-            if let Some(q) = buf[from..].iter().position(|&c| c == b'\n') {
+            if let Some(q) = buf[from..end_nl].iter().position(|&c| c == b'\n') {
                 let cut = from + q + 1;
-                if cut < buf.len() && cut > *cuts.last().unwrap_or(&0) {
+                if cut < end_nl && cut > *cuts.last().unwrap_or(&0) {
                     cuts.push(cut);
                 }
             }
         }
-        // The last piece stays sequential so that a record cut by the block end is
-        // carried over.
+        cuts.push(end_nl);
         let last = *cuts.last().unwrap_or(&0);
         let inner: Vec<(usize, usize)> = cuts.windows(2).map(|w| (w[0], w[1])).collect();
         let strict = self.strict;
