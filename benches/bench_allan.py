@@ -16,16 +16,15 @@ import statistics
 import time
 
 import allantools
+import imunoise
 import numpy as np
 
-import imunoise
 
-
-def median_time(fn, repeats: int) -> float:
+def median_time(fn, repeats: int, *args, **kwargs) -> float:
     times = []
     for _ in range(repeats):
         t0 = time.perf_counter()
-        fn()
+        fn(*args, **kwargs)
         times.append(time.perf_counter() - t0)
     return statistics.median(times)
 
@@ -50,12 +49,11 @@ def main() -> None:
             peer_taus = "octave" if taus == "octave" else ours_taus
             repeats_peer = 3 if n <= 10**6 else 1
             peer = median_time(
-                lambda: allantools.oadev(one, rate=fs, data_type="freq", taus=peer_taus),
-                repeats_peer,
+                allantools.oadev, repeats_peer, one, rate=fs, data_type="freq", taus=peer_taus
             )
             for channels in (1, 6):
                 x = one if channels == 1 else data
-                ours = median_time(lambda: imunoise.adev(x, fs, taus=taus), 5)
+                ours = median_time(imunoise.adev, 5, x, fs, taus=taus)
                 peer_c = peer * channels
                 print(f"| {n:.0e} | {label} | {channels} | {ours:.3f} | {peer_c:.3f}"
                       f"{' (6×1)' if channels > 1 else ''} | {peer_c / ours:.0f}× |", flush=True)

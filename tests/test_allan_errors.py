@@ -83,6 +83,11 @@ def test_out_of_range_taus_are_dropped_with_one_warning():
     np.testing.assert_allclose(r.taus, [0.1, 1.0])  # 0.01 s < 1/fs; 1.04 s merges with 1.0 s
 
 
+def test_values_too_large_for_double_precision():
+    with pytest.raises(ValueError, match="x is too large in magnitude"):
+        imunoise.adev(np.array([0.0, 9.5e153, 0.0, 1.0]), 1.0)
+
+
 def test_bad_confidence_and_overlapping():
     with pytest.raises(ValueError, match=r"confidence must be in \(0, 1\); got 1.5"):
         imunoise.adev(GOOD, 1.0, confidence=1.5)

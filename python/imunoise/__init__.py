@@ -5,23 +5,32 @@ fitting, log readers for VectorNav VN-100 (ASCII and binary), CSV and ROS bags,
 plots and reports. Start with ``imunoise.adev(x, fs)``.
 """
 
+from imunoise import units
 from imunoise._core import __version__
 from imunoise.allan import AllanResult, adev, hdev, mdev, tdev, totdev
+from imunoise.datasheet import compare
+from imunoise.noise import NoiseModel, fit
 from imunoise.readers import ImuLog, ParseIssues
 from imunoise.readers.read import read
 from imunoise.readers.vn_write import write_vn_ascii, write_vn_binary
+from imunoise.simulate import simulate
 
 __all__ = [
     "__version__",
     "AllanResult",
     "ImuLog",
+    "NoiseModel",
     "ParseIssues",
     "adev",
+    "compare",
+    "fit",
     "hdev",
     "mdev",
+    "simulate",
     "tdev",
     "totdev",
     "read",
     "write_vn_ascii",
     "write_vn_binary",
+    "units",
 ]

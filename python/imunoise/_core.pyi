@@ -69,3 +69,20 @@ def write_vn_binary(
     selection: list[tuple[int, int]], columns: dict[str, npt.NDArray[np.float64]]
 ) -> bytes:
     """Binary packets for ``selection`` from columns named as in vn_binary_columns."""
+def fit_wls(
+    taus: npt.NDArray[np.float64],
+    var: npt.NDArray[np.float64],
+    edf: npt.NDArray[np.float64],
+    terms: list[bool],
+    reweight: int = 3,
+    min_share: float = 0.25,
+    min_z: float = 2.0,
+) -> tuple[
+    npt.NDArray[np.float64],  # (Q², N², B², K², R²)
+    npt.NDArray[np.float64],  # (5, 5) covariance of the squares
+    npt.NDArray[np.bool_],  # supported
+    float,  # chi2
+    int,  # dof
+]:
+    """(Q², N², B², K², R²), their (5, 5) covariance, supported flags, χ², dof of
+    the EDF-weighted NNLS noise-model fit of one channel."""

@@ -89,6 +89,14 @@ pub fn analyse(phases: &[Vec<f64>], statistic: Statistic, ms: &[usize]) -> CoreR
     let mut alpha = vec![0; pairs.len()];
     let mut alpha_identified = vec![false; pairs.len()];
     for (i, &(v, a)) in per_pair.iter().enumerate() {
+        if !v.is_finite() {
+            let (t, c) = pairs[i];
+            return Err(CoreError::Numerical(format!(
+                "x is too large in magnitude: the variance at m = {} overflows double \
+                 precision (channel {c}); rescale x",
+                ms[t]
+            )));
+        }
         var.push(v);
         if let Some(a) = a {
             alpha[i] = a;
@@ -186,6 +194,13 @@ mod tests {
         assert!(!a.alpha_identified[4]);
         assert_eq!(a.alpha[4], a.alpha[2]);
         assert!(a.edf.iter().all(|e| *e > 0.0));
+    }
+
+    #[test]
+    fn overflow_is_an_error_not_nan() {
+        let phases = column_phases(vec![[0.0, 9.5e153, 0.0].iter().copied()]).unwrap();
+        let err = analyse(&phases, Statistic::Allan { overlapping: true }, &[1]).unwrap_err();
+        assert!(err.to_string().contains("too large"), "{err}");
     }
 
     #[test]

@@ -8,6 +8,7 @@ use pyo3::prelude::*;
 use crate::error::CoreError;
 
 mod allan;
+mod fit;
 mod vn;
 
 impl From<CoreError> for PyErr {
@@ -24,5 +25,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     allan::register(m)?;
     vn::register(m)?;
+    fit::register(m)?;
     Ok(())
 }

@@ -35,9 +35,10 @@ class ParseIssues:
         :data:`ISSUE_KINDS`; every kind is present, zero when nothing happened.
     first : Mapping[str, tuple[int, ...]]
         The first few locations of each kind: 1-based line numbers for text
-        formats, 0-based byte offsets for binary ones.
+        formats, 0-based byte offsets for binary ones, 1-based message numbers
+        for bags.
     location : str
-        ``"line"`` or ``"byte"``: what the numbers in ``first`` are.
+        ``"line"``, ``"byte"`` or ``"message"``: what the numbers in ``first`` are.
     """
 
     counts: Mapping[str, int]

@@ -1,0 +1,246 @@
+"""Datasheets as data: load a sensor specification and compare a fitted model.
+
+A specification is a TOML file (``specs/vn100.toml`` ships with imunoise; see it
+for the format). :func:`compare` takes the fitted models of a gyroscope and/or
+an accelerometer and returns, for every specified quantity and every axis, the
+measured value, the specification, their ratio and a verdict.
+
+TOML is read with :mod:`tomllib` (Python ≥ 3.11) or the ``tomli`` back-port on
+Python 3.10 (a dependency there).
+
+Examples
+--------
+>>> import imunoise
+>>> # models fitted to gyro (rad/s) and accelerometer (m/s²) Allan deviations:
+>>> # cmp = imunoise.compare({"gyro": mg, "accel": ma}, "vn100")
+>>> # print(cmp.text())
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+from dataclasses import dataclass
+from importlib import resources
+from pathlib import Path
+
+import numpy as np
+
+from imunoise import units as _units
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover - exercised on 3.10 only
+    import tomli as tomllib
+
+__all__ = ["Spec", "SpecItem", "Comparison", "load_spec", "compare", "available_specs"]
+
+
+@dataclass(frozen=True)
+class SpecItem:
+    """One specified quantity: term, value in ``unit``, ``limit`` ("max"/"typical")."""
+
+    sensor: str
+    term: str
+    quantity: str
+    value: float
+    unit: str
+    limit: str
+
+
+@dataclass(frozen=True)
+class Spec:
+    """A sensor datasheet: its name, source and specified items."""
+
+    name: str
+    source: str
+    items: tuple[SpecItem, ...]
+
+
+def available_specs() -> list[str]:
+    """Names of the specifications shipped with imunoise."""
+    folder = resources.files("imunoise") / "specs"
+    return sorted(p.name[:-5] for p in folder.iterdir() if p.name.endswith(".toml"))
+
+
+def load_spec(spec) -> Spec:
+    """Load a specification by name (``"vn100"``) or from a TOML file path."""
+    if isinstance(spec, Spec):
+        return spec
+    if not isinstance(spec, (str, Path)):
+        raise TypeError(f"spec must be a name, a path or a Spec; got {type(spec).__name__}")
+    path = Path(spec)
+    if path.suffix == ".toml" or path.exists():
+        if not path.is_file():
+            raise ValueError(f"spec file {str(path)!r} does not exist")
+        text = path.read_text(encoding="utf-8")
+        origin = str(path)
+    else:
+        name = str(spec).lower()
+        res = resources.files("imunoise") / "specs" / f"{name}.toml"
+        if not res.is_file():
+            raise ValueError(
+                f"spec must be one of {available_specs()} or a .toml path; got {spec!r}"
+            )
+        text = res.read_text(encoding="utf-8")
+        origin = f"imunoise/specs/{name}.toml"
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ValueError(f"spec {origin}: invalid TOML: {exc}") from None
+    items = []
+    for sensor in _units.SENSORS:
+        for i, entry in enumerate(data.get(sensor, [])):
+            where = f"spec {origin}: {sensor}[{i}]"
+            try:
+                item = SpecItem(
+                    sensor=sensor,
+                    term=str(entry["term"]),
+                    quantity=str(entry.get("quantity", entry["term"])),
+                    value=float(entry["value"]),
+                    unit=str(entry["unit"]),
+                    limit=str(entry.get("limit", "max")),
+                )
+            except (KeyError, TypeError, ValueError) as exc:
+                raise ValueError(f"{where}: needs term, value and unit ({exc})") from None
+            if item.limit not in ("max", "typical"):
+                raise ValueError(f"{where}: limit must be 'max' or 'typical'; got {item.limit!r}")
+            if not (math.isfinite(item.value) and item.value > 0):
+                raise ValueError(f"{where}: value must be finite and > 0; got {item.value!r}")
+            _units.unit_info(item.term, item.unit, sensor)  # validates term and unit
+            items.append(item)
+    if not items:
+        raise ValueError(f"spec {origin} specifies nothing (no [[gyro]] or [[accel]] entries)")
+    return Spec(name=str(data.get("name", origin)), source=str(data.get("source", "")),
+                items=tuple(items))
+
+
+@dataclass(frozen=True)
+class Comparison:
+    """Measured vs specified, one row per (quantity, axis).
+
+    Each row is a dict: ``sensor, term, quantity, unit, limit, spec, axis,
+    measured, std, ratio, verdict`` where ``ratio = measured/spec`` and
+    ``verdict`` is ``"pass"`` (measured ≤ spec), ``"marginal"`` (above the spec
+    but within two standard uncertainties of it), ``"fail"``, or
+    ``"unresolved"`` (the data do not resolve that term, e.g. too short a log
+    for B).
+    """
+
+    spec: Spec
+    rows: tuple[dict, ...]
+
+    @property
+    def passed(self) -> bool:
+        """True when no row fails (marginal and unresolved rows do not fail)."""
+        return all(r["verdict"] != "fail" for r in self.rows)
+
+    def text(self) -> str:
+        """Fixed-width text rendering."""
+        header = ["sensor", "quantity", "axis", "measured", "spec", "ratio", "verdict"]
+        body = []
+        for r in self.rows:
+            meas = "—" if r["verdict"] == "unresolved" else f"{r['measured']:.4g}"
+            if r["verdict"] != "unresolved" and np.isfinite(r["std"]):
+                meas += f" ± {r['std']:.2g}"
+            bound = "<" if r["limit"] == "max" else "typ."
+            body.append([
+                r["sensor"], f"{r['quantity']} ({r['term']})", r["axis"], meas,
+                f"{bound} {r['spec']:g} {r['label']}",
+                "—" if not np.isfinite(r["ratio"]) else f"{r['ratio']:.2f}",
+                r["verdict"],
+            ])
+        widths = [max(len(x[i]) for x in [header, *body]) for i in range(len(header))]
+        lines = [f"{self.spec.name} — {self.spec.source}"]
+        for row in [header, *body]:
+            lines.append("  ".join(c.ljust(w) for c, w in zip(row, widths, strict=True)).rstrip())
+        lines.insert(2, "  ".join("-" * w for w in widths))
+        return "\n".join(lines)
+
+
+def _verdict(resolved: bool, measured: float, std: float, spec: float) -> str:
+    if not resolved:
+        return "unresolved"
+    if measured <= spec:
+        return "pass"
+    if np.isfinite(std) and measured - 2.0 * std <= spec:
+        return "marginal"
+    return "fail"
+
+
+def compare(models, spec="vn100", *, sensor: str = "gyro", input_units: dict | None = None,
+            axes=None) -> Comparison:
+    """Compare fitted noise models with a datasheet.
+
+    Parameters
+    ----------
+    models : NoiseModel or dict
+        ``{"gyro": model_g, "accel": model_a}`` (either key may be missing), or
+        a single model whose kind is given by ``sensor``.
+    spec : str, path or Spec
+        A shipped specification name (``"vn100"``) or a TOML file.
+    sensor : {"gyro", "accel"}
+        Kind of a single model.
+    input_units : dict, optional
+        Units of the rate data per sensor, e.g. ``{"gyro": "deg/s"}``; default
+        rad/s and m/s².
+    axes : sequence of str, optional
+        Axis names (default X, Y, Z for three channels).
+
+    Returns
+    -------
+    Comparison
+    """
+    from imunoise.noise import NoiseModel, _axis_names
+
+    if isinstance(models, NoiseModel):
+        if sensor not in _units.SENSORS:
+            raise ValueError(f"sensor must be one of {_units.SENSORS}; got {sensor!r}")
+        models = {sensor: models}
+    if not isinstance(models, dict) or not models:
+        raise TypeError(
+            "models must be a NoiseModel or a dict {'gyro': model, 'accel': model}; "
+            f"got {type(models).__name__}"
+        )
+    for key, m in models.items():
+        if key not in _units.SENSORS:
+            raise ValueError(f"models keys must be 'gyro' or 'accel'; got {key!r}")
+        if not isinstance(m, NoiseModel):
+            raise TypeError(f"models[{key!r}] must be a NoiseModel; got {type(m).__name__}")
+    input_units = dict(input_units or {})
+    spec = load_spec(spec)
+    rows = []
+    for item in spec.items:
+        model = models.get(item.sensor)
+        if model is None:
+            continue
+        info = _units.unit_info(item.term, item.unit, item.sensor)
+        iu = input_units.get(item.sensor)
+        values = _units.convert(model.value(item.term), item.term, info.name,
+                                sensor=item.sensor, input_unit=iu)
+        stds = _units.convert(model.std(item.term), item.term, info.name,
+                              sensor=item.sensor, input_unit=iu)
+        sup = np.atleast_1d(model.supported[item.term])
+        for i, ax in enumerate(_axis_names(model.channels, axes)):
+            measured = float(values[i])
+            ok = bool(sup[i])
+            ratio = measured / item.value if ok else math.nan
+            rows.append({
+                "sensor": item.sensor,
+                "term": item.term,
+                "quantity": item.quantity,
+                "unit": info.name,
+                "label": info.label,
+                "limit": item.limit,
+                "spec": item.value,
+                "axis": ax,
+                "measured": measured if ok else math.nan,
+                "std": float(stds[i]) if ok else math.nan,
+                "ratio": ratio,
+                "verdict": _verdict(ok, measured, float(stds[i]), item.value),
+            })
+    if not rows:
+        raise ValueError(
+            f"spec {spec.name!r} specifies nothing for the given models ({sorted(models)})"
+        )
+    return Comparison(spec=spec, rows=tuple(rows))

@@ -1,0 +1,223 @@
+"""Parameter files for estimators: Kalibr, OpenVINS, and JSON of a full model.
+
+Kalibr's IMU model (``imu.yaml``) and OpenVINS' ``kalibr_imu_chain.yaml`` take
+continuous-time densities in SI units:
+
+=============================  =======================  ====================
+key                            noise-model coefficient  unit
+=============================  =======================  ====================
+``gyroscope_noise_density``    N of the gyro            rad/s/√Hz
+``gyroscope_random_walk``      K of the gyro            rad/s²/√Hz
+``accelerometer_noise_density`` N of the accelerometer  m/s²/√Hz
+``accelerometer_random_walk``  K of the accelerometer   m/s³/√Hz
+=============================  =======================  ====================
+
+(N in rad/√s is numerically rad/s/√Hz, K in rad/s/√s is rad/s²/√Hz.) The
+files hold one number per sensor, so the axes are combined: ``combine="max"``
+(default, the worst axis: conservative, what Kalibr's authors recommend when in
+doubt) or ``"rms"`` (√ of the mean square over axes). Kalibr's documentation
+also suggests inflating the values of a still-bench characterisation for a
+moving platform; do that with ``inflate`` (default 1: the measured values).
+
+All files are written atomically: a temporary file in the same directory is
+written, flushed and ``os.replace``-d onto the target.
+
+References
+----------
+Kalibr wiki, "IMU Noise Model" (ethz-asl/kalibr).
+OpenVINS documentation, "Sensor Calibration" / ``kalibr_imu_chain.yaml``.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import tempfile
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+from imunoise import units as _units
+
+__all__ = [
+    "kalibr_dict",
+    "kalibr_yaml",
+    "openvins_yaml",
+    "model_json",
+    "write_atomic",
+    "write_kalibr",
+    "write_openvins",
+    "write_json",
+]
+
+
+def write_atomic(path, text: str) -> Path:
+    """Write ``text`` to ``path`` atomically (temp file in the same dir + os.replace)."""
+    path = Path(path)
+    directory = path.parent if str(path.parent) else Path(".")
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=directory)
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as fh:
+            fh.write(text)
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        try:
+            os.unlink(tmp)
+        except OSError:
+            pass
+        raise
+    return path
+
+
+def _combine(model, term: str, combine: str, sensor: str, input_unit) -> float:
+    values = model.value(term)
+    sup = np.atleast_1d(model.supported[term])
+    scale = _units.input_scale(sensor, input_unit)
+    if not sup.any():
+        warnings.warn(
+            f"the {sensor} model has no resolved {term} on any axis; writing 0 "
+            f"(an estimator may need a small positive value)",
+            RuntimeWarning,
+            stacklevel=4,
+        )
+        return 0.0
+    v = values[sup] * scale
+    if combine == "max":
+        return float(np.max(v))
+    return float(math.sqrt(np.mean(v**2)))
+
+
+def kalibr_dict(gyro=None, accel=None, *, rostopic: str = "/imu0", update_rate=None,
+                combine: str = "max", inflate: float = 1.0, gyro_unit: str | None = None,
+                accel_unit: str | None = None) -> dict:
+    """The values of a Kalibr ``imu.yaml`` (SI, continuous time).
+
+    Parameters
+    ----------
+    gyro, accel : NoiseModel, optional
+        Models fitted to gyroscope and accelerometer rates (at least one).
+    rostopic : str
+    update_rate : float, optional
+        IMU rate in Hz; default the models' ``fs``.
+    combine : {"max", "rms"}
+        How the axes are combined (worst axis or root mean square).
+    inflate : float
+        Multiplier on every density (≥ 1 for a moving platform).
+    gyro_unit, accel_unit : str, optional
+        Units of the rate data the models were fitted to (default rad/s, m/s²).
+    """
+    if gyro is None and accel is None:
+        raise ValueError("gyro and accel are both None; pass at least one NoiseModel")
+    if combine not in ("max", "rms"):
+        raise ValueError(f"combine must be 'max' or 'rms'; got {combine!r}")
+    if not (math.isfinite(inflate) and inflate > 0):
+        raise ValueError(f"inflate must be finite and > 0; got {inflate!r}")
+    if update_rate is None:
+        update_rate = (gyro if gyro is not None else accel).fs
+    update_rate = float(update_rate)
+    if not (math.isfinite(update_rate) and update_rate > 0):
+        raise ValueError(f"update_rate must be finite and > 0; got {update_rate!r}")
+    out: dict = {}
+    if accel is not None:
+        out["accelerometer_noise_density"] = inflate * _combine(
+            accel, "N", combine, "accel", accel_unit)
+        out["accelerometer_random_walk"] = inflate * _combine(
+            accel, "K", combine, "accel", accel_unit)
+    if gyro is not None:
+        out["gyroscope_noise_density"] = inflate * _combine(gyro, "N", combine, "gyro", gyro_unit)
+        out["gyroscope_random_walk"] = inflate * _combine(gyro, "K", combine, "gyro", gyro_unit)
+    out["rostopic"] = str(rostopic)
+    out["update_rate"] = update_rate
+    return out
+
+
+_COMMENTS = {
+    "accelerometer_noise_density": "m/s^2/sqrt(Hz), continuous time (N)",
+    "accelerometer_random_walk": "m/s^3/sqrt(Hz), continuous time (K)",
+    "gyroscope_noise_density": "rad/s/sqrt(Hz), continuous time (N)",
+    "gyroscope_random_walk": "rad/s^2/sqrt(Hz), continuous time (K)",
+    "rostopic": "the IMU ROS topic",
+    "update_rate": "Hz (for discretization of the values above)",
+}
+
+
+def _scalar(v) -> str:
+    if isinstance(v, str):
+        return v
+    return f"{v:.6e}" if v else "0.0"
+
+
+def kalibr_yaml(gyro=None, accel=None, **kwargs) -> str:
+    """Kalibr ``imu.yaml`` text (see :func:`kalibr_dict` for the options)."""
+    d = kalibr_dict(gyro, accel, **kwargs)
+    combine = kwargs.get("combine", "max")
+    lines = [
+        "# IMU noise model for Kalibr, written by imunoise",
+        f"# axes combined by: {combine}",
+    ]
+    for k, v in d.items():
+        val = f"{v:.1f}" if k == "update_rate" else _scalar(v)
+        lines.append(f"{k}: {val}  # {_COMMENTS[k]}")
+    return "\n".join(lines) + "\n"
+
+
+def openvins_yaml(gyro=None, accel=None, *, imu_name: str = "imu0", **kwargs) -> str:
+    """OpenVINS-style ``kalibr_imu_chain.yaml`` text (identity T_i_b, calibrated model)."""
+    d = kalibr_dict(gyro, accel, **kwargs)
+    lines = [
+        "%YAML:1.0",
+        "",
+        f"{imu_name}:",
+        "  T_i_b:",
+        "    - [1.0, 0.0, 0.0, 0.0]",
+        "    - [0.0, 1.0, 0.0, 0.0]",
+        "    - [0.0, 0.0, 1.0, 0.0]",
+        "    - [0.0, 0.0, 0.0, 1.0]",
+    ]
+    for k in (
+        "accelerometer_noise_density",
+        "accelerometer_random_walk",
+        "gyroscope_noise_density",
+        "gyroscope_random_walk",
+    ):
+        if k in d:
+            lines.append(f"  {k}: {_scalar(d[k])}")
+    lines += [
+        "  model: calibrated",
+        f"  rostopic: {d['rostopic']}",
+        "  time_offset: 0.0",
+        f"  update_rate: {d['update_rate']:.1f}",
+    ]
+    return "\n".join(lines) + "\n"
+
+
+def model_json(model=None, **models) -> str:
+    """JSON text of one model (``model_json(m)``) or several (``model_json(gyro=g, accel=a)``)."""
+    if model is not None and models:
+        raise ValueError("pass either one model or keyword models, not both")
+    if model is not None:
+        payload = model.to_dict()
+    elif models:
+        payload = {name: m.to_dict() for name, m in models.items()}
+    else:
+        raise ValueError("model_json needs a NoiseModel")
+    return json.dumps(payload, indent=2, allow_nan=False) + "\n"
+
+
+def write_kalibr(path, gyro=None, accel=None, **kwargs) -> Path:
+    """Write a Kalibr ``imu.yaml`` atomically; returns the path."""
+    return write_atomic(path, kalibr_yaml(gyro, accel, **kwargs))
+
+
+def write_openvins(path, gyro=None, accel=None, **kwargs) -> Path:
+    """Write an OpenVINS ``kalibr_imu_chain.yaml`` atomically; returns the path."""
+    return write_atomic(path, openvins_yaml(gyro, accel, **kwargs))
+
+
+def write_json(path, model=None, **models) -> Path:
+    """Write the full model(s) as JSON atomically; returns the path."""
+    return write_atomic(path, model_json(model, **models))

@@ -1,0 +1,598 @@
+"""Delimited text logs: CSV exported from a bag, logger output, whitespace columns.
+
+:func:`read_csv` maps columns (by header name or 0-based index) to the channels of
+:class:`~imunoise.readers.log.ImuLog`, converts units to the SI units of
+:data:`~imunoise.readers.log.CHANNELS`, and accounts for every data line: each one
+becomes a sample or is counted as ``malformed_field`` with its 1-based line number.
+A column that carries raw VN-100 sentences (``$VNYMR,...*hh``) is decoded by the VN
+parser and wins over parsed numeric columns of the same channels.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+import os
+import re
+import warnings
+from collections.abc import Callable, Mapping, Sequence
+
+import numpy as np
+
+from imunoise.readers._sentences import IssueTally, sentence_rows
+from imunoise.readers.log import CHANNELS, ImuLog, resolve_fs
+
+__all__ = ["UNITS", "read_csv"]
+
+_G = 9.80665
+
+#: Unit name -> (channel family, factor to SI, offset) with SI = value * factor + offset.
+UNITS: Mapping[str, tuple[str, float, float]] = {
+    **{u: ("angular_rate", 1.0, 0.0) for u in ("rad/s", "rad/sec", "rps")},
+    **{u: ("angular_rate", math.pi / 180, 0.0) for u in ("deg/s", "deg/sec", "dps", "°/s")},
+    "deg/h": ("angular_rate", math.pi / 180 / 3600, 0.0),
+    "mrad/s": ("angular_rate", 1e-3, 0.0),
+    **{u: ("acceleration", 1.0, 0.0) for u in ("m/s^2", "m/s2", "m/s²", "mps2")},
+    "g": ("acceleration", _G, 0.0),
+    "mg": ("acceleration", _G * 1e-3, 0.0),
+    "gauss": ("magnetic", 1.0, 0.0),
+    "mgauss": ("magnetic", 1e-3, 0.0),
+    **{u: ("magnetic", 1e4, 0.0) for u in ("t", "tesla")},
+    "mt": ("magnetic", 10.0, 0.0),
+    **{u: ("magnetic", 1e-2, 0.0) for u in ("ut", "µt", "microtesla")},
+    "nt": ("magnetic", 1e-5, 0.0),
+    "deg": ("angle", 1.0, 0.0),
+    "rad": ("angle", 180 / math.pi, 0.0),
+    "1": ("unitless", 1.0, 0.0),
+    **{u: ("temperature", 1.0, 0.0) for u in ("degc", "c", "°c")},
+    "k": ("temperature", 1.0, -273.15),
+    "kpa": ("pressure", 1.0, 0.0),
+    "pa": ("pressure", 1e-3, 0.0),
+    **{u: ("pressure", 0.1, 0.0) for u in ("hpa", "mbar")},
+    "bar": ("pressure", 100.0, 0.0),
+    "m/s": ("velocity", 1.0, 0.0),
+    "s": ("time", 1.0, 0.0),
+    "ms": ("time", 1e-3, 0.0),
+    **{u: ("time", 1e-6, 0.0) for u in ("us", "µs")},
+    "ns": ("time", 1e-9, 0.0),
+}
+
+_FAMILY = {
+    "gyro": "angular_rate",
+    "accel": "acceleration",
+    "mag": "magnetic",
+    "ypr": "angle",
+    "quaternion": "unitless",
+    "temperature": "temperature",
+    "pressure": "pressure",
+    "delta_theta": "angle",
+    "delta_velocity": "velocity",
+    "time": "time",
+}
+
+# Header-name patterns, matched against the normalised name (lower case, separators
+# replaced by "_", unit suffix removed, a leading "field_" dropped).
+_AXES = "xyz"
+_VECTOR_PREFIXES = {
+    "gyro": ("gyro", "gyr", "gyroscope", "g", "w", "omega", "angular_velocity", "ang_vel"),
+    "accel": ("acc", "accel", "accelerometer", "acceleration", "a", "linear_acceleration"),
+    "mag": ("mag", "magnetometer", "m", "magnetic_field", "b"),
+}
+_TIME_NAMES = (
+    "time",
+    "timestamp",
+    "t",
+    "stamp",
+    "header_stamp",
+    "ros_t",
+    "bag_t",
+    "%time",
+    "time_s",
+    "time_ns",
+    "timestamp_ns",
+)
+_RAW_NAMES = ("raw", "sentence", "raw_imu_string", "vnymr")
+_SENTENCE = re.compile(r"\$VN[A-Z]{3}[,*]")
+
+_CHUNK_BYTES = 1 << 22
+
+
+def _normalise(name: str) -> tuple[str, str | None]:
+    """Normalised header name and the unit written in it (``gx [deg/s]``), if any."""
+    name = name.strip().strip('"').strip()
+    unit = None
+    m = re.match(r"^(.*?)\s*[\[(]([^\])]+)[\])]\s*$", name)
+    if m:
+        name, unit = m.group(1), m.group(2).strip()
+    norm = re.sub(r"[.\-\s/:]+", "_", name.lower()).strip("_")
+    if norm.startswith("field_"):
+        norm = norm[len("field_") :]
+    return norm, unit
+
+
+def _unit_factor(channel: str, unit: str) -> tuple[float, float]:
+    key = unit.strip().lower().replace(" ", "")
+    if key not in UNITS and channel == "mag" and key in ("g", "mg"):
+        key = {"g": "gauss", "mg": "mgauss"}[key]
+    if key not in UNITS:
+        raise ValueError(f"units[{channel!r}]: unknown unit {unit!r}; known units: {sorted(UNITS)}")
+    family, factor, offset = UNITS[key]
+    if family != _FAMILY[channel]:
+        raise ValueError(
+            f"units[{channel!r}]: {unit!r} is a unit of {family}, not of {_FAMILY[channel]}"
+        )
+    return factor, offset
+
+
+def _open(source) -> tuple[io.BufferedIOBase, int, str]:
+    if isinstance(source, bytes | bytearray | memoryview):
+        data = bytes(source)
+        return io.BytesIO(data), len(data), "<bytes>"
+    if isinstance(source, str | os.PathLike):
+        path = os.fspath(source)
+        return open(path, "rb"), os.path.getsize(path), path
+    raise TypeError(f"source must be a path or bytes; got {type(source).__name__}")
+
+
+def _lines(fh, total: int, progress: Callable[[int, int], None] | None):
+    """Yield (first_line_number, list_of_lines) chunks; lines without line endings."""
+    line_no = 1
+    rest = b""
+    done = 0
+    first = True
+    while True:
+        block = fh.read(_CHUNK_BYTES)
+        done += len(block)
+        if first:
+            if block.startswith(b"\xef\xbb\xbf"):
+                block = block[3:]
+            first = False
+        if not block:
+            if rest:
+                yield line_no, [rest.decode("latin-1").rstrip("\r")]
+            if progress is not None:
+                progress(done, total)
+            return
+        block = rest + block
+        cut = block.rfind(b"\n")
+        if cut < 0:
+            rest = block
+            continue
+        rest = block[cut + 1 :]
+        lines = block[:cut].decode("latin-1").split("\n")
+        yield line_no, [ln[:-1] if ln.endswith("\r") else ln for ln in lines]
+        line_no += len(lines)
+        if progress is not None:
+            progress(done, total)
+
+
+def _split(line: str, delimiter: str | None) -> list[str]:
+    if delimiter is None:
+        return line.split()
+    if '"' in line:
+        try:
+            return next(csv.reader([line], delimiter=delimiter))
+        except (csv.Error, StopIteration):
+            return line.split(delimiter)
+    return line.split(delimiter)
+
+
+def _is_number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
+def _auto_columns(names: list[str], raw_col: int | None) -> dict[str, list[int]]:
+    """Channel -> column indices from common header names."""
+    norm = [_normalise(n)[0] for n in names]
+    index = {n: i for i, n in reversed(list(enumerate(norm)))}
+    found: dict[str, list[int]] = {}
+    if raw_col is None:
+        for channel, prefixes in _VECTOR_PREFIXES.items():
+            for prefix in prefixes:
+                cols = [index.get(f"{prefix}_{ax}", index.get(f"{prefix}{ax}", -1)) for ax in _AXES]
+                if min(cols) >= 0:
+                    found[channel] = cols
+                    break
+        if all(n in index for n in ("yaw", "pitch", "roll")):
+            found["ypr"] = [index["yaw"], index["pitch"], index["roll"]]
+        for prefix in ("q", "quat", "quaternion", "orientation"):
+            cols = [index.get(f"{prefix}_{c}", index.get(f"{prefix}{c}", -1)) for c in "xyzw"]
+            if min(cols) >= 0:
+                found["quaternion"] = cols
+                break
+        for channel, options in (
+            ("temperature", ("temperature", "temp")),
+            ("pressure", ("pressure", "pres", "baro")),
+        ):
+            for opt in options:
+                if opt in index:
+                    found[channel] = [index[opt]]
+                    break
+    for opt in _TIME_NAMES:
+        if opt in index and index[opt] != raw_col:
+            found["time"] = [index[opt]]
+            break
+    return found
+
+
+def _resolve(spec, names: list[str] | None, ncols: int, what: str) -> int:
+    if isinstance(spec, bool) or not isinstance(spec, int | str | np.integer):
+        raise TypeError(f"{what}: a column is a name or a 0-based index; got {spec!r}")
+    if isinstance(spec, str):
+        if names is None:
+            raise ValueError(f"{what}: column {spec!r} given by name but the file has no header")
+        if spec in names:
+            return names.index(spec)
+        norm = [_normalise(n)[0] for n in names]
+        if _normalise(spec)[0] in norm:
+            return norm.index(_normalise(spec)[0])
+        raise ValueError(f"{what}: no column named {spec!r}; columns are {names}")
+    if not 0 <= int(spec) < ncols:
+        raise ValueError(f"{what}: column index {spec} outside 0..{ncols - 1}")
+    return int(spec)
+
+
+def read_csv(
+    source,
+    *,
+    strict: bool = False,
+    fs: float | None = None,
+    progress: Callable[[int, int], None] | None = None,
+    columns: Mapping[str, Sequence[int | str] | int | str] | None = None,
+    units: Mapping[str, str] | None = None,
+    delimiter: str | None = None,
+    time_column: int | str | None = None,
+) -> ImuLog:
+    """Read an IMU log from delimited text.
+
+    Parameters
+    ----------
+    source : str, os.PathLike or bytes
+        The file, or its contents.
+    strict : bool
+        Raise ``ValueError`` naming the line and the reason at the first data line
+        that does not parse, instead of counting it as ``malformed_field``.
+    fs : float, optional
+        Sample rate in Hz, used when the file has no time column.
+    progress : callable, optional
+        Called as ``progress(done_bytes, total_bytes)`` after each chunk read.
+    columns : mapping, optional
+        Channel -> columns, each a header name or a 0-based index, e.g.
+        ``{"gyro": ["gx", "gy", "gz"], "accel": [3, 4, 5], "time": "t"}``.
+        Channels are those of :data:`~imunoise.readers.log.CHANNELS` plus ``"time"``
+        and ``"raw"`` (a column of VN sentences). Default: recognised from the
+        header (``gyro_x``/``gx``/``wx``/``angular_velocity.x``, ``acc_x``/``ax``/
+        ``linear_acceleration.x``, ``mag_x``/``mx``, ``yaw``/``pitch``/``roll``,
+        ``qx..qw``, ``temperature``, ``pressure``, ``time``/``timestamp``/``t``/
+        ``stamp``/``ros_t``/``bag_t``), or a column holding ``$VN`` sentences.
+    units : mapping, optional
+        Channel -> unit of the file's values (see :data:`UNITS`), e.g.
+        ``{"gyro": "deg/s", "accel": "g", "mag": "uT", "time": "ns"}``. Default: a
+        unit written in the header (``gx [deg/s]``, ``acc_x (g)``), else the SI unit
+        of the channel; a time column whose median step exceeds 10^4 is taken as
+        nanoseconds.
+    delimiter : str, optional
+        Field separator. Default: ``,`` if the first line has one, else tab, else
+        ``;``, else runs of whitespace.
+    time_column : int or str, optional
+        Shortcut for ``columns["time"]``.
+
+    Returns
+    -------
+    ImuLog
+        ``format="csv"``; ``fs`` from the time column where present.
+
+    Notes
+    -----
+    Blank lines and ``#`` comment lines before the header are not data. A data line
+    with a different number of fields than the header (or first line), a field that
+    is not a number, or a non-finite value in a used column is ``malformed_field``.
+    Fields with quoted line breaks are not supported.
+    """
+    units = dict(units or {})
+    columns = dict(columns or {})
+    if time_column is not None:
+        columns["time"] = time_column
+    for ch in columns:
+        if ch not in CHANNELS and ch not in ("time", "raw"):
+            raise ValueError(
+                f"columns: unknown channel {ch!r}; use {list(CHANNELS) + ['time', 'raw']}"
+            )
+    for ch in units:
+        if ch not in _FAMILY:
+            raise ValueError(f"units: unknown channel {ch!r}; use {list(_FAMILY)}")
+    if delimiter is not None and (not isinstance(delimiter, str) or len(delimiter) != 1):
+        raise ValueError(f"delimiter must be one character or None; got {delimiter!r}")
+
+    fh, total, name = _open(source)
+    tally = IssueTally()
+    with fh:
+        chunks = _lines(fh, total, progress)
+        state = _Reader(name, strict, columns, units, delimiter, tally)
+        state.total = total
+        for first_line, lines in chunks:
+            state.feed(first_line, lines)
+    return state.finish(fs)
+
+
+class _Reader:
+    """Streaming state of one :func:`read_csv` call."""
+
+    def __init__(self, name, strict, columns, units, delimiter, tally):
+        self.name = name
+        self.strict = strict
+        self.user_columns = columns
+        self.user_units = units
+        self.delimiter = delimiter
+        self.tally = tally
+        self.layout_done = False
+        self.numeric: dict[str, list[int]] = {}
+        self.raw_col: int | None = None
+        self.buf: np.ndarray | None = None  # (capacity, used numeric columns), grown as needed
+        self.total = 0
+        self.raw_items: list[bytes] = []  # VN fields of the current chunk
+        self.raw_lines: list[int] = []
+        self.vn_parts: list[dict[str, np.ndarray]] = []
+        self.vn_time: list[np.ndarray | None] = []
+        self.messages: dict[str, int] = {}
+        self.rows = 0
+
+    # -- layout -------------------------------------------------------------------
+    def _layout(self, line: str, line_no: int, next_line: str | None) -> bool:
+        """Decide delimiter, header and columns from the first data line.
+
+        Returns True when ``line`` was a header (and so is not data).
+        """
+        if self.delimiter is None:
+            for d in (",", "\t", ";"):
+                if d in line:
+                    self.delimiter = d
+                    break
+        fields = _split(line, self.delimiter)
+        header = any(
+            not _is_number(f) and "$VN" not in f and re.match(r"\s*[A-Za-z_%\"]", f) is not None
+            for f in fields
+        )
+        names = [f.strip() for f in fields] if header else None
+        self.ncols = len(fields)
+        sample = line if not header else next_line
+        sample_fields = _split(sample, self.delimiter) if sample is not None else []
+
+        cols = self.user_columns
+        explicit = any(ch in CHANNELS for ch in cols)
+        auto = _auto_columns(names, None) if names is not None and not explicit else {}
+        raw_col = None
+        if "raw" in cols:
+            raw_col = _resolve(cols["raw"], names, self.ncols, "columns['raw']")
+        elif not explicit:
+            taken = {i for idx in auto.values() for i in idx}
+            for i, f in enumerate(sample_fields[: self.ncols]):
+                if i not in taken and _SENTENCE.search(f):
+                    raw_col = i
+                    break
+            if raw_col is None and names is not None:
+                norm = [_normalise(n)[0] for n in names]
+                for opt in _RAW_NAMES:
+                    i = norm.index(opt) if opt in norm else -1
+                    if (
+                        i >= 0
+                        and i not in taken
+                        and not (i < len(sample_fields) and _is_number(sample_fields[i]))
+                    ):
+                        raw_col = i
+                        break
+        numeric: dict[str, list[int]] = {}
+        header_units: dict[str, str] = {}
+        if names is not None and not explicit:
+            numeric = auto if raw_col is None else _auto_columns(names, raw_col)
+        elif names is not None and "time" not in cols:
+            time_auto = _auto_columns(names, raw_col).get("time")
+            if time_auto is not None:
+                numeric["time"] = time_auto
+        for ch, spec in cols.items():
+            if ch == "raw":
+                continue
+            specs = [spec] if isinstance(spec, int | str | np.integer) else list(spec)
+            want = 1 if ch == "time" else CHANNELS[ch][0]
+            if len(specs) != want:
+                raise ValueError(f"columns[{ch!r}] needs {want} column(s); got {spec!r}")
+            numeric[ch] = [_resolve(s, names, self.ncols, f"columns[{ch!r}]") for s in specs]
+        if names is not None:
+            for ch, idx in numeric.items():
+                unit = _normalise(names[idx[0]])[1]
+                if unit is not None and ch not in self.user_units:
+                    header_units[ch] = unit
+        if not numeric and raw_col is None:
+            raise ValueError(
+                f"{self.name}: no IMU columns recognised in "
+                f"{names if names is not None else f'{self.ncols} unnamed columns'}; "
+                "pass columns={'gyro': [...], ...}"
+            )
+        self.numeric = numeric
+        self.raw_col = raw_col
+        self.names = names
+        self.used = sorted({i for idx in numeric.values() for i in idx})
+        self.pos = {i: k for k, i in enumerate(self.used)}
+        self.conv = {}
+        for ch in numeric:
+            unit = self.user_units.get(ch, header_units.get(ch))
+            self.conv[ch] = None if unit is None else _unit_factor(ch, unit)
+        self.layout_done = True
+        return header
+
+    # -- rows -----------------------------------------------------------------------
+    def _bad(self, line_no: int, reason: str) -> None:
+        if self.strict:
+            if self.raw_items:  # a bad sentence on an earlier line is reported first
+                sentence_rows(
+                    self.raw_items, self.raw_lines, self.tally, strict=True, source=self.name
+                )
+            raise ValueError(f"{self.name}: line {line_no}: {reason}")
+        self.tally.add("malformed_field", line_no)
+
+    def feed(self, first_line: int, lines: list[str]) -> None:
+        start = 0
+        if not self.layout_done:
+            while start < len(lines) and (
+                not lines[start].strip() or lines[start].lstrip().startswith("#")
+            ):
+                start += 1
+            if start == len(lines):
+                return
+            nxt = next((ln for ln in lines[start + 1 :] if ln.strip()), None)
+            if self._layout(lines[start], first_line + start, nxt):
+                start += 1
+        if self.raw_col is None and self._fast(first_line, lines, start):
+            return
+        self._slow(first_line, lines, start)
+
+    def _fast(self, first_line: int, lines: list[str], start: int) -> bool:
+        """Whole-chunk numeric parse; False sends the chunk to the line-by-line path."""
+        body = lines[start:]
+        line_idx = np.array([i for i, ln in enumerate(body) if ln.strip()], dtype=np.int64)
+        if not len(line_idx):
+            return True
+        text = "\n".join(body)
+        if self.delimiter is not None and '"' not in text:
+            if text.count(self.delimiter) != len(line_idx) * (self.ncols - 1):
+                return False
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("error")
+                arr = np.loadtxt(
+                    io.StringIO(text),
+                    delimiter=self.delimiter,
+                    dtype=np.float64,
+                    comments=None,
+                    ndmin=2,
+                    quotechar='"' if self.delimiter is not None else None,
+                )
+        except (ValueError, UserWarning):
+            return False
+        if arr.shape != (len(line_idx), self.ncols):
+            return False
+        arr = arr[:, self.used]
+        if not np.isfinite(arr).all():
+            return False
+        self._append(arr, len(text))
+        return True
+
+    def _slow(self, first_line: int, lines: list[str], start: int) -> None:
+        out = np.empty((len(lines) - start, len(self.used)), dtype=np.float64)
+        keep_lines = []
+        n = 0
+        for k in range(start, len(lines)):
+            line = lines[k]
+            if not line.strip():
+                continue
+            line_no = first_line + k
+            fields = _split(line, self.delimiter)
+            if len(fields) != self.ncols:
+                self._bad(line_no, f"{len(fields)} fields, expected {self.ncols}")
+                continue
+            row = out[n]
+            ok = True
+            for j, col in enumerate(self.used):
+                text = fields[col].strip()
+                try:
+                    value = float(text)
+                except ValueError:
+                    self._bad(line_no, f"column {col + 1} is not a number: {text[:40]!r}")
+                    ok = False
+                    break
+                if not math.isfinite(value):
+                    self._bad(line_no, f"column {col + 1} is not finite: {text[:40]!r}")
+                    ok = False
+                    break
+                row[j] = value
+            if not ok:
+                continue
+            if self.raw_col is not None:
+                self.raw_items.append(fields[self.raw_col].encode("latin-1"))
+                self.raw_lines.append(line_no)
+            keep_lines.append(line_no)
+            n += 1
+        out = out[:n].copy()
+        if self.raw_col is not None:
+            rows = sentence_rows(
+                self.raw_items, self.raw_lines, self.tally, strict=self.strict, source=self.name
+            )
+            self.raw_items, self.raw_lines = [], []
+            out = out[rows.kept]
+            self.vn_parts.append(rows.channels)
+            self.vn_time.append(rows.time)
+            for key, count in rows.messages.items():
+                self.messages[key] = self.messages.get(key, 0) + count
+        self._append(out, sum(len(ln) + 1 for ln in lines))
+
+    # -- result ---------------------------------------------------------------------
+    def _append(self, rows: np.ndarray, chunk_chars: int) -> None:
+        """Copy a chunk's rows into one buffer sized from the file size (memory ~ output)."""
+        need = self.rows + len(rows)
+        if self.buf is None or need > len(self.buf):
+            per_char = max(len(rows), 1) / max(chunk_chars, 1)
+            estimate = int(per_char * self.total * 1.02) + 16
+            cap = max(need, estimate if self.buf is None else int(len(self.buf) * 1.5))
+            buf = np.empty((cap, len(self.used)), dtype=np.float64)
+            if self.buf is not None:
+                buf[: self.rows] = self.buf[: self.rows]
+            self.buf = buf
+        self.buf[self.rows : need] = rows
+        self.rows = need
+
+    def finish(self, fs: float | None) -> ImuLog:
+        if not self.layout_done:
+            raise ValueError(f"{self.name}: no data lines")
+        data = self.buf[: self.rows] if self.buf is not None else np.zeros((0, len(self.used)))
+        if self.buf is not None and len(self.buf) > 1.1 * self.rows + 16:
+            data = data.copy()  # do not keep a much larger buffer alive through views
+        self.buf = None
+        channels: dict[str, np.ndarray] = {}
+        messages: dict[str, int] = dict(self.messages)
+        time = None
+        vn_time = None
+        if self.raw_col is not None:
+            parts = [p for p in self.vn_parts if p]
+            for name in parts[0] if parts else ():
+                channels[name] = np.concatenate([p[name] for p in parts])
+            times = [t for p, t in zip(self.vn_parts, self.vn_time, strict=True) if p]
+            if times and all(t is not None for t in times):
+                vn_time = np.concatenate(times)
+            self.vn_parts = []
+        else:
+            messages["csv"] = len(data)
+        for ch, idx in self.numeric.items():
+            pos = [self.pos[i] for i in idx]
+            if pos == list(range(pos[0], pos[0] + len(pos))):
+                values = data[:, pos[0] : pos[0] + len(pos)]  # a view: no copy
+            else:
+                values = data[:, pos]
+            conv = self.conv[ch]
+            if ch == "time":
+                t = values[:, 0]
+                if conv is None and len(t) > 1 and np.median(np.abs(np.diff(t))) > 1e4:
+                    conv = UNITS["ns"][1:]
+                if conv is not None:
+                    t = t * conv[0] + conv[1]
+                time = t
+                continue
+            if conv is not None:
+                values = values * conv[0] + conv[1]
+            channels[ch] = values[:, 0] if CHANNELS[ch][0] == 1 else values
+        if time is None:
+            time = vn_time
+        issues = self.tally.issues("line")
+        return ImuLog(
+            fs=resolve_fs(time, fs, self.name),
+            source=self.name,
+            format="csv",
+            issues=issues,
+            time=time,
+            messages=messages,
+            **channels,
+        )

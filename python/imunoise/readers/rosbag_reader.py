@@ -1,0 +1,413 @@
+"""ROS bags: ROS 1 ``.bag``, ROS 2 sqlite3 ``.db3`` and MCAP, through ``rosbags``.
+
+:func:`read_rosbag` reads one IMU topic into an :class:`~imunoise.readers.log.ImuLog`:
+
+* ``sensor_msgs/msg/Imu``: gyro (rad/s), accel (m/s²), orientation quaternion
+  (x, y, z, w; left out when the driver marks it absent with covariance[0] = -1 or
+  sends zeros), time from ``header.stamp``. A single ``sensor_msgs/msg/MagneticField``
+  topic with the same stamps is merged in as ``mag`` (Tesla -> Gauss).
+* ``sensor_msgs/msg/MagneticField`` alone (``topic=`` it, or when it is the only one).
+* Any message type with a string field carrying a raw VN-100 sentence (the usual
+  lab-driver format, e.g. ``vn_driver/msg/Vectornav`` with ``string raw``): the
+  sentence is decoded by the VN parser and wins over any parsed fields of the same
+  message; time from the message's ``header.stamp``, else the bag's receive time.
+
+Custom message types are registered from the definitions stored in the bag (MCAP
+schemas, ROS 1 connection headers, ROS 2 ``message_definitions`` where the bag has
+them), so the original message packages are not needed. A ROS 2 ``.db3`` written
+before Iron carries no definitions: pass ``msg_defs={"pkg/msg/Type": "<.msg text>"}``
+(or a ready ``typestore``). Without either, a topic of unknown type is still read when
+its serialized messages contain ``$VN`` sentences: the sentence is cut out of the
+message bytes and the bag's receive time is used (with a warning).
+
+Issue locations are 1-based message numbers on the topic (``issues.location ==
+"message"``).
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+import warnings
+from collections.abc import Callable, Mapping
+from pathlib import Path
+
+import numpy as np
+
+from imunoise.readers._sentences import IssueTally, sentence_rows
+from imunoise.readers.log import ImuLog, resolve_fs
+
+__all__ = ["read_rosbag"]
+
+IMU = "sensor_msgs/msg/Imu"
+MAG = "sensor_msgs/msg/MagneticField"
+TESLA_TO_GAUSS = 1e4
+_BATCH = 20_000  # messages per call of the VN parser
+
+_MAGIC = {b"#ROSBAG": ".bag", b"\x89MCAP": ".mcap", b"SQLite format 3": ".db3"}
+
+
+def _typestore(typestore, msg_defs: Mapping[str, str] | None):
+    from rosbags.typesys import Stores, get_types_from_msg, get_typestore
+
+    store = typestore if typestore is not None else get_typestore(Stores.LATEST)
+    if msg_defs:
+        types = {}
+        for name, text in msg_defs.items():
+            if not isinstance(text, str):
+                raise TypeError(f"msg_defs[{name!r}] must be .msg text; got {type(text).__name__}")
+            types.update(get_types_from_msg(text, name))
+        store.register(types)
+    return store
+
+
+def _find_vn_field(msg, path=()) -> tuple[str, ...] | None:
+    """Attribute path of the first string field holding ``$VN`` in a decoded message."""
+    fields = getattr(msg, "__dataclass_fields__", None)
+    if fields is None:
+        return None
+    for name in fields:
+        value = getattr(msg, name, None)
+        if isinstance(value, str) and "$VN" in value:
+            return (*path, name)
+        if hasattr(value, "__msgtype__"):
+            found = _find_vn_field(value, (*path, name))
+            if found:
+                return found
+    return None
+
+
+def _cut_sentence(raw: bytes) -> bytes:
+    """The printable run starting at ``$VN`` in serialized message bytes (b"" if none)."""
+    start = raw.find(b"$VN")
+    if start < 0:
+        return b""
+    end = start
+    while end < len(raw) and 0x20 <= raw[end] < 0x7F:
+        end += 1
+    return raw[start:end]
+
+
+def _stamp(msg) -> int:
+    header = getattr(msg, "header", None) or getattr(msg, "Header", None)
+    stamp = getattr(header, "stamp", None)
+    if stamp is None:
+        return 0
+    return int(stamp.sec) * 1_000_000_000 + int(stamp.nanosec)
+
+
+def read_rosbag(
+    source,
+    *,
+    strict: bool = False,
+    fs: float | None = None,
+    progress: Callable[[int, int], None] | None = None,
+    topic: str | None = None,
+    msg_defs: Mapping[str, str] | None = None,
+    typestore=None,
+) -> ImuLog:
+    """Read the IMU topic of a ROS 1, ROS 2 (sqlite3) or MCAP bag.
+
+    Parameters
+    ----------
+    source : str, os.PathLike or bytes
+        A ``.bag``, ``.mcap`` or ``.db3`` file, or a ROS 2 bag directory (with its
+        ``metadata.yaml``); bytes are written to a temporary file first.
+    strict : bool
+        Raise ``ValueError`` naming the message number at the first message that
+        does not decode, instead of counting it.
+    fs : float, optional
+        Sample rate used when the topic carries no usable timestamps.
+    progress : callable, optional
+        Called as ``progress(done, total)`` in bytes (estimated from messages read).
+    topic : str, optional
+        The topic to read. Default: the one topic carrying VN sentences, else the
+        one ``sensor_msgs/msg/Imu`` topic, else the one ``MagneticField`` topic.
+    msg_defs : mapping, optional
+        Message type -> ``.msg`` definition text, for bags that do not embed their
+        definitions (ROS 2 ``.db3`` before Iron). Nested types must be given too
+        unless they are standard ROS types.
+    typestore : rosbags.typesys.store.Typestore, optional
+        A typestore that already knows the bag's types (used as the default).
+
+    Returns
+    -------
+    ImuLog
+        ``format="rosbag"``; ``messages`` counts the decoded records by type and
+        lists the topics that were not read as ``"ignored <topic> [<type>]"``.
+    """
+    from rosbags.highlevel import AnyReader, AnyReaderError
+
+    if isinstance(source, bytes | bytearray | memoryview):
+        data = bytes(source)
+        suffix = next((s for m, s in _MAGIC.items() if data.startswith(m)), None)
+        if suffix is None:
+            raise ValueError("source: bytes are not a ROS 1 bag, an MCAP file or a sqlite3 bag")
+        with tempfile.TemporaryDirectory() as tmp:
+            path = Path(tmp) / f"bag{suffix}"
+            path.write_bytes(data)
+            log = read_rosbag(
+                path,
+                strict=strict,
+                fs=fs,
+                progress=progress,
+                topic=topic,
+                msg_defs=msg_defs,
+                typestore=typestore,
+            )
+        return _with_source(log, "<bytes>")
+    if not isinstance(source, str | os.PathLike):
+        raise TypeError(f"source must be a path or bytes; got {type(source).__name__}")
+    path = Path(source)
+    if not path.exists():
+        raise FileNotFoundError(f"source: no such bag {str(path)!r}")
+    name = str(path)
+    total = (
+        sum(p.stat().st_size for p in path.iterdir() if p.is_file())
+        if path.is_dir()
+        else path.stat().st_size
+    )
+
+    default = _typestore(typestore, msg_defs) if (typestore or msg_defs) else None
+    try:
+        reader = AnyReader([path], default_typestore=default)
+        reader.open()
+    except AnyReaderError as exc:
+        if default is not None or "type definitions" not in str(exc):
+            raise ValueError(f"{name}: cannot open bag: {exc}") from exc
+        reader = AnyReader([path], default_typestore=_typestore(None, None))
+        reader.open()
+    try:
+        return _read(reader, name, total, strict, fs, progress, topic)
+    finally:
+        reader.close()
+
+
+def _with_source(log: ImuLog, source: str) -> ImuLog:
+    from dataclasses import replace
+
+    return replace(log, source=source)
+
+
+def _read(reader, name, total, strict, fs, progress, topic) -> ImuLog:
+    known = reader.typestore.fielddefs
+    topics: dict[str, list] = {}
+    for conn in reader.connections:
+        topics.setdefault(conn.topic, []).append(conn)
+
+    def first_message(conns):
+        for conn, _t, raw in reader.messages(connections=conns):
+            return conn, raw
+        return None, None
+
+    kinds: dict[str, tuple[str, tuple[str, ...] | None]] = {}
+    for tp, conns in topics.items():
+        msgtype = conns[0].msgtype
+        if msgtype == IMU:
+            kinds[tp] = ("imu", None)
+        elif msgtype == MAG:
+            kinds[tp] = ("mag", None)
+        else:
+            conn, raw = first_message(conns)
+            if raw is None:
+                kinds[tp] = ("other", None)
+            elif msgtype in known:
+                try:
+                    field = _find_vn_field(reader.deserialize(raw, msgtype))
+                except Exception:  # a message that does not decode is not a VN topic
+                    field = None
+                kinds[tp] = ("vn", field) if field else ("other", None)
+            else:
+                kinds[tp] = ("vn-bytes", None) if b"$VN" in raw else ("other", None)
+
+    if topic is not None:
+        if topic not in topics:
+            raise ValueError(f"topic: {topic!r} is not in the bag; topics are {sorted(topics)}")
+        chosen = topic
+    else:
+        chosen = None
+        for group in (("vn", "vn-bytes"), ("imu",), ("mag",)):
+            cands = sorted(tp for tp, (k, _f) in kinds.items() if k in group)
+            if len(cands) > 1:
+                raise ValueError(f"{name}: several IMU topics {cands}; choose one with topic=")
+            if cands:
+                chosen = cands[0]
+                break
+        if chosen is None:
+            listing = {tp: conns[0].msgtype for tp, conns in topics.items()}
+            raise ValueError(
+                f"{name}: no IMU topic (sensor_msgs/msg/Imu, MagneticField or a message "
+                f"with a $VN sentence); topics are {listing}"
+            )
+    kind, field = kinds[chosen]
+    if kind == "other":
+        msgtype = topics[chosen][0].msgtype
+        if msgtype not in known:
+            raise ValueError(
+                f"{name}: topic {chosen!r} has type {msgtype!r}, whose definition is not "
+                "in the bag; pass msg_defs={type: '.msg text'}"
+            )
+        raise ValueError(
+            f"{name}: topic {chosen!r} ({msgtype}) is neither sensor_msgs Imu/MagneticField "
+            "nor a message with a $VN sentence"
+        )
+
+    count_all = sum(c.msgcount for conns in topics.values() for c in conns) or 1
+    done = [0]
+
+    def tick():
+        done[0] += 1
+        if progress is not None and done[0] % 1000 == 0:
+            progress(int(total * done[0] / count_all), total)
+
+    tally = IssueTally()
+    channels: dict[str, np.ndarray] = {}
+    messages: dict[str, int] = {}
+    merged_mag = None
+    if kind in ("imu", "mag"):
+        stamps, values = _read_sensor(reader, topics[chosen], kind, tally, strict, name, tick)
+        if kind == "imu":
+            gyro, accel, quat, has_quat = values
+            channels.update(gyro=gyro, accel=accel)
+            if has_quat:
+                channels["quaternion"] = quat
+            mags = [tp for tp, (k, _f) in kinds.items() if k == "mag"]
+            if topic is None and len(mags) == 1:
+                mstamps, (mag,) = _read_sensor(
+                    reader, topics[mags[0]], "mag", IssueTally(), False, name, lambda: None
+                )
+                if len(mstamps) == len(stamps) and np.array_equal(mstamps, stamps):
+                    channels["mag"] = mag
+                    merged_mag = mags[0]
+        else:
+            channels["mag"] = values[0]
+        messages[topics[chosen][0].msgtype] = len(stamps)
+        if merged_mag:
+            messages[MAG] = len(stamps)
+        time_ns = stamps
+    else:
+        items, stamps, locs = [], [], []
+        parts: list[dict[str, np.ndarray]] = []
+        kept_ns: list[np.ndarray] = []
+
+        def flush():
+            # sentences are decoded in batches so that no Python object per message
+            # outlives its batch
+            rows = sentence_rows(items, locs, tally, strict=strict, source=name, where="message")
+            if rows.channels:
+                parts.append(rows.channels)
+                kept_ns.append(np.asarray(stamps, dtype=np.int64)[rows.kept])
+            for key, count in rows.messages.items():
+                messages[key] = messages.get(key, 0) + count
+            items.clear()
+            stamps.clear()
+            locs.clear()
+
+        msgtype = topics[chosen][0].msgtype
+        for number, (_conn, t, raw) in enumerate(
+            reader.messages(connections=topics[chosen]), start=1
+        ):
+            tick()
+            if kind == "vn-bytes":
+                items.append(_cut_sentence(raw))
+                stamps.append(t)
+            else:
+                try:
+                    msg = reader.deserialize(raw, msgtype)
+                except Exception as exc:
+                    if strict:
+                        flush()  # a bad sentence in an earlier message is reported first
+                        raise ValueError(
+                            f"{name}: message {number}: does not decode: {exc}"
+                        ) from exc
+                    tally.add("malformed_field", number)
+                    continue
+                value = msg
+                for attr in field:
+                    value = getattr(value, attr, "")
+                items.append(value.encode("latin-1", "replace") if isinstance(value, str) else b"")
+                stamps.append(_stamp(msg) or t)
+            locs.append(number)
+            if len(items) >= _BATCH:
+                flush()
+        flush()
+        if kind == "vn-bytes":
+            warnings.warn(
+                f"{name}: topic {chosen!r} has type {msgtype!r} with no definition in the bag; "
+                "VN sentences were cut out of the message bytes and the bag receive time is "
+                "used (pass msg_defs= to use the message header stamps)",
+                stacklevel=3,
+            )
+        for ch in parts[0] if parts else ():
+            channels[ch] = np.concatenate([p[ch] for p in parts])
+        time_ns = np.concatenate(kept_ns) if kept_ns else np.zeros(0, dtype=np.int64)
+
+    for tp, conns in topics.items():
+        if tp != chosen and tp != merged_mag:
+            key = f"ignored {tp} [{conns[0].msgtype}]"
+            messages[key] = sum(c.msgcount for c in conns)
+    if progress is not None:
+        progress(total, total)
+    time = None
+    if len(time_ns) and np.all(time_ns > 0):
+        sec0 = int(time_ns[0]) // 1_000_000_000
+        time = sec0 + (time_ns - sec0 * 1_000_000_000) * 1e-9
+    return ImuLog(
+        fs=resolve_fs(time, fs, name),
+        source=name,
+        format="rosbag",
+        issues=tally.issues("message"),
+        time=time,
+        messages=messages,
+        **channels,
+    )
+
+
+def _read_sensor(reader, conns, kind, tally, strict, name, tick):
+    """Stamps (ns) and arrays of an Imu or MagneticField topic."""
+    n = sum(c.msgcount for c in conns)
+    stamps = np.zeros(n, dtype=np.int64)
+    width = 10 if kind == "imu" else 3
+    out = np.zeros((n, width), dtype=np.float64)
+    quat_flag = np.zeros(n, dtype=bool)
+    k = 0
+    msgtype = conns[0].msgtype
+    for number, (_conn, t, raw) in enumerate(reader.messages(connections=conns), start=1):
+        tick()
+        try:
+            msg = reader.deserialize(raw, msgtype)
+            if kind == "imu":
+                w, a, q = msg.angular_velocity, msg.linear_acceleration, msg.orientation
+                row = (w.x, w.y, w.z, a.x, a.y, a.z, q.x, q.y, q.z, q.w)
+                has_q = float(msg.orientation_covariance[0]) != -1.0 and any(
+                    v != 0 for v in row[6:]
+                )
+            else:
+                m = msg.magnetic_field
+                row = (m.x * TESLA_TO_GAUSS, m.y * TESLA_TO_GAUSS, m.z * TESLA_TO_GAUSS)
+                has_q = False
+            values = np.asarray(row, dtype=np.float64)
+        except Exception as exc:
+            if strict:
+                raise ValueError(f"{name}: message {number}: does not decode: {exc}") from exc
+            tally.add("malformed_field", number)
+            continue
+        used = values[:6] if kind == "imu" else values
+        if not np.isfinite(used).all():
+            if strict:
+                raise ValueError(f"{name}: message {number}: non-finite value")
+            tally.add("malformed_field", number)
+            continue
+        if k >= n:  # msgcount was short: grow
+            stamps = np.concatenate([stamps, np.zeros_like(stamps)])
+            out = np.concatenate([out, np.zeros_like(out)])
+            quat_flag = np.concatenate([quat_flag, np.zeros_like(quat_flag)])
+        out[k] = values
+        stamps[k] = _stamp(msg) or t
+        quat_flag[k] = has_q
+        k += 1
+    stamps, out, quat_flag = stamps[:k], out[:k], quat_flag[:k]
+    if kind == "mag":
+        return stamps, (out,)
+    has_quat = bool(k) and bool(quat_flag.all())
+    return stamps, (out[:, 0:3], out[:, 3:6], out[:, 6:10], has_quat)
