@@ -7,6 +7,7 @@
 pub mod allan;
 pub mod error;
 pub mod fit;
+pub mod vn;
 
 #[cfg(feature = "python")]
 mod bindings;

@@ -11,6 +11,8 @@ from imunoise.allan import AllanResult, adev, hdev, mdev, tdev, totdev
 from imunoise.datasheet import compare
 from imunoise.noise import NoiseModel, fit
 from imunoise.readers import ImuLog, ParseIssues
+from imunoise.readers.read import read
+from imunoise.readers.vn_write import write_vn_ascii, write_vn_binary
 from imunoise.simulate import simulate
 from imunoise.stats import describe, distribution
 
@@ -30,5 +32,8 @@ __all__ = [
     "simulate",
     "tdev",
     "totdev",
+    "read",
+    "write_vn_ascii",
+    "write_vn_binary",
     "units",
 ]

@@ -1,6 +1,10 @@
 # Hand-written stub of the Rust extension `imunoise._core`; keep it in step with
 # rust/bindings/. Arrays are numpy arrays; shapes are in the docstrings.
 
+import os
+from collections.abc import Callable
+from typing import Any
+
 import numpy as np
 import numpy.typing as npt
 
@@ -26,6 +30,45 @@ def estimator_terms(
 ) -> npt.NDArray[np.uint64]:
     """Terms each averaging factor's estimate averages (0: the tau does not fit)."""
 
+# --- VectorNav parsing and writing (rust/bindings/vn.rs) ------------------------------
+
+def parse_vn(
+    source: bytes | str | os.PathLike[str],
+    strict: bool = False,
+    progress: Callable[[int, int], object] | None = None,
+) -> dict[str, Any]:
+    """Decode a VN byte stream (bytes, or a path read in chunks) with the GIL released.
+
+    Keys: ``tables`` {message: {column: float64 array}}, ``messages`` {message: count},
+    ``issues`` {kind: count}, ``first`` {kind: [(byte_offset, line), ...]},
+    ``bytes_total``, ``bytes_parsed``, ``bytes_in_bad_records``, ``bytes_skipped``,
+    ``ascii_records``, ``binary_records``. ``progress(done, total)`` after every chunk.
+    """
+
+def vn_message_fields() -> dict[str, list[str]]:
+    """Field names, in order, of every decoded ASCII message type."""
+
+def vn_binary_fields() -> dict[str, tuple[int, dict[str, int]]]:
+    """Group name -> (group index, {field name: field number}) for decodable groups."""
+
+def vn_binary_columns(selection: list[tuple[int, int]]) -> tuple[list[str], str]:
+    """(column names in payload order, table name) for a (group, field mask) selection."""
+
+def write_vn_ascii(
+    message: str,
+    columns: list[npt.NDArray[np.float64]],
+    decimals: list[int] | None = None,
+    count: npt.NDArray[np.float64] | None = None,
+    status: npt.NDArray[np.float64] | None = None,
+    crc: bool = False,
+    eol: bytes = b"\r\n",
+) -> bytes:
+    """Sentences of ``message`` from columns in field order (XOR-8 or CRC-16)."""
+
+def write_vn_binary(
+    selection: list[tuple[int, int]], columns: dict[str, npt.NDArray[np.float64]]
+) -> bytes:
+    """Binary packets for ``selection`` from columns named as in vn_binary_columns."""
 def fit_wls(
     taus: npt.NDArray[np.float64],
     var: npt.NDArray[np.float64],

@@ -9,6 +9,7 @@ use crate::error::CoreError;
 
 mod allan;
 mod fit;
+mod vn;
 
 impl From<CoreError> for PyErr {
     fn from(err: CoreError) -> PyErr {
@@ -23,6 +24,7 @@ impl From<CoreError> for PyErr {
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     allan::register(m)?;
+    vn::register(m)?;
     fit::register(m)?;
     Ok(())
 }

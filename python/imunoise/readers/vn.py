@@ -1,0 +1,228 @@
+"""VectorNav VN-100 logs: ASCII sentences and binary packets, decoded in Rust.
+
+The Rust reader walks the byte stream once (ASCII and binary may be interleaved,
+with noise between records), checks every XOR-8 checksum and CRC-16, and returns
+one column table per message type. This module turns those tables into an
+:class:`~imunoise.readers.log.ImuLog`.
+
+Several message types in one stream
+-----------------------------------
+Each message type is decoded into its own table (``$VNYMR``, ``$VNIMU``, one per
+binary output configuration ...). ``ImuLog.messages`` counts the records of every
+type; the channels of the ``ImuLog`` come from *one* table, the richest one: the
+table that fills the most channels (gyro, accel, mag, ypr, quaternion,
+temperature, pressure, delta-theta/velocity), ties broken by the number of
+records. All tables, with every column, are available from :func:`read_vn_tables`.
+
+Units are the sensor's (spec §3.1, §5.3), which are already those of
+:data:`~imunoise.readers.log.CHANNELS`: gyro rad/s, accel m/s², mag Gauss, yaw/
+pitch/roll deg, temperature °C, pressure kPa, delta-theta deg, delta-velocity m/s.
+Where a message carries compensated and uncompensated values, the compensated
+ones are used. ``time`` is the binary ``TimeStartup`` (s since power-up) when a
+packet carries it; ASCII sentences carry no timestamps.
+"""
+
+from __future__ import annotations
+
+import errno
+import os
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from types import MappingProxyType
+
+import numpy as np
+
+from imunoise import _core
+from imunoise.readers.log import ISSUE_KINDS, ImuLog, ParseIssues, resolve_fs
+
+#: channel -> candidate column triples (compensated first), names without group prefix.
+_CHANNEL_COLUMNS: Mapping[str, tuple[tuple[str, ...], ...]] = {
+    "gyro": (("gyro_x", "gyro_y", "gyro_z"), ("uncomp_gyro_x", "uncomp_gyro_y", "uncomp_gyro_z")),
+    "accel": (
+        ("accel_x", "accel_y", "accel_z"),
+        ("uncomp_accel_x", "uncomp_accel_y", "uncomp_accel_z"),
+    ),
+    "mag": (("mag_x", "mag_y", "mag_z"), ("uncomp_mag_x", "uncomp_mag_y", "uncomp_mag_z")),
+    "ypr": (("yaw", "pitch", "roll"),),
+    "quaternion": (("qx", "qy", "qz", "qw"),),
+    "temperature": (("temperature",),),
+    "pressure": (("pressure",),),
+    "delta_theta": (("delta_theta_x", "delta_theta_y", "delta_theta_z"),),
+    "delta_velocity": (("delta_vel_x", "delta_vel_y", "delta_vel_z"),),
+}
+_GROUPS = ("common", "imu", "attitude", "time")
+
+
+@dataclass(frozen=True)
+class VnTables:
+    """Everything the VN reader decoded, before choosing channels.
+
+    Attributes
+    ----------
+    tables : Mapping[str, Mapping[str, np.ndarray]]
+        Per message type (``"VNYMR"``, ``"VNERR"``, ``"binary_143e003a00"`` ...)
+        the float64 columns by field name; binary column names are qualified by
+        group (``"common.yaw"``, ``"imu.uncomp_gyro_x"``).
+    messages : Mapping[str, int]
+        Records per message type, including command responses (``"VNRRG"``).
+    issues : ParseIssues
+        Skipped records and bytes; ``first`` holds line numbers when the stream
+        is mostly ASCII, byte offsets otherwise.
+    bytes_total, bytes_parsed, bytes_in_bad_records, bytes_skipped : int
+        Byte accounting: ``bytes_parsed + bytes_in_bad_records + bytes_skipped ==
+        bytes_total`` for every input.
+    ascii_records, binary_records : int
+        Decoded records of each framing.
+    """
+
+    tables: Mapping[str, Mapping[str, np.ndarray]]
+    messages: Mapping[str, int]
+    issues: ParseIssues
+    bytes_total: int
+    bytes_parsed: int
+    bytes_in_bad_records: int
+    bytes_skipped: int
+    ascii_records: int
+    binary_records: int
+
+    @property
+    def format(self) -> str:
+        """``"vn-binary"`` if binary packets outnumber sentences, else ``"vn-ascii"``."""
+        return "vn-binary" if self.binary_records > self.ascii_records else "vn-ascii"
+
+
+def _source_arg(source) -> bytes | str:
+    if isinstance(source, (bytes, bytearray, memoryview)):
+        return bytes(source)
+    if isinstance(source, (str, os.PathLike)):
+        path = os.fspath(source)
+        if not os.path.exists(path):
+            raise FileNotFoundError(errno.ENOENT, "no such file", path)
+        return path
+    raise TypeError(f"source must be a path or bytes; got {type(source).__name__}")
+
+
+def read_vn_tables(
+    source,
+    *,
+    strict: bool = False,
+    progress: Callable[[int, int], object] | None = None,
+) -> VnTables:
+    """Decode a VN stream (path or bytes) into per-message-type column tables.
+
+    Parameters
+    ----------
+    source : str, os.PathLike or bytes
+        A file (read in chunks, never whole into memory) or the bytes of a stream.
+    strict : bool
+        Raise ``ValueError`` naming the line (and byte offset) of the first damaged
+        record (bad checksum or CRC, malformed field, truncated record) instead of
+        skipping and counting it.
+    progress : callable, optional
+        ``progress(bytes_done, bytes_total)``, called every chunk (8 MB) of a file.
+
+    Returns
+    -------
+    VnTables
+    """
+    raw = _core.parse_vn(_source_arg(source), strict, progress)
+    binary = raw["binary_records"] > raw["ascii_records"]
+    pick = 0 if binary else 1
+    first = {k: tuple(loc[pick] for loc in raw["first"].get(k, ())) for k in ISSUE_KINDS}
+    issues = ParseIssues(
+        counts=dict(raw["issues"]), first=first, location="byte" if binary else "line"
+    )
+    tables = MappingProxyType(
+        {name: MappingProxyType(dict(cols)) for name, cols in raw["tables"].items()}
+    )
+    return VnTables(
+        tables=tables,
+        messages=MappingProxyType(dict(raw["messages"])),
+        issues=issues,
+        bytes_total=int(raw["bytes_total"]),
+        bytes_parsed=int(raw["bytes_parsed"]),
+        bytes_in_bad_records=int(raw["bytes_in_bad_records"]),
+        bytes_skipped=int(raw["bytes_skipped"]),
+        ascii_records=int(raw["ascii_records"]),
+        binary_records=int(raw["binary_records"]),
+    )
+
+
+def _lookup(cols: Mapping[str, np.ndarray], names: tuple[str, ...]) -> list[np.ndarray] | None:
+    for prefix in ("", *(g + "." for g in _GROUPS)):
+        found = [cols.get(prefix + n) for n in names]
+        if all(c is not None for c in found):
+            return found  # type: ignore[return-value]
+    return None
+
+
+def table_channels(cols: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
+    """The :class:`ImuLog` channels (and ``time``) one table can fill."""
+    out: dict[str, np.ndarray] = {}
+    for channel, candidates in _CHANNEL_COLUMNS.items():
+        for names in candidates:
+            found = _lookup(cols, names)
+            if found is not None:
+                out[channel] = found[0] if len(found) == 1 else np.column_stack(found)
+                break
+    time = _lookup(cols, ("time_startup",))
+    if time is not None:
+        out["time"] = time[0]
+    return out
+
+
+def _primary(tables: Mapping[str, Mapping[str, np.ndarray]]) -> dict[str, np.ndarray]:
+    best: tuple[int, int] = (-1, -1)
+    chosen: dict[str, np.ndarray] = {}
+    for cols in tables.values():
+        channels = table_channels(cols)
+        n = len(next(iter(cols.values()))) if cols else 0
+        filled = sum(1 for k in channels if k != "time")
+        if filled and (filled, n) > best:
+            best, chosen = (filled, n), channels
+    return chosen
+
+
+def vn_log(tables: VnTables, *, fs: float | None, source: str) -> ImuLog:
+    """Build the :class:`ImuLog` from decoded tables (channels from the richest table)."""
+    channels = _primary(tables.tables)
+    time = channels.pop("time", None)
+    rate = resolve_fs(time, fs, source)
+    return ImuLog(
+        fs=rate,
+        source=source,
+        format=tables.format,
+        issues=tables.issues,
+        time=time,
+        messages=tables.messages,
+        **channels,
+    )
+
+
+def read_vn(
+    source,
+    *,
+    strict: bool = False,
+    fs: float | None = None,
+    progress: Callable[[int, int], object] | None = None,
+) -> ImuLog:
+    """Read a VN-100 log (ASCII, binary or both interleaved) into an :class:`ImuLog`.
+
+    See :func:`read_vn_tables` for the arguments and the module docstring for how
+    channels are chosen when the stream has several message types.
+    """
+    name = "<bytes>" if isinstance(source, (bytes, bytearray, memoryview)) else os.fspath(source)
+    return vn_log(read_vn_tables(source, strict=strict, progress=progress), fs=fs, source=name)
+
+
+def parse_vn_sentences(
+    data: bytes, *, strict: bool = False, fs: float | None = None, source: str = "<bytes>"
+) -> ImuLog:
+    """Decode raw VN sentences found elsewhere (a CSV column, a ROS string field).
+
+    ``data`` is the sentences' bytes, e.g. joined with newlines; text around the
+    sentences is counted as skipped bytes, not an error.
+    """
+    if not isinstance(data, (bytes, bytearray, memoryview)):
+        raise TypeError(f"data must be bytes; got {type(data).__name__}")
+    return vn_log(read_vn_tables(bytes(data), strict=strict), fs=fs, source=source)

@@ -1,0 +1,577 @@
+//! VN ASCII sentences: the message table (spec §3.1, §3.2) and field decoding.
+//!
+//! A sentence is `$VN<ID>,f1,...,fn[,T...][,S....]*hh` (spec §2). Framing and
+//! checksums are handled by [`crate::vn::stream`]; this module turns the checked
+//! body (the bytes between `$` and `*`) into values.
+
+/// One asynchronous message type: header, backing register, field names in order.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct MsgSpec {
+    /// Header without `$`, e.g. `"VNYMR"`.
+    pub id: &'static str,
+    /// The measurement register whose read response has the same fields (0 if none).
+    pub register: u16,
+    /// Async data output type (register 6 value).
+    pub ador: u16,
+    pub fields: &'static [&'static str],
+}
+
+macro_rules! xyz {
+    ($p:literal) => {
+        [concat!($p, "_x"), concat!($p, "_y"), concat!($p, "_z")]
+    };
+}
+
+const fn cat<const A: usize, const B: usize, const C: usize>(
+    a: [&'static str; A],
+    b: [&'static str; B],
+) -> [&'static str; C] {
+    let mut out = [""; C];
+    let mut i = 0;
+    while i < A {
+        out[i] = a[i];
+        i += 1;
+    }
+    while i < C {
+        out[i] = b[i - A];
+        i += 1;
+    }
+    out
+}
+
+const YPR: [&str; 3] = ["yaw", "pitch", "roll"];
+const QUAT: [&str; 4] = ["qx", "qy", "qz", "qw"];
+const MAG: [&str; 3] = xyz!("mag");
+const ACC: [&str; 3] = xyz!("accel");
+const GYR: [&str; 3] = xyz!("gyro");
+const MA: [&str; 6] = cat(MAG, ACC);
+const MAR: [&str; 9] = cat(MA, GYR);
+const YMR: [&str; 12] = cat(YPR, MAR);
+const QMR: [&str; 13] = cat(QUAT, MAR);
+const YBA: [&str; 9] = cat(cat::<3, 3, 6>(YPR, xyz!("lin_accel")), GYR);
+const YIA: [&str; 9] = cat(
+    cat::<3, 3, 6>(YPR, ["lin_accel_n", "lin_accel_e", "lin_accel_d"]),
+    GYR,
+);
+const IMU: [&str; 11] = cat(MAR, ["temperature", "pressure"]);
+const DTV: [&str; 7] = cat(
+    cat::<1, 3, 4>(["delta_time"], xyz!("delta_theta")),
+    xyz!("delta_vel"),
+);
+const HVE: [&str; 3] = ["heave", "heave_rate", "delayed_heave"];
+const QTM: [&str; 7] = cat(QUAT, MAG);
+const QTA: [&str; 7] = cat(QUAT, ACC);
+const QTR: [&str; 7] = cat(QUAT, GYR);
+const QMA: [&str; 10] = cat(QUAT, MA);
+const QAR: [&str; 10] = cat(QUAT, cat::<3, 3, 6>(ACC, GYR));
+const DCM: [&str; 9] = [
+    "dcm_0", "dcm_1", "dcm_2", "dcm_3", "dcm_4", "dcm_5", "dcm_6", "dcm_7", "dcm_8",
+];
+const YCM: [&str; 13] = cat(YMR, ["temperature"]);
+const ICM: [&str; 12] = cat(
+    cat::<3, 3, 6>(YPR, MAG),
+    cat::<3, 3, 6>(xyz!("inertial_accel"), GYR),
+);
+const RAW: [&str; 10] = cat(
+    cat::<3, 3, 6>(xyz!("mag_volt"), xyz!("accel_volt")),
+    cat::<3, 1, 4>(xyz!("gyro_volt"), ["temperature_volt"]),
+);
+const CMV: [&str; 10] = cat(MAR, ["temperature"]);
+const STV: [&str; 7] = cat(QUAT, xyz!("gyro_bias"));
+const COV: [&str; 6] = cat(xyz!("att_var"), xyz!("gyro_bias_var"));
+
+/// Every decoded message type: spec tables 3.1 (current firmware) and 3.2 (legacy).
+pub static MESSAGES: &[MsgSpec] = &[
+    MsgSpec {
+        id: "VNYPR",
+        register: 8,
+        ador: 1,
+        fields: &YPR,
+    },
+    MsgSpec {
+        id: "VNQTN",
+        register: 9,
+        ador: 2,
+        fields: &QUAT,
+    },
+    MsgSpec {
+        id: "VNQMR",
+        register: 15,
+        ador: 8,
+        fields: &QMR,
+    },
+    MsgSpec {
+        id: "VNMAG",
+        register: 17,
+        ador: 10,
+        fields: &MAG,
+    },
+    MsgSpec {
+        id: "VNACC",
+        register: 18,
+        ador: 11,
+        fields: &ACC,
+    },
+    MsgSpec {
+        id: "VNGYR",
+        register: 19,
+        ador: 12,
+        fields: &GYR,
+    },
+    MsgSpec {
+        id: "VNMAR",
+        register: 20,
+        ador: 13,
+        fields: &MAR,
+    },
+    MsgSpec {
+        id: "VNYMR",
+        register: 27,
+        ador: 14,
+        fields: &YMR,
+    },
+    MsgSpec {
+        id: "VNYBA",
+        register: 239,
+        ador: 16,
+        fields: &YBA,
+    },
+    MsgSpec {
+        id: "VNYIA",
+        register: 240,
+        ador: 17,
+        fields: &YIA,
+    },
+    MsgSpec {
+        id: "VNIMU",
+        register: 54,
+        ador: 19,
+        fields: &IMU,
+    },
+    MsgSpec {
+        id: "VNDTV",
+        register: 80,
+        ador: 30,
+        fields: &DTV,
+    },
+    MsgSpec {
+        id: "VNHVE",
+        register: 115,
+        ador: 34,
+        fields: &HVE,
+    },
+    // Legacy / internal types (spec §3.2).
+    MsgSpec {
+        id: "VNQTM",
+        register: 0,
+        ador: 3,
+        fields: &QTM,
+    },
+    MsgSpec {
+        id: "VNQTA",
+        register: 0,
+        ador: 4,
+        fields: &QTA,
+    },
+    MsgSpec {
+        id: "VNQTR",
+        register: 0,
+        ador: 5,
+        fields: &QTR,
+    },
+    MsgSpec {
+        id: "VNQMA",
+        register: 0,
+        ador: 6,
+        fields: &QMA,
+    },
+    MsgSpec {
+        id: "VNQAR",
+        register: 0,
+        ador: 7,
+        fields: &QAR,
+    },
+    MsgSpec {
+        id: "VNDCM",
+        register: 0,
+        ador: 9,
+        fields: &DCM,
+    },
+    MsgSpec {
+        id: "VNYCM",
+        register: 0,
+        ador: 15,
+        fields: &YCM,
+    },
+    MsgSpec {
+        id: "VNICM",
+        register: 0,
+        ador: 18,
+        fields: &ICM,
+    },
+    MsgSpec {
+        id: "VNRAW",
+        register: 0,
+        ador: 252,
+        fields: &RAW,
+    },
+    MsgSpec {
+        id: "VNCMV",
+        register: 0,
+        ador: 253,
+        fields: &CMV,
+    },
+    MsgSpec {
+        id: "VNSTV",
+        register: 0,
+        ador: 254,
+        fields: &STV,
+    },
+    MsgSpec {
+        id: "VNCOV",
+        register: 0,
+        ador: 255,
+        fields: &COV,
+    },
+];
+
+/// Commands and their responses: well-formed, decoded as "seen" without a table.
+const COMMANDS: &[&[u8]] = &[
+    b"RRG", b"WRG", b"WNV", b"RFS", b"RST", b"TAR", b"KMD", b"KAD", b"SGB", b"ASY", b"BOM", b"FWU",
+    b"CMD",
+];
+
+/// `$VNERR` codes defined by the manual (spec §4).
+pub fn is_defined_error(code: u16) -> bool {
+    (1..=0x0C).contains(&code) || code == 0xFF
+}
+
+pub fn spec_by_id(id: &[u8]) -> Option<&'static MsgSpec> {
+    MESSAGES.iter().find(|m| m.id.as_bytes() == id)
+}
+
+fn spec_by_register(reg: u16) -> Option<&'static MsgSpec> {
+    MESSAGES
+        .iter()
+        .find(|m| m.register == reg && m.register != 0)
+}
+
+/// Most fields any message has (13) plus slack.
+pub const MAX_FIELDS: usize = 16;
+
+/// A decoded sentence body.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Decoded {
+    Data {
+        spec: &'static MsgSpec,
+        values: [f64; MAX_FIELDS],
+        /// Appended `T` field (counter / time), if any.
+        count: Option<f64>,
+        /// Appended `S` field (status word), if any.
+        status: Option<f64>,
+    },
+    /// A command or its response (`$VNRRG,05,115200`, `$VNWNV` ...): header id.
+    Command(&'static str),
+    /// `$VNERR,<code>` with a defined code.
+    DeviceError(u16),
+    /// Well-formed sentence of a type not decoded here.
+    Unknown,
+    Malformed(String),
+}
+
+const POW10: [f64; 23] = [
+    1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15, 1e16,
+    1e17, 1e18, 1e19, 1e20, 1e21, 1e22,
+];
+
+/// Parse a decimal number as VectorNav prints it (`+012.345`), correctly rounded.
+///
+/// Fast path: sign, digits, one dot, at most 15 significant digits — the value is
+/// an exact integer divided by an exact power of ten, one correctly rounded
+/// division, so the result equals Python's `float()`. Anything else goes through
+/// the standard library parser; non-finite values are rejected.
+#[inline]
+pub fn parse_f64(s: &[u8]) -> Option<f64> {
+    let (neg, digits) = match s.first() {
+        Some(b'-') => (true, &s[1..]),
+        Some(b'+') => (false, &s[1..]),
+        _ => (false, s),
+    };
+    let n = digits.len();
+    // At most 19 digits cannot overflow u64; exactness is checked below.
+    if n <= 20 {
+        let mut mant: u64 = 0;
+        let mut k = 0usize;
+        while k < n && digits[k].is_ascii_digit() {
+            mant = mant * 10 + (digits[k] - b'0') as u64;
+            k += 1;
+        }
+        let int_digits = k;
+        let mut frac = 0usize;
+        if k < n && digits[k] == b'.' {
+            k += 1;
+            let from = k;
+            while k < n && digits[k].is_ascii_digit() {
+                mant = mant * 10 + (digits[k] - b'0') as u64;
+                k += 1;
+            }
+            frac = k - from;
+        }
+        if k == n && int_digits + frac > 0 && mant <= (1u64 << 53) && frac < POW10.len() {
+            // Exact integer / exact power of ten: one correctly rounded division.
+            let v = mant as f64 / POW10[frac];
+            return Some(if neg { -v } else { v });
+        }
+    }
+    let text = std::str::from_utf8(s).ok()?;
+    let first_ok = text
+        .bytes()
+        .all(|c| c.is_ascii_digit() || b"+-.eE".contains(&c));
+    if !first_ok {
+        return None;
+    }
+    let v: f64 = text.parse().ok()?;
+    v.is_finite().then_some(v)
+}
+
+fn parse_uint(s: &[u8]) -> Option<u16> {
+    if s.is_empty() || s.len() > 5 {
+        return None;
+    }
+    let mut v: u32 = 0;
+    for &c in s {
+        if !c.is_ascii_digit() {
+            return None;
+        }
+        v = v * 10 + (c - b'0') as u32;
+    }
+    u16::try_from(v).ok()
+}
+
+fn header_id(body: &[u8]) -> Option<&[u8]> {
+    let h = body.get(..5)?;
+    (h[0] == b'V'
+        && h[1] == b'N'
+        && h[2..].iter().all(|c| c.is_ascii_uppercase())
+        && matches!(body.get(5), None | Some(b',')))
+    .then_some(h)
+}
+
+/// Decode a checked body (`VNYMR,+1.0,...`, without `$` and `*hh`).
+pub fn decode(body: &[u8]) -> Decoded {
+    let Some(id) = header_id(body) else {
+        return Decoded::Unknown;
+    };
+    let rest: &[u8] = if body.len() > 6 { &body[6..] } else { &[] };
+    let has_fields = body.len() > 5;
+    let mut fields = rest.split(|&c| c == b',');
+    let spec = match &id[2..] {
+        b"ERR" => {
+            let code = if has_fields { fields.next() } else { None };
+            return match (code.and_then(crate::vn::checksum::parse_hex), fields.next()) {
+                (Some(c), None) if code.is_some_and(|f| f.len() <= 2) && is_defined_error(c) => {
+                    Decoded::DeviceError(c)
+                }
+                _ => Decoded::Malformed(format!(
+                    "VNERR carries no defined error code: {:?}",
+                    String::from_utf8_lossy(rest)
+                )),
+            };
+        }
+        b"RRG" if has_fields => {
+            let reg_field = fields.next().unwrap_or(b"");
+            let Some(reg) = parse_uint(reg_field) else {
+                return Decoded::Malformed(format!(
+                    "VNRRG register number is not an integer: {:?}",
+                    String::from_utf8_lossy(reg_field)
+                ));
+            };
+            match spec_by_register(reg) {
+                Some(spec) if rest.len() > reg_field.len() => spec,
+                _ => return Decoded::Command("VNRRG"),
+            }
+        }
+        other => {
+            if let Some(spec) = spec_by_id(id) {
+                spec
+            } else if let Some(cmd) = COMMANDS.iter().find(|c| **c == other) {
+                return Decoded::Command(match *cmd {
+                    b"RRG" => "VNRRG",
+                    b"WRG" => "VNWRG",
+                    b"WNV" => "VNWNV",
+                    b"RFS" => "VNRFS",
+                    b"RST" => "VNRST",
+                    b"TAR" => "VNTAR",
+                    b"KMD" => "VNKMD",
+                    b"KAD" => "VNKAD",
+                    b"SGB" => "VNSGB",
+                    b"ASY" => "VNASY",
+                    b"BOM" => "VNBOM",
+                    b"FWU" => "VNFWU",
+                    _ => "VNCMD",
+                });
+            } else {
+                return Decoded::Unknown;
+            }
+        }
+    };
+    if !has_fields {
+        return Decoded::Malformed(format!("{} has no fields", spec.id));
+    }
+    let n = spec.fields.len();
+    let mut values = [0.0f64; MAX_FIELDS];
+    let mut count = None;
+    let mut status = None;
+    let mut k = 0usize;
+    for field in fields {
+        if k < n {
+            match parse_f64(field) {
+                Some(v) => values[k] = v,
+                None => {
+                    return Decoded::Malformed(format!(
+                        "{} field {} ({}) is not a number: {:?}",
+                        spec.id,
+                        k + 1,
+                        spec.fields[k],
+                        String::from_utf8_lossy(field)
+                    ))
+                }
+            }
+        } else {
+            // Appended fields (spec §2.5): T<decimal>, S<4 hex>, at most one each.
+            let ok = match field.first() {
+                Some(b'T') if count.is_none() => parse_f64(&field[1..]).map(|v| count = Some(v)),
+                Some(b'S') if status.is_none() && field.len() == 5 => {
+                    crate::vn::checksum::parse_hex(&field[1..]).map(|v| status = Some(v as f64))
+                }
+                _ => None,
+            };
+            if ok.is_none() {
+                return Decoded::Malformed(format!(
+                    "{} has {} or more fields; expected {} plus optional T/S fields, got {:?}",
+                    spec.id,
+                    k + 1,
+                    n,
+                    String::from_utf8_lossy(field)
+                ));
+            }
+        }
+        k += 1;
+    }
+    if k < n {
+        return Decoded::Malformed(format!("{} has {} fields; expected {}", spec.id, k, n));
+    }
+    Decoded::Data {
+        spec,
+        values,
+        count,
+        status,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn data(body: &str) -> (&'static str, Vec<f64>, Option<f64>, Option<f64>) {
+        match decode(body.as_bytes()) {
+            Decoded::Data {
+                spec,
+                values,
+                count,
+                status,
+            } => (spec.id, values[..spec.fields.len()].to_vec(), count, status),
+            other => panic!("{body}: {other:?}"),
+        }
+    }
+
+    #[test]
+    fn field_counts_match_spec() {
+        let expect = [
+            ("VNYPR", 3),
+            ("VNQTN", 4),
+            ("VNQMR", 13),
+            ("VNMAG", 3),
+            ("VNACC", 3),
+            ("VNGYR", 3),
+            ("VNMAR", 9),
+            ("VNYMR", 12),
+            ("VNYBA", 9),
+            ("VNYIA", 9),
+            ("VNIMU", 11),
+            ("VNDTV", 7),
+            ("VNQTM", 7),
+            ("VNQTA", 7),
+            ("VNQTR", 7),
+            ("VNQMA", 10),
+            ("VNQAR", 10),
+            ("VNDCM", 9),
+            ("VNYCM", 13),
+            ("VNICM", 12),
+            ("VNRAW", 10),
+            ("VNCMV", 10),
+            ("VNSTV", 7),
+            ("VNCOV", 6),
+        ];
+        for (id, n) in expect {
+            assert_eq!(
+                spec_by_id(id.as_bytes()).map(|s| s.fields.len()),
+                Some(n),
+                "{id}"
+            );
+        }
+    }
+
+    #[test]
+    fn a1_values() {
+        let (id, v, c, s) = data("VNYMR,+100.949,-007.330,+000.715,-00.0049,-00.2449,+00.5397,-01.258,-00.100,-09.701,-00.000018,+00.001122,-00.000551");
+        assert_eq!(id, "VNYMR");
+        assert_eq!(v[0], 100.949);
+        assert_eq!(v[1], -7.33);
+        assert_eq!(v[5], 0.5397);
+        assert_eq!(v[9], -0.000018);
+        assert_eq!((c, s), (None, None));
+    }
+
+    #[test]
+    fn appended_fields_and_registers() {
+        let (_, _, c, s) = data("VNYPR,+010.071,+000.278,-002.026,T1162704");
+        assert_eq!((c, s), (Some(1162704.0), None));
+        let (_, _, c, s) = data("VNYPR,+010.071,+000.278,-002.026,S0010,T5");
+        assert_eq!((c, s), (Some(5.0), Some(16.0)));
+        let (id, v, _, _) = data("VNRRG,08,-114.314,+000.058,-001.773");
+        assert_eq!((id, v[0]), ("VNYPR", -114.314));
+        assert_eq!(decode(b"VNRRG,05,115200"), Decoded::Command("VNRRG"));
+        assert_eq!(decode(b"VNRRG,8"), Decoded::Command("VNRRG"));
+        assert_eq!(decode(b"VNWNV"), Decoded::Command("VNWNV"));
+        assert_eq!(decode(b"VNERR,03"), Decoded::DeviceError(3));
+        assert!(matches!(decode(b"VNERR,12"), Decoded::Malformed(_)));
+        assert_eq!(decode(b"VNGPS,1,2"), Decoded::Unknown);
+        assert!(matches!(decode(b"VNYPR,+1,+2"), Decoded::Malformed(_)));
+        assert!(matches!(decode(b"VNYPR,+1,+2,3,4"), Decoded::Malformed(_)));
+        assert!(matches!(decode(b"VNYPR,+1,+2,x"), Decoded::Malformed(_)));
+        assert!(matches!(
+            decode(b"VNMAR,1,2,3,4,5,6,-0.0.000840,1,2"),
+            Decoded::Malformed(_)
+        ));
+    }
+
+    #[test]
+    fn floats_match_std() {
+        for s in [
+            "+100.949",
+            "-00.000018",
+            "0",
+            "-0.0",
+            "+084.322",
+            "1e3",
+            "12345678901234567.5",
+        ] {
+            let want: f64 = s.parse().unwrap();
+            assert_eq!(parse_f64(s.as_bytes()), Some(want), "{s}");
+        }
+        for s in ["", "+", ".", "-.", "1..2", "nan", "inf", "1,2", "0x1"] {
+            assert_eq!(parse_f64(s.as_bytes()), None, "{s}");
+        }
+    }
+}

@@ -1,0 +1,879 @@
+//! One reader for any VectorNav byte stream: ASCII sentences and binary packets,
+//! interleaved, with noise between them.
+//!
+//! Every input byte ends up in exactly one of three places: a decoded record
+//! (`bytes_parsed`), a damaged or undecoded ASCII record (`bytes_in_bad_records`,
+//! counted per record as `bad_checksum`, `malformed_field`, `unknown_message`,
+//! `truncated_record` or `device_error`), or the `bytes_skipped` count (noise,
+//! including the bytes of binary candidates that failed their CRC; such a
+//! candidate is also counted as `bad_checksum` when its header is one that has
+//! framed a good packet before, and as `truncated_record` when the stream ends
+//! inside it).
+//!
+//! Framing rules (spec §1, §2, §5): at `0xFA` try a binary packet (validate by
+//! CRC, on failure drop one byte); at `$` try a sentence: printable bytes up to
+//! `*`, 2 or 4 hex digits (or `XX`), then an optional `\r` and `\n`. A sentence
+//! cut by a control byte, another `$` or the end of input is `truncated_record`.
+//!
+//! Large pure-ASCII blocks are split at newlines and parsed on all cores, then
+//! concatenated in order.
+
+use std::io::Read;
+
+use rayon::prelude::*;
+
+use crate::error::{CoreError, CoreResult};
+use crate::vn::ascii::{self, Decoded};
+use crate::vn::binary::{self, HeaderScan, Layout};
+use crate::vn::checksum;
+use crate::vn::{IssueKind, Location, Table, VnData};
+
+/// The 2024 SDK rejects ASCII packets longer than this (spec §2.1).
+pub const MAX_SENTENCE: usize = 320;
+/// Below this a block is parsed on one thread.
+const PARALLEL_MIN: usize = 1 << 20;
+/// Chunk size for reading files.
+pub const CHUNK: usize = 8 << 20;
+/// Layouts remembered per reader (distinct binary configurations).
+const MAX_LAYOUTS: usize = 16;
+/// CRC failures remembered before their configuration is confirmed.
+const MAX_PENDING: usize = 64;
+
+/// A strict-mode failure: kind, location, reason.
+pub type Failure = (IssueKind, Location, String);
+
+enum Ascii {
+    /// More input is needed to decide.
+    Need,
+    /// Not a sentence start: drop the `$` as noise.
+    Noise,
+    /// A record spanning `..end` with the given outcome.
+    Record { end: usize, outcome: Outcome },
+}
+
+enum Outcome {
+    Good { body: (usize, usize) },
+    Issue(IssueKind, String),
+}
+
+fn is_check_char(c: u8) -> bool {
+    c.is_ascii_hexdigit() || c == b'X'
+}
+
+/// Scan a sentence starting at `buf[i] == b'$'`.
+fn scan_ascii(buf: &[u8], i: usize, fin: bool) -> Ascii {
+    let n = buf.len();
+    let is_vn = buf.get(i + 1) == Some(&b'V') && buf.get(i + 2) == Some(&b'N');
+    let limit = (i + MAX_SENTENCE).min(n);
+    // Common case first: find '*' and check the bytes before it in one
+    // branch-free pass; fall back to the byte loop to locate a bad byte.
+    let mut j = i + 1;
+    if let Some(p) = buf[i + 1..limit].iter().position(|&c| c == b'*') {
+        let bad = buf[i + 1..i + 1 + p].iter().fold(false, |acc, &c| {
+            acc | (c == b'$') | !(0x20..=0x7E).contains(&c)
+        });
+        if !bad {
+            j = i + 1 + p;
+        }
+    }
+    while j < limit {
+        let c = buf[j];
+        if c == b'*' {
+            break;
+        }
+        if c == b'$' || !(0x20..=0x7E).contains(&c) {
+            return if is_vn {
+                // A line end that cuts the sentence belongs to it.
+                let end = if c == b'\r' || c == b'\n' {
+                    eat_eol(buf, j)
+                } else {
+                    j
+                };
+                if !fin && end == n {
+                    return Ascii::Need;
+                }
+                Ascii::Record {
+                    end,
+                    outcome: Outcome::Issue(
+                        IssueKind::TruncatedRecord,
+                        format!("sentence cut short by byte 0x{c:02X} before its checksum"),
+                    ),
+                }
+            } else {
+                Ascii::Noise
+            };
+        }
+        j += 1;
+    }
+    if j >= limit {
+        if limit == n && n - i < MAX_SENTENCE {
+            if !fin {
+                return Ascii::Need;
+            }
+            return if is_vn {
+                Ascii::Record {
+                    end: n,
+                    outcome: Outcome::Issue(
+                        IssueKind::TruncatedRecord,
+                        "input ends inside a sentence".to_string(),
+                    ),
+                }
+            } else {
+                Ascii::Noise
+            };
+        }
+        return if is_vn {
+            Ascii::Record {
+                end: limit,
+                outcome: Outcome::Issue(
+                    IssueKind::MalformedField,
+                    format!("no '*' within {MAX_SENTENCE} bytes of '$'"),
+                ),
+            }
+        } else {
+            Ascii::Noise
+        };
+    }
+    // buf[j] == '*'
+    let star = j;
+    let mut k = star + 1;
+    while k < n && k < star + 5 && is_check_char(buf[k]) {
+        k += 1;
+    }
+    if !fin && k + 2 > n {
+        return Ascii::Need;
+    }
+    let body = &buf[i + 1..star];
+    let digits = &buf[star + 1..k];
+    let after = buf.get(k).copied();
+    // Four or more check characters: CRC-16 only (a fall-back to XOR-8 on the
+    // first two would accept 1 in 256 damaged CRC sentences). Two or three:
+    // XOR-8 on the first two (a third is trailing text).
+    let mut used = None;
+    if digits.len() >= 4 {
+        if checksum::verify(body, &digits[..4]).is_some() {
+            used = Some(4);
+        }
+    } else if digits.len() >= 2 {
+        if checksum::verify(body, &digits[..2]).is_some() {
+            used = Some(2);
+        }
+    } else if digits.is_empty() && matches!(after, None | Some(b'\r') | Some(b'\n')) {
+        used = Some(0);
+    }
+    let Some(used) = used else {
+        if !is_vn {
+            return Ascii::Noise;
+        }
+        let field = if digits.len() >= 4 {
+            &digits[..4]
+        } else {
+            &digits[..digits.len().min(2)]
+        };
+        let reason = match field.len() {
+            2 | 4 if field != b"XX" && field != b"XXXX" => format!(
+                "checksum mismatch: field {} but XOR-8 is {:02X} and CRC-16 is {:04X}",
+                String::from_utf8_lossy(field),
+                checksum::xor8(body),
+                checksum::crc16(body)
+            ),
+            _ => format!(
+                "check field {:?} is not 2 or 4 hex digits",
+                String::from_utf8_lossy(field)
+            ),
+        };
+        let end = star + 1 + field.len();
+        return Ascii::Record {
+            end: eat_eol(buf, end),
+            outcome: Outcome::Issue(IssueKind::BadChecksum, reason),
+        };
+    };
+    let end = eat_eol(buf, star + 1 + used);
+    Ascii::Record {
+        end,
+        outcome: Outcome::Good {
+            body: (i + 1, star),
+        },
+    }
+}
+
+/// Count one record of `key` without allocating once the key exists.
+fn bump(map: &mut std::collections::BTreeMap<String, u64>, key: &str) {
+    match map.get_mut(key) {
+        Some(n) => *n += 1,
+        None => {
+            map.insert(key.to_string(), 1);
+        }
+    }
+}
+
+fn eat_eol(buf: &[u8], mut end: usize) -> usize {
+    if buf.get(end) == Some(&b'\r') {
+        end += 1;
+    }
+    if buf.get(end) == Some(&b'\n') {
+        end += 1;
+    }
+    end
+}
+
+/// Sequential parser state. Offsets passed in are relative to the current block;
+/// `base` is the absolute offset of the block start.
+pub struct Parser {
+    strict: bool,
+    size_hint: u64,
+    pub data: VnData,
+    /// Absolute offset of the current block's first byte.
+    base: u64,
+    /// Newlines counted before absolute offset `line_pos` (for locations).
+    lines: u64,
+    line_pos: u64,
+    /// End (absolute) of the current run of skipped bytes, to record each run once.
+    skip_end: u64,
+    /// Binary configurations seen: layout, table name, decoded rows (moved to
+    /// `data.tables` by `finish`).
+    layouts: Vec<(Layout, String, Table)>,
+    /// Indices into `layouts` of configurations that framed a good packet.
+    good_layouts: Vec<usize>,
+    /// CRC failures of configurations not (yet) seen in a good packet: counted as
+    /// `bad_checksum` once the configuration frames a good packet.
+    pending: Vec<(usize, Location)>,
+    /// First damaged record in strict mode: kind, location, reason.
+    pub fail: Option<Failure>,
+}
+
+impl Parser {
+    pub fn new(strict: bool) -> Parser {
+        Parser::with_size_hint(strict, 0)
+    }
+
+    /// A parser for a stream of about `size_hint` bytes: tables reserve their
+    /// rows once (untouched capacity costs address space, not memory).
+    pub fn with_size_hint(strict: bool, size_hint: u64) -> Parser {
+        Parser {
+            size_hint,
+            strict,
+            data: VnData::default(),
+            base: 0,
+            lines: 0,
+            line_pos: 0,
+            skip_end: u64::MAX,
+            layouts: Vec::new(),
+            good_layouts: Vec::new(),
+            pending: Vec::new(),
+            fail: None,
+        }
+    }
+
+    /// Rows to reserve for a table whose records are `len` bytes long.
+    fn rows_hint(&self, len: usize) -> usize {
+        let left = self.size_hint.saturating_sub(self.base);
+        (left / len.max(1) as u64).min(1 << 32) as usize
+    }
+
+    fn location(&mut self, buf: &[u8], i: usize) -> Location {
+        let abs = self.base + i as u64;
+        if abs >= self.line_pos {
+            let from = (self.line_pos.saturating_sub(self.base)) as usize;
+            let from = from.min(i);
+            self.lines += buf[from..i].iter().filter(|&&c| c == b'\n').count() as u64;
+            self.line_pos = abs;
+        }
+        Location {
+            offset: abs,
+            line: self.lines + 1,
+        }
+    }
+
+    fn issue(&mut self, buf: &[u8], i: usize, kind: IssueKind, reason: &str) {
+        let fails = self.strict && kind.fails_strict() && self.fail.is_none();
+        let wants = self.data.issues.wants_location(kind);
+        if fails || wants {
+            let loc = self.location(buf, i);
+            if wants {
+                self.data.issues.first[kind as usize].push(loc);
+            }
+            if fails {
+                self.fail = Some((kind, loc, reason.to_string()));
+            }
+        }
+        self.data.issues.counts[kind as usize] += 1;
+    }
+
+    fn skip(&mut self, buf: &[u8], i: usize, n: usize) {
+        let abs = self.base + i as u64;
+        if abs != self.skip_end {
+            let kind = IssueKind::BytesSkipped;
+            if self.data.issues.wants_location(kind) {
+                let loc = self.location(buf, i);
+                self.data.issues.first[kind as usize].push(loc);
+            }
+        }
+        self.skip_end = abs + n as u64;
+        self.data.issues.counts[IssueKind::BytesSkipped as usize] += n as u64;
+        self.data.bytes_skipped += n as u64;
+    }
+
+    fn push_ascii(&mut self, decoded: Decoded, buf: &[u8], i: usize, len: usize) {
+        match decoded {
+            Decoded::Data {
+                spec,
+                values,
+                count,
+                status,
+            } => {
+                if !self.data.tables.contains_key(spec.id) {
+                    let mut table = Table::new(spec.fields.iter().map(|s| s.to_string()).collect());
+                    table.reserve(self.rows_hint(len));
+                    self.data.tables.insert(spec.id.to_string(), table);
+                }
+                let Some(table) = self.data.tables.get_mut(spec.id) else {
+                    return;
+                };
+                for (col, v) in table.columns.iter_mut().zip(values.iter()) {
+                    col.push(*v);
+                }
+                table.len += 1;
+                if let Some(c) = count {
+                    table.set_extra("serial_count", c);
+                }
+                if let Some(s) = status {
+                    table.set_extra("status", s);
+                }
+                self.data.bytes_parsed += len as u64;
+                self.data.ascii_records += 1;
+            }
+            Decoded::Command(id) => {
+                bump(&mut self.data.messages, id);
+                self.data.bytes_parsed += len as u64;
+                self.data.ascii_records += 1;
+            }
+            Decoded::DeviceError(code) => {
+                let table = self
+                    .data
+                    .tables
+                    .entry("VNERR".to_string())
+                    .or_insert_with(|| Table::new(vec!["code".to_string()]));
+                table.columns[0].push(code as f64);
+                table.len += 1;
+                self.issue(buf, i, IssueKind::DeviceError, "device error report");
+                self.data.bytes_in_bad_records += len as u64;
+            }
+            Decoded::Unknown => {
+                self.issue(
+                    buf,
+                    i,
+                    IssueKind::UnknownMessage,
+                    "message type not decoded",
+                );
+                self.data.bytes_in_bad_records += len as u64;
+            }
+            Decoded::Malformed(reason) => {
+                self.issue(buf, i, IssueKind::MalformedField, &reason);
+                self.data.bytes_in_bad_records += len as u64;
+            }
+        }
+    }
+
+    fn layout_index(&mut self, buf: &[u8], i: usize) -> Result<usize, bool> {
+        // Fast path: a known header.
+        for (k, (l, _, _)) in self.layouts.iter().enumerate() {
+            let h = &l.header;
+            if buf.get(i + 1..i + 1 + h.len()) == Some(h.as_slice()) {
+                return Ok(k);
+            }
+        }
+        match binary::parse_header(&buf[i..]) {
+            HeaderScan::Incomplete => Err(true),
+            HeaderScan::Invalid => Err(false),
+            HeaderScan::Ok(layout) => {
+                if self.layouts.len() >= MAX_LAYOUTS {
+                    // Forget configurations that never framed a good packet.
+                    let keep: Vec<usize> = self.good_layouts.clone();
+                    if keep.len() >= MAX_LAYOUTS {
+                        return Err(false);
+                    }
+                    let mut kept = Vec::new();
+                    for (k, entry) in self.layouts.drain(..).enumerate() {
+                        if keep.contains(&k) {
+                            kept.push(entry);
+                        }
+                    }
+                    self.layouts = kept;
+                    self.pending.clear();
+                    self.good_layouts = (0..self.layouts.len()).collect();
+                }
+                let name = layout.table_name();
+                self.layouts.push((layout, name, Table::default()));
+                Ok(self.layouts.len() - 1)
+            }
+        }
+    }
+
+    /// Parse `buf` (absolute offset `self.base`). Returns the number of bytes
+    /// consumed; unless `fin`, a record cut by the end of `buf` is left for the
+    /// next call (at most [`binary::MAX_PACKET`] bytes).
+    pub fn feed(&mut self, buf: &[u8], fin: bool) -> usize {
+        let n = buf.len();
+        let mut i = 0usize;
+        while i < n {
+            if self.fail.is_some() {
+                return n;
+            }
+            match buf[i] {
+                b'$' => match scan_ascii(buf, i, fin) {
+                    Ascii::Need => break,
+                    Ascii::Noise => {
+                        self.skip(buf, i, 1);
+                        i += 1;
+                    }
+                    Ascii::Record { end, outcome } => {
+                        let len = end - i;
+                        match outcome {
+                            Outcome::Good { body } => {
+                                let d = ascii::decode(&buf[body.0..body.1]);
+                                self.push_ascii(d, buf, i, len);
+                            }
+                            Outcome::Issue(kind, reason) => {
+                                self.issue(buf, i, kind, &reason);
+                                self.data.bytes_in_bad_records += len as u64;
+                            }
+                        }
+                        i = end;
+                    }
+                },
+                0xFA => match self.binary_at(buf, i, fin) {
+                    None => break,
+                    Some(next) => i = next,
+                },
+                _ => {
+                    let j = buf[i..]
+                        .iter()
+                        .position(|&c| c == b'$' || c == 0xFA)
+                        .map_or(n, |p| i + p);
+                    self.skip(buf, i, j - i);
+                    i = j;
+                }
+            }
+        }
+        // Keep the line count current up to the consumed end: the next block
+        // no longer sees these bytes.
+        let from = (self.line_pos.saturating_sub(self.base) as usize).min(i);
+        self.lines += buf[from..i].iter().filter(|&&c| c == b'\n').count() as u64;
+        self.base += i as u64;
+        self.line_pos = self.base;
+        self.data.bytes_total += i as u64;
+        i
+    }
+
+    /// Try a binary packet at `buf[i] == 0xFA`; `None` means "need more input".
+    fn binary_at(&mut self, buf: &[u8], i: usize, fin: bool) -> Option<usize> {
+        let n = buf.len();
+        let k = match self.layout_index(buf, i) {
+            Ok(k) => k,
+            Err(true) if !fin => return None,
+            Err(_) => {
+                self.skip(buf, i, 1);
+                return Some(i + 1);
+            }
+        };
+        let hl = 1 + self.layouts[k].0.header.len();
+        let size = match binary::payload_size(&self.layouts[k].0, &buf[i + hl..]) {
+            Ok(s) => s,
+            Err(true) if !fin => return None,
+            Err(_) => {
+                self.skip(buf, i, 1);
+                return Some(i + 1);
+            }
+        };
+        let end = i + hl + size + 2;
+        if end > n {
+            if !fin {
+                return None;
+            }
+            if self.good_layouts.contains(&k) {
+                self.issue(
+                    buf,
+                    i,
+                    IssueKind::TruncatedRecord,
+                    "input ends inside a binary packet",
+                );
+                self.data.bytes_in_bad_records += (n - i) as u64;
+                return Some(n);
+            }
+            self.skip(buf, i, 1);
+            return Some(i + 1);
+        }
+        if !binary::crc_ok(&buf[i..end]) {
+            if self.good_layouts.contains(&k) {
+                let reason = "binary packet CRC mismatch";
+                // The record is counted; its bytes are re-scanned (resync one byte).
+                self.issue(buf, i, IssueKind::BadChecksum, reason);
+            } else if self.pending.len() < MAX_PENDING {
+                let loc = self.location(buf, i);
+                self.pending.push((k, loc));
+            }
+            self.skip(buf, i, 1);
+            return Some(i + 1);
+        }
+        if !self.good_layouts.contains(&k) {
+            self.good_layouts.push(k);
+            let kind = IssueKind::BadChecksum;
+            for (_, loc) in self.pending.iter().filter(|(p, _)| *p == k) {
+                if self.data.issues.wants_location(kind) {
+                    self.data.issues.first[kind as usize].push(*loc);
+                }
+                self.data.issues.counts[kind as usize] += 1;
+                if self.strict && self.fail.is_none() {
+                    self.fail = Some((kind, *loc, "binary packet CRC mismatch".to_string()));
+                }
+            }
+            self.pending.retain(|(p, _)| *p != k);
+        }
+        let (layout, _, table) = &mut self.layouts[k];
+        if table.names.is_empty() {
+            *table = Table::new(layout.column_names());
+            let rows = (self.size_hint.saturating_sub(self.base + i as u64) / (end - i) as u64)
+                .min(1 << 32) as usize;
+            table.reserve(rows);
+        }
+        binary::decode_into(layout, &buf[i + hl..i + hl + size], &mut table.columns);
+        table.len += 1;
+        self.data.bytes_parsed += (end - i) as u64;
+        self.data.binary_records += 1;
+        Some(end)
+    }
+
+    /// Parse a block, using all cores when it is large and pure ASCII.
+    pub fn feed_block(&mut self, buf: &[u8], fin: bool) -> usize {
+        if buf.len() < PARALLEL_MIN || self.fail.is_some() || buf.contains(&0xFA) {
+            return self.feed(buf, fin);
+        }
+        // Everything up to the last newline is split into pieces at newlines and
+        // parsed in parallel; only the tail after it (part of one line, which may
+        // continue in the next block) is parsed sequentially and carried over.
+        let Some(end_nl) = buf.iter().rposition(|&c| c == b'\n').map(|p| p + 1) else {
+            return self.feed(buf, fin);
+        };
+        let pieces = (rayon::current_num_threads() * 4).max(2);
+        let step = end_nl / pieces;
+        let mut cuts = vec![0usize];
+        for p in 1..pieces {
+            let from = (p * step).max(*cuts.last().unwrap_or(&0));
+            if let Some(q) = buf[from..end_nl].iter().position(|&c| c == b'\n') {
+                let cut = from + q + 1;
+                if cut < end_nl && cut > *cuts.last().unwrap_or(&0) {
+                    cuts.push(cut);
+                }
+            }
+        }
+        cuts.push(end_nl);
+        let last = *cuts.last().unwrap_or(&0);
+        let inner: Vec<(usize, usize)> = cuts.windows(2).map(|w| (w[0], w[1])).collect();
+        let strict = self.strict;
+        let results: Vec<(VnData, Option<Failure>, u64)> = inner
+            .par_iter()
+            .map(|&(a, b)| {
+                let piece = &buf[a..b];
+                let mut p = Parser::with_size_hint(strict, piece.len() as u64);
+                p.feed(piece, true);
+                let nl = piece.iter().filter(|&&c| c == b'\n').count() as u64;
+                (p.data, p.fail, nl)
+            })
+            .collect();
+        // Lines before the block (kept current by `feed`).
+        let mut line_shift = self.lines;
+        for ((a, b), (mut data, fail, nl)) in inner.iter().zip(results) {
+            let shift_offset = self.base + *a as u64;
+            for locs in data.issues.first.iter_mut() {
+                for l in locs.iter_mut() {
+                    l.offset += shift_offset;
+                }
+            }
+            let first_merge = self.data.tables.is_empty();
+            self.data.merge(data, line_shift);
+            if first_merge && self.size_hint > 0 {
+                // Extrapolate rows from the first piece and reserve once.
+                let done = (self.base + *b as u64).max(1) as f64;
+                let scale = self.size_hint as f64 / done;
+                for t in self.data.tables.values_mut() {
+                    t.reserve(((t.len as f64) * scale * 1.01) as usize);
+                }
+            }
+            if let Some((kind, loc, reason)) = fail {
+                let loc = Location {
+                    offset: loc.offset + shift_offset,
+                    line: loc.line + line_shift,
+                };
+                self.fail = Some((kind, loc, reason));
+                return buf.len();
+            }
+            line_shift += nl;
+        }
+        // Continue sequentially from `last`.
+        self.lines = line_shift;
+        self.line_pos = self.base + last as u64;
+        self.base += last as u64;
+        self.skip_end = u64::MAX;
+        last + self.feed(&buf[last..], fin)
+    }
+
+    /// Finish: pad tables and turn a strict-mode failure into an error.
+    pub fn finish(mut self) -> CoreResult<VnData> {
+        if let Some((kind, loc, reason)) = self.fail.take() {
+            return Err(CoreError::Parse(format!(
+                "line {} (byte offset {}): {}: {}",
+                loc.line,
+                loc.offset,
+                kind.name(),
+                reason
+            )));
+        }
+        for (_, name, table) in self.layouts.drain(..) {
+            if table.len > 0 {
+                self.data.tables.insert(name, table);
+            }
+        }
+        for (name, t) in self.data.tables.iter_mut() {
+            t.finish();
+            t.shrink();
+            if name != "VNERR" {
+                self.data.messages.insert(name.clone(), t.len as u64);
+            }
+        }
+        Ok(self.data)
+    }
+}
+
+/// Parse a whole in-memory stream.
+pub fn parse_bytes(data: &[u8], strict: bool) -> CoreResult<VnData> {
+    let mut p = Parser::with_size_hint(strict, data.len() as u64);
+    let mut pos = 0usize;
+    while pos < data.len() {
+        let end = (pos + CHUNK).min(data.len());
+        let fin = end == data.len();
+        let used = p.feed_block(&data[pos..end], fin);
+        if p.fail.is_some() {
+            break;
+        }
+        if used == 0 && !fin {
+            // A record straddles the chunk end: extend by one more chunk.
+            let end2 = (end + CHUNK).min(data.len());
+            let used2 = p.feed_block(&data[pos..end2], end2 == data.len());
+            pos += used2;
+            if used2 == 0 {
+                break;
+            }
+            continue;
+        }
+        pos += used;
+    }
+    p.finish()
+}
+
+/// Parse a stream from a reader in chunks of [`CHUNK`] bytes, calling
+/// `progress(bytes_done, total)` after each chunk.
+pub fn parse_reader<R: Read>(
+    mut reader: R,
+    total: u64,
+    strict: bool,
+    progress: &mut dyn FnMut(u64, u64) -> CoreResult<()>,
+) -> CoreResult<VnData> {
+    let mut p = Parser::with_size_hint(strict, total);
+    let mut buf: Vec<u8> = Vec::with_capacity(CHUNK + binary::MAX_PACKET);
+    let mut done: u64 = 0;
+    let mut eof = false;
+    while !eof {
+        let keep = buf.len();
+        buf.resize(keep + CHUNK, 0);
+        let mut filled = keep;
+        while filled < buf.len() {
+            let got = reader.read(&mut buf[filled..])?;
+            if got == 0 {
+                eof = true;
+                break;
+            }
+            filled += got;
+        }
+        buf.truncate(filled);
+        done += (filled - keep) as u64;
+        let used = p.feed_block(&buf, eof);
+        buf.drain(..used);
+        progress(done, total.max(done))?;
+        if p.fail.is_some() {
+            break;
+        }
+    }
+    p.finish()
+}
+
+/// Parse a file in chunks (memory ≈ the output tables plus one chunk).
+pub fn parse_file(
+    path: &std::path::Path,
+    strict: bool,
+    progress: &mut dyn FnMut(u64, u64) -> CoreResult<()>,
+) -> CoreResult<VnData> {
+    let file = std::fs::File::open(path)
+        .map_err(|e| CoreError::Io(format!("cannot open {}: {e}", path.display())))?;
+    let total = file.metadata().map(|m| m.len()).unwrap_or(0);
+    parse_reader(file, total, strict, progress)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    const A1: &[u8] = b"$VNYMR,+100.949,-007.330,+000.715,-00.0049,-00.2449,+00.5397,-01.258,-00.100,-09.701,-00.000018,+00.001122,-00.000551*69\r\n";
+    const B1: [u8; 26] = [
+        0xFA, 0x01, 0x09, 0x00, 0x70, 0x05, 0x00, 0x03, 0x0A, 0x00, 0x00, 0x00, 0x48, 0x0E, 0x2C,
+        0x42, 0x08, 0x4C, 0x37, 0xC1, 0x10, 0x38, 0x8B, 0xC2, 0xD4, 0xCB,
+    ];
+
+    fn accounted(d: &VnData, n: usize) -> bool {
+        d.bytes_total == n as u64
+            && d.bytes_parsed + d.bytes_in_bad_records + d.bytes_skipped == n as u64
+            && d.issues.count(IssueKind::BytesSkipped) == d.bytes_skipped
+    }
+
+    #[test]
+    fn spec_sentences() {
+        let text = b"$VNYPR,+010.071,+000.278,-002.026*60\r\n\
+$VNYPR,+010.071,+000.278,-002.026,T1162704*2F\r\n\
+$VNYPR,+010.071,+000.278,-002.026,S0000*1F\n\
+$VNRRG,27,+006.380,+000.023,-001.953,+1.0640,-0.2531,+3.0614,+00.005,+00.344,-09.758,-0.001222,-0.000450,-0.001218*4F\r\n\
+$VNERR,03*72\r\n$VNWNV*57\r\n$VNRRG,15*92EA\r\n\
+$VNQMR,-0.017057,-0.000767,+0.056534,+0.998255,+1.0670,-0.2568,+3.0696,-00.019,+00.320,-09.802,-0.002801,-0.001186,-0.001582*65\r\n\
+$VNERR,12*72\r\n";
+        let d = parse_bytes(text, false).unwrap();
+        assert!(accounted(&d, text.len()));
+        let ypr = &d.tables["VNYPR"];
+        assert_eq!(ypr.len, 3);
+        assert_eq!(ypr.columns[0], vec![10.071; 3]);
+        let t = &ypr
+            .extra
+            .iter()
+            .find(|(n, _)| n == "serial_count")
+            .unwrap()
+            .1;
+        assert!(t[0].is_nan() && t[1] == 1162704.0 && t[2].is_nan());
+        assert_eq!(d.tables["VNYMR"].columns[0], vec![6.380]);
+        assert_eq!(d.issues.count(IssueKind::DeviceError), 1);
+        assert_eq!(d.issues.count(IssueKind::BadChecksum), 1);
+        assert_eq!(d.issues.count(IssueKind::MalformedField), 1);
+        assert_eq!(d.messages["VNWNV"], 1);
+        assert_eq!(d.messages["VNRRG"], 1);
+        assert_eq!(d.issues.first[IssueKind::BadChecksum as usize][0].line, 8);
+        let err = parse_bytes(text, true).unwrap_err();
+        assert!(err.to_string().starts_with("line 8 "), "{err}");
+    }
+
+    #[test]
+    fn interleaved_and_truncated() {
+        let mut s = Vec::new();
+        s.extend_from_slice(b"noise");
+        s.extend_from_slice(&B1);
+        s.extend_from_slice(A1);
+        s.extend_from_slice(&B1);
+        s.extend_from_slice(&A1[..50]);
+        s.extend_from_slice(&B1);
+        s.extend_from_slice(&B1[..20]);
+        let d = parse_bytes(&s, false).unwrap();
+        assert!(accounted(&d, s.len()));
+        assert_eq!(d.binary_records, 3);
+        assert_eq!(d.ascii_records, 1);
+        assert_eq!(d.issues.count(IssueKind::TruncatedRecord), 2);
+        assert_eq!(d.issues.count(IssueKind::BytesSkipped), 5);
+        // Corrupt the CRC of the second packet: counted, neighbours kept.
+        let mut bad = s.clone();
+        bad[5 + 26 + A1.len() + 25] ^= 1;
+        let d = parse_bytes(&bad, false).unwrap();
+        assert_eq!(d.binary_records, 2);
+        assert_eq!(d.issues.count(IssueKind::BadChecksum), 1);
+        assert!(accounted(&d, s.len()));
+    }
+
+    #[test]
+    fn chunked_reader_equals_whole() {
+        let mut s = Vec::new();
+        for k in 0..5000 {
+            if k % 7 == 0 {
+                s.extend_from_slice(&B1);
+            }
+            s.extend_from_slice(A1);
+        }
+        let whole = parse_bytes(&s, false).unwrap();
+        struct Slow<'a>(&'a [u8], usize);
+        impl std::io::Read for Slow<'_> {
+            fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+                let n = buf.len().min(self.1).min(self.0.len());
+                buf[..n].copy_from_slice(&self.0[..n]);
+                self.0 = &self.0[n..];
+                Ok(n)
+            }
+        }
+        let mut calls = 0;
+        let chunked = parse_reader(Slow(&s, 977), s.len() as u64, false, &mut |_, _| {
+            calls += 1;
+            Ok(())
+        })
+        .unwrap();
+        assert_eq!(whole, chunked);
+        assert_eq!(whole.tables["VNYMR"].len, 5000);
+        assert!(calls >= 1);
+    }
+
+    #[test]
+    fn parallel_equals_sequential() {
+        let mut s = Vec::new();
+        for k in 0..40_000u32 {
+            if k % 1000 == 3 {
+                s.extend_from_slice(&A1[..60]);
+                s.push(b'\n');
+            }
+            s.extend_from_slice(A1);
+        }
+        let par = parse_bytes(&s, false).unwrap();
+        let mut p = Parser::new(false);
+        p.feed(&s, true);
+        let seq = p.finish().unwrap();
+        assert_eq!(par, seq);
+        assert_eq!(par.tables["VNYMR"].len, 40_000);
+        assert_eq!(par.issues.count(IssueKind::TruncatedRecord), 40);
+        let err = parse_bytes(&s, true).unwrap_err().to_string();
+        assert!(err.starts_with("line 4 "), "{err}");
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 300, ..ProptestConfig::default() })]
+
+        #[test]
+        fn random_bytes_are_accounted(data in proptest::collection::vec(any::<u8>(), 0..3000)) {
+            let d = parse_bytes(&data, false).unwrap();
+            prop_assert!(accounted(&d, data.len()));
+        }
+
+        #[test]
+        fn mutated_streams_are_accounted(
+            edits in proptest::collection::vec((any::<u16>(), any::<u8>(), 0u8..3), 0..20)
+        ) {
+            let mut s = Vec::new();
+            for _ in 0..10 {
+                s.extend_from_slice(A1);
+                s.extend_from_slice(&B1);
+            }
+            for (pos, byte, op) in edits {
+                let i = pos as usize % (s.len() + 1);
+                match op {
+                    0 => s.insert(i, byte),
+                    1 if i < s.len() => { s.remove(i); }
+                    _ if i < s.len() => s[i] = byte,
+                    _ => {}
+                }
+            }
+            let d = parse_bytes(&s, false).unwrap();
+            prop_assert!(accounted(&d, s.len()));
+            let _ = parse_bytes(&s, true);
+        }
+    }
+}
