@@ -5,7 +5,7 @@ fitting, log readers for VectorNav VN-100 (ASCII and binary), CSV and ROS bags,
 plots and reports. Start with ``imunoise.adev(x, fs)``.
 """
 
-from imunoise import units
+from imunoise import export, units
 from imunoise._core import __version__
 from imunoise.allan import AllanResult, adev, hdev, mdev, tdev, totdev
 from imunoise.datasheet import compare
@@ -35,5 +35,6 @@ __all__ = [
     "read",
     "write_vn_ascii",
     "write_vn_binary",
+    "export",
     "units",
 ]
