@@ -45,6 +45,14 @@ def parse_vn(
     ``ascii_records``, ``binary_records``. ``progress(done, total)`` after every chunk.
     """
 
+def parse_vn_chunk(data: bytes, strict: bool = False, fin: bool = False) -> dict[str, Any]:
+    """Decode the complete records at the start of ``data`` (all of it when ``fin``).
+
+    Same keys as :func:`parse_vn` plus ``bytes_consumed``: the bytes decoded; the rest
+    (a record cut by the end of ``data``) starts the next piece. Locations are relative
+    to ``data``.
+    """
+
 def vn_message_fields() -> dict[str, list[str]]:
     """Field names, in order, of every decoded ASCII message type."""
 

@@ -105,6 +105,27 @@ fn parse_vn<'py>(
     to_dict(py, data)
 }
 
+/// parse_vn_chunk(data, strict=False, fin=False) -> dict
+///
+/// Like `parse_vn` on `bytes`, for one piece of a longer stream: only complete
+/// records are decoded (all of `data` when `fin`); `"bytes_consumed"` says how
+/// far, so the caller can carry the rest into the next piece. Locations are
+/// relative to `data`.
+#[pyfunction]
+#[pyo3(signature = (data, strict=false, fin=false))]
+fn parse_vn_chunk<'py>(
+    py: Python<'py>,
+    data: &Bound<'py, PyBytes>,
+    strict: bool,
+    fin: bool,
+) -> PyResult<Bound<'py, PyDict>> {
+    let slice: &[u8] = data.as_bytes();
+    let (used, parsed) = py.detach(|| stream::parse_prefix(slice, strict, fin))?;
+    let out = to_dict(py, parsed)?;
+    out.set_item("bytes_consumed", used)?;
+    Ok(out)
+}
+
 /// vn_message_fields() -> dict[str, list[str]]: field names of every ASCII message.
 #[pyfunction]
 fn vn_message_fields(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
@@ -212,6 +233,7 @@ fn vn_binary_fields(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(vn_binary_fields, m)?)?;
     m.add_function(wrap_pyfunction!(parse_vn, m)?)?;
+    m.add_function(wrap_pyfunction!(parse_vn_chunk, m)?)?;
     m.add_function(wrap_pyfunction!(vn_message_fields, m)?)?;
     m.add_function(wrap_pyfunction!(write_vn_ascii, m)?)?;
     m.add_function(wrap_pyfunction!(vn_binary_columns, m)?)?;

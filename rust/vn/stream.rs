@@ -671,6 +671,17 @@ pub fn parse_bytes(data: &[u8], strict: bool) -> CoreResult<VnData> {
     p.finish()
 }
 
+/// Parse the complete records at the start of `data`, one piece of a longer
+/// stream: returns the number of bytes consumed and the records decoded from
+/// them. Unless `fin`, a record cut by the end of `data` is not consumed; the
+/// caller passes it again at the start of the next piece. Locations in the
+/// result are relative to `data` (offset 0, line 1).
+pub fn parse_prefix(data: &[u8], strict: bool, fin: bool) -> CoreResult<(usize, VnData)> {
+    let mut p = Parser::with_size_hint(strict, data.len() as u64);
+    let used = p.feed_block(data, fin);
+    p.finish().map(|d| (used, d))
+}
+
 /// Parse a stream from a reader in chunks of [`CHUNK`] bytes, calling
 /// `progress(bytes_done, total)` after each chunk.
 pub fn parse_reader<R: Read>(
@@ -821,6 +832,40 @@ $VNERR,12*72\r\n";
         assert_eq!(whole, chunked);
         assert_eq!(whole.tables["VNYMR"].len, 5000);
         assert!(calls >= 1);
+    }
+
+    #[test]
+    fn prefixes_add_up_to_the_whole() {
+        let mut s = Vec::new();
+        for k in 0..3000 {
+            if k % 5 == 0 {
+                s.extend_from_slice(&B1);
+            }
+            s.extend_from_slice(A1);
+        }
+        let whole = parse_bytes(&s, false).unwrap();
+        for piece in [61usize, 1000, 4096] {
+            let (mut pos, mut rows, mut packets, mut total) = (0usize, 0usize, 0u64, 0u64);
+            let mut want = piece;
+            loop {
+                let end = (pos + want).min(s.len());
+                let fin = end == s.len();
+                let (used, d) = parse_prefix(&s[pos..end], false, fin).unwrap();
+                rows += d.tables.get("VNYMR").map_or(0, |t| t.len);
+                packets += d.binary_records;
+                total += d.bytes_total;
+                assert_eq!(d.issues.counts.iter().sum::<u64>(), 0);
+                // A piece shorter than a record consumes nothing: offer more.
+                want = if used == 0 { want * 2 } else { piece };
+                pos += used;
+                if fin {
+                    break;
+                }
+            }
+            assert_eq!(rows, whole.tables["VNYMR"].len);
+            assert_eq!(packets, whole.binary_records);
+            assert_eq!(total, s.len() as u64);
+        }
     }
 
     #[test]

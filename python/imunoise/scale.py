@@ -1,0 +1,927 @@
+"""Scale: logs larger than memory, and fleets of logs.
+
+Out of core
+-----------
+:func:`convert` streams a log into a columnar file without holding it in memory:
+the file is read in pieces of ``chunk_bytes``, each piece cut after its last
+complete record (the Rust parser reports how many bytes it consumed; the cut
+record starts the next piece), and each piece's rows are appended to the output.
+Memory stays about three pieces (the bytes, their decoded columns, the rows being
+written) whatever the size of the log. :func:`load` opens the result as an
+:class:`~imunoise.readers.log.ImuLog` whose channels are memory-mapped ``.npy``
+arrays, which :func:`imunoise.adev` reads in place (the Allan core takes arrays of
+any strides without copying them), so ``convert → load → adev → fit`` analyses a
+log larger than RAM.
+
+Output layouts (chosen by ``out``):
+
+``DIR`` (no suffix)
+    one ``<channel>.npy`` per channel (``gyro.npy`` (n, 3), ``time.npy`` (n,) ...)
+    plus ``meta.json`` (sample rate, source, parse issues, message counts).
+``OUT.npy``
+    one structured array, a field per channel (``a["gyro"]`` is (n, 3)), plus
+    ``OUT.meta.json``.
+``OUT.parquet``
+    a column per axis (``gyro_x`` ...) written row group by row group (needs
+    pyarrow); the metadata are the file's key-value metadata (``fs``, ``source``,
+    ``imunoise``: the JSON of ``meta.json``). :func:`load` reads Parquet into
+    memory.
+
+VN-100 logs (ASCII, binary, or both) are streamed; CSV and ROS bags are read
+whole by :func:`imunoise.read` and then written the same way.
+
+Fleets
+------
+:func:`batch` analyses many logs with dask.distributed: one task per log (read,
+Allan deviation, noise fit, datasheet comparison), one result row per log, sensor
+and axis. A log that fails becomes one row with its error message.
+"""
+
+from __future__ import annotations
+
+import glob
+import json
+import os
+import shutil
+import sys
+import warnings
+from collections.abc import Callable, Iterable, Mapping
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from imunoise import _core
+from imunoise.readers.log import CHANNELS, DEFAULT_FS, ISSUE_KINDS, ImuLog, ParseIssues
+
+__all__ = ["Conversion", "batch", "convert", "load", "BATCH_SENSORS"]
+
+#: Default bytes read per piece by :func:`convert`.
+CHUNK_BYTES = 64 << 20
+#: First locations kept per issue kind (as the Rust reader keeps).
+_FIRST_KEEP = 5
+_META_VERSION = 1
+_AXES = ("x", "y", "z")
+
+
+# ---------------------------------------------------------------------------
+# Conversion
+# ---------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Conversion:
+    """What :func:`convert` wrote.
+
+    Attributes
+    ----------
+    out : Path
+        The output (directory, ``.npy`` or ``.parquet`` file); open it with :func:`load`.
+    files : tuple of Path
+        Every file written (data files and the metadata file).
+    samples : int
+        Rows written.
+    channels : tuple of str
+        Channels written (``time`` included when the log has timestamps).
+    fs : float
+        Sample rate in Hz, resolved as :func:`imunoise.read` does.
+    issues : ParseIssues
+        What the reader skipped, summed over the pieces.
+    bytes_read : int
+        Size of the input.
+    """
+
+    out: Path
+    files: tuple[Path, ...]
+    samples: int
+    channels: tuple[str, ...]
+    fs: float
+    issues: ParseIssues
+    bytes_read: int
+
+
+def _column_names(channel: str) -> list[str]:
+    """Parquet column names of a channel: ``gyro_x`` ..., ``quaternion_w`` ..., ``time``."""
+    cols = 1 if channel == "time" else CHANNELS[channel][0]
+    if cols == 1:
+        return [channel]
+    axes = ("w", "x", "y", "z") if channel == "quaternion" else _AXES
+    return [f"{channel}_{a}" for a in axes[:cols]]
+
+
+def _width(channel: str) -> int:
+    return 1 if channel == "time" else CHANNELS[channel][0]
+
+
+def _order(channels: Iterable[str]) -> list[str]:
+    """Channels in a fixed order: ``time`` first, then :data:`CHANNELS` order."""
+    have = set(channels)
+    return [c for c in ("time", *CHANNELS) if c in have]
+
+
+class _NpyAppender:
+    """A 1-D or 2-D float64 ``.npy`` file grown by appending rows.
+
+    The header is written first for zero rows and rewritten in place at the end
+    (numpy reserves room in the header for any row count, so its length does
+    not change).
+    """
+
+    def __init__(self, path: Path, dtype: np.dtype, row_shape: tuple[int, ...]):
+        self.path = path
+        self.dtype = np.dtype(dtype)
+        self.row_shape = row_shape
+        self.rows = 0
+        self.f = open(path, "wb")  # noqa: SIM115 - closed in close()
+        self._header()
+        self.data_start = self.f.tell()
+
+    def _header(self) -> None:
+        np.lib.format.write_array_header_1_0(
+            self.f,
+            {"descr": np.lib.format.dtype_to_descr(self.dtype), "fortran_order": False,
+             "shape": (self.rows, *self.row_shape)},
+        )
+
+    def append(self, rows: np.ndarray) -> None:
+        rows = np.ascontiguousarray(rows, dtype=self.dtype)
+        self.f.write(memoryview(rows).cast("B"))
+        self.rows += len(rows)
+
+    def close(self) -> None:
+        if self.f.closed:
+            return
+        end = self.f.tell()
+        self.f.seek(0)
+        self._header()
+        if self.f.tell() != self.data_start:  # pragma: no cover - numpy guarantees room
+            self.f.close()
+            raise OSError(f"{self.path}: the .npy header grew when rewritten")
+        self.f.seek(end)
+        self.f.close()
+
+
+class _Sink:
+    """Where one message type's rows go; subclasses per output layout."""
+
+    def __init__(self, staging: Path, channels: list[str]):
+        self.staging = staging
+        self.channels = channels
+        self.rows = 0
+
+    def append(self, cols: Mapping[str, np.ndarray]) -> None:
+        raise NotImplementedError
+
+    def close(self, meta: dict) -> None:
+        raise NotImplementedError
+
+    def publish(self, out: Path, meta: dict) -> list[Path]:
+        """Move the finished files to ``out``; returns the files."""
+        raise NotImplementedError
+
+    def discard(self) -> None:
+        if self.staging.is_dir():
+            shutil.rmtree(self.staging, ignore_errors=True)
+        else:
+            self.staging.unlink(missing_ok=True)
+
+
+class _DirSink(_Sink):
+    def __init__(self, staging: Path, channels: list[str]):
+        super().__init__(staging, channels)
+        staging.mkdir(parents=True, exist_ok=True)
+        self.files = {
+            ch: _NpyAppender(staging / f"{ch}.npy", np.float64,
+                             () if _width(ch) == 1 else (_width(ch),))
+            for ch in channels
+        }
+
+    def append(self, cols):
+        for ch, f in self.files.items():
+            f.append(cols[ch])
+        self.rows += len(cols[self.channels[0]])
+
+    def close(self, meta):
+        for f in self.files.values():
+            f.close()
+
+    def publish(self, out, meta):
+        out.mkdir(parents=True, exist_ok=True)
+        files = []
+        for ch in self.channels:
+            dest = out / f"{ch}.npy"
+            os.replace(self.staging / f"{ch}.npy", dest)
+            files.append(dest)
+        meta_path = out / "meta.json"
+        meta_path.write_text(json.dumps(meta, indent=1))
+        shutil.rmtree(self.staging, ignore_errors=True)
+        return [*files, meta_path]
+
+
+def _record_dtype(channels: list[str]) -> np.dtype:
+    return np.dtype([
+        (ch, np.float64) if _width(ch) == 1 else (ch, np.float64, (_width(ch),))
+        for ch in channels
+    ])
+
+
+class _NpySink(_Sink):
+    def __init__(self, staging: Path, channels: list[str]):
+        super().__init__(staging, channels)
+        self.dtype = _record_dtype(channels)
+        self.file = _NpyAppender(staging, self.dtype, ())
+
+    def append(self, cols):
+        m = len(cols[self.channels[0]])
+        rows = np.empty(m, dtype=self.dtype)
+        for ch in self.channels:
+            rows[ch] = cols[ch]
+        self.file.append(rows)
+        self.rows += m
+
+    def close(self, meta):
+        self.file.close()
+
+    def publish(self, out, meta):
+        os.replace(self.staging, out)
+        meta_path = _npy_meta_path(out)
+        meta_path.write_text(json.dumps(meta, indent=1))
+        return [out, meta_path]
+
+
+def _npy_meta_path(out: Path) -> Path:
+    return out.with_name(out.stem + ".meta.json")
+
+
+class _ParquetSink(_Sink):
+    def __init__(self, staging: Path, channels: list[str]):
+        super().__init__(staging, channels)
+        import pyarrow as pa
+        import pyarrow.parquet as pq
+
+        self.pa = pa
+        self.names = [n for ch in channels for n in _column_names(ch)]
+        self.schema = pa.schema([(n, pa.float64()) for n in self.names])
+        self.writer = pq.ParquetWriter(staging, self.schema)
+
+    def append(self, cols):
+        arrays = []
+        for ch in self.channels:
+            a = np.asarray(cols[ch])
+            if a.ndim == 1:
+                arrays.append(self.pa.array(a))
+            else:
+                arrays += [self.pa.array(np.ascontiguousarray(a[:, j])) for j in range(a.shape[1])]
+        self.writer.write_batch(self.pa.record_batch(arrays, schema=self.schema))
+        self.rows += len(cols[self.channels[0]])
+
+    def close(self, meta):
+        if meta is not None:
+            self.writer.add_key_value_metadata({
+                "fs": repr(meta["fs"]), "source": meta["source"], "imunoise": json.dumps(meta),
+            })
+        self.writer.close()
+
+    def publish(self, out, meta):
+        os.replace(self.staging, out)
+        return [out]
+
+
+def _layout(out: Path) -> str:
+    suffix = out.suffix.lower()
+    if suffix == ".npy":
+        return "npy"
+    if suffix == ".parquet":
+        return "parquet"
+    if suffix:
+        raise ValueError(
+            f"out must be a directory (no suffix), a .npy or a .parquet file; got {str(out)!r}"
+        )
+    return "dir"
+
+
+class _Writer:
+    """Routes each message type's rows to its own staging sink; publishes one."""
+
+    def __init__(self, out: Path, layout: str):
+        self.out = out
+        self.layout = layout
+        self.sinks: dict[str, _Sink] = {}
+
+    def _staging(self, k: int) -> Path:
+        name = f".{self.out.name}.partial-{k}"
+        if self.layout == "npy":
+            name += ".npy"
+        elif self.layout == "parquet":
+            name += ".parquet"
+        return self.out.parent / name
+
+    def append(self, table: str, cols: Mapping[str, np.ndarray]) -> None:
+        sink = self.sinks.get(table)
+        if sink is None:
+            channels = _order(cols)
+            cls = {"dir": _DirSink, "npy": _NpySink, "parquet": _ParquetSink}[self.layout]
+            sink = cls(self._staging(len(self.sinks)), channels)
+            self.sinks[table] = sink
+        sink.append(cols)
+
+    def finish(self, primary: str | None, meta: dict) -> list[Path]:
+        for name, sink in self.sinks.items():
+            sink.close(meta if name == primary else None)
+        files: list[Path] = []
+        for name, sink in self.sinks.items():
+            if name == primary:
+                files = sink.publish(self.out, meta)
+            else:
+                sink.discard()
+        return files
+
+    def abort(self) -> None:
+        for sink in self.sinks.values():
+            try:
+                sink.close(None)
+            except Exception:  # noqa: BLE001 - best effort clean-up
+                pass
+            sink.discard()
+
+
+class _Steps:
+    """Exact median of the positive timestamp steps, from per-piece histograms."""
+
+    def __init__(self):
+        self.last: float | None = None
+        self.values = np.empty(0)
+        self.counts = np.empty(0, dtype=np.int64)
+        self._pending: list[tuple[np.ndarray, np.ndarray]] = []
+        self._pending_len = 0
+
+    def add(self, t: np.ndarray) -> None:
+        if len(t) == 0:
+            return
+        t = np.asarray(t, dtype=np.float64)
+        steps = np.diff(t, prepend=t[:1] if self.last is None else np.array([self.last]))
+        if self.last is None:
+            steps = steps[1:]
+        self.last = float(t[-1])
+        steps = steps[steps > 0]
+        if len(steps):
+            v, c = np.unique(steps, return_counts=True)
+            self._pending.append((v, c))
+            self._pending_len += len(v)
+            if self._pending_len > 1 << 20:
+                self._compact()
+
+    def _compact(self) -> None:
+        if not self._pending:
+            return
+        vals = np.concatenate([self.values, *(v for v, _ in self._pending)])
+        cnts = np.concatenate([self.counts, *(c for _, c in self._pending)])
+        self.values, inverse = np.unique(vals, return_inverse=True)
+        self.counts = np.bincount(inverse, weights=cnts, minlength=len(self.values)).astype(
+            np.int64
+        )
+        self._pending, self._pending_len = [], 0
+
+    def median(self) -> float | None:
+        """``np.median`` of all positive steps (None without any)."""
+        self._compact()
+        total = int(self.counts.sum())
+        if total == 0:
+            return None
+        cum = np.cumsum(self.counts)
+        lo = self.values[np.searchsorted(cum, (total - 1) // 2, side="right")]
+        hi = self.values[np.searchsorted(cum, total // 2, side="right")]
+        return float(lo) if total % 2 else float(np.mean(np.array([lo, hi])))
+
+
+def _resolve_fs(steps: _Steps | None, fs: float | None, source: str) -> float:
+    """As :func:`imunoise.readers.log.resolve_fs`, from the streamed step histogram."""
+    med = steps.median() if steps is not None else None
+    if med is not None:
+        return float(1.0 / med)
+    if fs is not None:
+        fs = float(fs)
+        if not (np.isfinite(fs) and fs > 0):
+            raise ValueError(f"fs must be a positive finite number of Hz; got {fs!r}")
+        return fs
+    warnings.warn(
+        f"{source}: no timestamps and no fs given; assuming {DEFAULT_FS:g} Hz "
+        "(pass fs= to set the sample rate)",
+        stacklevel=3,
+    )
+    return DEFAULT_FS
+
+
+class _Tally:
+    """Issues, message counts and record counts summed over pieces."""
+
+    def __init__(self):
+        self.counts = dict.fromkeys(ISSUE_KINDS, 0)
+        self.first: dict[str, list[tuple[int, int]]] = {k: [] for k in ISSUE_KINDS}
+        self.messages: dict[str, int] = {}
+        self.ascii = 0
+        self.binary = 0
+        self.rows: dict[str, int] = {}
+
+    def add(self, raw: dict, offset: int, lines: int) -> None:
+        for k in ISSUE_KINDS:
+            self.counts[k] += int(raw["issues"].get(k, 0))
+            keep = self.first[k]
+            for off, line in raw["first"].get(k, ()):
+                if len(keep) < _FIRST_KEEP:
+                    keep.append((int(off) + offset, int(line) + lines))
+        for name, n in raw["messages"].items():
+            self.messages[name] = self.messages.get(name, 0) + int(n)
+        self.ascii += int(raw["ascii_records"])
+        self.binary += int(raw["binary_records"])
+
+    @property
+    def format(self) -> str:
+        return "vn-binary" if self.binary > self.ascii else "vn-ascii"
+
+    def issues(self) -> ParseIssues:
+        binary = self.format == "vn-binary"
+        first = {k: tuple(loc[0 if binary else 1] for loc in v) for k, v in self.first.items()}
+        return ParseIssues(counts=self.counts, first=first, location="byte" if binary else "line")
+
+
+def _table_channels(cols: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
+    from imunoise.readers.vn import table_channels
+
+    return table_channels(cols)
+
+
+def _primary(rows: Mapping[str, tuple[int, int]]) -> str | None:
+    """The VN reader's choice of table: most channels filled, then most rows."""
+    best, chosen = (-1, -1), None
+    for name, (filled, n) in rows.items():
+        if filled and (filled, n) > best:
+            best, chosen = (filled, n), name
+    return chosen
+
+
+def _stream_vn(path: Path, writer: _Writer, chunk_bytes: int, progress) -> tuple:
+    """Parse ``path`` piece by piece into ``writer``; returns (tally, steps per table, rows)."""
+    tally = _Tally()
+    steps: dict[str, _Steps] = {}
+    shape: dict[str, tuple[int, int]] = {}
+    total = path.stat().st_size
+    offset, lines, done = 0, 0, 0
+    carry = b""
+    with open(path, "rb") as f:
+        while True:
+            block = f.read(chunk_bytes)
+            done += len(block)
+            fin = len(block) < chunk_bytes
+            data = carry + block if carry else block
+            del block
+            raw = _core.parse_vn_chunk(data, False, fin)
+            used = int(raw["bytes_consumed"])
+            tally.add(raw, offset, lines)
+            for name, cols in raw["tables"].items():
+                chans = _table_channels(cols)
+                if not chans:
+                    continue
+                n = len(next(iter(chans.values())))
+                if n == 0:
+                    continue
+                filled = sum(1 for k in chans if k != "time")
+                prev = shape.get(name, (filled, 0))
+                shape[name] = (filled, prev[1] + n)
+                if "time" in chans:
+                    steps.setdefault(name, _Steps()).add(chans["time"])
+                writer.append(name, chans)
+            del raw
+            lines += data.count(b"\n", 0, used)
+            offset += used
+            carry = data[used:]
+            del data
+            if progress is not None:
+                progress(done, max(total, done))
+            if fin:
+                break
+    return tally, steps, shape
+
+
+def _meta(*, fs, source, fmt, issues: ParseIssues, messages, samples, channels, table) -> dict:
+    return {
+        "imunoise_columnar": _META_VERSION,
+        "fs": fs,
+        "source": source,
+        "format": fmt,
+        "samples": samples,
+        "channels": list(channels),
+        "table": table,
+        "messages": dict(messages),
+        "issues": {
+            "counts": dict(issues.counts),
+            "first": {k: list(v) for k, v in issues.first.items()},
+            "location": issues.location,
+        },
+    }
+
+
+def convert(
+    path,
+    out,
+    *,
+    fs: float | None = None,
+    chunk_bytes: int = CHUNK_BYTES,
+    format: str = "auto",
+    progress: Callable[[int, int], object] | None = None,
+) -> Conversion:
+    """Convert a log into a columnar file that :func:`load` memory-maps.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The log. VN-100 logs (ASCII, binary or both) are streamed with memory
+        bounded by ``chunk_bytes``; CSV and ROS bags are read whole.
+    out : str or os.PathLike
+        A directory (no suffix), a ``.npy`` or a ``.parquet`` file (see the module
+        docstring for the layouts). An existing output is replaced.
+    fs : float, optional
+        Sample rate of logs without timestamps, as for :func:`imunoise.read`.
+    chunk_bytes : int
+        Bytes read per piece (default 64 MiB); peak memory is a few times this.
+    format : str
+        As for :func:`imunoise.read` (``"auto"`` detects it).
+    progress : callable, optional
+        ``progress(bytes_done, bytes_total)`` after every piece.
+
+    Returns
+    -------
+    Conversion
+
+    Notes
+    -----
+    The channels come from one message type, chosen as :func:`imunoise.read`
+    chooses (the table filling the most channels, then the longest), so
+    ``load(convert(p, out).out)`` holds exactly the arrays of ``imunoise.read(p)``,
+    with the same ``fs`` and parse issue counts.
+    """
+    from imunoise.readers.read import FORMATS, detect_format
+
+    path = Path(os.fspath(path))
+    out = Path(os.fspath(out))
+    if isinstance(chunk_bytes, bool) or not isinstance(chunk_bytes, (int, np.integer)):
+        raise TypeError(f"chunk_bytes must be an int; got {type(chunk_bytes).__name__}")
+    if chunk_bytes < 4096:
+        raise ValueError(f"chunk_bytes must be at least 4096; got {chunk_bytes}")
+    if format not in FORMATS:
+        raise ValueError(f"format must be one of {FORMATS}; got {format!r}")
+    layout = _layout(out)
+    if layout == "parquet":
+        try:
+            import pyarrow  # noqa: F401
+        except ImportError:
+            raise ImportError("Parquet output needs pyarrow (pip install pyarrow)") from None
+    if not path.exists():
+        raise FileNotFoundError(2, "no such file", str(path))
+    if format == "auto":
+        format = detect_format(path)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    writer = _Writer(out, layout)
+    try:
+        if format in ("vn-ascii", "vn-binary") and path.is_file():
+            tally, steps, shape = _stream_vn(path, writer, int(chunk_bytes), progress)
+            primary = _primary(shape)
+            rate = _resolve_fs(steps.get(primary) if primary else None, fs, str(path))
+            issues, messages, fmt = tally.issues(), tally.messages, tally.format
+        else:
+            from imunoise.readers.read import read
+
+            log = read(path, format=format, fs=fs, progress=progress)
+            chans = {ch: getattr(log, ch) for ch in _order([*log.channels, "time"])
+                     if getattr(log, ch) is not None}
+            primary = "log" if chans and len(log) else None
+            shape = {}
+            if primary:
+                step = max(1, chunk_bytes // (8 * sum(_width(c) for c in chans)))
+                for i in range(0, len(log), step):
+                    writer.append(primary, {c: a[i:i + step] for c, a in chans.items()})
+            rate, issues, messages, fmt = log.fs, log.issues, log.messages, log.format
+        if primary is None:
+            raise ValueError(f"{path}: no usable records ({issues})")
+        sink = writer.sinks[primary]
+        meta = _meta(fs=rate, source=str(path), fmt=fmt, issues=issues, messages=messages,
+                     samples=sink.rows, channels=sink.channels, table=primary)
+        _remove(out, layout)
+        files = writer.finish(primary, meta)
+    except BaseException:
+        writer.abort()
+        raise
+    return Conversion(out=out, files=tuple(files), samples=sink.rows,
+                      channels=tuple(sink.channels), fs=rate, issues=issues,
+                      bytes_read=path.stat().st_size)
+
+
+def _remove(out: Path, layout: str) -> None:
+    """Clear a previous output at ``out`` (only what a conversion writes)."""
+    if layout == "dir":
+        if out.exists() and not out.is_dir():
+            raise ValueError(f"out {str(out)!r} exists and is not a directory")
+        if out.is_dir():
+            for name in ["meta.json", *(f"{c}.npy" for c in ("time", *CHANNELS))]:
+                (out / name).unlink(missing_ok=True)
+    elif layout == "npy":
+        _npy_meta_path(out).unlink(missing_ok=True)
+
+
+def _read_meta(out: Path, layout: str) -> dict:
+    if layout == "parquet":
+        import pyarrow.parquet as pq
+
+        kv = pq.read_metadata(out).metadata or {}
+        raw = kv.get(b"imunoise")
+        if raw is None:
+            raise ValueError(f"{out}: not written by imunoise convert (no 'imunoise' metadata)")
+        return json.loads(raw)
+    meta_path = out / "meta.json" if layout == "dir" else _npy_meta_path(out)
+    if not meta_path.exists():
+        raise ValueError(f"{out}: not written by imunoise convert (no {meta_path.name})")
+    return json.loads(meta_path.read_text())
+
+
+def load(out) -> ImuLog:
+    """Open the output of :func:`convert` as an :class:`ImuLog`.
+
+    The channels of a directory or ``.npy`` output are read-only memory maps:
+    nothing is read until used, and :func:`imunoise.adev` reads them in place.
+    A ``.parquet`` output is read into memory.
+
+    Parameters
+    ----------
+    out : str, os.PathLike or Conversion
+
+    Returns
+    -------
+    ImuLog
+        ``source``, ``format``, ``fs``, ``issues`` and ``messages`` are those of
+        the converted log.
+    """
+    if isinstance(out, Conversion):
+        out = out.out
+    out = Path(os.fspath(out))
+    if not out.exists():
+        raise FileNotFoundError(2, "no such file or directory", str(out))
+    layout = "dir" if out.is_dir() else _layout(out)
+    meta = _read_meta(out, layout)
+    channels = meta["channels"]
+    if layout == "dir":
+        arrays = {ch: np.load(out / f"{ch}.npy", mmap_mode="r") for ch in channels}
+    elif layout == "npy":
+        rec = np.load(out, mmap_mode="r")
+        arrays = {ch: rec[ch] for ch in channels}
+    else:
+        import pyarrow.parquet as pq
+
+        table = pq.read_table(out)
+        arrays = {}
+        for ch in channels:
+            cols = [table.column(n).to_numpy() for n in _column_names(ch)]
+            arrays[ch] = cols[0] if len(cols) == 1 else np.column_stack(cols)
+    iss = meta["issues"]
+    issues = ParseIssues(counts=iss["counts"], first={k: tuple(v) for k, v in
+                                                      iss["first"].items()},
+                         location=iss["location"])
+    return ImuLog(fs=float(meta["fs"]), source=meta["source"], format=meta["format"],
+                  issues=issues, messages=meta["messages"], **arrays)
+
+
+# ---------------------------------------------------------------------------
+# Fleets
+# ---------------------------------------------------------------------------
+
+#: Sensors analysed by :func:`batch`.
+BATCH_SENSORS = ("gyro", "accel")
+_TERM_ORDER = ("N", "B", "K", "Q", "R")
+_VERDICT_RANK = {"fail": 3, "marginal": 2, "pass": 1, "unresolved": 0}
+#: Averaging times of the batch analysis: log-spaced points per decade (as the report).
+BATCH_TAUS = 10
+
+
+def _expand(paths) -> list[str]:
+    if isinstance(paths, (str, os.PathLike)):
+        paths = [paths]
+    out: list[str] = []
+    for p in paths:
+        if not isinstance(p, (str, os.PathLike)):
+            raise TypeError(f"paths must be paths or glob patterns; got {type(p).__name__}")
+        text = os.fspath(p)
+        matches = sorted(glob.glob(text)) if glob.has_magic(text) else [text]
+        if not matches:
+            raise ValueError(f"paths: the pattern {text!r} matches no file")
+        out += matches
+    if not out:
+        raise ValueError("paths must name at least one log; got none")
+    return out
+
+
+def _base_row(path: str) -> dict:
+    row: dict = {"path": path, "sensor": None, "axis": None, "format": None,
+                 "samples": 0, "fs": np.nan, "duration_s": np.nan}
+    for kind in ISSUE_KINDS:
+        row[f"issues_{kind}"] = 0
+    for t in _TERM_ORDER:
+        row[t] = np.nan
+        row[f"{t}_std"] = np.nan
+        row[f"{t}_supported"] = False
+    row["verdict"] = None
+    row["error"] = None
+    return row
+
+
+def analyse_log(path: str, spec=None, fs: float | None = None) -> list[dict]:
+    """The batch rows of one log: one per sensor and axis, or one error row.
+
+    Reads the log (:func:`imunoise.read`), computes the overlapping Allan
+    deviation on :data:`BATCH_TAUS` taus per decade, fits the noise model
+    (:func:`imunoise.fit`) and compares it with ``spec`` (a name, a TOML file or
+    a :class:`~imunoise.datasheet.Spec`; ``None`` skips the comparison). Never
+    raises for a bad log: the exception becomes the ``error`` of one row.
+    """
+    import imunoise
+
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            log = imunoise.read(path, fs=fs)
+        if len(log) < 2:
+            raise ValueError(f"no usable records ({log.issues})")
+        sensors = [s for s in BATCH_SENSORS if getattr(log, s) is not None]
+        if not sensors:
+            raise ValueError(f"no gyro or accel channel (has {', '.join(log.channels)})")
+        models = {s: imunoise.fit(imunoise.adev(getattr(log, s), log.fs, taus=BATCH_TAUS))
+                  for s in sensors}
+        verdicts: dict[tuple[str, str], dict[str, str]] = {}
+        if spec is not None:
+            for r in imunoise.compare(models, spec).rows:
+                verdicts.setdefault((r["sensor"], r["axis"]), {})[r["term"]] = r["verdict"]
+        rows = []
+        for s in sensors:
+            m = models[s]
+            for j, axis in enumerate(("X", "Y", "Z")[: m.channels]):
+                row = _base_row(path)
+                row.update(sensor=s, axis=axis, format=log.format, samples=len(log),
+                           fs=log.fs, duration_s=log.duration)
+                for kind, n in log.issues.counts.items():
+                    row[f"issues_{kind}"] = int(n)
+                for t in _TERM_ORDER:
+                    row[t] = float(np.atleast_1d(m.value(t))[j])
+                    row[f"{t}_std"] = float(np.atleast_1d(m.std(t))[j])
+                    row[f"{t}_supported"] = bool(np.atleast_1d(m.supported[t])[j])
+                v = verdicts.get((s, axis), {})
+                if v:
+                    row["verdict"] = max(v.values(), key=_VERDICT_RANK.__getitem__)
+                for t in _TERM_ORDER:
+                    row[f"verdict_{t}"] = v.get(t)
+                rows.append(row)
+        return rows
+    except Exception as exc:  # noqa: BLE001 - a bad log is a row, not a failed batch
+        row = _base_row(path)
+        for t in _TERM_ORDER:
+            row[f"verdict_{t}"] = None
+        row["error"] = f"{type(exc).__name__}: {exc}"
+        return [row]
+
+
+def _frame(rows: list[dict]):
+    import pandas as pd
+
+    df = pd.DataFrame(rows)
+    cols = list(_base_row("").keys())
+    cols.remove("error")
+    cols += [f"verdict_{t}" for t in _TERM_ORDER] + ["error"]
+    df = df.reindex(columns=cols)
+    df["samples"] = df["samples"].astype("int64")
+    for kind in ISSUE_KINDS:
+        df[f"issues_{kind}"] = df[f"issues_{kind}"].astype("int64")
+    for t in _TERM_ORDER:
+        df[f"{t}_supported"] = df[f"{t}_supported"].astype(bool)
+    return df
+
+
+def _bar(enabled: bool | None, total: int):
+    if enabled is None:
+        enabled = sys.stderr.isatty()
+    if not enabled:
+        return None
+    try:
+        from tqdm import tqdm
+    except ImportError:  # pragma: no cover - tqdm is optional
+        return None
+    return tqdm(total=total, file=sys.stderr, unit="log", desc="imunoise batch")
+
+
+def batch(
+    paths,
+    client=None,
+    spec="vn100",
+    *,
+    fs: float | None = None,
+    progress: bool | None = None,
+):
+    """Characterise many logs in parallel with dask.distributed.
+
+    Parameters
+    ----------
+    paths : str, path or sequence of them
+        Logs or glob patterns (``"logs/*.bin"``), expanded in sorted order.
+    client : None, False, str or distributed.Client
+        ``None``: start a local cluster on this machine (2 worker processes, one
+        thread each) for this call; a ``Client``: use it unchanged; a string: the
+        address of a running scheduler (``"tcp://host:8786"``); ``False``: no Dask,
+        analyse the logs one after another in this process (the reference path:
+        the results are identical).
+    spec : str, path, Spec or None
+        Datasheet to compare with (``"vn100"``, a TOML file); ``None`` or
+        ``"none"`` skips the verdict.
+    fs : float, optional
+        Sample rate of logs without timestamps.
+    progress : bool, optional
+        Show a progress bar on stderr; default: when stderr is a terminal.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per log, sensor (gyro, accel) and axis (X, Y, Z), in the order of
+        ``paths``: ``path, sensor, axis, format, samples, fs, duration_s``, the
+        parse issue counts ``issues_<kind>``, the fitted coefficients ``N, B, K,
+        Q, R`` in the log's units (rad/s or m/s² per √s ... as
+        :class:`~imunoise.noise.NoiseModel`), their standard uncertainties
+        ``<term>_std`` and ``<term>_supported``, the datasheet ``verdict`` (worst
+        over the specified terms: fail, marginal, pass, unresolved) and per term
+        ``verdict_<term>``, and ``error``. A log that cannot be analysed has one
+        row with ``sensor`` empty and the exception in ``error``.
+
+    Notes
+    -----
+    The workers must be able to import imunoise and to read the paths (on a
+    remote cluster: the same files at the same paths).
+    """
+    from imunoise.datasheet import load_spec
+
+    files = _expand(paths)
+    if isinstance(spec, str) and spec.lower() == "none":
+        spec = None
+    if spec is not None:
+        spec = load_spec(spec)  # fail early, and ship the parsed spec to the workers
+    bar = _bar(progress, len(files))
+    try:
+        if client is False:
+            results = []
+            for p in files:
+                results.append(analyse_log(p, spec, fs))
+                if bar is not None:
+                    bar.update(1)
+        else:
+            results = _run_dask(files, client, spec, fs, bar)
+    finally:
+        if bar is not None:
+            bar.close()
+    return _frame([row for rows in results for row in rows])
+
+
+def _run_dask(files, client, spec, fs, bar) -> list[list[dict]]:
+    try:
+        from distributed import Client, LocalCluster, as_completed
+    except ImportError:
+        raise ImportError(
+            "imunoise.batch needs dask.distributed (pip install 'imunoise[scale]'); "
+            "pass client=False to run without it"
+        ) from None
+    own_cluster = own_client = None
+    if client is None:
+        own_cluster = LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                   dashboard_address=None)
+        client = own_client = Client(own_cluster)
+    elif isinstance(client, str):
+        client = own_client = Client(client)
+    elif not isinstance(client, Client):
+        raise TypeError(
+            "client must be None, False, a scheduler address or a distributed.Client; "
+            f"got {type(client).__name__}"
+        )
+    try:
+        futures = [client.submit(analyse_log, p, spec, fs, pure=False) for p in files]
+        index = {f.key: i for i, f in enumerate(futures)}
+        results: list[list[dict] | None] = [None] * len(files)
+        for fut in as_completed(futures):
+            i = index[fut.key]
+            try:
+                results[i] = fut.result()
+            except Exception as exc:  # noqa: BLE001 - a lost worker must not lose the batch
+                row = _base_row(files[i])
+                for t in _TERM_ORDER:
+                    row[f"verdict_{t}"] = None
+                row["error"] = f"{type(exc).__name__}: {exc}"
+                results[i] = [row]
+            if bar is not None:
+                bar.update(1)
+        return results  # type: ignore[return-value]
+    finally:
+        if own_client is not None:
+            own_client.close()
+        if own_cluster is not None:
+            own_cluster.close()
