@@ -13,6 +13,7 @@ from imunoise.noise import NoiseModel, fit
 from imunoise.readers import ImuLog, ParseIssues
 from imunoise.readers.read import read
 from imunoise.readers.vn_write import write_vn_ascii, write_vn_binary
+from imunoise.scale import batch
 from imunoise.simulate import simulate
 from imunoise.stats import describe, distribution
 
@@ -23,6 +24,7 @@ __all__ = [
     "NoiseModel",
     "ParseIssues",
     "adev",
+    "batch",
     "compare",
     "describe",
     "distribution",

@@ -102,12 +102,36 @@ def _build_parser() -> argparse.ArgumentParser:
     s.add_argument("log", metavar="LOG")
     _fs_arg(s)
 
-    c = sub.add_parser("convert", help="convert a log to CSV, Parquet or NPZ",
+    c = sub.add_parser("convert", help="convert a log to .npy, Parquet, CSV or NPZ",
                        description="Write the log's channels to OUTPUT; the format follows the "
-                       "suffix: .csv, .parquet (needs pyarrow) or .npz.")
+                       "suffix: a directory (no suffix: one memory-mappable .npy per channel "
+                       "plus meta.json), .npy (one structured array), .parquet (needs "
+                       "pyarrow), .csv or .npz. VN logs to a directory, .npy or .parquet are "
+                       "streamed with bounded memory, whatever their size.")
     c.add_argument("log", metavar="LOG")
     _fs_arg(c)
     c.add_argument("-o", "--output", required=True, metavar="OUTPUT")
+    c.add_argument("--chunk-mb", type=_positive_float, default=64.0, metavar="MB",
+                   help="bytes read per piece when streaming (default: %(default)s MB)")
+    _progress_args(c)
+
+    b = sub.add_parser("batch", help="characterise many logs in parallel (Dask)",
+                       description="Allan deviation, noise fit and datasheet verdict of every "
+                       "log, one row per log, sensor and axis, computed with dask.distributed "
+                       "(a local cluster of 2 worker processes unless --scheduler is given). "
+                       "A log that fails gets a row with its error.")
+    b.add_argument("logs", metavar="LOG", nargs="+", help="logs or glob patterns ('logs/*.bin')")
+    b.add_argument("-o", "--output", required=True, metavar="OUTPUT",
+                   help="results table: .parquet (needs pyarrow) or .csv")
+    b.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                   help="address of a running Dask scheduler (default: a local cluster)")
+    b.add_argument("--serial", action="store_true",
+                   help="no Dask: analyse the logs one after another in this process")
+    b.add_argument("--spec", default="vn100",
+                   help="datasheet to compare with: a name or a TOML file (default: "
+                   "%(default)s); 'none' to skip")
+    _fs_arg(b)
+    _progress_args(b)
 
     m = sub.add_parser("simulate", help="write the log of a simulated still VN-100",
                        description="Write the log of a still VN-100 (gravity on -Z, a constant "
@@ -296,8 +320,11 @@ def _columns(log) -> tuple[list[str], list[np.ndarray]]:
 def _cmd_convert(args) -> int:
     out = Path(args.output)
     suffix = out.suffix.lower()
-    if suffix not in (".csv", ".parquet", ".npz"):
-        _fail(f"--output must end in .csv, .parquet or .npz; got {str(out)!r}")
+    if suffix not in ("", ".npy", ".csv", ".parquet", ".npz"):
+        _fail(f"--output must be a directory or end in .npy, .parquet, .csv or .npz; "
+              f"got {str(out)!r}")
+    if suffix in ("", ".npy", ".parquet"):
+        return _convert_streaming(args, out)
     if suffix == ".parquet":
         try:
             import pyarrow  # noqa: F401
@@ -319,6 +346,53 @@ def _cmd_convert(args) -> int:
     else:
         np.savez(out, fs=log.fs, **dict(zip(names, cols, strict=True)))
     print(f"wrote {len(log)} samples x {len(names)} columns to {out}")
+    return 0
+
+
+def _convert_streaming(args, out: Path) -> int:
+    from imunoise import scale
+    from imunoise.report import _Progress
+
+    bar = _Progress(args.progress, 0)
+    try:
+        done = scale.convert(args.log, out, fs=args.fs, chunk_bytes=int(args.chunk_mb * 2**20),
+                             progress=bar.reader(f"converting {Path(args.log).name}"))
+    except ImportError as exc:
+        _fail(str(exc))
+    finally:
+        bar.close()
+    print(f"wrote {done.samples} samples ({', '.join(done.channels)}) at {done.fs:.6g} Hz to "
+          f"{done.out}; parse issues: {done.issues}")
+    return 0
+
+
+def _cmd_batch(args) -> int:
+    from imunoise import scale
+
+    out = Path(args.output)
+    suffix = out.suffix.lower()
+    if suffix not in (".parquet", ".csv"):
+        _fail(f"--output must end in .parquet or .csv; got {str(out)!r}")
+    if args.serial and args.scheduler:
+        _fail("--serial and --scheduler exclude each other")
+    client = False if args.serial else args.scheduler
+    try:
+        df = scale.batch(args.logs, client=client, spec=args.spec, fs=args.fs,
+                         progress=args.progress)
+    except ImportError as exc:
+        _fail(str(exc))
+    out.parent.mkdir(parents=True, exist_ok=True)
+    if suffix == ".csv":
+        df.to_csv(out, index=False)
+    else:
+        try:
+            df.to_parquet(out, index=False)
+        except ImportError:
+            _fail("Parquet output needs pyarrow (pip install pyarrow); or use a .csv output")
+    failed = df.loc[df["error"].notna(), "path"].tolist()
+    logs = df["path"].nunique()
+    print(f"wrote {len(df)} rows for {logs} logs to {out}"
+          + (f"; {len(failed)} failed: {', '.join(failed)}" if failed else ""))
     return 0
 
 
@@ -390,6 +464,7 @@ _COMMANDS = {
     "fit": _cmd_fit,
     "stats": _cmd_stats,
     "convert": _cmd_convert,
+    "batch": _cmd_batch,
     "simulate": _cmd_simulate,
     "demo": _cmd_demo,
 }
