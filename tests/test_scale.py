@@ -7,10 +7,9 @@ import subprocess
 import sys
 import textwrap
 
+import imunoise
 import numpy as np
 import pytest
-
-import imunoise
 from imunoise import scale
 from imunoise.cli import demo_long_log, main
 
