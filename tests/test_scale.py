@@ -223,3 +223,34 @@ def test_cli_batch_writes_table(fleet, tmp_path, capsys):
     assert len(pd.read_csv(out)) == 3 * 6 + 1
     assert main(["batch", str(d / "nothing*.bin"), "-o", str(out), "--serial"]) == 2
     assert "matches no file" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("n", [2, 9, 10, 1001])
+def test_streamed_step_median_equals_numpy(n):
+    rng = np.random.default_rng(n)
+    t = np.cumsum(rng.choice([0.0, 0.00125, 0.00125, 0.0012501, -0.5, 0.0025], size=n))
+    steps = scale._Steps()
+    for piece in np.array_split(t, 4):
+        steps.add(piece)
+    d = np.diff(t)
+    d = d[d > 0]
+    assert steps.median() == (np.median(d) if len(d) else None)
+
+
+def test_convert_csv_is_read_whole_and_equal(logs, tmp_path, capsys):
+    csv = tmp_path / "log.csv"
+    assert main(["convert", str(logs["binary"]), "-o", str(csv)]) == 0
+    capsys.readouterr()
+    ref = imunoise.read(csv)
+    done = scale.convert(csv, tmp_path / "c.npy", chunk_bytes=8192)
+    _same_log(ref, scale.load(done.out))
+
+
+def test_parquet_metadata(logs, tmp_path):
+    pq = pytest.importorskip("pyarrow.parquet")
+    out = tmp_path / "p.parquet"
+    done = scale.convert(logs["binary"], out)
+    table = pq.read_table(out)
+    assert table.column_names[:4] == ["time", "gyro_x", "gyro_y", "gyro_z"]
+    # Written after the rows: the file's key-value metadata.
+    assert float(pq.read_metadata(out).metadata[b"fs"]) == done.fs
