@@ -6,7 +6,18 @@ plots and reports. Start with ``imunoise.adev(x, fs)``.
 """
 
 from imunoise._core import __version__
-from imunoise.allan import AllanResult, adev, hdev, mdev, tdev, totdev
+from imunoise.allan import (
+    AllanResult,
+    adev,
+    hdev,
+    htotdev,
+    mdev,
+    mtotdev,
+    tdev,
+    theo1,
+    totdev,
+    ttotdev,
+)
 from imunoise.readers import ImuLog, ParseIssues
 
 __all__ = [
@@ -16,7 +27,11 @@ __all__ = [
     "ParseIssues",
     "adev",
     "hdev",
+    "htotdev",
     "mdev",
+    "mtotdev",
     "tdev",
+    "theo1",
     "totdev",
+    "ttotdev",
 ]
