@@ -7,7 +7,18 @@ plots and reports. Start with ``imunoise.adev(x, fs)``.
 
 from imunoise import export, units
 from imunoise._core import __version__
-from imunoise.allan import AllanResult, adev, hdev, mdev, tdev, totdev
+from imunoise.allan import (
+    AllanResult,
+    adev,
+    hdev,
+    htotdev,
+    mdev,
+    mtotdev,
+    tdev,
+    theo1,
+    totdev,
+    ttotdev,
+)
 from imunoise.datasheet import compare
 from imunoise.noise import NoiseModel, fit
 from imunoise.readers import ImuLog, ParseIssues
@@ -26,15 +37,19 @@ __all__ = [
     "compare",
     "describe",
     "distribution",
+    "export",
     "fit",
     "hdev",
+    "htotdev",
     "mdev",
+    "mtotdev",
+    "read",
     "simulate",
     "tdev",
+    "theo1",
     "totdev",
-    "read",
+    "ttotdev",
+    "units",
     "write_vn_ascii",
     "write_vn_binary",
-    "export",
-    "units",
 ]
