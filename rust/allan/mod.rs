@@ -1,6 +1,7 @@
 //! The Allan family over cumulative sums: estimates, noise identification and
 //! equivalent degrees of freedom for many channels and taus at once.
 
+pub mod blocked;
 pub mod edf;
 pub mod noise_id;
 pub mod phase;
@@ -30,10 +31,10 @@ pub struct Analysis {
 }
 
 /// Cumulative phases of several channels, computed in parallel. Each item yields
-/// one channel's samples and may be iterated twice.
+/// one channel's samples.
 pub fn column_phases<I>(columns: Vec<I>) -> CoreResult<Vec<Vec<f64>>>
 where
-    I: Iterator<Item = f64> + Clone + Send,
+    I: Iterator<Item = f64> + Send,
 {
     let several = columns.len() > 1;
     columns
@@ -78,12 +79,23 @@ pub fn analyse(phases: &[Vec<f64>], statistic: Statistic, ms: &[usize]) -> CoreR
         .flat_map(|t| (0..channels).map(move |c| (t, c)))
         .collect();
     let (dmax, estimator) = noise_model_of(statistic);
+    // The overlapping Allan and Hadamard variances sweep all taus of a channel at
+    // once (see `blocked`); every other statistic goes tau by tau.
+    let swept: Option<Vec<Vec<f64>>> = statistic.blocked_difference().map(|difference| {
+        phases
+            .par_iter()
+            .map(|c| blocked::sums_of_squares(c, ms, difference))
+            .collect()
+    });
     let per_pair: Vec<(f64, Option<i32>)> = pairs
         .par_iter()
         .map(|&(t, c)| {
-            let est = statistic.estimate(&phases[c], ms[t]);
+            let var = match &swept {
+                Some(sums) => statistic.variance_from_sum(sums[c][t], ms[t], terms[t]),
+                None => statistic.estimate(&phases[c], ms[t]).var,
+            };
             let id_m = statistic.noise_id_factor(ms[t]);
-            (est.var, noise_id::identify_alpha(&phases[c], id_m, dmax))
+            (var, noise_id::identify_alpha(&phases[c], id_m, dmax))
         })
         .collect();
 

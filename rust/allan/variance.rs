@@ -3,6 +3,7 @@
 //! τ = m·τ0 together with the number of terms in its sum, counted as Stable32
 //! and allantools count them. References: NIST SP 1065 (Riley 2008), eqs. 6–25.
 
+use super::blocked::Difference;
 use super::sum::{sum_of_squared_combinations, sum_of_squares, Neumaier};
 use super::total;
 
@@ -97,6 +98,25 @@ impl Statistic {
             Statistic::Theo1 => ((3 * m) / 4).max(1),
             _ => m,
         }
+    }
+
+    /// For the overlapping Allan and Hadamard variances: the order of the
+    /// difference whose squares `blocked::sums_of_squares` sums for all taus at once.
+    pub fn blocked_difference(self) -> Option<Difference> {
+        match self {
+            Statistic::Allan { overlapping: true } => Some(Difference::Second),
+            Statistic::Hadamard { overlapping: true } => Some(Difference::Third),
+            _ => None,
+        }
+    }
+
+    /// The variance from a sum of squared differences (see `blocked_difference`).
+    pub fn variance_from_sum(self, sum: f64, m: usize, terms: usize) -> f64 {
+        let divisor = match self {
+            Statistic::Hadamard { .. } => 6.0,
+            _ => 2.0,
+        };
+        sum / (divisor * (m as f64).powi(2) * terms as f64)
     }
 
     /// The variance at averaging factor `m` over the cumulative phase `c`.
