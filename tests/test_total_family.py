@@ -240,3 +240,17 @@ def test_taus_out_of_range_are_dropped_with_a_warning():
     with pytest.warns(UserWarning, match="dropped"):
         r = imunoise.theo1(y, 1.0, taus=np.array([3.0, 4.0]))
     np.testing.assert_array_equal(r.m, [4])
+
+
+def test_long_records_at_long_taus_warn_before_a_slow_run(monkeypatch):
+    # The warning comes before the kernel runs; stop there instead of waiting.
+    import imunoise.allan as allan_module
+
+    def refuse(*_args, **_kwargs):
+        raise RuntimeError("kernel reached")
+
+    monkeypatch.setattr(allan_module._core, "analyse", refuse)
+    x = np.random.default_rng(0).normal(size=720_000)
+    with pytest.warns(UserWarning, match=r"O\(n·m\) per tau.*minutes.*pass taus="):
+        with pytest.raises(RuntimeError, match="kernel reached"):
+            imunoise.mtotdev(x, 40.0)
