@@ -168,7 +168,7 @@ def test_demo(tmp_path, capsys, read):
     assert code == 0, err
     assert str((tmp_path / "demo" / "report.html").resolve()) in out
     md = (tmp_path / "demo" / "report.md").read_text()
-    assert "| long | <simulated VN-100, 0.2 h> |" in md
+    assert "| long | <simulated VectorNav VN-100, 0.2 h> |" in md
 
 
 @pytest.mark.skipif(not all(hasattr(imunoise, f) for f in ("simulate", "write_vn_ascii", "read")),

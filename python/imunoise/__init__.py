@@ -25,6 +25,7 @@ from imunoise.readers import ImuLog, ParseIssues
 from imunoise.readers.read import read
 from imunoise.readers.vn_write import write_vn_ascii, write_vn_binary
 from imunoise.simulate import simulate
+from imunoise.simulate_log import simulate_log
 from imunoise.stats import describe, distribution
 
 __all__ = [
@@ -45,6 +46,7 @@ __all__ = [
     "mtotdev",
     "read",
     "simulate",
+    "simulate_log",
     "tdev",
     "theo1",
     "totdev",
