@@ -192,11 +192,8 @@ def _cmd_adev(args) -> int:
 
 
 def _cmd_fit(args) -> int:
-    import imunoise
     from imunoise import report
 
-    if not hasattr(imunoise, "fit"):
-        _fail("the noise model (imunoise.fit) is not part of this installation")
     log = _read(args)
     sensors = [args.sensor] if args.sensor else [s for s in ("gyro", "accel")
                                                   if getattr(log, s) is not None]
