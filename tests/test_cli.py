@@ -8,30 +8,9 @@ import numpy as np
 import pytest
 from imunoise.cli import main
 
-needs_read = pytest.mark.skipif(not hasattr(imunoise, "read"),
-                                reason="imunoise.read has not landed")
-
-
-def _standin_read(path, fs=None, progress=None):
-    """Test-only stand-in for imunoise.read until the readers land: $VNYMR lines only."""
-    rows = []
-    with open(path) as f:
-        for line in f:
-            if line.startswith("$VNYMR,") and "*" in line:
-                rows.append([float(v) for v in line[7:line.index("*")].split(",")])
-    if not rows:
-        raise ValueError(f"{path}: no usable records")
-    a = np.array(rows)
-    return imunoise.ImuLog(fs=fs or 40.0, source=str(path), format="vn-ascii",
-                           issues=imunoise.ParseIssues.none(), ypr=a[:, 0:3], mag=a[:, 3:6],
-                           accel=a[:, 6:9], gyro=a[:, 9:12])
-
 
 @pytest.fixture
-def read(monkeypatch):
-    """imunoise.read, or the stand-in when the readers have not landed."""
-    if not hasattr(imunoise, "read"):
-        monkeypatch.setattr(imunoise, "read", _standin_read, raising=False)
+def read():
     return imunoise.read
 
 
@@ -54,8 +33,6 @@ def test_missing_file(cmd, tmp_path, capsys):
     argv = [cmd, str(tmp_path / "missing.txt")]
     if cmd == "convert":
         argv += ["-o", str(tmp_path / "x.csv")]
-    if cmd == "fit" and not hasattr(imunoise, "fit"):
-        pytest.skip("imunoise.fit has not landed")
     code, _, err = _run(argv, capsys)
     assert code == 2
     assert "missing.txt" in _one_line_error(err)
@@ -114,7 +91,6 @@ def test_subprocess_no_traceback(tmp_path):
     _one_line_error(proc.stderr)
 
 
-@needs_read
 def test_unreadable_and_empty_logs(tmp_path, capsys):
     garbage = tmp_path / "garbage.bin"
     garbage.write_bytes(bytes(range(256)) * 20)
@@ -161,18 +137,15 @@ def test_report_command_on_bundled_log(tmp_path, capsys, read):
     assert "| both | vn100_stationary_5min.txt |" in md
 
 
-@pytest.mark.skipif(not hasattr(imunoise, "simulate"), reason="imunoise.simulate has not landed")
 def test_demo(tmp_path, capsys, read):
     code, out, err = _run(["demo", "-o", str(tmp_path / "demo"), "--hours", "0.2",
                            "--no-progress"], capsys)
     assert code == 0, err
     assert str((tmp_path / "demo" / "report.html").resolve()) in out
     md = (tmp_path / "demo" / "report.md").read_text()
-    assert "| long | <simulated VN-100, 0.2 h> |" in md
+    assert "| long | <simulated VectorNav VN-100, 0.2 h> |" in md
 
 
-@pytest.mark.skipif(not all(hasattr(imunoise, f) for f in ("simulate", "write_vn_ascii", "read")),
-                    reason="imunoise.simulate, the VN writers or imunoise.read have not landed")
 def test_simulate_writes_a_readable_vn_log(tmp_path, capsys):
     out = tmp_path / "still.txt"
     code, _, err = _run(["simulate", "-o", str(out), "--hours", "0.01", "--seed", "3"], capsys)
@@ -183,7 +156,6 @@ def test_simulate_writes_a_readable_vn_log(tmp_path, capsys):
     assert log.gyro.std(axis=0) == pytest.approx([6.1e-5 * np.sqrt(40)] * 3, rel=0.1)
 
 
-@pytest.mark.skipif(not hasattr(imunoise, "fit"), reason="imunoise.fit has not landed")
 def test_fit_prints_datasheet_table(capsys, read):
     from imunoise import report
     from imunoise.cli import bundled_log

@@ -152,8 +152,6 @@ def test_single_log_does_both(tmp_path):
     assert len(rep.allan["gyro"].taus) > 10
 
 
-@pytest.mark.skipif(not report.model_available(), reason="noise model (imunoise.fit, "
-                    "compare, export) has not landed in this build")
 def test_model_files_and_tables_match_fit(built):
     from imunoise import export
 
@@ -191,7 +189,6 @@ def test_model_files_and_tables_match_fit(built):
     assert {r[-1] for r in cmp[1:]} <= {"pass", "marginal", "fail", "unresolved"}
 
 
-@pytest.mark.skipif(not hasattr(imunoise, "read"), reason="imunoise.read has not landed")
 def test_report_on_bundled_real_log(tmp_path):
     from imunoise.cli import bundled_log
 

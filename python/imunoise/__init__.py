@@ -7,7 +7,18 @@ plots and reports. Start with ``imunoise.adev(x, fs)``.
 
 from imunoise import export, units
 from imunoise._core import __version__
-from imunoise.allan import AllanResult, adev, hdev, mdev, tdev, totdev
+from imunoise.allan import (
+    AllanResult,
+    adev,
+    hdev,
+    htotdev,
+    mdev,
+    mtotdev,
+    tdev,
+    theo1,
+    totdev,
+    ttotdev,
+)
 from imunoise.datasheet import compare
 from imunoise.noise import NoiseModel, fit
 from imunoise.readers import ImuLog, ParseIssues
@@ -15,6 +26,7 @@ from imunoise.readers.read import read
 from imunoise.readers.vn_write import write_vn_ascii, write_vn_binary
 from imunoise.scale import batch
 from imunoise.simulate import simulate
+from imunoise.simulate_log import simulate_log
 from imunoise.stats import describe, distribution
 
 __all__ = [
@@ -28,15 +40,20 @@ __all__ = [
     "compare",
     "describe",
     "distribution",
+    "export",
     "fit",
     "hdev",
+    "htotdev",
     "mdev",
-    "simulate",
-    "tdev",
-    "totdev",
+    "mtotdev",
     "read",
+    "simulate",
+    "simulate_log",
+    "tdev",
+    "theo1",
+    "totdev",
+    "ttotdev",
+    "units",
     "write_vn_ascii",
     "write_vn_binary",
-    "export",
-    "units",
 ]

@@ -23,7 +23,7 @@ def analyse(
 ]:
     """(var, terms, alpha, alpha_identified, edf) for x (n, channels) at averaging
     factors ms; 2-D outputs are (len(ms), channels). statistic: adev, oadev, mdev,
-    hdev, ohdev, totdev."""
+    hdev, ohdev, totdev, mtotdev, htotdev, theo1."""
 
 def estimator_terms(
     statistic: str, n_phase: int, ms: npt.NDArray[np.uint64]

@@ -33,6 +33,7 @@ autocorrelation", Proc. 18th EFTF (2004).
 from __future__ import annotations
 
 import numbers
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -44,7 +45,19 @@ from imunoise.taus import averaging_factors, keep_estimable
 #: One-sigma confidence, erf(1/√2).
 ONE_SIGMA = 0.6826894921370859
 
-__all__ = ["AllanResult", "adev", "mdev", "hdev", "tdev", "totdev", "ONE_SIGMA"]
+__all__ = [
+    "AllanResult",
+    "adev",
+    "mdev",
+    "hdev",
+    "tdev",
+    "totdev",
+    "mtotdev",
+    "ttotdev",
+    "htotdev",
+    "theo1",
+    "ONE_SIGMA",
+]
 
 
 @dataclass(frozen=True)
@@ -57,7 +70,8 @@ class AllanResult:
     Attributes
     ----------
     kind : str
-        ``"adev"``, ``"mdev"``, ``"hdev"``, ``"tdev"`` or ``"totdev"``.
+        ``"adev"``, ``"mdev"``, ``"hdev"``, ``"tdev"``, ``"totdev"``, ``"mtotdev"``,
+        ``"ttotdev"``, ``"htotdev"`` or ``"theo1"``.
     overlapping : bool
         Whether the estimator uses every start sample (stride 1) or stride m.
     taus : ndarray, (T,)
@@ -187,12 +201,169 @@ def totdev(x, fs, taus="octave", *, confidence: float = ONE_SIGMA):
     return _deviation("totdev", "totdev", x, fs, taus, confidence, True)
 
 
-def _deviation(kind, statistic, x, fs, taus, confidence, overlapping) -> AllanResult:
+#: SP 1065 (Riley 2008) / Riley, "Confidence intervals and bias corrections for the
+#: Stable32 variance functions" (2000): biased/unbiased variance ratio by α.
+_MTOT_BIAS = {2: 0.94, 1: 0.83, 0: 0.73, -1: 0.70, -2: 0.69}
+_HTOT_BIAS = {0: 0.995, -1: 0.851, -2: 0.771, -3: 0.717, -4: 0.679}
+#: Howe, "TheoH: a hybrid, high-confidence statistic" (Metrologia 2006) and
+#: SP 1065: AVAR/Theo1 = a + b/m^c by α (white FM: 1, unbiased).
+_THEO1_BIAS = {
+    2: (0.09, 0.74, 0.40),
+    1: (0.14, 0.82, 0.30),
+    0: (1.00, 0.00, 1.00),
+    -1: (1.87, -1.05, 0.79),
+    -2: (2.70, -1.53, 0.85),
+}
+
+
+def mtotdev(x, fs, taus="octave", *, confidence: float = ONE_SIGMA, bias_correction=False):
+    r"""Modified total deviation (SP 1065 eq. 27; Howe & Vernotte 1999).
+
+    Each of the N − 3m + 1 phase subsequences of 3m points (N = n + 1) has its
+    linear trend removed (from the means of its two halves), is extended by
+    uninverted even reflection to 9m points, and contributes the mean of its 6m
+    squared second differences of m-point phase means:
+    :math:`\mathrm{Mod\,Tot}\,\sigma^2(\tau) = \frac{1}{2\tau^2(N-3m+1)}
+    \sum_i \frac{1}{6m}\sum_j (\bar x_j - 2\bar x_{j+m} + \bar x_{j+2m})^2`.
+    Taus up to N/3 (as allantools). EDF: SP 1065 Table 8.
+
+    Parameters
+    ----------
+    x, fs, taus, confidence
+        As for :func:`adev`.
+    bias_correction : bool, optional
+        Divide the variance by the published bias factor for the noise type
+        identified at each tau (``alpha`` in the result). Default False: the
+        estimate is then a function of the data alone, reproducible and equal to
+        allantools' and Stable32's uncorrected values; the correction depends on
+        the noise identification, which is uncertain where the curve changes
+        slope, and a misidentified tau would jump. Turn it on to compare with
+        Allan-variance values of the same noise (a datasheet, a fitted model).
+        Factors (SP 1065): white PM 0.94, flicker PM 0.83, white FM 0.73,
+        flicker FM 0.70, random-walk FM 0.69.
+
+    Returns
+    -------
+    AllanResult
+    """
+    return _deviation(
+        "mtotdev", "mtotdev", x, fs, taus, confidence, True, bias_correction=bias_correction
+    )
+
+
+def ttotdev(x, fs, taus="octave", *, confidence: float = ONE_SIGMA, bias_correction=False):
+    r"""Time total deviation, τ·MTOTDEV/√3 (SP 1065 eq. 28, with τ² in the variance;
+    the τ³ printed there is a typo), in input units × seconds. Parameters, EDF and
+    bias correction as for :func:`mtotdev`."""
+    return _deviation(
+        "ttotdev", "mtotdev", x, fs, taus, confidence, True, bias_correction=bias_correction
+    )
+
+
+def htotdev(x, fs, taus="octave", *, confidence: float = ONE_SIGMA, bias_correction=False):
+    r"""Hadamard total deviation (SP 1065 eq. 29; Howe, Beard, Greenhall, Riley 2005).
+
+    The MTOT construction applied to the *rate* samples: each of the n − 3m + 1
+    subsequences of 3m samples is detrended, reflected to 9m samples, and
+    contributes the mean of its 6m squared second differences of m-sample means
+    divided by 6. At m = 1 the overlapping Hadamard deviation is returned (as
+    Stable32 and allantools do). Insensitive to a linear rate drift. Taus up to n/3.
+    EDF: SP 1065 gives none for HTOT; the overlapping Hadamard EDF (Greenhall) is
+    used, a conservative lower bound.
+
+    Parameters
+    ----------
+    x, fs, taus, confidence
+        As for :func:`adev`.
+    bias_correction : bool, optional
+        Divide the variance by the published bias factor for the noise type
+        identified at each tau (``alpha`` in the result). Default False: the
+        estimate is then a function of the data alone, reproducible and equal to
+        allantools' and Stable32's uncorrected values; the correction depends on
+        the noise identification, which is uncertain where the curve changes
+        slope, and a misidentified tau would jump. Turn it on to compare with
+        Allan-variance values of the same noise (a datasheet, a fitted model).
+        Factors (SP 1065): white FM 0.995, flicker FM 0.851, random-walk FM 0.771,
+        flicker-walk FM 0.717, random-run FM 0.679; none is published for phase
+        noise (α > 0), where no correction is applied, nor at m = 1.
+
+    Returns
+    -------
+    AllanResult
+    """
+    return _deviation(
+        "htotdev", "htotdev", x, fs, taus, confidence, True, bias_correction=bias_correction
+    )
+
+
+def theo1(x, fs, taus="octave", *, confidence: float = ONE_SIGMA, bias_correction=False):
+    r"""Theo1 deviation (SP 1065 eq. 30; Howe & Peppler 2003), even m only.
+
+    :math:`\mathrm{Theo1}(m) = \frac{1}{0.75\,(N-m)(m\tau_0)^2}\sum_{i=0}^{N-m-1}
+    \sum_{\delta=0}^{m/2-1}\frac{[(x_i - x_{i-\delta+m/2}) + (x_{i+m} - x_{i+\delta+m/2})]^2}
+    {m/2-\delta}` over the N = n + 1 phase points, for even 2 ≤ m < N.
+
+    Tau convention: ``r.taus`` is m/fs, the averaging factor, as allantools reports
+    it and as the NBS14 reference table lists it; the estimate belongs to the Allan
+    variance at the *effective* averaging time 0.75·m/fs (multiply ``r.taus`` by
+    0.75 to plot Theo1 next to ADEV). Odd m from a grid are skipped; explicit odd
+    taus are dropped with a warning. ``r.n`` counts (N − m)·m/2 terms, as allantools
+    does. Noise identification uses the factor 0.75·m; EDF: the SP 1065 Theo1
+    formulas (Howe & Tasset) with r = 0.75·m.
+
+    Parameters
+    ----------
+    x, fs, taus, confidence
+        As for :func:`adev`.
+    bias_correction : bool, optional
+        Divide the variance by the published bias factor for the noise type
+        identified at each tau (``alpha`` in the result). Default False: the
+        estimate is then a function of the data alone, reproducible and equal to
+        allantools' and Stable32's uncorrected values; the correction depends on
+        the noise identification, which is uncertain where the curve changes
+        slope, and a misidentified tau would jump. Turn it on to compare with
+        Allan-variance values of the same noise (a datasheet, a fitted model).
+        With it, the variance is multiplied by AVAR/Theo1 = a + b/m^c (Howe 2006,
+        SP 1065): white PM 0.09 + 0.74/m^0.40, flicker PM 0.14 + 0.82/m^0.30,
+        white FM 1, flicker FM 1.87 − 1.05/m^0.79, random-walk FM 2.70 − 1.53/m^0.85.
+
+    Returns
+    -------
+    AllanResult
+    """
+    return _deviation(
+        "theo1", "theo1", x, fs, taus, confidence, True, bias_correction=bias_correction
+    )
+
+
+def _bias_factor(kind, alpha, m):
+    """Multiplier of the variance that removes the published bias; alpha (T, ch)."""
+    if kind in ("mtotdev", "ttotdev"):
+        table = np.vectorize(lambda a: 1.0 / _MTOT_BIAS[int(np.clip(a, -2, 2))])
+        return table(alpha)
+    if kind == "htotdev":
+        f = np.vectorize(lambda a: 1.0 / _HTOT_BIAS[int(a)] if a <= 0 else 1.0)(
+            np.clip(alpha, -4, 2)
+        )
+        return np.where((m == 1)[:, None], 1.0, f)
+    a, b, c = (
+        np.vectorize(lambda al, k=k: _THEO1_BIAS[int(np.clip(al, -2, 2))][k])(alpha)
+        for k in range(3)
+    )
+    return a + b / (m[:, None].astype(float) ** c)
+
+
+def _deviation(
+    kind, statistic, x, fs, taus, confidence, overlapping, *, bias_correction=False
+) -> AllanResult:
     data, one_d = _as_samples(x)
     fs = _check_fs(fs)
     confidence = _check_confidence(confidence)
+    _check_bool("bias_correction", bias_correction)
     n = data.shape[0]
     m, user_given = averaging_factors(taus, fs, n)
+    if kind == "theo1" and not user_given:
+        m = m[m % 2 == 0]  # Theo1 is defined for even m only
     m = m.astype(np.uint64)
     terms = _core.estimator_terms(statistic, n + 1, m)
     m = keep_estimable(m.astype(np.int64), terms.astype(np.int64), fs, user_given, kind)
@@ -201,9 +372,12 @@ def _deviation(kind, statistic, x, fs, taus, confidence, overlapping) -> AllanRe
             f"x has {n} samples, too few for any tau of {kind} "
             f"(the shortest tau needs at least {_minimum_samples(statistic)})"
         )
+    _warn_if_quadratic_cost(statistic, n, m, data.shape[1])
     var, terms, alpha, identified, edf = _core.analyse(data, statistic, m.astype(np.uint64))
     tau = m / fs
-    if kind == "tdev":
+    if bias_correction:
+        var = var * _bias_factor(kind, alpha, m)
+    if kind in ("tdev", "ttotdev"):
         var = var * (tau**2 / 3.0)[:, None]
     dev = np.sqrt(var)
     ci_low, ci_high = chi2_interval(dev, edf, confidence)
@@ -234,6 +408,27 @@ def chi2_interval(dev, edf, confidence):
         low = dev * np.sqrt(edf / _stats.chi2.ppf(1.0 - tail, edf))
         high = dev * np.sqrt(edf / _stats.chi2.ppf(tail, edf))
     return low, high
+
+
+#: Statistics whose exact evaluation costs O(n·m) per tau rather than O(n).
+_QUADRATIC_COST = ("mtotdev", "htotdev", "theo1")
+#: Roughly what this machine class does per second in those kernels (inner steps).
+_QUADRATIC_STEPS_PER_SECOND = 1e9
+
+
+def _warn_if_quadratic_cost(statistic: str, n: int, m: np.ndarray, channels: int) -> None:
+    """A long record at long taus makes the total family slow: say so up front."""
+    if statistic not in _QUADRATIC_COST:
+        return
+    steps = 9.0 * n * float(np.sum(m)) * channels
+    seconds = steps / _QUADRATIC_STEPS_PER_SECOND
+    if seconds > 60:
+        warnings.warn(
+            f"{statistic} costs O(n·m) per tau: {n} samples up to m = {int(m.max())} "
+            f"will take roughly {seconds / 60:.0f} minutes; pass taus= with shorter taus "
+            "(e.g. an array of seconds) to limit it",
+            stacklevel=4,
+        )
 
 
 def _minimum_samples(statistic: str) -> int:

@@ -19,18 +19,6 @@ SENSORS = ("gyro", "accel", "mag")
 KINDS = ("adev", "mdev", "hdev", "tdev", "totdev")
 _AXES = ("X", "Y", "Z")
 
-#: Noise of the simulated long log of ``imunoise demo``, in SI units: the VN-100
-#: datasheet's noise densities and in-run bias stabilities (gyro 0.0035 °/s/√Hz and
-#: 10 °/h; accelerometer 0.14 mg/√Hz and 0.04 mg); the datasheet gives no rate random
-#: walk, so K is a typical MEMS value (gyro 2e-6 rad/s/√s, accel 3e-5 m/s²/√s).
-DEMO_NOISE = {
-    "gyro": {"N": 0.0035 * np.pi / 180.0, "B": 10.0 * np.pi / 180.0 / 3600.0, "K": 2e-6},
-    "accel": {"N": 0.14e-3 * 9.80665, "B": 0.04e-3 * 9.80665, "K": 3e-5},
-}
-#: Still-sensor means of the simulated log: gravity on -Z, Earth rate ignored.
-DEMO_MEAN = {"gyro": (0.0, 0.0, 0.0), "accel": (0.0, 0.0, -9.80665)}
-
-
 class _Parser(argparse.ArgumentParser):
     """argparse with one-line errors and exit status 2."""
 
@@ -187,27 +175,6 @@ def _read(args):
     return _load(args.log, "input", _Progress(False, 0), args.fs)
 
 
-def _simulate(n: int, fs: float, seed: int | None, coeffs: dict) -> np.ndarray:
-    """(n, 3) noise with the given coefficients, from :func:`imunoise.simulate`."""
-    import imunoise
-
-    if not hasattr(imunoise, "simulate"):
-        _fail("imunoise.simulate is not part of this installation")
-    return np.asarray(imunoise.simulate(n, fs, channels=3, seed=seed, **coeffs))
-
-
-def _write_log(log, path: Path, fmt: str) -> None:
-    """Write an ImuLog as VN ASCII ($VNYMR) or VN binary with the readers' writers."""
-    import imunoise
-
-    if not hasattr(imunoise, "write_vn_ascii"):
-        _fail("the VN writers (imunoise.write_vn_ascii) are not part of this installation")
-    if fmt == "vn-ascii":
-        imunoise.write_vn_ascii(log, "VNYMR", path=path)
-    else:
-        imunoise.write_vn_binary(log, path=path)
-
-
 # --- commands ------------------------------------------------------------------------
 
 
@@ -249,11 +216,8 @@ def _cmd_adev(args) -> int:
 
 
 def _cmd_fit(args) -> int:
-    import imunoise
     from imunoise import report
 
-    if not hasattr(imunoise, "fit"):
-        _fail("the noise model (imunoise.fit) is not part of this installation")
     log = _read(args)
     sensors = [args.sensor] if args.sensor else [s for s in ("gyro", "accel")
                                                   if getattr(log, s) is not None]
@@ -397,34 +361,11 @@ def _cmd_batch(args) -> int:
 
 
 def _cmd_simulate(args) -> int:
-    out = Path(args.output)
-    log = demo_long_log(args.hours, args.fs, seed=args.seed, full=True)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    _write_log(log, out, args.format)
-    print(f"wrote {len(log)} samples ({args.hours:g} h at {args.fs:g} Hz, {args.format}) "
-          f"to {out}")
+    from imunoise.simulate_log import simulate_log
+
+    out = simulate_log(args.output, args.hours, args.fs, format=args.format, seed=args.seed)
+    print(f"wrote {args.hours:g} h at {args.fs:g} Hz ({args.format}) to {out}")
     return 0
-
-
-def demo_long_log(hours: float, fs: float = 40.0, seed: int | None = 1, full: bool = False):
-    """A simulated still VN-100 recording (:data:`DEMO_NOISE`) as an ImuLog.
-
-    ``full=True`` adds a constant attitude and magnetic field (what a ``$VNYMR``
-    sentence carries besides the inertial channels).
-    """
-    from imunoise.readers.log import ImuLog
-
-    n = int(round(hours * 3600 * fs))
-    if n < 2:
-        _fail(f"--hours {hours:g} at {fs:g} Hz gives fewer than 2 samples")
-    chans = {}
-    for i, sensor in enumerate(("gyro", "accel")):
-        s = None if seed is None else seed + i
-        chans[sensor] = _simulate(n, fs, s, DEMO_NOISE[sensor]) + np.asarray(DEMO_MEAN[sensor])
-    if full:
-        chans["ypr"] = np.broadcast_to(np.array([-77.7, -1.3, 0.15]), (n, 3))
-        chans["mag"] = np.broadcast_to(np.array([0.045, 0.247, -0.338]), (n, 3))
-    return ImuLog.from_arrays(fs, source=f"<simulated VN-100, {hours:g} h>", **chans)
 
 
 def bundled_log() -> Path:
@@ -435,16 +376,11 @@ def bundled_log() -> Path:
 
 
 def _cmd_demo(args) -> int:
-    import imunoise
     from imunoise import report
+    from imunoise.simulate_log import still_log
 
     short = bundled_log()
-    long = None
-    if hasattr(imunoise, "simulate"):
-        long = demo_long_log(args.hours, seed=args.seed)
-    else:
-        print("imunoise: note: imunoise.simulate is not part of this installation; the demo "
-              "analyses the bundled 5-minute log alone", file=sys.stderr)
+    long = still_log(args.hours, 40.0, spec="vn100", seed=args.seed)
     # The bundled log is VN ASCII without timestamps, recorded at 40 Hz.
     rep = report.build(short, long, args.output, spec="vn100", fs=40.0, progress=args.progress)
     print(f"demo report: {rep.html.resolve()}")

@@ -39,7 +39,7 @@ from imunoise import plot as _plot
 from imunoise import stats as _stats
 from imunoise.readers.log import CHANNELS, ImuLog
 
-__all__ = ["Report", "build", "model_available"]
+__all__ = ["Report", "build"]
 
 #: Sensors whose Allan deviation and noise model the report computes.
 ALLAN_SENSORS = ("gyro", "accel")
@@ -68,16 +68,6 @@ def _read_log(
 def _allan(x: np.ndarray, fs: float):
     """Overlapping Allan deviation of (n, 3) samples on the report's tau grid."""
     return imunoise.adev(x, fs, taus=TAUS_PER_DECADE)
-
-
-def model_available() -> bool:
-    """Whether the noise model (fit, compare, export) is part of this installation."""
-    import importlib.util
-
-    return (
-        all(hasattr(imunoise, name) for name in ("fit", "compare"))
-        and importlib.util.find_spec("imunoise.export") is not None
-    )
 
 
 def _fit(result):
@@ -471,7 +461,6 @@ def _build(short, long, out: Path, spec, fs, bar: _Progress) -> Report:
 
     # 4. Allan deviation + 5. noise model
     bar.step("Allan deviation")
-    have_model = model_available()
     allan: dict[str, object] = {}
     models: dict[str, object] = {}
     for sensor in ALLAN_SENSORS:
@@ -479,9 +468,8 @@ def _build(short, long, out: Path, spec, fs, bar: _Progress) -> Report:
         if y is not None:
             allan[sensor] = _allan(y, long_log.fs)
     bar.step("noise model")
-    if have_model:
-        for sensor, r in allan.items():
-            models[sensor] = _fit(r)
+    for sensor, r in allan.items():
+        models[sensor] = _fit(r)
     doc.h(2, "4. Allan deviation")
     doc.p(f"Overlapping Allan deviation of the {'long' if long is not None else 'only'} log, "
           f"{TAUS_PER_DECADE} taus per decade, error bars at the "
@@ -510,21 +498,15 @@ def _build(short, long, out: Path, spec, fs, bar: _Progress) -> Report:
 
     doc.h(2, "5. Noise coefficients")
     model_files: list[Path] = []
-    if not have_model:
-        doc.p("The noise model (`imunoise.fit`) is not part of this installation: no noise "
-              "coefficients, no noise.json and no imu.yaml were produced.")
-    else:
-        doc.p("Weighted least-squares fit of σ²(τ) = 3Q²/τ² + N²/τ + (2 ln2/π)B² + K²τ/3 + "
-              "R²τ²/2 (IEEE Std 952), standard uncertainties from the fit.")
-        for sensor, m in models.items():
-            header, rows = _datasheet_rows(m, sensor)
-            doc.table(header, rows, caption=f"{sensor} noise coefficients per axis")
-        model_files = _write_model_files(models, out, long_log.fs)
+    doc.p("Weighted least-squares fit of σ²(τ) = 3Q²/τ² + N²/τ + (2 ln2/π)B² + K²τ/3 + "
+          "R²τ²/2 (IEEE Std 952), standard uncertainties from the fit.")
+    for sensor, m in models.items():
+        header, rows = _datasheet_rows(m, sensor)
+        doc.table(header, rows, caption=f"{sensor} noise coefficients per axis")
+    model_files = _write_model_files(models, out, long_log.fs)
 
     doc.h(2, "6. Datasheet comparison")
-    if not have_model:
-        doc.p("Needs the noise model; not available.")
-    elif spec is None:
+    if spec is None:
         doc.p("No datasheet given (`--spec`).")
     else:
         header, rows = _compare_rows(models, spec)

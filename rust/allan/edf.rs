@@ -118,6 +118,48 @@ pub fn totvar_edf(alpha: i32, m: usize, n_samples: usize) -> f64 {
     }
 }
 
+/// SP 1065 Table 8: edf = b·(T/τ) − c for MTOT (and TTOT), T/τ = n/m, for
+/// α = 2 … −2 (white PM to random-walk FM); α outside is clamped into that range.
+/// Never below one degree of freedom.
+pub fn mtotvar_edf(alpha: i32, m: usize, n_samples: usize) -> f64 {
+    const TABLE8: [(f64, f64); 5] = [
+        (1.90, 2.10),
+        (1.20, 1.40),
+        (1.10, 1.20),
+        (0.85, 0.50),
+        (0.75, 0.31),
+    ];
+    let (b, c) = TABLE8[(2 - alpha.clamp(-2, 2)) as usize];
+    (b * n_samples as f64 / m as f64 - c).max(1.0)
+}
+
+/// SP 1065 (after Howe & Tasset) EDF of Theo1 at averaging factor m over
+/// `n_phase` phase points, with r = 0.75·m the effective averaging factor;
+/// α clamped into [−2, 2]. Never below one degree of freedom.
+pub fn theo1_edf(alpha: i32, m: usize, n_phase: usize) -> f64 {
+    let n = n_phase as f64;
+    let r = 0.75 * m as f64;
+    let edf = match alpha.clamp(-2, 2) {
+        2 => (0.86 * (n + 1.0) * (n - 4.0 * r / 3.0) / (n - r)) * (r / (r + 1.14)),
+        1 => {
+            ((4.798 * n * n - 6.374 * n * r + 12.387 * r) / ((r + 36.6).sqrt() * (n - r)))
+                * (r / (r + 0.3))
+        }
+        0 => ((4.1 * n + 0.8) / r - (3.1 * n + 6.5) / n) * (r.powf(1.5) / (r.powf(1.5) + 5.2)),
+        -1 => ((2.0 * n * n - 1.3 * n * r - 3.5 * r) / (n * r)) * (r.powi(3) / (r.powi(3) + 2.3)),
+        _ => {
+            let a = 4.4 * n - 1.0;
+            ((4.4 * n - 2.0) / (2.9 * r))
+                * ((a * a - 8.6 * r * a + 11.4 * r * r) / (4.4 * n - 3.0).powi(2))
+        }
+    };
+    if edf.is_finite() {
+        edf.max(1.0)
+    } else {
+        1.0
+    }
+}
+
 /// Greenhall eq. (10).
 fn basic_sum(j: f64, big_m: f64, s: f64, f: Option<f64>, alpha: i32, d: u32) -> f64 {
     let mut total = sz(0.0, f, alpha, d).powi(2);
@@ -269,6 +311,20 @@ mod tests {
     fn totvar_table_values() {
         assert!((totvar_edf(0, 10, 1000) - 150.0).abs() < 1e-12);
         assert!((totvar_edf(-2, 10, 1000) - (93.0 - 0.36)).abs() < 1e-12);
+    }
+
+    #[test]
+    fn total_family_edf_tables() {
+        // Table 8, white FM: 1.10·n/m − 1.20.
+        assert!((mtotvar_edf(0, 10, 1000) - 108.8).abs() < 1e-12);
+        assert!((mtotvar_edf(-4, 10, 1000) - (75.0 - 0.31)).abs() < 1e-12);
+        // Theo1 white FM at N = 1001, m = 100 (r = 75).
+        let r: f64 = 75.0;
+        let n: f64 = 1001.0;
+        let want =
+            ((4.1 * n + 0.8) / r - (3.1 * n + 6.5) / n) * (r.powf(1.5) / (r.powf(1.5) + 5.2));
+        assert!((theo1_edf(0, 100, 1001) - want).abs() < 1e-12);
+        assert!(theo1_edf(-2, 1000, 1001) >= 1.0);
     }
 
     #[test]

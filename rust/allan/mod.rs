@@ -1,10 +1,12 @@
 //! The Allan family over cumulative sums: estimates, noise identification and
 //! equivalent degrees of freedom for many channels and taus at once.
 
+pub mod blocked;
 pub mod edf;
 pub mod noise_id;
 pub mod phase;
 pub mod sum;
+pub mod total;
 pub mod variance;
 
 use rayon::prelude::*;
@@ -29,10 +31,10 @@ pub struct Analysis {
 }
 
 /// Cumulative phases of several channels, computed in parallel. Each item yields
-/// one channel's samples and may be iterated twice.
+/// one channel's samples.
 pub fn column_phases<I>(columns: Vec<I>) -> CoreResult<Vec<Vec<f64>>>
 where
-    I: Iterator<Item = f64> + Clone + Send,
+    I: Iterator<Item = f64> + Send,
 {
     let several = columns.len() > 1;
     columns
@@ -77,11 +79,23 @@ pub fn analyse(phases: &[Vec<f64>], statistic: Statistic, ms: &[usize]) -> CoreR
         .flat_map(|t| (0..channels).map(move |c| (t, c)))
         .collect();
     let (dmax, estimator) = noise_model_of(statistic);
+    // The overlapping Allan and Hadamard variances sweep all taus of a channel at
+    // once (see `blocked`); every other statistic goes tau by tau.
+    let swept: Option<Vec<Vec<f64>>> = statistic.blocked_difference().map(|difference| {
+        phases
+            .par_iter()
+            .map(|c| blocked::sums_of_squares(c, ms, difference))
+            .collect()
+    });
     let per_pair: Vec<(f64, Option<i32>)> = pairs
         .par_iter()
         .map(|&(t, c)| {
-            let est = statistic.estimate(&phases[c], ms[t]);
-            (est.var, noise_id::identify_alpha(&phases[c], ms[t], dmax))
+            let var = match &swept {
+                Some(sums) => statistic.variance_from_sum(sums[c][t], ms[t], terms[t]),
+                None => statistic.estimate(&phases[c], ms[t]).var,
+            };
+            let id_m = statistic.noise_id_factor(ms[t]);
+            (var, noise_id::identify_alpha(&phases[c], id_m, dmax))
         })
         .collect();
 
@@ -111,8 +125,10 @@ pub fn analyse(phases: &[Vec<f64>], statistic: Statistic, ms: &[usize]) -> CoreR
         .iter()
         .enumerate()
         .map(|(i, &(t, _))| match estimator {
-            Some(est) => edf::greenhall_edf(alpha[i], est, ms[t], n_phase),
-            None => edf::totvar_edf(alpha[i], ms[t], n_samples),
+            EdfModel::Greenhall(est) => edf::greenhall_edf(alpha[i], est, ms[t], n_phase),
+            EdfModel::Total => edf::totvar_edf(alpha[i], ms[t], n_samples),
+            EdfModel::ModifiedTotal => edf::mtotvar_edf(alpha[i], ms[t], n_samples),
+            EdfModel::Theo1 => edf::theo1_edf(alpha[i], ms[t], n_phase),
         })
         .collect();
     Ok(Analysis {
@@ -125,14 +141,31 @@ pub fn analyse(phases: &[Vec<f64>], statistic: Statistic, ms: &[usize]) -> CoreR
     })
 }
 
-/// Maximum differencing for noise identification and the EDF estimator (None:
-/// the total variance's own EDF table).
-fn noise_model_of(statistic: Statistic) -> (u32, Option<edf::Estimator>) {
+/// How the EDF of an estimator is obtained.
+#[derive(Clone, Copy, Debug)]
+enum EdfModel {
+    /// Greenhall's algorithm for this difference estimator.
+    Greenhall(edf::Estimator),
+    /// SP 1065 Table 7 (TOTVAR).
+    Total,
+    /// SP 1065 Table 8 (MTOT, and TTOT which is MTOT scaled).
+    ModifiedTotal,
+    /// SP 1065 Theo1 formulas (Howe & Tasset).
+    Theo1,
+}
+
+/// Maximum differencing for noise identification and the EDF model.
+fn noise_model_of(statistic: Statistic) -> (u32, EdfModel) {
     use edf::Estimator;
+    let ohvar = Estimator {
+        d: 3,
+        overlapping: true,
+        modified: false,
+    };
     match statistic {
         Statistic::Allan { overlapping } => (
             2,
-            Some(Estimator {
+            EdfModel::Greenhall(Estimator {
                 d: 2,
                 overlapping,
                 modified: false,
@@ -140,7 +173,7 @@ fn noise_model_of(statistic: Statistic) -> (u32, Option<edf::Estimator>) {
         ),
         Statistic::Modified => (
             2,
-            Some(Estimator {
+            EdfModel::Greenhall(Estimator {
                 d: 2,
                 overlapping: true,
                 modified: true,
@@ -148,13 +181,18 @@ fn noise_model_of(statistic: Statistic) -> (u32, Option<edf::Estimator>) {
         ),
         Statistic::Hadamard { overlapping } => (
             3,
-            Some(Estimator {
+            EdfModel::Greenhall(Estimator {
                 d: 3,
                 overlapping,
                 modified: false,
             }),
         ),
-        Statistic::Total => (2, None),
+        Statistic::Total => (2, EdfModel::Total),
+        Statistic::ModifiedTotal => (2, EdfModel::ModifiedTotal),
+        // SP 1065 gives no EDF formula for HTOT; the overlapping Hadamard EDF is a
+        // lower bound (HTOT is OHVAR with extra, reflected terms) and exact at m = 1.
+        Statistic::HadamardTotal => (3, EdfModel::Greenhall(ohvar)),
+        Statistic::Theo1 => (2, EdfModel::Theo1),
     }
 }
 

@@ -9,34 +9,56 @@ use super::sum::Neumaier;
 use crate::error::{CoreError, CoreResult};
 
 /// Cumulative sum of mean-removed samples. `samples` may be strided (a column of
-/// a C-ordered 2-D array); it is read twice and never copied.
+/// a C-ordered 2-D array); it is gathered once into the output vector, which is
+/// then transformed in place (one allocation, three sequential passes).
 pub fn cumulative_phase<I>(samples: I) -> CoreResult<Vec<f64>>
 where
-    I: Iterator<Item = f64> + Clone,
+    I: Iterator<Item = f64>,
 {
-    let mut mean_acc = Neumaier::new();
-    let mut n = 0usize;
-    for v in samples.clone() {
-        if !v.is_finite() {
-            return Err(CoreError::InvalidArgument(format!(
-                "x must be finite; sample {n} is {v}"
-            )));
-        }
-        mean_acc.add(v);
-        n += 1;
-    }
+    let mut phase = Vec::with_capacity(samples.size_hint().0 + 1);
+    phase.push(0.0);
+    phase.extend(samples);
+    let n = phase.len() - 1;
     if n == 0 {
         return Err(CoreError::InvalidArgument("x must not be empty".into()));
     }
-    let mean = mean_acc.value() / n as f64;
-    let mut phase = Vec::with_capacity(n + 1);
-    phase.push(0.0);
-    let mut running = Neumaier::new();
-    for v in samples {
-        running.add(v - mean);
-        phase.push(running.value());
+    if let Some(k) = phase[1..].iter().position(|v| !v.is_finite()) {
+        return Err(CoreError::InvalidArgument(format!(
+            "x must be finite; sample {k} is {}",
+            phase[k + 1]
+        )));
+    }
+    let mean = compensated_sum(&phase[1..]) / n as f64;
+    // Knuth's branch-free two-sum keeps the rounding error of every addition; the
+    // running sum and its error term form two independent dependency chains.
+    let mut sum = 0.0f64;
+    let mut comp = 0.0f64;
+    for value in phase[1..].iter_mut() {
+        let v = *value - mean;
+        let t = sum + v;
+        let bp = t - sum;
+        comp += (sum - (t - bp)) + (v - bp);
+        sum = t;
+        *value = sum + comp;
     }
     Ok(phase)
+}
+
+/// Sum of a slice: blocks of 256 in eight plain lanes, blocks added with compensation.
+fn compensated_sum(values: &[f64]) -> f64 {
+    let mut total = Neumaier::new();
+    for block in values.chunks(256) {
+        let (chunks, rest) = block.as_chunks::<8>();
+        let mut lanes = [0.0f64; 8];
+        for chunk in chunks {
+            for (lane, v) in lanes.iter_mut().zip(chunk) {
+                *lane += v;
+            }
+        }
+        let block_sum: f64 = lanes.iter().sum::<f64>() + rest.iter().sum::<f64>();
+        total.add(block_sum);
+    }
+    total.value()
 }
 
 #[cfg(test)]

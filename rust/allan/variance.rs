@@ -3,7 +3,9 @@
 //! τ = m·τ0 together with the number of terms in its sum, counted as Stable32
 //! and allantools count them. References: NIST SP 1065 (Riley 2008), eqs. 6–25.
 
+use super::blocked::Difference;
 use super::sum::{sum_of_squared_combinations, sum_of_squares, Neumaier};
+use super::total;
 
 /// A variance estimate and the number of terms it averages.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -30,6 +32,12 @@ pub enum Statistic {
     Hadamard { overlapping: bool },
     /// Total variance (SP 1065 eq. 25, reflection at both ends).
     Total,
+    /// Modified total variance (SP 1065 eq. 27); m ≤ N/3.
+    ModifiedTotal,
+    /// Hadamard total variance (overlapping Hadamard at m = 1); m ≤ n/3.
+    HadamardTotal,
+    /// Theo1 (SP 1065 eq. 30), even m only; effective τ = 0.75·m·τ0.
+    Theo1,
 }
 
 impl Statistic {
@@ -54,7 +62,61 @@ impl Statistic {
                     0
                 }
             }
+            // allantools' limits: m ≤ len(phase)/3 and m ≤ len(rate)/3.
+            Statistic::ModifiedTotal => {
+                if 3 * m <= n_phase {
+                    n_phase + 1 - 3 * m
+                } else {
+                    0
+                }
+            }
+            Statistic::HadamardTotal => {
+                let n = n_phase.saturating_sub(1);
+                if 3 * m > n {
+                    0
+                } else if m == 1 {
+                    Statistic::Hadamard { overlapping: true }.terms(n_phase, 1)
+                } else {
+                    n + 1 - 3 * m
+                }
+            }
+            // Terms counted as allantools counts them: (N − m) outer × m/2 inner.
+            Statistic::Theo1 => {
+                if m.is_multiple_of(2) && m < n_phase {
+                    (n_phase - m) * (m / 2)
+                } else {
+                    0
+                }
+            }
         }
+    }
+
+    /// Averaging factor at which the noise type is identified: m itself, except
+    /// for Theo1 whose estimate belongs to τ = 0.75·m·τ0.
+    pub fn noise_id_factor(self, m: usize) -> usize {
+        match self {
+            Statistic::Theo1 => ((3 * m) / 4).max(1),
+            _ => m,
+        }
+    }
+
+    /// For the overlapping Allan and Hadamard variances: the order of the
+    /// difference whose squares `blocked::sums_of_squares` sums for all taus at once.
+    pub fn blocked_difference(self) -> Option<Difference> {
+        match self {
+            Statistic::Allan { overlapping: true } => Some(Difference::Second),
+            Statistic::Hadamard { overlapping: true } => Some(Difference::Third),
+            _ => None,
+        }
+    }
+
+    /// The variance from a sum of squared differences (see `blocked_difference`).
+    pub fn variance_from_sum(self, sum: f64, m: usize, terms: usize) -> f64 {
+        let divisor = match self {
+            Statistic::Hadamard { .. } => 6.0,
+            _ => 2.0,
+        };
+        sum / (divisor * (m as f64).powi(2) * terms as f64)
     }
 
     /// The variance at averaging factor `m` over the cumulative phase `c`.
@@ -102,6 +164,12 @@ impl Statistic {
             }
             Statistic::Modified => modified_sum(c, m, terms) / (2.0 * mf.powi(4) * terms as f64),
             Statistic::Total => total_sum(c, m) / (2.0 * mf * mf * terms as f64),
+            Statistic::ModifiedTotal => total::mtot_var(c, m),
+            Statistic::HadamardTotal if m == 1 => {
+                Statistic::Hadamard { overlapping: true }.estimate(c, 1).var
+            }
+            Statistic::HadamardTotal => total::htot_var(c, m),
+            Statistic::Theo1 => total::theo1_var(c, m),
         };
         Estimate { var, terms }
     }

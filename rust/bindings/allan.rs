@@ -15,9 +15,13 @@ fn parse_statistic(name: &str) -> PyResult<Statistic> {
         "hdev" => Statistic::Hadamard { overlapping: false },
         "ohdev" => Statistic::Hadamard { overlapping: true },
         "totdev" => Statistic::Total,
+        "mtotdev" => Statistic::ModifiedTotal,
+        "htotdev" => Statistic::HadamardTotal,
+        "theo1" => Statistic::Theo1,
         other => {
             return Err(PyValueError::new_err(format!(
-                "statistic must be one of adev, oadev, mdev, hdev, ohdev, totdev; got {other:?}"
+                "statistic must be one of adev, oadev, mdev, hdev, ohdev, totdev, mtotdev, \
+                 htotdev, theo1; got {other:?}"
             )))
         }
     })

@@ -1,0 +1,89 @@
+"""imunoise vs allantools for the total family and Theo1, same run, same data.
+
+    python benches/bench_total.py [--quick] [--million-max-m M]
+
+Part 1: MTOTDEV, HTOTDEV and Theo1 on 10^4 white-FM samples at octave taus
+(``--quick``: 2000 samples; allantools needs minutes per statistic at 10^4).
+allantools runs once per case (it is the slow side), imunoise three times; the
+agreement of the two is printed too.
+Part 2: imunoise alone on 10^6 samples, octave taus up to m = ``--million-max-m``
+(default 1024): the estimators cost O(n·m) per tau, see docs/total.md.
+Prints Markdown tables of medians and ratios.
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import io
+import os
+import platform
+import statistics
+import time
+import warnings
+
+import allantools
+import imunoise
+import numpy as np
+
+CASES = [
+    ("mtotdev", imunoise.mtotdev, allantools.mtotdev),
+    ("htotdev", imunoise.htotdev, allantools.htotdev),
+    ("theo1", imunoise.theo1, allantools.theo1),
+]
+
+
+def timed(fn, repeats: int) -> tuple[float, object]:
+    times, out = [], None
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        out = fn()
+        times.append(time.perf_counter() - t0)
+    return statistics.median(times), out
+
+
+def peer_call(fn, y, fs):
+    with warnings.catch_warnings(), contextlib.redirect_stdout(io.StringIO()):
+        warnings.simplefilter("ignore")
+        return fn(y, rate=fs, data_type="freq", taus="octave")
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true", help="2000 samples for part 1")
+    parser.add_argument("--million-max-m", type=int, default=1024)
+    args = parser.parse_args()
+    print(
+        f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
+        f"Python {platform.python_version()}, numpy {np.__version__}, "
+        f"allantools {allantools.__version__}, imunoise {imunoise.__version__}"
+    )
+    fs = 100.0
+    n = 2000 if args.quick else 10_000
+    y = np.random.default_rng(0).normal(size=n)
+    print(f"\n### {n} samples, octave taus\n")
+    print("| statistic | taus | imunoise (s) | allantools (s) | ratio | max rel. diff |")
+    print("|---|---|---|---|---|---|")
+    for name, ours_fn, peer_fn in CASES:
+        ours, r = timed(lambda f=ours_fn: f(y, fs), 3)
+        peer, (_t, dev, _e, _n) = timed(lambda f=peer_fn: peer_call(f, y, fs), 1)
+        diff = float(np.max(np.abs(r.dev / dev - 1.0)))
+        print(
+            f"| {name} | {len(r.taus)} | {ours:.4f} | {peer:.2f} | {peer / ours:.0f}x "
+            f"| {diff:.1e} |"
+        )
+
+    n = 1_000_000
+    y = np.random.default_rng(1).normal(size=n)
+    m = 2 ** np.arange(int(np.log2(args.million_max_m)) + 1)
+    print(f"\n### {n} samples, imunoise alone, octave taus m = 1 … {m[-1]}\n")
+    print("| statistic | taus | imunoise (s) |")
+    print("|---|---|---|")
+    for name, ours_fn, _peer in CASES:
+        taus = m / fs if name != "theo1" else m[m % 2 == 0] / fs
+        ours, r = timed(lambda f=ours_fn, t=taus: f(y, fs, taus=t), 1)
+        print(f"| {name} | {len(r.taus)} | {ours:.2f} |")
+
+
+if __name__ == "__main__":
+    main()

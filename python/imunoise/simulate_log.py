@@ -1,0 +1,118 @@
+"""Logs of a simulated still IMU, written in the sensor's own format.
+
+The noise of each inertial channel comes from :func:`imunoise.simulate` with the
+coefficients of a datasheet (the N and B it specifies; K, which datasheets of MEMS
+parts rarely give, from ``DEFAULT_K``), on top of what a still sensor reads:
+gravity on −Z, a constant attitude and a constant Earth field.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import numpy as np
+
+from imunoise.datasheet import load_spec
+from imunoise.readers.log import ImuLog
+from imunoise.simulate import simulate
+from imunoise.units import convert_back
+
+__all__ = ["DEFAULT_K", "noise_of_spec", "simulate_log", "still_log"]
+
+#: Rate random walk used where the datasheet gives none (typical MEMS values):
+#: gyro rad/s/√s, accelerometer m/s²/√s.
+DEFAULT_K = {"gyro": 2e-6, "accel": 3e-5}
+
+#: What a still, level VN-100 reads besides noise (Earth rate ignored).
+_STILL_MEAN = {"gyro": (0.0, 0.0, 0.0), "accel": (0.0, 0.0, -9.80665)}
+_STILL_YPR = (-77.7, -1.3, 0.15)  # deg
+_STILL_MAG = (0.045, 0.247, -0.338)  # Gauss
+_FORMATS = ("vn-ascii", "vn-binary")
+
+
+def noise_of_spec(spec="vn100") -> dict[str, dict[str, float]]:
+    """Noise coefficients in SI units (rad/s and m/s² rates) from a datasheet.
+
+    Parameters
+    ----------
+    spec : str, path or mapping
+        A built-in datasheet name (``"vn100"``), a TOML file in the format of
+        ``imunoise/specs/vn100.toml``, or a mapping ``{"gyro": {"N": …, "B": …,
+        "K": …}, "accel": {…}}`` already in SI units (returned as given).
+    """
+    if isinstance(spec, dict):
+        return {sensor: dict(terms) for sensor, terms in spec.items()}
+    loaded = load_spec(spec)
+    noise: dict[str, dict[str, float]] = {s: {"K": DEFAULT_K[s]} for s in DEFAULT_K}
+    for item in loaded.items:
+        if item.sensor in noise and item.term in ("Q", "N", "B", "K", "R"):
+            noise[item.sensor][item.term] = float(
+                convert_back(item.value, item.term, item.unit, sensor=item.sensor)
+            )
+    return noise
+
+
+def still_log(hours: float, fs: float = 40.0, *, spec="vn100", seed=None) -> ImuLog:
+    """An :class:`ImuLog` of a still sensor with the noise of ``spec``: gyro and
+    accelerometer simulated, attitude and magnetic field constant."""
+    hours = float(hours)
+    fs = float(fs)
+    if not (np.isfinite(hours) and hours > 0):
+        raise ValueError(f"hours must be positive and finite; got {hours!r}")
+    if not (np.isfinite(fs) and fs > 0):
+        raise ValueError(f"fs must be positive and finite (Hz); got {fs!r}")
+    n = int(round(hours * 3600.0 * fs))
+    if n < 2:
+        raise ValueError(f"hours={hours:g} at fs={fs:g} Hz gives {n} samples; at least 2 needed")
+    noise = noise_of_spec(spec)
+    rng = np.random.default_rng(seed)
+    channels = {}
+    for sensor in ("gyro", "accel"):
+        coefficients = noise.get(sensor, {})
+        channels[sensor] = simulate(n, fs, channels=3, seed=rng, **coefficients) + np.asarray(
+            _STILL_MEAN[sensor]
+        )
+    channels["ypr"] = np.broadcast_to(np.array(_STILL_YPR), (n, 3))
+    channels["mag"] = np.broadcast_to(np.array(_STILL_MAG), (n, 3))
+    label = "IMU" if isinstance(spec, dict) else load_spec(spec).name
+    return ImuLog.from_arrays(fs, source=f"<simulated {label}, {hours:g} h>", **channels)
+
+
+def simulate_log(path, hours: float, fs: float = 40.0, format: str = "vn-ascii",
+                 spec="vn100", seed=None) -> Path:
+    """Write the log of a still VN-100 with datasheet-level noise.
+
+    Parameters
+    ----------
+    path : str or path-like
+        File to write (parent directories are created).
+    hours : float
+        Length of the recording.
+    fs : float, optional
+        Output rate in Hz (the VN-100 default is 40 Hz).
+    format : {"vn-ascii", "vn-binary"}, optional
+        ``$VNYMR`` sentences with 8-bit checksums, or binary packets with
+        TimeStartup, YawPitchRoll, angular rate, acceleration and magnetic field.
+    spec : str, path or mapping, optional
+        Noise source, see :func:`noise_of_spec`.
+    seed : int or None, optional
+        Seed of the noise generator.
+
+    Returns
+    -------
+    pathlib.Path
+        The file written; ``imunoise.read`` reads it back.
+    """
+    from imunoise.readers.vn_write import write_vn_ascii, write_vn_binary
+
+    if format not in _FORMATS:
+        raise ValueError(f"format must be one of {', '.join(_FORMATS)}; got {format!r}")
+    log = still_log(hours, fs, spec=spec, seed=seed)
+    path = Path(os.fspath(path))
+    path.parent.mkdir(parents=True, exist_ok=True)
+    if format == "vn-ascii":
+        write_vn_ascii(log, "VNYMR", path=path)
+    else:
+        write_vn_binary(log, path=path)
+    return path
