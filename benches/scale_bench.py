@@ -52,13 +52,13 @@ print(json.dumps(out))
 
 def generate(path: Path, size: int) -> tuple[int, float]:
     import imunoise
-    from imunoise.cli import demo_long_log
+    from imunoise.simulate_log import still_log
 
     t = time.perf_counter()
     seed = 0
     with open(path, "wb") as f:
         while f.tell() < size:
-            log = demo_long_log(0.05, FS, seed=1000 + 2 * seed, full=True)
+            log = still_log(0.05, FS, seed=1000 + seed)
             f.write(imunoise.write_vn_ascii(log, "VNYMR"))
             seed += 1
     return path.stat().st_size, time.perf_counter() - t

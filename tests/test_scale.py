@@ -11,13 +11,14 @@ import imunoise
 import numpy as np
 import pytest
 from imunoise import scale
-from imunoise.cli import demo_long_log, main
+from imunoise.cli import main
+from imunoise.simulate_log import still_log
 
 FS = 40.0
 
 
 def _log(hours: float, seed: int):
-    return demo_long_log(hours, FS, seed=seed, full=True)
+    return still_log(hours, FS, seed=seed)
 
 
 def _same_log(a, b) -> None:
