@@ -41,14 +41,46 @@ where
         .into_par_iter()
         .enumerate()
         .map(|(channel, col)| {
-            phase::cumulative_phase(col).map_err(|e| match e {
-                CoreError::InvalidArgument(msg) if several => {
-                    CoreError::InvalidArgument(format!("{msg} (channel {channel})"))
-                }
-                other => other,
-            })
+            phase::cumulative_phase(col).map_err(|e| name_channel(e, channel, several))
         })
         .collect()
+}
+
+/// Cumulative phases of the columns of a C-ordered `(n, channels)` array given as
+/// its row-major data: one pass over the rows scatters the samples into the
+/// channels' phase vectors (each column gathered separately would stream the whole
+/// array once per channel), then the channels are transformed in parallel.
+pub fn row_major_phases(data: &[f64], channels: usize) -> CoreResult<Vec<Vec<f64>>> {
+    if channels == 0 || !data.len().is_multiple_of(channels) {
+        return Err(CoreError::InvalidArgument(format!(
+            "x has {} values, not a whole number of rows of {channels} channels",
+            data.len()
+        )));
+    }
+    let n = data.len() / channels;
+    let mut phases: Vec<Vec<f64>> = (0..channels).map(|_| vec![0.0; n + 1]).collect();
+    for (i, row) in data.chunks_exact(channels).enumerate() {
+        for (phase, &value) in phases.iter_mut().zip(row) {
+            phase[i + 1] = value;
+        }
+    }
+    let several = channels > 1;
+    phases
+        .into_par_iter()
+        .enumerate()
+        .map(|(channel, phase)| {
+            phase::into_cumulative_phase(phase).map_err(|e| name_channel(e, channel, several))
+        })
+        .collect()
+}
+
+fn name_channel(err: CoreError, channel: usize, several: bool) -> CoreError {
+    match err {
+        CoreError::InvalidArgument(msg) if several => {
+            CoreError::InvalidArgument(format!("{msg} (channel {channel})"))
+        }
+        other => other,
+    }
 }
 
 /// Estimates the statistic at every averaging factor in `ms` for every phase,
@@ -269,6 +301,27 @@ mod tests {
         let phases = column_phases(vec![[1.0, 2.0, 4.0].iter().copied()]).unwrap();
         let err = analyse(&phases, Statistic::Allan { overlapping: true }, &[2]).unwrap_err();
         assert!(err.to_string().contains("does not fit"));
+    }
+
+    #[test]
+    fn row_major_phases_equal_column_phases() {
+        let data: Vec<f64> = (0..300).map(|k| ((k * 7919) % 101) as f64 - 50.0).collect();
+        let rows = row_major_phases(&data, 3).unwrap();
+        let columns = column_phases(
+            (0..3)
+                .map(|c| data.iter().skip(c).step_by(3).copied())
+                .collect(),
+        )
+        .unwrap();
+        assert_eq!(rows, columns);
+        assert!(row_major_phases(&data, 7).is_err());
+        let mut bad = data.clone();
+        bad[4] = f64::NAN; // row 1, channel 1
+        let err = row_major_phases(&bad, 3).unwrap_err().to_string();
+        assert!(
+            err.contains("sample 1") && err.contains("channel 1"),
+            "{err}"
+        );
     }
 
     #[test]

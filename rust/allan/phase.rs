@@ -18,7 +18,13 @@ where
     let mut phase = Vec::with_capacity(samples.size_hint().0 + 1);
     phase.push(0.0);
     phase.extend(samples);
-    let n = phase.len() - 1;
+    into_cumulative_phase(phase)
+}
+
+/// The same transformation for samples already gathered behind a leading slot:
+/// `phase[0]` is overwritten with 0 and `phase[1..]` holds y_0 … y_{n−1}.
+pub fn into_cumulative_phase(mut phase: Vec<f64>) -> CoreResult<Vec<f64>> {
+    let n = phase.len().saturating_sub(1);
     if n == 0 {
         return Err(CoreError::InvalidArgument("x must not be empty".into()));
     }
@@ -28,6 +34,7 @@ where
             phase[k + 1]
         )));
     }
+    phase[0] = 0.0;
     let mean = compensated_sum(&phase[1..]) / n as f64;
     // Knuth's branch-free two-sum keeps the rounding error of every addition; the
     // running sum and its error term form two independent dependency chains.

@@ -50,12 +50,20 @@ fn analyse<'py>(
     let view = x.as_array();
     let ms: Vec<usize> = ms.as_array().iter().map(|&m| m as usize).collect();
     let result = py.detach(|| {
-        let columns: Vec<_> = view
-            .columns()
-            .into_iter()
-            .map(|c| c.into_iter().copied())
-            .collect();
-        let phases = allan::column_phases(columns)?;
+        // A C-ordered array with several channels is scattered row by row in one
+        // pass; anything else (one channel, Fortran order, strided views) is
+        // gathered column by column.
+        let phases = match view.as_slice() {
+            Some(data) if view.ncols() > 1 => allan::row_major_phases(data, view.ncols())?,
+            _ => {
+                let columns: Vec<_> = view
+                    .columns()
+                    .into_iter()
+                    .map(|c| c.into_iter().copied())
+                    .collect();
+                allan::column_phases(columns)?
+            }
+        };
         allan::analyse(&phases, statistic, &ms)
     })?;
     let shape = (ms.len(), result.channels);
