@@ -52,7 +52,7 @@ from pathlib import Path
 import numpy as np
 
 from imunoise import _core
-from imunoise.readers.log import CHANNELS, DEFAULT_FS, ISSUE_KINDS, ImuLog, ParseIssues
+from imunoise.readers.log import CHANNELS, ISSUE_KINDS, ImuLog, ParseIssues, fs_from_median_step
 
 __all__ = ["Conversion", "batch", "convert", "load", "BATCH_SENSORS"]
 
@@ -394,24 +394,6 @@ class _Steps:
         return float(lo) if total % 2 else float(np.mean(np.array([lo, hi])))
 
 
-def _resolve_fs(steps: _Steps | None, fs: float | None, source: str) -> float:
-    """As :func:`imunoise.readers.log.resolve_fs`, from the streamed step histogram."""
-    med = steps.median() if steps is not None else None
-    if med is not None:
-        return float(1.0 / med)
-    if fs is not None:
-        fs = float(fs)
-        if not (np.isfinite(fs) and fs > 0):
-            raise ValueError(f"fs must be a positive finite number of Hz; got {fs!r}")
-        return fs
-    warnings.warn(
-        f"{source}: no timestamps and no fs given; assuming {DEFAULT_FS:g} Hz "
-        "(pass fs= to set the sample rate)",
-        stacklevel=3,
-    )
-    return DEFAULT_FS
-
-
 class _Tally:
     """Issues, message counts and record counts summed over pieces."""
 
@@ -586,7 +568,10 @@ def convert(
         if format in ("vn-ascii", "vn-binary") and path.is_file():
             tally, steps, shape = _stream_vn(path, writer, int(chunk_bytes), progress)
             primary = _primary(shape)
-            rate = _resolve_fs(steps.get(primary) if primary else None, fs, str(path))
+            step_histogram = steps.get(primary) if primary else None
+            rate = fs_from_median_step(
+                step_histogram.median() if step_histogram is not None else None, fs, str(path)
+            )
             issues, messages, fmt = tally.issues(), tally.messages, tally.format
         else:
             from imunoise.readers.read import read

@@ -202,11 +202,22 @@ class ImuLog:
 
 def resolve_fs(time: np.ndarray | None, fs: float | None, source: str) -> float:
     """The sample rate: median timestamp step, else ``fs``, else the default with a warning."""
+    median_step = None
     if time is not None and len(time) > 1:
         steps = np.diff(np.asarray(time, dtype=np.float64))
         steps = steps[steps > 0]
         if len(steps):
-            return float(1.0 / np.median(steps))
+            median_step = float(np.median(steps))
+    return fs_from_median_step(median_step, fs, source, stacklevel=4)
+
+
+def fs_from_median_step(
+    median_step: float | None, fs: float | None, source: str, *, stacklevel: int = 3
+) -> float:
+    """1 / ``median_step`` when the log had timestamps, else ``fs``, else
+    :data:`DEFAULT_FS` with a warning (``stacklevel`` points it at the caller's caller)."""
+    if median_step is not None:
+        return float(1.0 / median_step)
     if fs is not None:
         fs = float(fs)
         if not (np.isfinite(fs) and fs > 0):
@@ -215,6 +226,6 @@ def resolve_fs(time: np.ndarray | None, fs: float | None, source: str) -> float:
     warnings.warn(
         f"{source}: no timestamps and no fs given; assuming {DEFAULT_FS:g} Hz "
         "(pass fs= to set the sample rate)",
-        stacklevel=3,
+        stacklevel=stacklevel,
     )
     return DEFAULT_FS
