@@ -36,14 +36,8 @@ pub fn column_phases<I>(columns: Vec<I>) -> CoreResult<Vec<Vec<f64>>>
 where
     I: Iterator<Item = f64> + Send,
 {
-    let several = columns.len() > 1;
-    columns
-        .into_par_iter()
-        .enumerate()
-        .map(|(channel, col)| {
-            phase::cumulative_phase(col).map_err(|e| name_channel(e, channel, several))
-        })
-        .collect()
+    let gathered = columns.into_par_iter().map(phase::gather).collect();
+    transform_in_parallel(gathered)
 }
 
 /// Cumulative phases of the columns of a C-ordered `(n, channels)` array given as
@@ -64,23 +58,25 @@ pub fn row_major_phases(data: &[f64], channels: usize) -> CoreResult<Vec<Vec<f64
             phase[i + 1] = value;
         }
     }
-    let several = channels > 1;
-    phases
+    transform_in_parallel(phases)
+}
+
+/// Turns gathered samples (behind a leading slot) into cumulative phases, one
+/// channel per task; errors name the channel when there are several.
+fn transform_in_parallel(gathered: Vec<Vec<f64>>) -> CoreResult<Vec<Vec<f64>>> {
+    let several = gathered.len() > 1;
+    gathered
         .into_par_iter()
         .enumerate()
         .map(|(channel, phase)| {
-            phase::into_cumulative_phase(phase).map_err(|e| name_channel(e, channel, several))
+            phase::into_cumulative_phase(phase).map_err(|e| match e {
+                CoreError::InvalidArgument(msg) if several => {
+                    CoreError::InvalidArgument(format!("{msg} (channel {channel})"))
+                }
+                other => other,
+            })
         })
         .collect()
-}
-
-fn name_channel(err: CoreError, channel: usize, several: bool) -> CoreError {
-    match err {
-        CoreError::InvalidArgument(msg) if several => {
-            CoreError::InvalidArgument(format!("{msg} (channel {channel})"))
-        }
-        other => other,
-    }
 }
 
 /// Estimates the statistic at every averaging factor in `ms` for every phase,

@@ -15,10 +15,18 @@ pub fn cumulative_phase<I>(samples: I) -> CoreResult<Vec<f64>>
 where
     I: Iterator<Item = f64>,
 {
+    into_cumulative_phase(gather(samples))
+}
+
+/// The samples behind one leading slot, the layout [`into_cumulative_phase`] takes.
+pub fn gather<I>(samples: I) -> Vec<f64>
+where
+    I: Iterator<Item = f64>,
+{
     let mut phase = Vec::with_capacity(samples.size_hint().0 + 1);
     phase.push(0.0);
     phase.extend(samples);
-    into_cumulative_phase(phase)
+    phase
 }
 
 /// The same transformation for samples already gathered behind a leading slot:
