@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use numpy::{IntoPyArray, PyReadonlyArray1};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
-use pyo3::types::{PyBytes, PyDict, PyList};
+use pyo3::types::{PyBytes, PyDict, PyList, PySlice};
 
 use crate::error::CoreError;
 use crate::vn::ascii::MESSAGES;
@@ -19,8 +19,15 @@ fn to_dict<'py>(py: Python<'py>, data: VnData) -> PyResult<Bound<'py, PyDict>> {
     let tables = PyDict::new(py);
     for (name, table) in data.tables {
         let cols = PyDict::new(py);
-        for (col_name, col) in table.names.into_iter().zip(table.columns) {
-            cols.set_item(col_name, col.into_pyarray(py))?;
+        // One (rows, columns) array, handed over without a copy; every column is
+        // a strided view of it, so adjacent columns (x, y, z) form (n, 3) views.
+        let shape = (table.len, table.names.len());
+        let matrix = numpy::ndarray::Array2::from_shape_vec(shape, table.values)
+            .map_err(|e| PyValueError::new_err(format!("table {name}: {e}")))?
+            .into_pyarray(py);
+        let all = PySlice::full(py);
+        for (k, col_name) in table.names.into_iter().enumerate() {
+            cols.set_item(col_name, matrix.get_item((&all, k))?)?;
         }
         for (col_name, col) in table.extra {
             cols.set_item(col_name, col.into_pyarray(py))?;

@@ -6,6 +6,7 @@
 //! and the reader resynchronises one byte later.
 
 use crate::vn::checksum::crc16;
+use crate::vn::Table;
 
 /// The SDK caps `0xFA` packets at 2000 bytes (spec §5.1).
 pub const MAX_PACKET: usize = 2000;
@@ -467,16 +468,20 @@ fn f32_at(p: &[u8], off: usize) -> f64 {
     }
 }
 
-/// Decode a CRC-checked payload into `out` (one push per column, in
-/// [`Layout::column_names`] order). Returns `TimeStartup` in seconds if present.
-pub fn decode_into(layout: &Layout, payload: &[u8], out: &mut [Vec<f64>]) -> Option<f64> {
+/// Decode a CRC-checked payload as one row of `table` (whose columns are
+/// [`Layout::column_names`]). Returns `TimeStartup` in seconds if present.
+pub fn decode_into(layout: &Layout, payload: &[u8], table: &mut Table) -> Option<f64> {
+    let nc = table.ncols();
+    if table.values.capacity() - table.values.len() < nc {
+        table.reserve(table.len.max(1024));
+    }
+    let start = table.values.len();
+    let out = &mut table.values;
     let mut off = 0usize;
     let mut col = 0usize;
     let mut time = None;
     let mut push = |col: &mut usize, v: f64| {
-        if let Some(c) = out.get_mut(*col) {
-            c.push(v);
-        }
+        out.push(v);
         *col += 1;
     };
     for &(g, k) in &layout.fields {
@@ -548,6 +553,9 @@ pub fn decode_into(layout: &Layout, payload: &[u8], out: &mut [Vec<f64>]) -> Opt
         };
         off += size;
     }
+    // Exactly one value per column, whatever the payload held.
+    table.values.resize(start + nc, f64::NAN);
+    table.len += 1;
     time
 }
 
@@ -575,9 +583,9 @@ mod tests {
         assert_eq!(hl + size + 2, bytes.len());
         assert!(crc_ok(bytes));
         let names = layout.column_names();
-        let mut out = vec![Vec::new(); names.len()];
-        let t = decode_into(&layout, &bytes[hl..hl + size], &mut out);
-        let vals = out.iter().map(|c| c[0]).collect();
+        let mut table = Table::new(names.clone());
+        let t = decode_into(&layout, &bytes[hl..hl + size], &mut table);
+        let vals = table.values.clone();
         (layout, names, vals, t)
     }
 

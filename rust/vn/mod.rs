@@ -102,38 +102,101 @@ impl Issues {
     }
 }
 
-/// One message type's decoded records as columns of `f64`.
+/// One message type's decoded records: a row-major matrix of `f64`.
 ///
-/// `columns[k]` holds field `names[k]` for every record. `extra` columns (the
-/// appended `T`/`S` fields of ASCII sentences) are created when first seen and
-/// hold NaN for records that lack them.
+/// Row `r` holds the record's fields in `names` order at
+/// `values[r * names.len()..(r + 1) * names.len()]`: one write stream per record
+/// while parsing, and one array that the bindings hand to numpy without a copy
+/// (columns and channel triples are views of it). `extra` columns (the appended
+/// `T`/`S` fields of ASCII sentences) are created when first seen and hold NaN
+/// for records that lack them.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Table {
     pub names: Vec<String>,
-    pub columns: Vec<Vec<f64>>,
+    pub values: Vec<f64>,
     pub extra: Vec<(String, Vec<f64>)>,
     pub len: usize,
 }
 
+/// Buffers at least this large are backed by transparent huge pages where the
+/// kernel offers them (as numpy does for its own large arrays).
+const HUGE_MIN_BYTES: usize = 4 << 20;
+
+/// Ask the kernel to back `v`'s allocation with transparent huge pages: a
+/// first touch then costs one fault per 2 MB instead of one per 4 kB, which is
+/// most of the time spent writing a large fresh output table. Only advice: a
+/// kernel that refuses it changes nothing.
+#[cfg(target_os = "linux")]
+pub(crate) fn advise_huge_pages(v: &Vec<f64>) {
+    extern "C" {
+        fn madvise(addr: *mut core::ffi::c_void, len: usize, advice: core::ffi::c_int) -> i32;
+    }
+    const MADV_HUGEPAGE: core::ffi::c_int = 14;
+    const PAGE: usize = 4096;
+    let bytes = v.capacity() * std::mem::size_of::<f64>();
+    if bytes < HUGE_MIN_BYTES {
+        return;
+    }
+    let addr = v.as_ptr() as usize;
+    let start = (addr + PAGE - 1) & !(PAGE - 1);
+    let end = (addr + bytes) & !(PAGE - 1);
+    if end > start {
+        // SAFETY: [start, end) lies inside the live allocation of `v` (its whole
+        // capacity); MADV_HUGEPAGE changes neither its contents nor its validity,
+        // only how the kernel backs it. A failure (old kernel, other page size)
+        // is harmless, so the result is ignored.
+        unsafe {
+            madvise(start as *mut core::ffi::c_void, end - start, MADV_HUGEPAGE);
+        }
+    }
+}
+
+#[cfg(not(target_os = "linux"))]
+pub(crate) fn advise_huge_pages(_v: &Vec<f64>) {}
+
 impl Table {
     pub fn new(names: Vec<String>) -> Table {
-        let columns = names.iter().map(|_| Vec::new()).collect();
         Table {
             names,
-            columns,
+            values: Vec::new(),
             extra: Vec::new(),
             len: 0,
         }
     }
 
-    /// Make room for `rows` more rows in every column.
-    pub fn reserve(&mut self, rows: usize) {
-        let want = self.len + rows;
-        for c in &mut self.columns {
-            if c.capacity() < want {
-                c.reserve(want - c.len());
-            }
+    /// Fields per record.
+    #[inline]
+    pub fn ncols(&self) -> usize {
+        self.names.len()
+    }
+
+    /// Column `k` as a vector (a copy; for tests and small tables).
+    pub fn column(&self, k: usize) -> Vec<f64> {
+        let nc = self.ncols();
+        if k >= nc {
+            return Vec::new();
         }
+        self.values.iter().skip(k).step_by(nc).copied().collect()
+    }
+
+    /// Make room for `rows` more rows.
+    pub fn reserve(&mut self, rows: usize) {
+        let want = (self.len + rows).saturating_mul(self.ncols());
+        if self.values.capacity() < want {
+            self.values.reserve(want - self.values.len());
+            advise_huge_pages(&self.values);
+        }
+    }
+
+    /// Append one record (`row.len() == ncols()`).
+    #[inline]
+    pub fn push_row(&mut self, row: &[f64]) {
+        if self.values.capacity() - self.values.len() < row.len() {
+            // Grow geometrically, with the huge-page advice for the new buffer.
+            self.reserve(self.len.max(1024));
+        }
+        self.values.extend_from_slice(row);
+        self.len += 1;
     }
 
     /// Set an extra column's value for the last pushed row.
@@ -161,17 +224,17 @@ impl Table {
 
     /// Give back capacity reserved beyond the rows decoded.
     pub fn shrink(&mut self) {
-        for c in &mut self.columns {
-            if c.capacity() > c.len() + c.len() / 8 + 64 {
-                c.shrink_to_fit();
-            }
+        let v = &mut self.values;
+        if v.capacity() > v.len() + v.len() / 8 + 64 {
+            v.shrink_to_fit();
         }
     }
 
     fn append(&mut self, mut other: Table) {
-        for (mine, theirs) in self.columns.iter_mut().zip(other.columns.iter_mut()) {
-            mine.append(theirs);
+        if self.values.capacity() - self.values.len() < other.values.len() {
+            self.reserve(other.len.max(self.len));
         }
+        self.values.append(&mut other.values);
         self.finish();
         other.finish();
         for (name, col) in other.extra {

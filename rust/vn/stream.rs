@@ -330,10 +330,7 @@ impl Parser {
                 let Some(table) = self.data.tables.get_mut(spec.id) else {
                     return;
                 };
-                for (col, v) in table.columns.iter_mut().zip(values.iter()) {
-                    col.push(*v);
-                }
-                table.len += 1;
+                table.push_row(&values[..spec.fields.len()]);
                 if let Some(c) = count {
                     table.set_extra("serial_count", c);
                 }
@@ -354,8 +351,7 @@ impl Parser {
                     .tables
                     .entry("VNERR".to_string())
                     .or_insert_with(|| Table::new(vec!["code".to_string()]));
-                table.columns[0].push(code as f64);
-                table.len += 1;
+                table.push_row(&[code as f64]);
                 self.issue(buf, i, IssueKind::DeviceError, "device error report");
                 self.data.bytes_in_bad_records += len as u64;
             }
@@ -537,8 +533,7 @@ impl Parser {
                 .min(1 << 32) as usize;
             table.reserve(rows);
         }
-        binary::decode_into(layout, &buf[i + hl..i + hl + size], &mut table.columns);
-        table.len += 1;
+        binary::decode_into(layout, &buf[i + hl..i + hl + size], table);
         self.data.bytes_parsed += (end - i) as u64;
         self.data.binary_records += 1;
         Some(end)
@@ -760,7 +755,7 @@ $VNERR,12*72\r\n";
         assert!(accounted(&d, text.len()));
         let ypr = &d.tables["VNYPR"];
         assert_eq!(ypr.len, 3);
-        assert_eq!(ypr.columns[0], vec![10.071; 3]);
+        assert_eq!(ypr.column(0), vec![10.071; 3]);
         let t = &ypr
             .extra
             .iter()
@@ -768,7 +763,7 @@ $VNERR,12*72\r\n";
             .unwrap()
             .1;
         assert!(t[0].is_nan() && t[1] == 1162704.0 && t[2].is_nan());
-        assert_eq!(d.tables["VNYMR"].columns[0], vec![6.380]);
+        assert_eq!(d.tables["VNYMR"].column(0), vec![6.380]);
         assert_eq!(d.issues.count(IssueKind::DeviceError), 1);
         assert_eq!(d.issues.count(IssueKind::BadChecksum), 1);
         assert_eq!(d.issues.count(IssueKind::MalformedField), 1);

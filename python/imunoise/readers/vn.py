@@ -156,6 +156,33 @@ def _lookup(cols: Mapping[str, np.ndarray], names: tuple[str, ...]) -> list[np.n
     return None
 
 
+def _stack(cols: list[np.ndarray]) -> np.ndarray:
+    """``np.column_stack(cols)``, without the copy when the columns are adjacent.
+
+    The Rust reader returns each table as one row-major matrix and its columns as
+    views of it, so ``gyro_x, gyro_y, gyro_z`` sit 8 bytes apart in every row: the
+    (n, 3) channel is then a read-only view of those rows. Element ``(r, j)`` of
+    the view is the very element ``cols[j][r]``, so this is exact whatever the
+    columns' origin; anything else is stacked.
+    """
+    first = cols[0]
+    step = first.itemsize
+    addr = first.__array_interface__["data"][0]
+    adjacent = all(
+        c.ndim == 1
+        and c.dtype == first.dtype
+        and len(c) == len(first)
+        and c.strides == first.strides
+        and c.__array_interface__["data"][0] == addr + j * step
+        for j, c in enumerate(cols)
+    )
+    if adjacent and len(first) > 1:
+        return np.lib.stride_tricks.as_strided(
+            first, shape=(len(first), len(cols)), strides=(first.strides[0], step), writeable=False
+        )
+    return np.column_stack(cols)
+
+
 def table_channels(cols: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
     """The :class:`ImuLog` channels (and ``time``) one table can fill."""
     out: dict[str, np.ndarray] = {}
@@ -163,7 +190,7 @@ def table_channels(cols: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
         for names in candidates:
             found = _lookup(cols, names)
             if found is not None:
-                out[channel] = found[0] if len(found) == 1 else np.column_stack(found)
+                out[channel] = found[0] if len(found) == 1 else _stack(found)
                 break
     time = _lookup(cols, ("time_startup",))
     if time is not None:
