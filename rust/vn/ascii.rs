@@ -298,8 +298,9 @@ pub fn parse_f64(s: &[u8]) -> Option<f64> {
         _ => (false, s),
     };
     let n = digits.len();
-    // At most 19 digits cannot overflow u64; exactness is checked below.
-    if n <= 20 {
+    // At most 19 digits cannot overflow u64 (19 characters hold at most 19
+    // digits); exactness is checked below.
+    if n <= 19 {
         let mut mant: u64 = 0;
         let mut k = 0usize;
         while k < n && digits[k].is_ascii_digit() {
@@ -332,6 +333,121 @@ pub fn parse_f64(s: &[u8]) -> Option<f64> {
     }
     let v: f64 = text.parse().ok()?;
     v.is_finite().then_some(v)
+}
+
+/// Largest mantissa for which `mant / 10^frac` is one correctly rounded division.
+const EXACT_MANT: u64 = 1 << 53;
+
+/// A plain decimal number at `b[*j..]` (`[+-]digits[.digits]`, the grammar of
+/// [`parse_f64`]'s fast path), XOR-ing every byte into `x`; on success `*j` is
+/// the first byte after it. `None` whenever [`parse_f64`] would not take its fast
+/// path, so the value is bit-identical to [`parse_f64`] and to Python's `float()`.
+#[inline(always)]
+fn fast_number(b: &[u8], j: &mut usize, x: &mut u8) -> Option<f64> {
+    let mut k = *j;
+    let mut c = *b.get(k)?;
+    let neg = c == b'-';
+    if neg || c == b'+' {
+        *x ^= c;
+        k += 1;
+        c = *b.get(k)?;
+    }
+    let mut mant: u64 = 0;
+    let mut digits = 0usize;
+    loop {
+        let d = c.wrapping_sub(b'0');
+        if d > 9 {
+            break;
+        }
+        mant = mant.wrapping_mul(10).wrapping_add(d as u64);
+        *x ^= c;
+        digits += 1;
+        k += 1;
+        c = *b.get(k)?;
+    }
+    let mut frac = 0usize;
+    if c == b'.' {
+        *x ^= c;
+        k += 1;
+        c = *b.get(k)?;
+        loop {
+            let d = c.wrapping_sub(b'0');
+            if d > 9 {
+                break;
+            }
+            mant = mant.wrapping_mul(10).wrapping_add(d as u64);
+            *x ^= c;
+            frac += 1;
+            k += 1;
+            c = *b.get(k)?;
+        }
+    }
+    let total = digits + frac;
+    // More than 19 digits may have wrapped `mant`: leave those to the slow path.
+    if total == 0 || total > 19 || mant > EXACT_MANT || frac >= POW10.len() {
+        return None;
+    }
+    *j = k;
+    let v = mant as f64 / POW10[frac];
+    Some(if neg { -v } else { v })
+}
+
+/// Fast path for the common sentence: `$VN` + the id of a data message of
+/// [`MESSAGES`] + exactly its fields as plain decimal numbers + `*` + two hex
+/// digits matching the XOR-8 checksum, followed by a byte that is not a check
+/// character (`\r`, `\n`, anything else but a hex digit or `X`).
+///
+/// `b` starts at the `$`. Returns the spec, the values and the offset of the
+/// `*` (relative to `b`); the caller adds the line end. `None` means "not this
+/// simple": the general scanner and [`decode`] then decide, so every sentence
+/// this accepts is one they accept with the same values (checked by
+/// `fast_path_agrees` and the fuzz target), and everything else goes their way.
+#[inline]
+pub fn fast_sentence(
+    b: &[u8],
+    hint: Option<&'static MsgSpec>,
+) -> Option<(&'static MsgSpec, [f64; MAX_FIELDS], usize)> {
+    let head = b.get(..7)?;
+    if head[1] != b'V' || head[2] != b'N' || head[6] != b',' {
+        return None;
+    }
+    let id = &head[1..6];
+    let spec = match hint {
+        Some(h) if h.id.as_bytes() == id => h,
+        _ => spec_by_id(id)?,
+    };
+    // The general decoder's header rule (three upper-case letters) holds for
+    // every id of MESSAGES, so a match above implies it.
+    let mut x = id.iter().fold(b',', |a, &c| a ^ c);
+    let mut values = [0.0f64; MAX_FIELDS];
+    let n = spec.fields.len();
+    let mut j = 7usize;
+    for (k, v) in values.iter_mut().enumerate().take(n) {
+        *v = fast_number(b, &mut j, &mut x)?;
+        let sep = *b.get(j)?;
+        let want = if k + 1 == n { b'*' } else { b',' };
+        if sep != want {
+            return None;
+        }
+        if sep == b',' {
+            x ^= sep;
+        }
+        j += 1;
+    }
+    let star = j - 1;
+    // The scanner looks for '*' within MAX_SENTENCE bytes of '$'.
+    if star >= crate::vn::stream::MAX_SENTENCE {
+        return None;
+    }
+    // Two check digits, the byte after them, and one more (a possible LF after
+    // CR) must be in the buffer, or the scanner would ask for more input.
+    let field = b.get(star + 1..star + 5)?;
+    let hex = |c: u8| crate::vn::checksum::parse_hex(&[c]);
+    let check = (hex(field[0])? << 4) | hex(field[1])?;
+    if field[2].is_ascii_hexdigit() || field[2] == b'X' || check != x as u16 {
+        return None;
+    }
+    Some((spec, values, star))
 }
 
 fn parse_uint(s: &[u8]) -> Option<u16> {
@@ -557,6 +673,28 @@ mod tests {
     }
 
     #[test]
+    fn fast_sentence_takes_the_common_case() {
+        let a1 = b"$VNYMR,+100.949,-007.330,+000.715,-00.0049,-00.2449,+00.5397,-01.258,-00.100,-09.701,-00.000018,+00.001122,-00.000551*69\r\n";
+        let (spec, v, star) = fast_sentence(a1, None).unwrap();
+        assert_eq!((spec.id, star), ("VNYMR", a1.len() - 5));
+        assert_eq!((v[0], v[1], v[9]), (100.949, -7.33, -0.000018));
+        // Each of these leaves it to the general path.
+        for s in [
+            &b"$VNYMR,+100.949*69\r\n"[..],
+            b"$VNYPR,+010.071,+000.278,-002.026,T1162704*2F\r\n",
+            b"$VNYPR,+010.071,+000.278,-002.026*61\r\n",
+            b"$VNYPR,+010.071,+000.278,-002.026*60",
+            b"$VNYPR,+010.071,+000.278,-002.026*60A\r\n",
+            b"$VNYPR,+010.071,+000.278,1e2*60\r\n",
+            b"$VNRRG,08,-114.314,+000.058,-001.773*4F\r\n",
+        ] {
+            assert!(fast_sentence(s, None).is_none(), "{}", String::from_utf8_lossy(s));
+        }
+        let ok = b"$VNYPR,+010.071,+000.278,-002.026*60\r\n";
+        assert!(fast_sentence(ok, None).is_some());
+    }
+
+    #[test]
     fn floats_match_std() {
         for s in [
             "+100.949",
@@ -566,6 +704,11 @@ mod tests {
             "+084.322",
             "1e3",
             "12345678901234567.5",
+            // 20 digits would wrap a u64 mantissa: must not come out as 1.0.
+            "18446744073709551617",
+            "+1844674407370955161.7",
+            "9007199254740993",
+            "0.1234567890123456789",
         ] {
             let want: f64 = s.parse().unwrap();
             assert_eq!(parse_f64(s.as_bytes()), Some(want), "{s}");

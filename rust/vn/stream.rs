@@ -240,6 +240,11 @@ pub struct Parser {
     pending: Vec<(usize, Location)>,
     /// First damaged record in strict mode: kind, location, reason.
     pub fail: Option<Failure>,
+    /// Message type of the last sentence taken by the fast path.
+    last_spec: Option<&'static ascii::MsgSpec>,
+    /// Whether common sentences take [`ascii::fast_sentence`] (off only to check
+    /// that the result is the same without it).
+    fast: bool,
 }
 
 impl Parser {
@@ -262,7 +267,16 @@ impl Parser {
             good_layouts: Vec::new(),
             pending: Vec::new(),
             fail: None,
+            last_spec: None,
+            fast: true,
         }
+    }
+
+    /// The same parser without the ASCII fast path: every sentence goes through
+    /// the general scanner and decoder. For equivalence tests and fuzzing.
+    pub fn without_fast_path(mut self) -> Parser {
+        self.fast = false;
+        self
     }
 
     /// Rows to reserve for a table whose records are `len` bytes long.
@@ -417,6 +431,7 @@ impl Parser {
                 return n;
             }
             match buf[i] {
+                b'$' if self.fast && self.fast_ascii(buf, &mut i) => {}
                 b'$' => match scan_ascii(buf, i, fin) {
                     Ascii::Need => break,
                     Ascii::Noise => {
@@ -460,6 +475,31 @@ impl Parser {
         self.line_pos = self.base;
         self.data.bytes_total += i as u64;
         i
+    }
+
+    /// The common sentence ([`ascii::fast_sentence`]) at `buf[*i] == b'$'`:
+    /// decoded and `*i` moved past it, or `false` with nothing changed.
+    #[inline]
+    fn fast_ascii(&mut self, buf: &[u8], i: &mut usize) -> bool {
+        let Some((spec, values, star)) = ascii::fast_sentence(&buf[*i..], self.last_spec) else {
+            return false;
+        };
+        self.last_spec = Some(spec);
+        let end = eat_eol(buf, *i + star + 3);
+        let len = end - *i;
+        let table = match self.data.tables.get_mut(spec.id) {
+            Some(t) => t,
+            None => {
+                let mut table = Table::new(spec.fields.iter().map(|s| s.to_string()).collect());
+                table.reserve(self.rows_hint(len));
+                self.data.tables.entry(spec.id.to_string()).or_insert(table)
+            }
+        };
+        table.push_row(&values[..spec.fields.len()]);
+        self.data.bytes_parsed += len as u64;
+        self.data.ascii_records += 1;
+        *i = end;
+        true
     }
 
     /// Try a binary packet at `buf[i] == 0xFA`; `None` means "need more input".
@@ -566,11 +606,13 @@ impl Parser {
         let last = *cuts.last().unwrap_or(&0);
         let inner: Vec<(usize, usize)> = cuts.windows(2).map(|w| (w[0], w[1])).collect();
         let strict = self.strict;
+        let fast = self.fast;
         let results: Vec<(VnData, Option<Failure>, u64)> = inner
             .par_iter()
             .map(|&(a, b)| {
                 let piece = &buf[a..b];
                 let mut p = Parser::with_size_hint(strict, piece.len() as u64);
+                p.fast = fast;
                 p.feed(piece, true);
                 let nl = piece.iter().filter(|&&c| c == b'\n').count() as u64;
                 (p.data, p.fail, nl)
@@ -884,8 +926,92 @@ $VNERR,12*72\r\n";
         assert!(err.starts_with("line 4 "), "{err}");
     }
 
+    /// Sequential parse without the ASCII fast path: the reference behaviour.
+    fn reference(data: &[u8], strict: bool) -> CoreResult<VnData> {
+        let mut p = Parser::new(strict).without_fast_path();
+        p.feed(data, true);
+        p.finish()
+    }
+
+    /// A number as text: sign, digits, dot, digits, in every combination the
+    /// grammar allows and some it does not (empty, 20+ digits, stray bytes).
+    fn number() -> impl Strategy<Value = String> {
+        (
+            prop_oneof![Just(""), Just("+"), Just("-")],
+            "[0-9]{0,21}",
+            prop_oneof![Just(""), Just(".")],
+            "[0-9]{0,24}",
+            prop_oneof![8 => Just(""), 1 => Just("e3"), 1 => Just("x")],
+        )
+            .prop_map(|(s, a, d, b, t)| format!("{s}{a}{d}{b}{t}"))
+    }
+
+    /// Sentences of random message types with random fields, then checksum or
+    /// CRC (right, wrong or `XX`), appended T/S fields and line ends.
+    fn sentences() -> impl Strategy<Value = Vec<u8>> {
+        let one = (
+            0..ascii::MESSAGES.len() + 2,
+            proptest::collection::vec(number(), 0..15),
+            0u8..6,
+            prop_oneof![Just(""), Just(",T123"), Just(",S00A1"), Just(",T1,S0001")],
+            prop_oneof![Just("\r\n"), Just("\n"), Just(""), Just("\r"), Just("7"), Just("X")],
+            any::<bool>(),
+        )
+            .prop_map(|(m, fields, check, tail, eol, exact)| {
+                let id = match ascii::MESSAGES.get(m) {
+                    Some(spec) => spec.id,
+                    None if m == ascii::MESSAGES.len() => "VNRRG",
+                    None => "VNGPS",
+                };
+                let mut body = id.to_string();
+                let n = ascii::MESSAGES.get(m).map_or(fields.len(), |s| s.fields.len());
+                let take = if exact { n.min(fields.len()) } else { fields.len() };
+                for f in fields.iter().take(take) {
+                    body.push(',');
+                    body.push_str(f);
+                }
+                if exact {
+                    for _ in take..n {
+                        body.push_str(",+1.5");
+                    }
+                }
+                body.push_str(tail);
+                let x = checksum::xor8(body.as_bytes());
+                let c = checksum::crc16(body.as_bytes());
+                let field = match check {
+                    0 | 1 => format!("{x:02X}"),
+                    2 => format!("{x:02x}"),
+                    3 => format!("{c:04X}"),
+                    4 => format!("{:02X}", x ^ 1),
+                    _ => "XX".to_string(),
+                };
+                format!("${body}*{field}{eol}").into_bytes()
+            });
+        proptest::collection::vec(one, 1..40).prop_map(|v| v.concat())
+    }
+
     proptest! {
         #![proptest_config(ProptestConfig { cases: 300, ..ProptestConfig::default() })]
+
+        #[test]
+        fn fast_path_agrees(s in sentences(), cut in any::<u16>()) {
+            // Debug text compares NaN padding and the sign of zero exactly.
+            let text = |d: CoreResult<VnData>| match d {
+                Ok(d) => format!("{d:?}"),
+                Err(e) => e.to_string(),
+            };
+            let want = text(reference(&s, false));
+            prop_assert_eq!(text(parse_bytes(&s, false)), want.clone());
+            let mut p = Parser::new(false);
+            p.feed(&s, true);
+            prop_assert_eq!(text(p.finish()), want);
+            // Cut anywhere: what is consumed and decoded agrees too.
+            let cut = cut as usize % (s.len() + 1);
+            let (mut a, mut b) = (Parser::new(false), Parser::new(false).without_fast_path());
+            prop_assert_eq!(a.feed(&s[..cut], false), b.feed(&s[..cut], false));
+            prop_assert_eq!(text(a.finish()), text(b.finish()));
+            prop_assert_eq!(text(parse_bytes(&s, true)), text(reference(&s, true)));
+        }
 
         #[test]
         fn random_bytes_are_accounted(data in proptest::collection::vec(any::<u8>(), 0..3000)) {
