@@ -207,6 +207,38 @@ fn bump(map: &mut std::collections::BTreeMap<String, u64>, key: &str) {
     }
 }
 
+/// Offset of the first packet at or after `from` (within `window` bytes) whose
+/// header frames a fixed-size packet with a good CRC inside `buf`.
+fn good_packet_at_or_after(buf: &[u8], from: usize, window: usize) -> Option<usize> {
+    let end = from.saturating_add(window).min(buf.len());
+    let mut i = from;
+    while i < end {
+        let at = i + buf.get(i..end)?.iter().position(|&c| c == 0xFA)?;
+        if let HeaderScan::Ok(layout) = binary::parse_header(&buf[at..]) {
+            if let Some(size) = layout.fixed_payload {
+                let stop = at + 1 + layout.header.len() + size + 2;
+                if stop <= buf.len() && binary::crc_ok(&buf[at..stop]) {
+                    return Some(at);
+                }
+            }
+        }
+        i = at + 1;
+    }
+    None
+}
+
+/// Number of `\n` bytes: 64 at a time into a byte counter, which compiles to a
+/// few vector compares and adds per block (a plain `filter().count()` widens
+/// every byte to 64 bits).
+pub fn count_newlines(buf: &[u8]) -> u64 {
+    let mut blocks = buf.chunks_exact(64);
+    let mut total = 0u64;
+    for b in &mut blocks {
+        total += b.iter().fold(0u8, |a, &c| a + (c == b'\n') as u8) as u64;
+    }
+    total + blocks.remainder().iter().filter(|&&c| c == b'\n').count() as u64
+}
+
 fn eat_eol(buf: &[u8], mut end: usize) -> usize {
     if buf.get(end) == Some(&b'\r') {
         end += 1;
@@ -245,6 +277,10 @@ pub struct Parser {
     /// Whether common sentences take [`ascii::fast_sentence`] (off only to check
     /// that the result is the same without it).
     fast: bool,
+    /// Blocks at least this long are parsed on all cores.
+    parallel_min: usize,
+    /// Pieces parsed on other cores and merged (for tests).
+    merged_pieces: u64,
 }
 
 impl Parser {
@@ -269,6 +305,8 @@ impl Parser {
             fail: None,
             last_spec: None,
             fast: true,
+            parallel_min: PARALLEL_MIN,
+            merged_pieces: 0,
         }
     }
 
@@ -276,6 +314,14 @@ impl Parser {
     /// the general scanner and decoder. For equivalence tests and fuzzing.
     pub fn without_fast_path(mut self) -> Parser {
         self.fast = false;
+        self
+    }
+
+    /// The same parser, splitting blocks of at least `bytes` bytes across cores
+    /// (default 1 MiB). Small values exercise the parallel paths on small inputs
+    /// (equivalence tests, fuzzing); the result never depends on it.
+    pub fn with_parallel_min(mut self, bytes: usize) -> Parser {
+        self.parallel_min = bytes;
         self
     }
 
@@ -290,7 +336,7 @@ impl Parser {
         if abs >= self.line_pos {
             let from = (self.line_pos.saturating_sub(self.base)) as usize;
             let from = from.min(i);
-            self.lines += buf[from..i].iter().filter(|&&c| c == b'\n').count() as u64;
+            self.lines += count_newlines(&buf[from..i]);
             self.line_pos = abs;
         }
         Location {
@@ -470,7 +516,7 @@ impl Parser {
         // Keep the line count current up to the consumed end: the next block
         // no longer sees these bytes.
         let from = (self.line_pos.saturating_sub(self.base) as usize).min(i);
-        self.lines += buf[from..i].iter().filter(|&&c| c == b'\n').count() as u64;
+        self.lines += count_newlines(&buf[from..i]);
         self.base += i as u64;
         self.line_pos = self.base;
         self.data.bytes_total += i as u64;
@@ -581,8 +627,11 @@ impl Parser {
 
     /// Parse a block, using all cores when it is large and pure ASCII.
     pub fn feed_block(&mut self, buf: &[u8], fin: bool) -> usize {
-        if buf.len() < PARALLEL_MIN || self.fail.is_some() || buf.contains(&0xFA) {
+        if buf.len() < self.parallel_min || self.fail.is_some() {
             return self.feed(buf, fin);
+        }
+        if buf.contains(&0xFA) {
+            return self.feed_block_binary(buf, fin);
         }
         // Everything up to the last newline is split into pieces at newlines and
         // parsed in parallel; only the tail after it (part of one line, which may
@@ -614,7 +663,9 @@ impl Parser {
                 let mut p = Parser::with_size_hint(strict, piece.len() as u64);
                 p.fast = fast;
                 p.feed(piece, true);
-                let nl = piece.iter().filter(|&&c| c == b'\n').count() as u64;
+                // `feed` consumed the whole piece and counted its newlines
+                // (unless strict mode stopped it, when the count is not used).
+                let nl = p.lines;
                 (p.data, p.fail, nl)
             })
             .collect();
@@ -655,6 +706,127 @@ impl Parser {
         last + self.feed(&buf[last..], fin)
     }
 
+    /// Parse a block that holds binary packets on all cores, with exactly the
+    /// result of [`Parser::feed`].
+    ///
+    /// The block is cut into pieces that start where a packet with a good CRC
+    /// starts; each piece is parsed by a fresh parser. A piece is *clean* when
+    /// its parser consumed it to the byte, found no issue of any kind (nothing
+    /// skipped, no CRC failure pending), and its configurations fit the layout
+    /// table: then the sequential parser, arriving at the piece's first byte,
+    /// would frame the very same records (framing of good records does not
+    /// depend on the parser's state) and end exactly at the next piece. Clean
+    /// pieces are merged in order; from the first piece that is not clean on,
+    /// the rest of the block is parsed sequentially, so damaged streams get the
+    /// sequential answer by construction, at sequential speed.
+    fn feed_block_binary(&mut self, buf: &[u8], fin: bool) -> usize {
+        if !self.pending.is_empty() {
+            // A good packet in any piece could confirm these: stay sequential.
+            return self.feed(buf, fin);
+        }
+        let pieces = (rayon::current_num_threads() * 4).max(2);
+        let step = buf.len() / pieces;
+        let mut starts = vec![0usize];
+        for p in 1..pieces {
+            let from = (p * step).max(*starts.last().unwrap_or(&0) + 1);
+            if from >= buf.len() {
+                break;
+            }
+            if let Some(at) = good_packet_at_or_after(buf, from, step.max(1 << 12)) {
+                if at > *starts.last().unwrap_or(&0) {
+                    starts.push(at);
+                }
+            }
+        }
+        if starts.len() < 2 {
+            return self.feed(buf, fin);
+        }
+        let bounds: Vec<(usize, usize)> = starts
+            .iter()
+            .enumerate()
+            .map(|(k, &a)| (a, starts.get(k + 1).copied().unwrap_or(buf.len())))
+            .collect();
+        let last = bounds.len() - 1;
+        let (strict, fast) = (self.strict, self.fast);
+        let results: Vec<(Parser, usize)> = bounds
+            .par_iter()
+            .enumerate()
+            .map(|(k, &(a, b))| {
+                let mut p = Parser::with_size_hint(strict, (b - a) as u64);
+                p.fast = fast;
+                let used = p.feed(&buf[a..b], fin && k == last);
+                (p, used)
+            })
+            .collect();
+        let mut consumed = 0usize;
+        for (k, (p, used)) in results.into_iter().enumerate() {
+            let (a, b) = bounds[k];
+            let whole = k == last || used == b - a;
+            let clean = whole
+                && p.fail.is_none()
+                && p.pending.is_empty()
+                && p.data.issues.counts.iter().all(|&c| c == 0);
+            if !clean || !self.adopt_layouts(&p) {
+                // Sequential from here: this piece starts where the clean ones
+                // before it ended, with the state they left.
+                return a + self.feed(&buf[a..], fin);
+            }
+            self.absorb(p, used, buf.len() - a);
+            // The last piece may leave a record cut by the block end for the
+            // next block.
+            consumed = a + used;
+        }
+        consumed
+    }
+
+    /// Whether the configurations of a clean piece fit in the layout table as
+    /// the sequential parser would have kept them (no eviction needed).
+    fn adopt_layouts(&self, p: &Parser) -> bool {
+        let new = p
+            .layouts
+            .iter()
+            .filter(|(l, _, _)| !self.layouts.iter().any(|(m, _, _)| m.header == l.header))
+            .count();
+        self.layouts.len() + new <= MAX_LAYOUTS
+    }
+
+    /// Merge a clean piece that ends `used` bytes further on; `left` is the
+    /// number of bytes from the piece start to the end of the block (for
+    /// reserving table rows once).
+    fn absorb(&mut self, mut p: Parser, used: usize, left: usize) {
+        let remaining = self.size_hint.saturating_sub(self.base).max(left as u64);
+        for (k_piece, (layout, name, table)) in p.layouts.drain(..).enumerate() {
+            let k = match self.layouts.iter().position(|(l, _, _)| l.header == layout.header) {
+                Some(k) => k,
+                None => {
+                    self.layouts.push((layout, name, Table::default()));
+                    self.layouts.len() - 1
+                }
+            };
+            if p.good_layouts.contains(&k_piece) && !self.good_layouts.contains(&k) {
+                self.good_layouts.push(k);
+            }
+            let mine = &mut self.layouts[k].2;
+            if mine.names.is_empty() {
+                // First rows of this configuration: reserve for the rest of the
+                // stream at this piece's density, then copy once.
+                let mut t = Table::new(table.names.clone());
+                let scale = remaining as f64 / used.max(1) as f64;
+                t.reserve(((table.len as f64) * scale * 1.01) as usize + table.len);
+                t.append(table);
+                *mine = t;
+            } else if !table.names.is_empty() {
+                mine.append(table);
+            }
+        }
+        let lines = p.lines;
+        self.merged_pieces += 1;
+        self.data.merge(std::mem::take(&mut p.data), 0);
+        self.lines += lines;
+        self.base += used as u64;
+        self.line_pos = self.base;
+    }
+
     /// Finish: pad tables and turn a strict-mode failure into an error.
     pub fn finish(mut self) -> CoreResult<VnData> {
         if let Some((kind, loc, reason)) = self.fail.take() {
@@ -684,7 +856,11 @@ impl Parser {
 
 /// Parse a whole in-memory stream.
 pub fn parse_bytes(data: &[u8], strict: bool) -> CoreResult<VnData> {
-    let mut p = Parser::with_size_hint(strict, data.len() as u64);
+    parse_bytes_with(Parser::with_size_hint(strict, data.len() as u64), data)
+}
+
+/// [`parse_bytes`] with a configured parser (see [`Parser::with_parallel_min`]).
+pub fn parse_bytes_with(mut p: Parser, data: &[u8]) -> CoreResult<VnData> {
     let mut pos = 0usize;
     while pos < data.len() {
         let end = (pos + CHUNK).min(data.len());
@@ -777,6 +953,16 @@ mod tests {
         0xFA, 0x01, 0x09, 0x00, 0x70, 0x05, 0x00, 0x03, 0x0A, 0x00, 0x00, 0x00, 0x48, 0x0E, 0x2C,
         0x42, 0x08, 0x4C, 0x37, 0xC1, 0x10, 0x38, 0x8B, 0xC2, 0xD4, 0xCB,
     ];
+
+    /// Test vector B2 of the spec: a second binary configuration.
+    fn binary_b2() -> Vec<u8> {
+        let hex = "FA0128 05A802C33FE789B0423DA96AC1D083543A923E0BBB1C2530BA047D1C413BB2833D4EEA9CBEF1BD93BEA4558CBD26C7773EF428E641 57CEC142C0E9";
+        let h: String = hex.chars().filter(|c| !c.is_whitespace()).collect();
+        (0..h.len())
+            .step_by(2)
+            .map(|i| u8::from_str_radix(&h[i..i + 2], 16).unwrap_or(0))
+            .collect()
+    }
 
     fn accounted(d: &VnData, n: usize) -> bool {
         d.bytes_total == n as u64
@@ -906,6 +1092,35 @@ $VNERR,12*72\r\n";
     }
 
     #[test]
+    fn parallel_binary_takes_clean_pieces() {
+        let b2 = binary_b2();
+        let mut s = Vec::new();
+        for k in 0..30_000 {
+            s.extend_from_slice(if k % 3 == 0 { &b2 } else { &B1 });
+            if k % 1000 == 0 {
+                s.extend_from_slice(A1);
+            }
+        }
+        let want = format!("{:?}", reference(&s, false).unwrap());
+        let mut p = Parser::with_size_hint(false, s.len() as u64);
+        let used = p.feed_block(&s, true);
+        assert_eq!(used, s.len());
+        assert!(p.merged_pieces >= 2, "{}", p.merged_pieces);
+        assert_eq!(format!("{:?}", p.finish().unwrap()), want);
+        // Damage in the middle: pieces before it are merged, the rest is sequential.
+        let half = s.len() / 2;
+        let mid = half + s[half..].iter().position(|&c| c == 0xFA).unwrap_or(0) + 6;
+        s[mid] ^= 0x55;
+        let want = format!("{:?}", reference(&s, false).unwrap());
+        let mut p = Parser::with_size_hint(false, s.len() as u64);
+        p.feed_block(&s, true);
+        assert!(p.merged_pieces >= 1);
+        let got = p.finish().unwrap();
+        assert_eq!(got.issues.count(IssueKind::BadChecksum), 1);
+        assert_eq!(format!("{got:?}"), want);
+    }
+
+    #[test]
     fn parallel_equals_sequential() {
         let mut s = Vec::new();
         for k in 0..40_000u32 {
@@ -1011,6 +1226,55 @@ $VNERR,12*72\r\n";
             prop_assert_eq!(a.feed(&s[..cut], false), b.feed(&s[..cut], false));
             prop_assert_eq!(text(a.finish()), text(b.finish()));
             prop_assert_eq!(text(parse_bytes(&s, true)), text(reference(&s, true)));
+        }
+
+        #[test]
+        fn parallel_binary_equals_sequential(
+            kinds in proptest::collection::vec(0u8..5, 20..200),
+            edits in proptest::collection::vec((any::<u16>(), any::<u8>(), 0u8..3), 0..8),
+            min in 0usize..3000,
+        ) {
+            // Packets of two configurations, sentences and noise, then damage.
+            let b2 = binary_b2();
+            let mut s = Vec::new();
+            for k in kinds {
+                match k {
+                    0 | 1 => s.extend_from_slice(&B1),
+                    2 => s.extend_from_slice(&b2),
+                    3 => s.extend_from_slice(A1),
+                    _ => s.extend_from_slice(b"\xfa\x01noise\n"),
+                }
+            }
+            for (pos, byte, op) in edits {
+                let i = pos as usize % (s.len() + 1);
+                match op {
+                    0 => s.insert(i, byte),
+                    1 if i < s.len() => { s.remove(i); }
+                    _ if i < s.len() => s[i] = byte,
+                    _ => {}
+                }
+            }
+            let text = |d: CoreResult<VnData>| match d {
+                Ok(d) => format!("{d:?}"),
+                Err(e) => e.to_string(),
+            };
+            for strict in [false, true] {
+                let par = parse_bytes_with(Parser::new(strict).with_parallel_min(min), &s);
+                prop_assert_eq!(text(par), text(reference(&s, strict)));
+            }
+            // In pieces too, as the file reader feeds them.
+            let mut r = Parser::new(false).with_parallel_min(min);
+            let mut pos = 0;
+            while pos < s.len() {
+                let end = (pos + 700).min(s.len());
+                let used = r.feed_block(&s[pos..end], end == s.len());
+                pos += if used == 0 && end < s.len() {
+                    r.feed_block(&s[pos..s.len()], true)
+                } else {
+                    used
+                };
+            }
+            prop_assert_eq!(text(r.finish()), text(reference(&s, false)));
         }
 
         #[test]
