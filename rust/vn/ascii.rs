@@ -688,7 +688,11 @@ mod tests {
             b"$VNYPR,+010.071,+000.278,1e2*60\r\n",
             b"$VNRRG,08,-114.314,+000.058,-001.773*4F\r\n",
         ] {
-            assert!(fast_sentence(s, None).is_none(), "{}", String::from_utf8_lossy(s));
+            assert!(
+                fast_sentence(s, None).is_none(),
+                "{}",
+                String::from_utf8_lossy(s)
+            );
         }
         let ok = b"$VNYPR,+010.071,+000.278,-002.026*60\r\n";
         assert!(fast_sentence(ok, None).is_some());

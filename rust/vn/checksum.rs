@@ -67,16 +67,20 @@ pub fn crc16_update(mut crc: u16, bytes: &[u8]) -> u16 {
     let t = &CRC_TABLES;
     let mut chunks = bytes.chunks_exact(8);
     for c in &mut chunks {
-        let hi = (crc >> 8) as u8;
-        let lo = crc as u8;
-        crc = t[7][(c[0] ^ hi) as usize]
-            ^ t[6][(c[1] ^ lo) as usize]
-            ^ t[5][c[2] as usize]
-            ^ t[4][c[3] as usize]
-            ^ t[3][c[4] as usize]
-            ^ t[2][c[5] as usize]
-            ^ t[1][c[6] as usize]
-            ^ t[0][c[7] as usize];
+        // One 8-byte load; the CRC so far is XOR-ed into the first two bytes
+        // (big-endian order: the CRC is not reflected).
+        let mut w = [0u8; 8];
+        w.copy_from_slice(c);
+        let v = u64::from_be_bytes(w) ^ ((crc as u64) << 48);
+        let b = |k: u32| ((v >> (56 - 8 * k)) & 0xFF) as usize;
+        crc = t[7][b(0)]
+            ^ t[6][b(1)]
+            ^ t[5][b(2)]
+            ^ t[4][b(3)]
+            ^ t[3][b(4)]
+            ^ t[2][b(5)]
+            ^ t[1][b(6)]
+            ^ t[0][b(7)];
     }
     for &b in chunks.remainder() {
         crc = (crc << 8) ^ t[0][((crc >> 8) as u8 ^ b) as usize];

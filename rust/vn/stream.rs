@@ -26,7 +26,7 @@ use crate::error::{CoreError, CoreResult};
 use crate::vn::ascii::{self, Decoded};
 use crate::vn::binary::{self, HeaderScan, Layout};
 use crate::vn::checksum;
-use crate::vn::{IssueKind, Location, Table, VnData};
+use crate::vn::{IssueKind, Location, Table, VnData, FIRST_KEEP};
 
 /// The 2024 SDK rejects ASCII packets longer than this (spec §2.1).
 pub const MAX_SENTENCE: usize = 320;
@@ -281,6 +281,9 @@ pub struct Parser {
     parallel_min: usize,
     /// Pieces parsed on other cores and merged (for tests).
     merged_pieces: u64,
+    /// Locations kept for runs of skipped bytes (one more in a piece of a
+    /// parallel parse, see [`Parser::feed_block`]).
+    skip_keep: usize,
 }
 
 impl Parser {
@@ -307,6 +310,7 @@ impl Parser {
             fast: true,
             parallel_min: PARALLEL_MIN,
             merged_pieces: 0,
+            skip_keep: FIRST_KEEP,
         }
     }
 
@@ -364,7 +368,7 @@ impl Parser {
         let abs = self.base + i as u64;
         if abs != self.skip_end {
             let kind = IssueKind::BytesSkipped;
-            if self.data.issues.wants_location(kind) {
+            if self.data.issues.first[kind as usize].len() < self.skip_keep {
                 let loc = self.location(buf, i);
                 self.data.issues.first[kind as usize].push(loc);
             }
@@ -656,23 +660,37 @@ impl Parser {
         let inner: Vec<(usize, usize)> = cuts.windows(2).map(|w| (w[0], w[1])).collect();
         let strict = self.strict;
         let fast = self.fast;
-        let results: Vec<(VnData, Option<Failure>, u64)> = inner
+        let results: Vec<(VnData, Option<Failure>, u64, u64)> = inner
             .par_iter()
             .map(|&(a, b)| {
                 let piece = &buf[a..b];
                 let mut p = Parser::with_size_hint(strict, piece.len() as u64);
                 p.fast = fast;
+                // One spare location, for a run of skipped bytes that turns out
+                // to continue one from the previous piece.
+                p.skip_keep = FIRST_KEEP + 1;
                 p.feed(piece, true);
                 // `feed` consumed the whole piece and counted its newlines
                 // (unless strict mode stopped it, when the count is not used).
                 let nl = p.lines;
-                (p.data, p.fail, nl)
+                (p.data, p.fail, nl, p.skip_end)
             })
             .collect();
         // Lines before the block (kept current by `feed`).
         let mut line_shift = self.lines;
-        for ((a, b), (mut data, fail, nl)) in inner.iter().zip(results) {
+        for ((a, b), (mut data, fail, nl, skip_end)) in inner.iter().zip(results) {
             let shift_offset = self.base + *a as u64;
+            let skipped = &mut data.issues.first[IssueKind::BytesSkipped as usize];
+            if self.skip_end == shift_offset && skipped.first().is_some_and(|l| l.offset == 0) {
+                // The sequential parser would extend the previous run here.
+                skipped.remove(0);
+            }
+            skipped.truncate(FIRST_KEEP);
+            self.skip_end = if skip_end == (b - a) as u64 {
+                self.base + *b as u64
+            } else {
+                u64::MAX
+            };
             for locs in data.issues.first.iter_mut() {
                 for l in locs.iter_mut() {
                     l.offset += shift_offset;
@@ -702,7 +720,6 @@ impl Parser {
         self.lines = line_shift;
         self.line_pos = self.base + last as u64;
         self.base += last as u64;
-        self.skip_end = u64::MAX;
         last + self.feed(&buf[last..], fin)
     }
 
@@ -796,7 +813,11 @@ impl Parser {
     fn absorb(&mut self, mut p: Parser, used: usize, left: usize) {
         let remaining = self.size_hint.saturating_sub(self.base).max(left as u64);
         for (k_piece, (layout, name, table)) in p.layouts.drain(..).enumerate() {
-            let k = match self.layouts.iter().position(|(l, _, _)| l.header == layout.header) {
+            let k = match self
+                .layouts
+                .iter()
+                .position(|(l, _, _)| l.header == layout.header)
+            {
                 Some(k) => k,
                 None => {
                     self.layouts.push((layout, name, Table::default()));
@@ -895,37 +916,83 @@ pub fn parse_prefix(data: &[u8], strict: bool, fin: bool) -> CoreResult<(usize, 
     p.finish().map(|d| (used, d))
 }
 
+/// Room kept in front of each chunk buffer for the unconsumed tail of the
+/// previous chunk (a record cut by the chunk end), so that it is joined to the
+/// next chunk without copying the chunk.
+const GAP: usize = 1 << 16;
+
+/// Append up to `want` bytes from `reader` to `buf` (without zeroing them first):
+/// bytes read, and whether the reader reported its end.
+fn fill<R: Read>(reader: &mut R, buf: &mut Vec<u8>, want: usize) -> CoreResult<(usize, bool)> {
+    let got = reader.by_ref().take(want as u64).read_to_end(buf)?;
+    Ok((got, got < want))
+}
+
 /// Parse a stream from a reader in chunks of [`CHUNK`] bytes, calling
 /// `progress(bytes_done, total)` after each chunk.
-pub fn parse_reader<R: Read>(
-    mut reader: R,
+///
+/// The next chunk is read while the current one is parsed; the parser sees
+/// the same sequence of blocks (previous tail + next chunk) as a plain
+/// read-then-parse loop.
+pub fn parse_reader<R: Read + Send>(
+    reader: R,
     total: u64,
     strict: bool,
     progress: &mut dyn FnMut(u64, u64) -> CoreResult<()>,
 ) -> CoreResult<VnData> {
-    let mut p = Parser::with_size_hint(strict, total);
-    let mut buf: Vec<u8> = Vec::with_capacity(CHUNK + binary::MAX_PACKET);
+    let p = Parser::with_size_hint(strict, total);
+    parse_reader_with(p, reader, total, CHUNK, progress)
+}
+
+/// [`parse_reader`] with a configured parser and chunk size (small chunks and
+/// a small [`Parser::with_parallel_min`] exercise every path on small inputs).
+pub fn parse_reader_with<R: Read + Send>(
+    mut p: Parser,
+    mut reader: R,
+    total: u64,
+    chunk: usize,
+    progress: &mut dyn FnMut(u64, u64) -> CoreResult<()>,
+) -> CoreResult<VnData> {
+    let chunk = chunk.max(1);
+    let mut cur: Vec<u8> = Vec::with_capacity(GAP + chunk);
+    cur.resize(GAP, 0);
+    let mut next: Vec<u8> = Vec::with_capacity(GAP + chunk);
+    next.resize(GAP, 0);
+    let (mut got, mut eof) = fill(&mut reader, &mut cur, chunk)?;
+    let mut from = GAP;
     let mut done: u64 = 0;
-    let mut eof = false;
-    while !eof {
-        let keep = buf.len();
-        buf.resize(keep + CHUNK, 0);
-        let mut filled = keep;
-        while filled < buf.len() {
-            let got = reader.read(&mut buf[filled..])?;
-            if got == 0 {
-                eof = true;
-                break;
-            }
-            filled += got;
-        }
-        buf.truncate(filled);
-        done += (filled - keep) as u64;
-        let used = p.feed_block(&buf, eof);
-        buf.drain(..used);
+    loop {
+        done += got as u64;
+        let block = &cur[from..];
+        let (used, ahead) = if eof {
+            (p.feed_block(block, true), Ok((0, true)))
+        } else {
+            next.truncate(GAP);
+            rayon::join(
+                || p.feed_block(block, false),
+                || fill(&mut reader, &mut next, chunk),
+            )
+        };
         progress(done, total.max(done))?;
-        if p.fail.is_some() {
+        if eof || p.fail.is_some() {
             break;
+        }
+        (got, eof) = ahead?;
+        let left = &cur[from + used..];
+        if left.len() <= GAP {
+            from = GAP - left.len();
+            next[from..GAP].copy_from_slice(left);
+        } else {
+            // A tail longer than the gap (a record longer than a chunk so far).
+            let mut joined = Vec::with_capacity(left.len() + next.len());
+            joined.extend_from_slice(left);
+            joined.extend_from_slice(&next[GAP..]);
+            next = joined;
+            from = 0;
+        }
+        std::mem::swap(&mut cur, &mut next);
+        if next.len() < GAP {
+            next.resize(GAP, 0);
         }
     }
     p.finish()
@@ -1169,7 +1236,14 @@ $VNERR,12*72\r\n";
             proptest::collection::vec(number(), 0..15),
             0u8..6,
             prop_oneof![Just(""), Just(",T123"), Just(",S00A1"), Just(",T1,S0001")],
-            prop_oneof![Just("\r\n"), Just("\n"), Just(""), Just("\r"), Just("7"), Just("X")],
+            prop_oneof![
+                Just("\r\n"),
+                Just("\n"),
+                Just(""),
+                Just("\r"),
+                Just("7"),
+                Just("X")
+            ],
             any::<bool>(),
         )
             .prop_map(|(m, fields, check, tail, eol, exact)| {
@@ -1179,8 +1253,14 @@ $VNERR,12*72\r\n";
                     None => "VNGPS",
                 };
                 let mut body = id.to_string();
-                let n = ascii::MESSAGES.get(m).map_or(fields.len(), |s| s.fields.len());
-                let take = if exact { n.min(fields.len()) } else { fields.len() };
+                let n = ascii::MESSAGES
+                    .get(m)
+                    .map_or(fields.len(), |s| s.fields.len());
+                let take = if exact {
+                    n.min(fields.len())
+                } else {
+                    fields.len()
+                };
                 for f in fields.iter().take(take) {
                     body.push(',');
                     body.push_str(f);
@@ -1275,6 +1355,43 @@ $VNERR,12*72\r\n";
                 };
             }
             prop_assert_eq!(text(r.finish()), text(reference(&s, false)));
+        }
+
+        #[test]
+        fn small_chunks_equal_whole(
+            kinds in proptest::collection::vec(0u8..6, 1..300),
+            chunk in 1usize..400,
+            flip in any::<u16>(),
+        ) {
+            let b2 = binary_b2();
+            let mut s = Vec::new();
+            for k in kinds {
+                match k {
+                    0 => s.extend_from_slice(&B1),
+                    1 => s.extend_from_slice(&b2),
+                    2 | 3 => s.extend_from_slice(A1),
+                    4 => s.extend_from_slice(&A1[..40]),
+                    _ => s.extend_from_slice(b"$VNRRG,05,115200*5C\n"),
+                }
+            }
+            let at = flip as usize % s.len();
+            s[at] ^= 0x20;
+            let want = format!("{:?}", reference(&s, false));
+            for min in [0usize, 1 << 20] {
+                let p = Parser::with_size_hint(false, s.len() as u64).with_parallel_min(min);
+                let mut calls = 0u64;
+                let got = parse_reader_with(p, &s[..], s.len() as u64, chunk, &mut |d, t| {
+                    calls += 1;
+                    assert!(d <= t);
+                    Ok(())
+                });
+                let got = format!("{got:?}");
+                if got != want {
+                    let k = got.bytes().zip(want.bytes()).take_while(|(a, b)| a == b).count();
+                    panic!("min {min}: got {} want {}", &got[k.saturating_sub(200)..(k + 300).min(got.len())], &want[k.saturating_sub(200)..(k + 300).min(want.len())]);
+                }
+                prop_assert!(calls >= (s.len() / chunk) as u64);
+            }
         }
 
         #[test]
