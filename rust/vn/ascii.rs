@@ -338,58 +338,81 @@ pub fn parse_f64(s: &[u8]) -> Option<f64> {
 /// Largest mantissa for which `mant / 10^frac` is one correctly rounded division.
 const EXACT_MANT: u64 = 1 << 53;
 
-/// A plain decimal number at `b[*j..]` (`[+-]digits[.digits]`, the grammar of
-/// [`parse_f64`]'s fast path), XOR-ing every byte into `x`; on success `*j` is
-/// the first byte after it. `None` whenever [`parse_f64`] would not take its fast
-/// path, so the value is bit-identical to [`parse_f64`] and to Python's `float()`.
+/// Eight bytes at `b[k..]`, little-endian (first byte lowest).
 #[inline(always)]
-fn fast_number(b: &[u8], j: &mut usize, x: &mut u8) -> Option<f64> {
-    let mut k = *j;
-    let mut c = *b.get(k)?;
+fn load8(b: &[u8], k: usize) -> Option<u64> {
+    let s: [u8; 8] = b.get(k..k + 8)?.try_into().ok()?;
+    Some(u64::from_le_bytes(s))
+}
+
+/// Digit values of the bytes of `w` (byte − `'0'`) and how many of its first
+/// bytes are decimal digits (0..=8), without a branch per byte.
+#[inline(always)]
+fn digit_run(w: u64) -> (u64, usize) {
+    // x is 0..=9 in exactly the bytes that are '0'..='9'. A byte of x above 9
+    // sets its high bit in x + 0x76 or in x; a carry out of such a byte only
+    // disturbs later bytes, and only the first non-digit is wanted.
+    let x = w ^ 0x3030_3030_3030_3030;
+    let nondigit = (x.wrapping_add(0x7676_7676_7676_7676) | x) & 0x8080_8080_8080_8080;
+    (x, (nondigit.trailing_zeros() / 8) as usize)
+}
+
+/// The value of the first `n` (1..=7) digit values of `x`, first most
+/// significant: shifted to the top as if led by zeros, then combined pairwise
+/// by multiplications (the eight-digit method of Lemire's fast_float).
+#[inline(always)]
+fn digits_value(x: u64, n: usize) -> u64 {
+    if n == 0 {
+        return 0;
+    }
+    let v = x << (8 * (8 - n));
+    let v = v.wrapping_mul(10).wrapping_add(v >> 8);
+    const MASK: u64 = 0x0000_00FF_0000_00FF;
+    let v1 = (v & MASK).wrapping_mul(100 + (1_000_000 << 32));
+    let v2 = ((v >> 16) & MASK).wrapping_mul(1 + (10_000 << 32));
+    (v1.wrapping_add(v2) >> 32) as u32 as u64
+}
+
+const POW10_U64: [u64; 8] = [1, 10, 100, 1_000, 10_000, 100_000, 1_000_000, 10_000_000];
+
+/// A plain decimal number at `b[*j..]`: `[+-]`, at most 7 digits, optionally
+/// `.` and at most 7 digits, at least one digit in all; on success `*j` is the
+/// first byte after it. At most 14 digits make a mantissa below 2^53, so the
+/// value is one correctly rounded division, bit-identical to [`parse_f64`]
+/// (whose fast path takes this grammar) and to Python's `float()`. `None`
+/// for anything else, and near the end of `b` (8-byte loads).
+#[inline(always)]
+fn fast_number(b: &[u8], j: &mut usize) -> Option<f64> {
+    // Signs are random in sensor data: no branch on them (a mispredicted
+    // branch per field cost more than the rest of the field).
+    let c = *b.get(*j)?;
     let neg = c == b'-';
-    if neg || c == b'+' {
-        *x ^= c;
-        k += 1;
-        c = *b.get(k)?;
-    }
-    let mut mant: u64 = 0;
-    let mut digits = 0usize;
-    loop {
-        let d = c.wrapping_sub(b'0');
-        if d > 9 {
-            break;
-        }
-        mant = mant.wrapping_mul(10).wrapping_add(d as u64);
-        *x ^= c;
-        digits += 1;
-        k += 1;
-        c = *b.get(k)?;
-    }
-    let mut frac = 0usize;
-    if c == b'.' {
-        *x ^= c;
-        k += 1;
-        c = *b.get(k)?;
-        loop {
-            let d = c.wrapping_sub(b'0');
-            if d > 9 {
-                break;
-            }
-            mant = mant.wrapping_mul(10).wrapping_add(d as u64);
-            *x ^= c;
-            frac += 1;
-            k += 1;
-            c = *b.get(k)?;
-        }
-    }
-    let total = digits + frac;
-    // More than 19 digits may have wrapped `mant`: leave those to the slow path.
-    if total == 0 || total > 19 || mant > EXACT_MANT || frac >= POW10.len() {
+    let mut k = *j + (neg | (c == b'+')) as usize;
+    let (x, whole) = digit_run(load8(b, k)?);
+    if whole == 8 {
         return None;
     }
+    let mut mant = digits_value(x, whole);
+    k += whole;
+    let mut frac = 0usize;
+    // `whole < 8`, so b[k] was loaded above and exists.
+    if b.get(k) == Some(&b'.') {
+        k += 1;
+        let (y, n) = digit_run(load8(b, k)?);
+        if n == 8 {
+            return None;
+        }
+        mant = mant * POW10_U64[n] + digits_value(y, n);
+        frac = n;
+        k += n;
+    }
+    if whole + frac == 0 {
+        return None;
+    }
+    debug_assert!(mant <= EXACT_MANT && frac < POW10.len());
     *j = k;
     let v = mant as f64 / POW10[frac];
-    Some(if neg { -v } else { v })
+    Some(f64::from_bits(v.to_bits() | (neg as u64) << 63))
 }
 
 /// Fast path for the common sentence: `$VN` + the id of a data message of
@@ -418,19 +441,15 @@ pub fn fast_sentence(
     };
     // The general decoder's header rule (three upper-case letters) holds for
     // every id of MESSAGES, so a match above implies it.
-    let mut x = id.iter().fold(b',', |a, &c| a ^ c);
     let mut values = [0.0f64; MAX_FIELDS];
     let n = spec.fields.len();
     let mut j = 7usize;
     for (k, v) in values.iter_mut().enumerate().take(n) {
-        *v = fast_number(b, &mut j, &mut x)?;
+        *v = fast_number(b, &mut j)?;
         let sep = *b.get(j)?;
         let want = if k + 1 == n { b'*' } else { b',' };
         if sep != want {
             return None;
-        }
-        if sep == b',' {
-            x ^= sep;
         }
         j += 1;
     }
@@ -444,6 +463,7 @@ pub fn fast_sentence(
     let field = b.get(star + 1..star + 5)?;
     let hex = |c: u8| crate::vn::checksum::parse_hex(&[c]);
     let check = (hex(field[0])? << 4) | hex(field[1])?;
+    let x = crate::vn::checksum::xor8(&b[1..star]);
     if field[2].is_ascii_hexdigit() || field[2] == b'X' || check != x as u16 {
         return None;
     }
@@ -696,6 +716,52 @@ mod tests {
         }
         let ok = b"$VNYPR,+010.071,+000.278,-002.026*60\r\n";
         assert!(fast_sentence(ok, None).is_some());
+    }
+
+    #[test]
+    fn fast_number_matches_parse_f64() {
+        let mut seed = 0x9E37_79B9_7F4A_7C15u64;
+        let mut digit = || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            b'0' + ((seed >> 33) % 10) as u8
+        };
+        let mut taken = 0;
+        for sign in ["", "+", "-"] {
+            for whole in 0..=9usize {
+                for frac in 0..=9usize {
+                    for dot in [false, true] {
+                        for _ in 0..40 {
+                            let mut t = sign.as_bytes().to_vec();
+                            t.extend((0..whole).map(|_| digit()));
+                            if dot {
+                                t.push(b'.');
+                                t.extend((0..frac).map(|_| digit()));
+                            }
+                            let len = t.len();
+                            t.extend_from_slice(b",+1.0*00\r\n-----");
+                            let mut j = 0;
+                            match fast_number(&t, &mut j) {
+                                Some(v) => {
+                                    taken += 1;
+                                    assert_eq!(j, len);
+                                    let want = parse_f64(&t[..len]).unwrap();
+                                    assert_eq!(v.to_bits(), want.to_bits(), "{t:?}");
+                                }
+                                None => assert!(
+                                    whole >= 8
+                                        || (dot && frac >= 8)
+                                        || whole + frac * dot as usize == 0,
+                                    "{t:?}"
+                                ),
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        assert!(taken > 10_000);
     }
 
     #[test]

@@ -127,13 +127,13 @@ const HUGE_MIN_BYTES: usize = 4 << 20;
 /// most of the time spent writing a large fresh output table. Only advice: a
 /// kernel that refuses it changes nothing.
 #[cfg(target_os = "linux")]
-pub(crate) fn advise_huge_pages(v: &Vec<f64>) {
+pub(crate) fn advise_huge_pages<T>(v: &Vec<T>) {
     extern "C" {
         fn madvise(addr: *mut core::ffi::c_void, len: usize, advice: core::ffi::c_int) -> i32;
     }
     const MADV_HUGEPAGE: core::ffi::c_int = 14;
     const PAGE: usize = 4096;
-    let bytes = v.capacity() * std::mem::size_of::<f64>();
+    let bytes = v.capacity() * std::mem::size_of::<T>();
     if bytes < HUGE_MIN_BYTES {
         return;
     }
@@ -152,7 +152,7 @@ pub(crate) fn advise_huge_pages(v: &Vec<f64>) {
 }
 
 #[cfg(not(target_os = "linux"))]
-pub(crate) fn advise_huge_pages(_v: &Vec<f64>) {}
+pub(crate) fn advise_huge_pages<T>(_v: &Vec<T>) {}
 
 impl Table {
     pub fn new(names: Vec<String>) -> Table {

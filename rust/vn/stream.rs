@@ -955,9 +955,11 @@ pub fn parse_reader_with<R: Read + Send>(
 ) -> CoreResult<VnData> {
     let chunk = chunk.max(1);
     let mut cur: Vec<u8> = Vec::with_capacity(GAP + chunk);
-    cur.resize(GAP, 0);
     let mut next: Vec<u8> = Vec::with_capacity(GAP + chunk);
-    next.resize(GAP, 0);
+    for b in [&mut cur, &mut next] {
+        crate::vn::advise_huge_pages(b);
+        b.resize(GAP, 0);
+    }
     let (mut got, mut eof) = fill(&mut reader, &mut cur, chunk)?;
     let mut from = GAP;
     let mut done: u64 = 0;
