@@ -230,6 +230,49 @@ impl Table {
         }
     }
 
+    /// Append the rows of `parts`, in order, copying them on all cores: the
+    /// pages of a fresh destination are then also first touched (and zeroed by
+    /// the kernel) on all cores, which is most of the cost of a large table.
+    /// If the table must grow, it makes room for `rows_hint` more rows (at
+    /// least the rows appended).
+    pub(crate) fn append_all(&mut self, mut parts: Vec<Table>, rows_hint: usize) {
+        use rayon::prelude::*;
+        let add: usize = parts.iter().map(|p| p.values.len()).sum();
+        if self.values.capacity() - self.values.len() < add {
+            let rows: usize = parts.iter().map(|p| p.len).sum();
+            self.reserve(rows_hint.max(rows));
+        }
+        let old = self.values.len();
+        if let Some(spare) = self.values.spare_capacity_mut().get_mut(..add) {
+            let mut rest = spare;
+            let mut slots = Vec::with_capacity(parts.len());
+            for p in &parts {
+                let (a, b) = rest.split_at_mut(p.values.len());
+                slots.push(a);
+                rest = b;
+            }
+            slots
+                .into_par_iter()
+                .zip(parts.par_iter())
+                .for_each(|(dst, p)| {
+                    for (d, s) in dst.iter_mut().zip(&p.values) {
+                        d.write(*s);
+                    }
+                });
+            // SAFETY: the slots partition exactly the `add` elements after
+            // `old`, and each was filled from a part of its own length above.
+            unsafe { self.values.set_len(old + add) };
+            for p in &mut parts {
+                p.values = Vec::new();
+            }
+        }
+        // Extra columns and the row count (and the values, had the room above
+        // been missing) part by part.
+        for p in parts {
+            self.append(p);
+        }
+    }
+
     fn append(&mut self, mut other: Table) {
         if self.values.capacity() - self.values.len() < other.values.len() {
             self.reserve(other.len.max(self.len));

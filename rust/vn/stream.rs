@@ -207,6 +207,33 @@ fn bump(map: &mut std::collections::BTreeMap<String, u64>, key: &str) {
     }
 }
 
+/// Tables of several pieces by message name, to append in one parallel copy.
+#[derive(Default)]
+struct TableParts(Vec<(String, Vec<Table>)>);
+
+impl TableParts {
+    /// Move the tables out of a piece's result.
+    fn take_from(&mut self, data: &mut VnData) {
+        for (name, t) in std::mem::take(&mut data.tables) {
+            match self.0.iter_mut().find(|(n, _)| *n == name) {
+                Some((_, v)) => v.push(t),
+                None => self.0.push((name, vec![t])),
+            }
+        }
+    }
+
+    /// Append them, in piece order, to the tables of `data`, reserving
+    /// `scale` rows per row appended when a table has to grow.
+    fn flush(&mut self, data: &mut VnData, scale: f64) {
+        for (name, parts) in self.0.drain(..) {
+            let rows: usize = parts.iter().map(|t| t.len).sum();
+            let names = parts.first().map(|t| t.names.clone()).unwrap_or_default();
+            let mine = data.tables.entry(name).or_insert_with(|| Table::new(names));
+            mine.append_all(parts, (rows as f64 * scale) as usize);
+        }
+    }
+}
+
 /// Offset of the first packet at or after `from` (within `window` bytes) whose
 /// header frames a fixed-size packet with a good CRC inside `buf`.
 fn good_packet_at_or_after(buf: &[u8], from: usize, window: usize) -> Option<usize> {
@@ -678,6 +705,7 @@ impl Parser {
             .collect();
         // Lines before the block (kept current by `feed`).
         let mut line_shift = self.lines;
+        let mut parts = TableParts::default();
         for ((a, b), (mut data, fail, nl, skip_end)) in inner.iter().zip(results) {
             let shift_offset = self.base + *a as u64;
             let skipped = &mut data.issues.first[IssueKind::BytesSkipped as usize];
@@ -696,26 +724,23 @@ impl Parser {
                     l.offset += shift_offset;
                 }
             }
-            let first_merge = self.data.tables.is_empty();
+            parts.take_from(&mut data);
             self.data.merge(data, line_shift);
-            if first_merge && self.size_hint > 0 {
-                // Extrapolate rows from the first piece and reserve once.
-                let done = (self.base + *b as u64).max(1) as f64;
-                let scale = self.size_hint as f64 / done;
-                for t in self.data.tables.values_mut() {
-                    t.reserve(((t.len as f64) * scale * 1.01) as usize);
-                }
-            }
             if let Some((kind, loc, reason)) = fail {
                 let loc = Location {
                     offset: loc.offset + shift_offset,
                     line: loc.line + line_shift,
                 };
                 self.fail = Some((kind, loc, reason));
+                let scale = self.rows_scale(self.base, *b, buf.len());
+                parts.flush(&mut self.data, scale);
                 return buf.len();
             }
             line_shift += nl;
         }
+        // The tables of all pieces, appended in one parallel copy.
+        let scale = self.rows_scale(self.base, last, buf.len());
+        parts.flush(&mut self.data, scale);
         // Continue sequentially from `last`.
         self.lines = line_shift;
         self.line_pos = self.base + last as u64;
@@ -775,77 +800,106 @@ impl Parser {
                 (p, used)
             })
             .collect();
-        let mut consumed = 0usize;
+        // The clean pieces from the start, as long as their configurations fit
+        // the layout table the sequential parser would keep.
+        let mut known: Vec<Vec<u8>> = self
+            .layouts
+            .iter()
+            .map(|(l, _, _)| l.header.clone())
+            .collect();
+        let mut clean = Vec::new();
+        let mut resume = None;
         for (k, (p, used)) in results.into_iter().enumerate() {
             let (a, b) = bounds[k];
-            let whole = k == last || used == b - a;
-            let clean = whole
+            let ok = (k == last || used == b - a)
                 && p.fail.is_none()
                 && p.pending.is_empty()
                 && p.data.issues.counts.iter().all(|&c| c == 0);
-            if !clean || !self.adopt_layouts(&p) {
+            let mut fits = ok;
+            if ok {
+                for (l, _, _) in &p.layouts {
+                    if !known.contains(&l.header) {
+                        known.push(l.header.clone());
+                    }
+                }
+                fits = known.len() <= MAX_LAYOUTS;
+            }
+            if !fits {
                 // Sequential from here: this piece starts where the clean ones
                 // before it ended, with the state they left.
-                return a + self.feed(&buf[a..], fin);
+                resume = Some(a);
+                break;
             }
-            self.absorb(p, used, buf.len() - a);
+            clean.push((p, used));
+        }
+        let consumed = self.absorb(clean, buf.len());
+        match resume {
+            Some(a) => a + self.feed(&buf[a..], fin),
             // The last piece may leave a record cut by the block end for the
             // next block.
-            consumed = a + used;
+            None => consumed,
         }
+    }
+
+    /// Merge clean pieces of a block, in order (see [`Parser::feed_block`]);
+    /// their tables are appended on all cores. Returns the bytes they consumed.
+    fn absorb(&mut self, pieces: Vec<(Parser, usize)>, block: usize) -> usize {
+        let start = self.base;
+        let mut binary_parts: Vec<(usize, Vec<Table>)> = Vec::new();
+        let mut ascii_parts = TableParts::default();
+        let mut consumed = 0usize;
+        for (mut p, used) in pieces {
+            for (k_piece, (layout, name, table)) in p.layouts.drain(..).enumerate() {
+                let k = match self
+                    .layouts
+                    .iter()
+                    .position(|(l, _, _)| l.header == layout.header)
+                {
+                    Some(k) => k,
+                    None => {
+                        self.layouts.push((layout, name, Table::default()));
+                        self.layouts.len() - 1
+                    }
+                };
+                if p.good_layouts.contains(&k_piece) && !self.good_layouts.contains(&k) {
+                    self.good_layouts.push(k);
+                }
+                if table.names.is_empty() {
+                    continue;
+                }
+                match binary_parts.iter_mut().find(|(j, _)| *j == k) {
+                    Some((_, parts)) => parts.push(table),
+                    None => binary_parts.push((k, vec![table])),
+                }
+            }
+            ascii_parts.take_from(&mut p.data);
+            let lines = p.lines;
+            self.merged_pieces += 1;
+            self.data.merge(std::mem::take(&mut p.data), 0);
+            self.lines += lines;
+            self.base += used as u64;
+            self.line_pos = self.base;
+            consumed += used;
+        }
+        let scale = self.rows_scale(start, consumed, block);
+        for (k, parts) in binary_parts {
+            let mine = &mut self.layouts[k].2;
+            if mine.names.is_empty() {
+                *mine = Table::new(parts[0].names.clone());
+            }
+            let rows: usize = parts.iter().map(|t| t.len).sum();
+            mine.append_all(parts, (rows as f64 * scale) as usize);
+        }
+        ascii_parts.flush(&mut self.data, scale);
         consumed
     }
 
-    /// Whether the configurations of a clean piece fit in the layout table as
-    /// the sequential parser would have kept them (no eviction needed).
-    fn adopt_layouts(&self, p: &Parser) -> bool {
-        let new = p
-            .layouts
-            .iter()
-            .filter(|(l, _, _)| !self.layouts.iter().any(|(m, _, _)| m.header == l.header))
-            .count();
-        self.layouts.len() + new <= MAX_LAYOUTS
-    }
-
-    /// Merge a clean piece that ends `used` bytes further on; `left` is the
-    /// number of bytes from the piece start to the end of the block (for
-    /// reserving table rows once).
-    fn absorb(&mut self, mut p: Parser, used: usize, left: usize) {
-        let remaining = self.size_hint.saturating_sub(self.base).max(left as u64);
-        for (k_piece, (layout, name, table)) in p.layouts.drain(..).enumerate() {
-            let k = match self
-                .layouts
-                .iter()
-                .position(|(l, _, _)| l.header == layout.header)
-            {
-                Some(k) => k,
-                None => {
-                    self.layouts.push((layout, name, Table::default()));
-                    self.layouts.len() - 1
-                }
-            };
-            if p.good_layouts.contains(&k_piece) && !self.good_layouts.contains(&k) {
-                self.good_layouts.push(k);
-            }
-            let mine = &mut self.layouts[k].2;
-            if mine.names.is_empty() {
-                // First rows of this configuration: reserve for the rest of the
-                // stream at this piece's density, then copy once.
-                let mut t = Table::new(table.names.clone());
-                let scale = remaining as f64 / used.max(1) as f64;
-                t.reserve(((table.len as f64) * scale * 1.01) as usize + table.len);
-                t.append(table);
-                *mine = t;
-            } else if !table.names.is_empty() {
-                mine.append(table);
-            }
-        }
-        let lines = p.lines;
-        self.merged_pieces += 1;
-        self.data.merge(std::mem::take(&mut p.data), 0);
-        self.lines += lines;
-        self.base += used as u64;
-        self.line_pos = self.base;
+    /// Rows to reserve per row decoded, when `done` bytes from absolute offset
+    /// `start` gave them: the rest of the stream (by the size hint) at the same
+    /// density, with 1 % slack.
+    fn rows_scale(&self, start: u64, done: usize, block: usize) -> f64 {
+        let left = self.size_hint.saturating_sub(start).max(block as u64) as f64;
+        left / done.max(1) as f64 * 1.01
     }
 
     /// Finish: pad tables and turn a strict-mode failure into an error.
