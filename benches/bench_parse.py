@@ -30,13 +30,15 @@ import numpy as np
 import pandas as pd
 
 
-def median_time(fn, repeats: int) -> float:
-    times = []
+def median_time(fn, repeats: int) -> tuple[float, float]:
+    """Median wall-clock and median CPU seconds (all threads of this process)."""
+    times, cpu = [], []
     for _ in range(repeats):
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         fn()
         times.append(time.perf_counter() - t0)
-    return statistics.median(times)
+        cpu.append(time.process_time() - c0)
+    return statistics.median(times), statistics.median(cpu)
 
 
 def still_log(n: int, fs: float, seed: int = 0) -> imunoise.ImuLog:
@@ -100,19 +102,22 @@ def main() -> None:
         assert len(log) == n and log.issues.total == 0
         ref = pandas_parser(path)
         np.testing.assert_allclose(ref[:, 9:12], log.gyro, rtol=1e-15, atol=0)
+        print(f"load average before: {os.getloadavg()[0]:.2f}")
         t_imu = median_time(lambda: imunoise.read(path, fs=40), repeats)
-        t_pd = median_time(lambda: pandas_parser(path), max(1, repeats - 2))
+        t_pd = median_time(lambda: pandas_parser(path), repeats)
         t_pd_plain = median_time(lambda: pandas_plain(path), max(1, repeats - 2))
         t_py = median_time(lambda: python_parser(path), 1)
-        print("| reader | checksums | median s | MB/s | imunoise speed-up |")
-        print("|---|---|---:|---:|---:|")
-        for name, chk, t in (
+        print(f"load average after: {os.getloadavg()[0]:.2f}\n")
+        print("| reader | checksums | median s | MB/s | CPU s | imunoise speed-up |")
+        print("|---|---|---:|---:|---:|---:|")
+        for name, chk, (t, c) in (
             ("imunoise.read", "all verified", t_imu),
             ('pandas.read_csv(comment="*")', "none", t_pd),
             ("pandas.read_csv + split '*'", "none", t_pd_plain),
             ("plain Python", "all verified", t_py),
         ):
-            print(f"| {name} | {chk} | {t:.3f} | {size / 1e6 / t:.0f} | {t / t_imu:.1f}x |")
+            ratio = t / t_imu[0]
+            print(f"| {name} | {chk} | {t:.3f} | {size / 1e6 / t:.0f} | {c:.3f} | {ratio:.1f}x |")
 
         m = int(minutes_bin * 60 * 800)
         bpath = tmp / "capture.bin"
@@ -121,13 +126,15 @@ def main() -> None:
         blog = imunoise.read(bpath)
         assert len(blog) == m and blog.issues.total == 0
         data = bpath.read_bytes()
+        print(f"\nBinary: {m} packets of {bsize // m} bytes, {bsize / 1e6:.1f} MB")
+        print(f"load average before: {os.getloadavg()[0]:.2f}")
         t_file = median_time(lambda: imunoise.read(bpath), repeats)
         t_mem = median_time(lambda: imunoise.read(data, fs=800), repeats)
-        print(f"\nBinary: {m} packets of {bsize // m} bytes, {bsize / 1e6:.1f} MB\n")
-        print("| source | median s | GB/s |")
-        print("|---|---:|---:|")
-        print(f"| file | {t_file:.3f} | {bsize / 1e9 / t_file:.2f} |")
-        print(f"| bytes in memory | {t_mem:.3f} | {bsize / 1e9 / t_mem:.2f} |")
+        print(f"load average after: {os.getloadavg()[0]:.2f}\n")
+        print("| source | median s | GB/s | CPU s |")
+        print("|---|---:|---:|---:|")
+        for name, (t, c) in (("file", t_file), ("bytes in memory", t_mem)):
+            print(f"| {name} | {t:.3f} | {bsize / 1e9 / t:.2f} | {c:.3f} |")
 
 
 if __name__ == "__main__":

@@ -62,7 +62,9 @@ class VnTables:
     tables : Mapping[str, Mapping[str, np.ndarray]]
         Per message type (``"VNYMR"``, ``"VNERR"``, ``"binary_143e003a00"`` ...)
         the float64 columns by field name; binary column names are qualified by
-        group (``"common.yaw"``, ``"imu.uncomp_gyro_x"``).
+        group (``"common.yaw"``, ``"imu.uncomp_gyro_x"``). The columns of one
+        type are strided views of one row-major (records, fields) array, so the
+        channels built from them are views too (no copy).
     messages : Mapping[str, int]
         Records per message type, including command responses (``"VNRRG"``).
     issues : ParseIssues
