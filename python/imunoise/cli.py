@@ -16,7 +16,7 @@ import numpy as np
 __all__ = ["main"]
 
 SENSORS = ("gyro", "accel", "mag")
-KINDS = ("adev", "mdev", "hdev", "tdev", "totdev")
+KINDS = ("adev", "mdev", "hdev", "tdev", "totdev", "theobr", "theoh")
 _AXES = ("X", "Y", "Z")
 
 class _Parser(argparse.ArgumentParser):
