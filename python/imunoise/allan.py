@@ -386,6 +386,8 @@ def theobr(x, fs, taus="octave", *, confidence: float = ONE_SIGMA):
     _check_theo_length("theobr", n)
     m, user_given = _theo1_factors(taus, fs, n)
     m = _keep_theobr(m, n, fs, user_given, "theobr", lower=0.0)
+    if m.size == 0:
+        raise ValueError(f"none of the taus is in range for theobr; got {taus!r}")
     _warn_theobr_cost("theobr", n, m, data.shape[1])
     var, terms, alpha, identified, edf = _core.analyse(data, "theobr", m.astype(np.uint64))
     return _assemble(

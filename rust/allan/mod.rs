@@ -201,6 +201,7 @@ pub fn analyse_plan(phases: &[Vec<f64>], plan: &[(Statistic, usize)]) -> CoreRes
                 EdfModel::Total => edf::totvar_edf(alpha[i], m, n_samples),
                 EdfModel::ModifiedTotal => edf::mtotvar_edf(alpha[i], m, n_samples),
                 EdfModel::Theo1 => edf::theo1_edf(alpha[i], m, n_phase),
+                EdfModel::TheoBR => theo::theobr_edf(alpha[i], m, n_phase),
             }
         })
         .collect();
@@ -225,6 +226,8 @@ enum EdfModel {
     ModifiedTotal,
     /// SP 1065 Theo1 formulas (Howe & Tasset).
     Theo1,
+    /// Theo1's EDF combined with the scatter of ThêoBR's bias ratio.
+    TheoBR,
 }
 
 /// Maximum differencing for noise identification and the EDF model.
@@ -265,9 +268,8 @@ fn noise_model_of(statistic: Statistic) -> (u32, EdfModel) {
         // SP 1065 gives no EDF formula for HTOT; the overlapping Hadamard EDF is a
         // lower bound (HTOT is OHVAR with extra, reflected terms) and exact at m = 1.
         Statistic::HadamardTotal => (3, EdfModel::Greenhall(ohvar)),
-        // ThêoBR is Theo1 times a constant: Theo1's EDF (as Stable32 and Howe's
-        // papers use it); the bias ratio's own scatter is not included.
-        Statistic::Theo1 | Statistic::TheoBR => (2, EdfModel::Theo1),
+        Statistic::Theo1 => (2, EdfModel::Theo1),
+        Statistic::TheoBR => (2, EdfModel::TheoBR),
     }
 }
 
@@ -330,6 +332,25 @@ mod tests {
         let known = vec![true, true, true, false, false];
         fill_from_nearest(&mut alpha, &known, 0, 1, 5);
         assert_eq!(alpha, vec![-2, -2, -2, -2, -2]);
+    }
+
+    #[test]
+    fn a_plan_equals_its_statistics_run_alone() {
+        let y: Vec<f64> = (0..400).map(|k| ((k * 7919 + 13) % 101) as f64).collect();
+        let z: Vec<f64> = y.iter().rev().map(|v| v * v).collect();
+        let phases = column_phases(vec![y.iter().copied(), z.iter().copied()]).unwrap();
+        let oadev = Statistic::Allan { overlapping: true };
+        let plan = [(oadev, 1), (oadev, 8), (Statistic::TheoBR, 16)];
+        let mixed = analyse_plan(&phases, &plan).unwrap();
+        let avar = analyse(&phases, oadev, &[1, 8]).unwrap();
+        let theobr = analyse(&phases, Statistic::TheoBR, &[16]).unwrap();
+        assert_eq!(mixed.var[..4], avar.var[..]);
+        assert_eq!(mixed.edf[..4], avar.edf[..]);
+        assert_eq!(mixed.var[4..], theobr.var[..]);
+        assert_eq!(mixed.terms, vec![399, 385, 385 * 8]);
+        // The slow single-tau path gives the same ThêoBR.
+        let alone = Statistic::TheoBR.estimate(&phases[1], 16).var;
+        assert!((alone - mixed.var[5]).abs() <= 1e-14 * alone);
     }
 
     #[test]
