@@ -106,7 +106,11 @@ def test_theobr_from_allantools_pieces(kind):
 # --- published Theo1 bias: what the ratio has to find -------------------------------------
 
 #: SP 1065 / Howe 2006: AVAR/Theo1 = a + b/m^c by noise type (white FM: 1).
-PUBLISHED_BIAS = {"white": (1.0, 0.0, 1.0), "flicker": (1.87, -1.05, 0.79), "walk": (2.70, -1.53, 0.85)}
+PUBLISHED_BIAS = {
+    "white": (1.0, 0.0, 1.0),
+    "flicker": (1.87, -1.05, 0.79),
+    "walk": (2.70, -1.53, 0.85),
+}
 
 
 @pytest.mark.parametrize("kind", ["white", "flicker", "walk"])
