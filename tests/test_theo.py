@@ -11,6 +11,9 @@ import imunoise
 import numpy as np
 import pytest
 from conftest import noise
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from hypothesis.extra import numpy as hnp
 from imunoise.cli import main
 
 # --- direct transcription of the definitions (plain loops, phase in samples) ------------
@@ -139,6 +142,29 @@ def test_scale_and_offset(fn):
     np.testing.assert_allclose(scaled.dev, 3.0 * base.dev, rtol=1e-9)
     np.testing.assert_array_equal(scaled.alpha, base.alpha)
     np.testing.assert_array_equal(scaled.taus, base.taus)
+
+
+@settings(max_examples=25, deadline=None)
+@given(
+    y=hnp.arrays(
+        np.float64,
+        st.integers(89, 260),
+        elements=st.floats(-1e6, 1e6, allow_nan=False, allow_infinity=False),
+    ),
+    scale=st.floats(1e-3, 1e3),
+    offset=st.floats(-1e3, 1e3),
+)
+def test_scale_and_offset_invariance_on_any_data(y, scale, offset):
+    if np.ptp(y) == 0:
+        return
+    for fn in (imunoise.theobr, imunoise.theoh):
+        base = fn(y, 10.0)
+        moved = fn(scale * y + offset, 10.0)
+        # Adding the offset rounds each sample to ~eps·|offset|: that much may be lost.
+        rounding = 1e-14 * (abs(offset) + scale * np.max(np.abs(y)))
+        np.testing.assert_allclose(
+            moved.dev, scale * base.dev, rtol=1e-7, atol=1e-9 * scale * np.ptp(y) + rounding
+        )
 
 
 def test_white_fm_theobr_agrees_with_the_allan_deviation():

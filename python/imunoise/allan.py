@@ -79,7 +79,8 @@ class AllanResult:
     taus : ndarray, (T,)
         Averaging times in seconds, ``m / fs``.
     m : ndarray of int, (T,)
-        Averaging factors.
+        Averaging factors (ThêoBR points of ``"theobr"``/``"theoh"``: Theo1's even m,
+        at ``taus = 0.75 * m / fs``).
     dev, var : ndarray
         The deviation and its square, in the input's units (TDEV: units × s).
     n : ndarray of int, (T,)
