@@ -5,6 +5,7 @@ pub mod blocked;
 pub mod edf;
 pub mod noise_id;
 pub mod phase;
+pub mod reflected;
 pub mod sum;
 pub mod total;
 pub mod variance;

@@ -27,6 +27,7 @@
 
 use rayon::prelude::*;
 
+use super::reflected::{reflected_sum, DIRECT_BELOW};
 use super::sum::Neumaier;
 
 /// Subsequences per parallel work item: large enough to amortise the scratch
@@ -130,7 +131,11 @@ pub fn mtot_var(c: &[f64], m: usize) -> f64 {
         }
         reflected_second_differences(zp, m, p)
     };
-    let total = sum_over_subsequences(terms, m, 15 * m, inner);
+    let total = if m < DIRECT_BELOW {
+        sum_over_subsequences(terms, m, 15 * m, inner)
+    } else {
+        reflected_sum(|k| c[k], n, m)
+    };
     let mf = m as f64;
     total / (12.0 * mf.powi(5) * terms as f64)
 }
@@ -155,7 +160,11 @@ pub fn htot_var(c: &[f64], m: usize) -> f64 {
         }
         reflected_second_differences(zp, m, p)
     };
-    let total = sum_over_subsequences(terms, m, 15 * m, inner);
+    let total = if m < DIRECT_BELOW {
+        sum_over_subsequences(terms, m, 15 * m, inner)
+    } else {
+        reflected_sum(|k| c[k + 1] - c[k], n, m)
+    };
     let mf = m as f64;
     total / (36.0 * mf.powi(3) * terms as f64)
 }
