@@ -6,7 +6,9 @@ pub mod edf;
 pub mod noise_id;
 pub mod phase;
 pub mod reflected;
+pub mod sliding;
 pub mod sum;
+pub mod theo1;
 pub mod total;
 pub mod variance;
 
