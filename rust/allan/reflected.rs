@@ -421,4 +421,26 @@ mod tests {
             }
         }
     }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig { cases: 200, ..Default::default() })]
+        #[test]
+        fn any_length_and_factor_matches_the_definition(
+            n in 3usize..260,
+            m_pick in 0.0f64..1.0,
+            seed in 0u64..1000,
+            order in 0usize..3,
+            offset in -1e4f64..1e4,
+        ) {
+            let m = 1 + (m_pick * (n / 3 - 1) as f64) as usize;
+            let mut v = noise(n, seed);
+            for _ in 0..order {
+                v = integrate(&v);
+            }
+            let shifted: Vec<f64> = v.iter().map(|x| x + offset).collect();
+            let v: Vec<f64> = shifted.iter().map(|x| x - offset).collect();
+            let (fast, slow) = (reflected_sum(|k| shifted[k], n, m), direct(&v, m));
+            proptest::prop_assert!((fast - slow).abs() <= 1e-10 * slow + 1e-300, "n {} m {}: {} vs {}", n, m, fast, slow);
+        }
+    }
 }

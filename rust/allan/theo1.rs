@@ -291,4 +291,27 @@ mod tests {
             }
         }
     }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig { cases: 200, ..Default::default() })]
+        #[test]
+        fn any_length_and_factor_matches_the_definition(
+            n in 3usize..700,
+            m_pick in 0.0f64..1.0,
+            seed in 0u64..1000,
+            order in 0usize..3,
+            offset in -1e4f64..1e4,
+        ) {
+            // Even m from 2 to n − 1.
+            let m = 2 * (1 + (m_pick * ((n - 1) / 2 - 1) as f64) as usize);
+            let mut c = noise(n, seed);
+            for _ in 0..order {
+                c = integrate(&c);
+            }
+            let shifted: Vec<f64> = c.iter().map(|x| x + offset).collect();
+            let c: Vec<f64> = shifted.iter().map(|x| x - offset).collect();
+            let (fast, slow) = (theo1_sum(&shifted, m), direct(&c, m));
+            proptest::prop_assert!((fast - slow).abs() <= 1e-10 * slow + 1e-300, "n {} m {}: {} vs {}", n, m, fast, slow);
+        }
+    }
 }
