@@ -31,7 +31,7 @@
 
 use rayon::prelude::*;
 
-use super::sum::Neumaier;
+use super::sum::{blocked_sum, Neumaier};
 
 /// Averaging factors below this use the direct O(n·m) sum (also cheaper there).
 pub const DIRECT_BELOW: usize = 16;
@@ -109,36 +109,27 @@ fn classes(m: usize) -> Vec<Class> {
 
 /// Σ_{e<m} e^d·F(p + e) for d = 0, 1, 2, from prefix moments of F.
 struct WindowMoments {
-    prefix: [Vec<f64>; 3],
+    prefix: Vec<[f64; 3]>,
 }
 
 impl WindowMoments {
     fn new(f: &[f64]) -> Self {
-        let mut prefix = [
-            Vec::with_capacity(f.len() + 1),
-            Vec::with_capacity(f.len() + 1),
-            Vec::with_capacity(f.len() + 1),
-        ];
+        let mut prefix = vec![[0.0f64; 3]; f.len() + 1];
         let mut acc = [0.0f64; 3];
-        for p in prefix.iter_mut() {
-            p.push(0.0);
-        }
-        for (t, &v) in f.iter().enumerate() {
+        for (t, (&v, slot)) in f.iter().zip(prefix[1..].iter_mut()).enumerate() {
             let tf = t as f64;
             acc[0] += v;
             acc[1] += tf * v;
             acc[2] += tf * tf * v;
-            for (p, &a) in prefix.iter_mut().zip(&acc) {
-                p.push(a);
-            }
+            *slot = acc;
         }
         Self { prefix }
     }
 
     #[inline]
     fn at(&self, p: usize, m: usize) -> [f64; 3] {
-        let d = |k: usize| self.prefix[k][p + m] - self.prefix[k][p];
-        let (m0, m1, m2) = (d(0), d(1), d(2));
+        let (hi, lo) = (self.prefix[p + m], self.prefix[p]);
+        let (m0, m1, m2) = (hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
         let pf = p as f64;
         [m0, m1 - pf * m0, m2 - 2.0 * pf * m1 + pf * pf * m0]
     }
@@ -173,14 +164,14 @@ fn class_sum(
 
     let (m_i, b_i) = (m as isize, b as isize);
     let count = |lo: isize, hi: isize| (hi - lo + 1).max(0) as f64;
-    let mut squares = Neumaier::new();
     // Σ F₊(u)²·#{j' : i0 ≤ u − j' < i0 + b} and the same for F₋.
-    for (a, (&fp, &fm)) in f_plus.iter().zip(&f_minus).enumerate() {
+    let squares = blocked_sum(len, |a| {
+        let (fp, fm) = (f_plus[a], f_minus[a]);
         let a = a as isize;
         let plus = count((a - b_i + 1).max(0), (m_i - 1).min(a));
         let minus = count((m_i - 1 - a).max(0), (m_i - 1).min(b_i + m_i - 2 - a));
-        squares.add(fp * fp * plus + fm * fm * minus);
-    }
+        fp * fp * plus + fm * fm * minus
+    });
 
     // Σ F₊(u)·F₋(v) over u = i + j', v = i − j': for each u, v runs over one
     // parity between max(u − 2m + 2, 2i0 − u) and min(u, 2(i0 + b − 1) − u);
@@ -189,22 +180,23 @@ fn class_sum(
     for (k, &fm) in f_minus.iter().enumerate() {
         stride2[k + 2] = stride2[k] + fm;
     }
-    let mut cross = Neumaier::new();
-    for (a, &fp) in f_plus.iter().enumerate() {
+    let cross = blocked_sum(len, |a| {
+        let fp = f_plus[a];
         let a = a as isize;
         let lo = (a - m_i + 1).max(m_i - 1 - a);
         let hi = (a + m_i - 1).min(2 * b_i + m_i - 3 - a);
         if hi >= lo {
-            cross.add(fp * (stride2[hi as usize + 2] - stride2[lo as usize]));
+            fp * (stride2[hi as usize + 2] - stride2[lo as usize])
+        } else {
+            0.0
         }
-    }
+    });
 
     // 2·Σ_i Σ_d G_d(i)·Σ_j' j'^d (F₊(i + j') + F₋(i − j')) and Σ_i (Σ_d G_d j'^d)².
     let plus_moments = WindowMoments::new(&f_plus);
     let minus_moments = WindowMoments::new(&f_minus);
     let mf = m as f64 - 1.0;
-    let mut mixed = Neumaier::new();
-    for i in 0..b {
+    let mixed = blocked_sum(b, |i| {
         let slope = starts.slope[i];
         let g = [
             class.z_end * starts.z_end[i]
@@ -228,9 +220,9 @@ fn class_sum(
                 term += g[d] * g[e] * power_sums[d + e];
             }
         }
-        mixed.add(term);
-    }
-    squares.value() + 2.0 * cross.value() + mixed.value()
+        term
+    });
+    squares + 2.0 * cross + mixed
 }
 
 /// Mean and least-squares slope of f(t), t < count (slope about t = (count − 1)/2).
