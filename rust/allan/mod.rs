@@ -8,6 +8,8 @@ pub mod phase;
 pub mod reflected;
 pub mod sliding;
 pub mod sum;
+#[cfg(test)]
+mod test_signals;
 pub mod theo1;
 pub mod total;
 pub mod variance;

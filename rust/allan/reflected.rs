@@ -31,6 +31,7 @@
 
 use rayon::prelude::*;
 
+use super::phase::least_squares_line;
 use super::sum::{blocked_sum, Neumaier};
 
 /// Averaging factors below this use the direct O(n·m) sum (also cheaper there).
@@ -225,28 +226,6 @@ fn class_sum(
     squares + 2.0 * cross + mixed
 }
 
-/// Mean and least-squares slope of f(t), t < count (slope about t = (count − 1)/2).
-fn least_squares_line(f: impl Fn(usize) -> f64, count: usize) -> (f64, f64) {
-    let mut sum = Neumaier::new();
-    for t in 0..count {
-        sum.add(f(t));
-    }
-    let mean = sum.value() / count as f64;
-    let centre = (count as f64 - 1.0) / 2.0;
-    let (mut cov, mut var) = (Neumaier::new(), Neumaier::new());
-    for t in 0..count {
-        let dt = t as f64 - centre;
-        cov.add(dt * (f(t) - mean));
-        var.add(dt * dt);
-    }
-    let slope = if var.value() > 0.0 {
-        cov.value() / var.value()
-    } else {
-        0.0
-    };
-    (mean, slope)
-}
-
 /// Σ_i Σ_{j<6m} D_j(i)² over the `len − 3m + 1` subsequences of `values(k)`,
 /// k < len. Needs m ≥ 1 and 3m ≤ len.
 pub fn reflected_sum<V>(values: V, len: usize, m: usize) -> f64
@@ -323,6 +302,7 @@ where
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::allan::test_signals::{integrate, noise};
 
     /// The definition, transcribed: detrend, reflect, sum D².
     fn direct(v: &[f64], m: usize) -> f64 {
@@ -350,28 +330,6 @@ mod tests {
             }
         }
         total
-    }
-
-    fn noise(n: usize, seed: u64) -> Vec<f64> {
-        let mut state = seed;
-        (0..n)
-            .map(|_| {
-                state = state
-                    .wrapping_mul(6364136223846793005)
-                    .wrapping_add(1442695040888963407);
-                ((state >> 11) as f64 / (1u64 << 53) as f64) - 0.5
-            })
-            .collect()
-    }
-
-    fn integrate(v: &[f64]) -> Vec<f64> {
-        let mut run = 0.0;
-        v.iter()
-            .map(|x| {
-                run += x;
-                run
-            })
-            .collect()
     }
 
     #[test]

@@ -21,6 +21,7 @@
 
 use rayon::prelude::*;
 
+use super::phase::least_squares_line;
 use super::sliding::sliding_dot;
 use super::sum::Neumaier;
 
@@ -207,25 +208,9 @@ pub fn theo1_sum(c: &[f64], m: usize) -> f64 {
 
 /// c minus its least-squares line (about the middle of the span).
 fn local_phase(c: &[f64]) -> Vec<f64> {
-    let n = c.len();
     let c0 = c[0];
-    let mut sum = Neumaier::new();
-    for v in c {
-        sum.add(v - c0);
-    }
-    let mean = sum.value() / n as f64;
-    let centre = (n as f64 - 1.0) / 2.0;
-    let (mut cov, mut var) = (Neumaier::new(), Neumaier::new());
-    for (t, v) in c.iter().enumerate() {
-        let dt = t as f64 - centre;
-        cov.add(dt * (v - c0 - mean));
-        var.add(dt * dt);
-    }
-    let slope = if var.value() > 0.0 {
-        cov.value() / var.value()
-    } else {
-        0.0
-    };
+    let (mean, slope) = least_squares_line(|t| c[t] - c0, c.len());
+    let centre = (c.len() as f64 - 1.0) / 2.0;
     c.iter()
         .enumerate()
         .map(|(t, v)| (v - c0 - mean) - slope * (t as f64 - centre))
@@ -235,6 +220,7 @@ fn local_phase(c: &[f64]) -> Vec<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::allan::test_signals::{integrate, noise};
 
     fn direct(c: &[f64], m: usize) -> f64 {
         let h = m / 2;
@@ -246,28 +232,6 @@ mod tests {
             }
         }
         s
-    }
-
-    fn noise(n: usize, seed: u64) -> Vec<f64> {
-        let mut state = seed;
-        (0..n)
-            .map(|_| {
-                state = state
-                    .wrapping_mul(6364136223846793005)
-                    .wrapping_add(1442695040888963407);
-                ((state >> 11) as f64 / (1u64 << 53) as f64) - 0.5
-            })
-            .collect()
-    }
-
-    fn integrate(v: &[f64]) -> Vec<f64> {
-        let mut run = 0.0;
-        v.iter()
-            .map(|x| {
-                run += x;
-                run
-            })
-            .collect()
     }
 
     #[test]
