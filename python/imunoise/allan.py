@@ -521,7 +521,6 @@ def _deviation(
             f"x has {n} samples, too few for any tau of {kind} "
             f"(the shortest tau needs at least {_minimum_samples(statistic)})"
         )
-    _warn_if_quadratic_cost(statistic, n, m, data.shape[1])
     var, terms, alpha, identified, edf = _core.analyse(data, statistic, m.astype(np.uint64))
     tau = m / fs
     if bias_correction:
@@ -566,27 +565,6 @@ def chi2_interval(dev, edf, confidence):
         low = dev * np.sqrt(edf / _stats.chi2.ppf(1.0 - tail, edf))
         high = dev * np.sqrt(edf / _stats.chi2.ppf(tail, edf))
     return low, high
-
-
-#: Statistics whose exact evaluation costs O(n·m) per tau rather than O(n).
-_QUADRATIC_COST = ("mtotdev", "htotdev", "theo1")
-#: Roughly what this machine class does per second in those kernels (inner steps).
-_QUADRATIC_STEPS_PER_SECOND = 1e9
-
-
-def _warn_if_quadratic_cost(statistic: str, n: int, m: np.ndarray, channels: int) -> None:
-    """A long record at long taus makes the total family slow: say so up front."""
-    if statistic not in _QUADRATIC_COST:
-        return
-    steps = 9.0 * n * float(np.sum(m)) * channels
-    seconds = steps / _QUADRATIC_STEPS_PER_SECOND
-    if seconds > 60:
-        warnings.warn(
-            f"{statistic} costs O(n·m) per tau: {n} samples up to m = {int(m.max())} "
-            f"will take roughly {seconds / 60:.0f} minutes; pass taus= with shorter taus "
-            "(e.g. an array of seconds) to limit it",
-            stacklevel=4,
-        )
 
 
 #: Theo1 kernel inner steps per second, release build, 2 shared cores (1.3e9-1.8e9 measured).

@@ -5,8 +5,13 @@ pub mod blocked;
 pub mod edf;
 pub mod noise_id;
 pub mod phase;
+pub mod reflected;
+pub mod sliding;
 pub mod sum;
+#[cfg(test)]
+mod test_signals;
 pub mod theo;
+pub mod theo1;
 pub mod total;
 pub mod variance;
 
