@@ -3,10 +3,10 @@
     python benches/bench_theo.py [--sizes 10000 100000] [--peer-size 2000]
 
 Part 1: imunoise.theobr and imunoise.theoh (octave taus, white FM, one channel) at
-each size, with the number of Theo1 steps the bias ratio costs (≈ N³/900) and the
-steps per second that makes. Part 2 (``--peer-size``, 0 to skip): allantools
-(2024.06) has no ThêoBR; its oadev and theo1 at the bias ratio's averaging factors
-plus theo1 at the octave taus give the same numbers (checked), timed once.
+each size, next to the time the cost warning predicts (its kernel-rate model).
+Part 2 (``--peer-size``, 0 to skip): allantools (2024.06) has no ThêoBR; its oadev
+and theo1 at the bias ratio's averaging factors plus theo1 at the octave taus give
+the same numbers (checked), timed once.
 Prints Markdown tables.
 """
 
@@ -23,7 +23,7 @@ import warnings
 import allantools
 import imunoise
 import numpy as np
-from imunoise import _core
+from imunoise import _core, allan
 
 
 def quiet(fn, *args, **kwargs):
@@ -51,6 +51,7 @@ def peer_theobr(y, fs, m):
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--sizes", type=int, nargs="+", default=[10_000, 100_000])
+    parser.add_argument("--no-theoh", action="store_true", help="time theobr only")
     parser.add_argument("--peer-size", type=int, default=2000)
     args = parser.parse_args()
     print(
@@ -58,18 +59,20 @@ def main() -> None:
         f"Python {platform.python_version()}, numpy {np.__version__}, "
         f"allantools {allantools.__version__}, imunoise {imunoise.__version__}\n"
     )
-    print("| samples | taus | theobr (s) | theoh (s) | bias-ratio Theo1 steps | steps/s |")
-    print("|---|---|---|---|---|---|")
+    print("| samples | taus | theobr (s) | theoh (s) | predicted (s) |")
+    print("|---|---|---|---|---|")
     for size in args.sizes:
         y = np.random.default_rng(1).normal(size=size)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # the cost warning, expected at 10^5
             t_br, br = timed(imunoise.theobr, y, 1.0)
-            t_h, _h = timed(imunoise.theoh, y, 1.0)
-        steps = _core.theobr_ratio_cost(size + 1)
+            t_h = float("nan") if args.no_theoh else timed(imunoise.theoh, y, 1.0)[0]
+        direct, fast = _core.theobr_work(size + 1, [int(m) for m in br.m])
+        predicted = (
+            direct / allan._THEO1_DIRECT_PER_SECOND + fast / allan._THEO1_FAST_PER_SECOND
+        )
         print(
-            f"| {size} | {len(br.taus)} | {t_br:.3g} | {t_h:.3g} | {steps:.3g} | "
-            f"{steps / t_br:.3g} |",
+            f"| {size} | {len(br.taus)} | {t_br:.3g} | {t_h:.3g} | {predicted:.3g} |",
             flush=True,
         )
     if args.peer_size:

@@ -39,8 +39,9 @@ def analyse_plan(
     """As :func:`analyse` with one statistic per tau (``statistics[t]`` at ``ms[t]``,
     ordered by tau); ThêoH is oadev at its short taus, then theobr."""
 
-def theobr_ratio_cost(n_phase: int) -> float:
-    """Theo1 inner steps ThêoBR's bias ratio costs per channel of n_phase phase points."""
+def theobr_work(n_phase: int, ms: list[int]) -> tuple[float, float]:
+    """(direct steps, fast units) of ThêoBR's bias ratio plus Theo1 at ms, per channel:
+    (N − m)·m/2 per Theo1 below the kernel's direct threshold, N·log2(m)² above."""
 
 def estimator_terms(
     statistic: str, n_phase: int, ms: npt.NDArray[np.uint64]

@@ -371,11 +371,12 @@ def theobr(x, fs, taus="octave", *, confidence: float = ONE_SIGMA):
     use Theo1's EDF alone, whose 68 % intervals then hold the true white-FM
     deviation in only 30–60 % of records at short taus.
 
-    Cost: the bias ratio needs Theo1 at n + 1 ≈ N/30 factors up to ≈ 0.13·N,
-    Σ (N − m)·m/2 ≈ N³/900 steps with the O(n·m) Theo1 kernel (seconds at 10⁴
-    samples, many minutes at 10⁵; a warning says so beforehand). The ratios are
-    computed in parallel. For long records, average blocks of samples first
-    (NIST's advice for ThêoBR: the bias ratio barely changes).
+    Cost: the bias ratio needs Theo1 at n + 1 ≈ N/30 factors up to ≈ 0.13·N, about
+    N²/30·log²N with the O(N log² m) Theo1 kernel, whatever taus are asked for:
+    0.26 s at 10⁴ samples, 44 s at 10⁵, about 2 hours at 10⁶ (a warning says so
+    beforehand). The ratios are computed in parallel. For long records average
+    blocks of samples first (NIST's advice for ThêoBR: the bias ratio barely
+    changes).
 
     Parameters
     ----------
@@ -567,8 +568,10 @@ def chi2_interval(dev, edf, confidence):
     return low, high
 
 
-#: Theo1 kernel inner steps per second, release build, 2 shared cores (1.3e9-1.8e9 measured).
-_THEO1_STEPS_PER_SECOND = 1.5e9
+#: Theo1 kernel rates, release build, 2 shared cores: direct multiply-adds per second
+#: (m < 256) and N·log2(m)² units per second of the fast expansion (measured).
+_THEO1_DIRECT_PER_SECOND = 1.2e9
+_THEO1_FAST_PER_SECOND = 1.1e9
 #: Fewest samples for which ThêoBR's bias ratio exists (N = n + 1 ≥ 90 phase points).
 _THEO_MIN_SAMPLES = 89
 
@@ -611,19 +614,17 @@ def _keep_theobr(m, n: int, fs: float, user_given: bool, kind: str, lower: float
 
 
 def _warn_theobr_cost(kind: str, n: int, m: np.ndarray, channels: int) -> None:
-    """The bias ratio costs ~N³/900 Theo1 steps per channel: say so up front."""
+    """The bias ratio needs Theo1 at N/30 averaging factors: say so up front when
+    that is long."""
     if m.size == 0:
         return
-    n_phase = n + 1
-    steps = _core.theobr_ratio_cost(n_phase) + float(
-        np.sum((n_phase - m).astype(float) * (m // 2))
-    )
-    seconds = steps * channels / _THEO1_STEPS_PER_SECOND
+    direct, fast = _core.theobr_work(n + 1, [int(v) for v in m])
+    seconds = channels * (direct / _THEO1_DIRECT_PER_SECOND + fast / _THEO1_FAST_PER_SECOND)
     if seconds > 60:
         warnings.warn(
-            f"{kind} costs about N³/900 steps for its bias ratio (Theo1 at N/30 averaging "
-            f"factors): {n} samples will take roughly {seconds / 60:.0f} minutes; average "
-            "blocks of samples first (x.reshape(-1, b).mean(axis=1) at fs/b) to shorten it",
+            f"{kind}'s bias ratio needs Theo1 at N/30 averaging factors (cost ~N² log²N): "
+            f"{n} samples will take roughly {seconds / 60:.0f} minutes; average blocks of "
+            "samples first (x.reshape(-1, b).mean(axis=1) at fs/b) to shorten it",
             stacklevel=3,
         )
 

@@ -10,9 +10,10 @@
 //! at 9 + 3i (τ = 0.75·m·τ0), so each ratio measures Theo1's bias at one τ
 //! between 9τ0 and 10 % of the record; κ is their mean.
 //!
-//! Cost. κ needs Theo1 at n + 1 ≈ N/30 averaging factors up to ≈ 0.13·N, which
-//! with an O(N·m) Theo1 kernel is Σ_i (N − m_i)·m_i/2 ≈ N³/900 inner steps: the
-//! dominant cost of ThêoBR for long records. The ratios are independent, so they
+//! Cost. κ needs Theo1 at n + 1 ≈ N/30 averaging factors up to ≈ 0.13·N: with
+//! the direct sum that is Σ_i (N − m_i)·m_i/2 ≈ N³/900 steps; with the kernel's
+//! O(N log² m) expansion above m = 256 it is ≈ N²/30·log²(m), the dominant cost
+//! of ThêoBR for long records all the same. The ratios are independent, so they
 //! are computed in parallel (one task per i, each kernel parallel inside) and
 //! summed in order with compensation, so κ does not depend on the thread count.
 
@@ -20,6 +21,7 @@ use rayon::prelude::*;
 
 use super::edf;
 use super::sum::Neumaier;
+use super::theo1;
 use super::total;
 use super::variance::Statistic;
 
@@ -105,18 +107,34 @@ pub fn theobr_edf(alpha: i32, m: usize, n_phase: usize) -> f64 {
     (1.0 / (1.0 / theo1 + 1.0 / ratio)).max(1.0)
 }
 
-/// Theo1 inner steps (multiply-adds) the bias ratio of one phase of `n_phase`
-/// points costs with the O(N·m) Theo1 kernel; 0 when it is not defined.
-pub fn ratio_cost(n_phase: usize) -> f64 {
-    let Some(n) = ratio_count(n_phase) else {
-        return 0.0;
-    };
-    (0..=n)
-        .map(|i| {
-            let m = ratio_factors(i).1;
-            n_phase.saturating_sub(m) as f64 * (m / 2) as f64
-        })
-        .sum()
+/// Work of one Theo1 evaluation at (N, m) in the kernel's two regimes:
+/// (direct steps, fast units). Below `theo1::DIRECT_BELOW` the direct sum costs
+/// (N − m)·m/2 multiply-adds; above, the expansion costs ∝ N·log²(m) (FFT
+/// sliding sums, recursive triangles), counted as N·log₂(m)² units. Callers turn
+/// both into seconds with measured rates.
+pub fn theo1_work(n_phase: usize, m: usize) -> (f64, f64) {
+    if m >= n_phase || m < 2 {
+        (0.0, 0.0)
+    } else if m < theo1::DIRECT_BELOW {
+        ((n_phase - m) as f64 * (m / 2) as f64, 0.0)
+    } else {
+        let l = (m as f64).log2();
+        (0.0, n_phase as f64 * l * l)
+    }
+}
+
+/// Work of the bias ratio of one phase of `n_phase` points plus Theo1 at `ms`,
+/// as (direct steps, fast units) (see [`theo1_work`]); the ratio's part is 0
+/// when it is not defined.
+pub fn theobr_work(n_phase: usize, ms: &[usize]) -> (f64, f64) {
+    let ratio_ms = ratio_count(n_phase)
+        .map(|n| (0..=n).map(|i| ratio_factors(i).1).collect::<Vec<_>>())
+        .unwrap_or_default();
+    ratio_ms
+        .iter()
+        .chain(ms)
+        .map(|&m| theo1_work(n_phase, m))
+        .fold((0.0, 0.0), |(a, b), (c, d)| (a + c, b + d))
 }
 
 #[cfg(test)]
@@ -219,9 +237,20 @@ mod tests {
     }
 
     #[test]
-    fn cost_counts_the_theo1_steps() {
-        assert_eq!(ratio_cost(50), 0.0);
-        // N = 90: one ratio, Theo1 at m = 12: (90 − 12)·6.
-        assert_eq!(ratio_cost(90), 78.0 * 6.0);
+    fn work_counts_the_theo1_regimes() {
+        assert_eq!(theobr_work(50, &[]), (0.0, 0.0));
+        // N = 90: one ratio, Theo1 at m = 12: (90 − 12)·6 direct steps.
+        assert_eq!(theobr_work(90, &[]), (78.0 * 6.0, 0.0));
+        assert_eq!(theobr_work(90, &[20]), (78.0 * 6.0 + 70.0 * 10.0, 0.0));
+        // N = 10001: ratios at m = 12, 16, …, 1332; 1024 adds N·log2(1024)² fast units.
+        let (direct, fast) = theobr_work(10_001, &[]);
+        let want: f64 = (12..256)
+            .step_by(4)
+            .map(|m| (10_001 - m) as f64 * (m / 2) as f64)
+            .sum();
+        assert_eq!(direct, want);
+        let (_, with_tau) = theobr_work(10_001, &[1024]);
+        assert!((with_tau - fast - 10_001.0 * 100.0).abs() < 1e-6 * fast);
+        assert_eq!(theo1_work(100, 100), (0.0, 0.0));
     }
 }

@@ -119,10 +119,11 @@ fn run_plan<'py>(
     Ok((var, terms.into_pyarray(py), alpha, identified, edf))
 }
 
-/// theobr_ratio_cost(n_phase) -> Theo1 inner steps of ThêoBR's bias ratio per channel
+/// theobr_work(n_phase, ms) -> (direct steps, fast units) of ThêoBR's bias ratio and
+/// Theo1 at `ms`, per channel (see `allan::theo::theo1_work`)
 #[pyfunction]
-fn theobr_ratio_cost(n_phase: usize) -> f64 {
-    allan::theo::ratio_cost(n_phase)
+fn theobr_work(n_phase: usize, ms: Vec<usize>) -> (f64, f64) {
+    allan::theo::theobr_work(n_phase, &ms)
 }
 
 /// estimator_terms(statistic, n_phase, ms) -> terms per averaging factor (0: does not fit)
@@ -146,6 +147,6 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(analyse, m)?)?;
     m.add_function(wrap_pyfunction!(estimator_terms, m)?)?;
     m.add_function(wrap_pyfunction!(analyse_plan, m)?)?;
-    m.add_function(wrap_pyfunction!(theobr_ratio_cost, m)?)?;
+    m.add_function(wrap_pyfunction!(theobr_work, m)?)?;
     Ok(())
 }
