@@ -50,15 +50,19 @@ pub fn sliding_dot(x: &[f64], w: &[f64]) -> Vec<f64> {
         zk.im = v * gain;
     }
     forward.process(&mut z);
-    // X_k = (Z_k + conj Z_{−k})/2, W_k = (Z_k − conj Z_{−k})/(2i); product X·W.
-    let mut product = vec![Complex::new(0.0, 0.0); size];
-    for k in 0..size {
-        let a = z[k];
-        let b = z[(size - k) % size].conj();
-        let xk = (a + b) * 0.5;
-        let wk = (a - b) * Complex::new(0.0, -0.5);
-        product[k] = xk * wk;
+    // X_k = (Z_k + conj Z_{−k})/2, W_k = (Z_k − conj Z_{−k})/(2i); the product X·W
+    // overwrites Z in place, the pair k, −k at a time.
+    let product_at = |a: Complex<f64>, b: Complex<f64>| {
+        let b = b.conj();
+        ((a + b) * 0.5) * ((a - b) * Complex::new(0.0, -0.5))
+    };
+    for k in 0..=size / 2 {
+        let j = (size - k) % size;
+        let (zk, zj) = (z[k], z[j]);
+        z[k] = product_at(zk, zj);
+        z[j] = product_at(zj, zk);
     }
+    let mut product = z;
     inverse.process(&mut product);
     let scale = 1.0 / (size as f64 * gain);
     (0..count)

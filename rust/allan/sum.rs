@@ -94,6 +94,7 @@ pub fn blocked_sum(count: usize, mut term: impl FnMut(usize) -> f64) -> f64 {
 /// estimators' sum of squared differences, c[i+2m] − 2c[i+m] + c[i] and the like.
 /// Slices of fixed-size chunks let the compiler drop bounds checks and vectorise;
 /// blocks of 256 squares are summed plainly and then added with compensation.
+#[inline(always)]
 pub fn sum_of_squared_combinations<const S: usize>(streams: [&[f64]; S], weights: [f64; S]) -> f64 {
     const BLOCK: usize = 256;
     let len = streams.iter().map(|s| s.len()).min().unwrap_or(0);
