@@ -245,14 +245,15 @@ def test_results_are_frozen_and_labelled(fn, kind):
         r.dev[0] = 1.0
 
 
-def test_cli_prints_theoh(tmp_path, capsys):
+@pytest.mark.parametrize("kind", ["theoh", "mtotdev", "ttotdev", "htotdev", "theo1"])
+def test_cli_prints_the_long_tau_family(tmp_path, capsys, kind):
     y = noise("white", 300, seed=3, channels=3)
     log = tmp_path / "log.csv"
     np.savetxt(log, y, delimiter=",", header="gyro_x,gyro_y,gyro_z", comments="")
-    assert main(["adev", str(log), "--fs", "10", "--kind", "theoh"]) == 0
+    assert main(["adev", str(log), "--fs", "10", "--kind", kind]) == 0
     out = capsys.readouterr().out
     rows = [line.split() for line in out.splitlines()[2:]]
-    r = imunoise.theoh(imunoise.read(log, fs=10.0).gyro, 10.0)
+    r = getattr(imunoise, kind)(imunoise.read(log, fs=10.0).gyro, 10.0)
     np.testing.assert_allclose([float(row[0]) for row in rows], r.taus, rtol=1e-5)
     np.testing.assert_allclose([float(row[2]) for row in rows], r.dev[:, 0], rtol=1e-6)
 

@@ -16,7 +16,8 @@ import numpy as np
 __all__ = ["main"]
 
 SENSORS = ("gyro", "accel", "mag")
-KINDS = ("adev", "mdev", "hdev", "tdev", "totdev", "theobr", "theoh")
+KINDS = ("adev", "mdev", "hdev", "tdev", "totdev", "mtotdev", "ttotdev", "htotdev", "theo1",
+         "theobr", "theoh")
 _AXES = ("X", "Y", "Z")
 
 class _Parser(argparse.ArgumentParser):
