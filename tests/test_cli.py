@@ -169,3 +169,21 @@ def test_fit_prints_datasheet_table(capsys, read):
     n_row = next(line for line in lines if " N " in f" {line} " and "deg/sqrt(h)" in line)
     want = next(r for r in model.table("gyro") if r["term"] == "N")
     assert f"{want['X']:.6g}" in n_row
+
+
+def test_fit_with_bootstrap_uncertainties(capsys, read):
+    from imunoise import report
+    from imunoise.cli import bundled_log
+
+    args = ["fit", str(bundled_log()), "--sensor", "gyro", "--fs", "40", "--bootstrap", "6"]
+    code, out, err = _run(args, capsys)
+    assert code == 0, err
+    log = read(bundled_log(), fs=40.0)
+    result = imunoise.adev(log.gyro, log.fs, taus=report.TAUS_PER_DECADE)
+    model = imunoise.fit(result, uncertainty="bootstrap", replicates=6, seed=0)
+    n_row = next(line for line in out.splitlines() if " N " in f" {line} ")
+    want = next(r for r in model.table("gyro") if r["term"] == "N")
+    assert f"± {want['X_std']:.6g}" in n_row
+
+    code, _, err = _run(args[:-1] + ["3"], capsys)
+    assert code == 2 and "--bootstrap must be >= 5" in _one_line_error(err)

@@ -7,7 +7,6 @@ import math
 import warnings
 from pathlib import Path
 
-import _fake_vn
 import numpy as np
 import pytest
 import vn_helpers
@@ -23,7 +22,6 @@ SHARED = Path("/work/shared/data")
 IG500N = SHARED / "other-imu" / "ig500n_static.txt"
 G = 9.80665
 VN_RTOL = vn_helpers.VN_RTOL
-vn_parser = vn_helpers.vn_parser  # fixture: stand-in VN parser, then the real one
 
 
 def _csv_rows(path):
@@ -34,7 +32,7 @@ def _csv_rows(path):
 # -- the real VN-100 CSV (ROS 2 bag export with a raw sentence column) ------------------
 
 
-def test_vn_csv_raw_column_wins(vn_parser):
+def test_vn_csv_raw_column_wins():
     rows = _csv_rows(VN_CSV)
     header, first, last = rows[0], rows[1], rows[-1]
     log = read_csv(VN_CSV)
@@ -56,7 +54,7 @@ def test_vn_csv_raw_column_wins(vn_parser):
     assert log.fs == pytest.approx(40.0, abs=0.05)
 
 
-def test_vn_csv_bad_sentences_counted_at_their_lines(vn_parser):
+def test_vn_csv_bad_sentences_counted_at_their_lines():
     text = VN_CSV.read_text().splitlines()
     # line numbers are 1-based file lines; line 1 is the header
     text[4] = text[4].replace("*6", "*0", 1) if "*6" in text[4] else text[4][:-3] + '00"'
@@ -263,10 +261,12 @@ def test_random_rows_are_all_accounted_for(rows, crlf):
 def test_strict_error_located_when_parser_names_no_line(monkeypatch):
     import imunoise.readers._sentences as sentences
 
+    real = sentences.parse_sentences
+
     def terse(data, *, strict, source):
         if strict and b"*00" in data:
             raise ValueError("checksum mismatch")  # names no line
-        return _fake_vn.parse_vn_sentences(data, strict=False, fs=1.0, source=source)
+        return real(data, strict=False, source=source)
 
     monkeypatch.setattr(sentences, "parse_sentences", terse)
     good = [ymr([k] * 12) for k in range(4)]

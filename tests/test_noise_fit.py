@@ -215,3 +215,64 @@ def test_fit_is_scale_equivariant(vn_like_small, scale, method):
         np.testing.assert_array_equal(a.supported[k], b.supported[k])
         np.testing.assert_allclose(b.value(k), scale * a.value(k), rtol=1e-6)
         np.testing.assert_allclose(b.std(k), scale * a.std(k), rtol=1e-5)
+
+
+# --- parametric bootstrap uncertainties -------------------------------------------------
+
+
+@pytest.mark.parametrize("truth", [{"N": 1e-3}, {"N": 1e-3, "K": 1e-4}])
+def test_bootstrap_std_matches_the_spread_of_repeated_experiments(truth):
+    # Oracle: 40 independent records of the true noise, fitted like the data; their
+    # spread is what an uncertainty should describe. The bootstrap sees one record.
+    # Tolerances: ~11 % sampling error on each spread; K's bootstrap also scales with
+    # the one record's K estimate. The independent-taus std is ~0.75 of the spread
+    # for N here, outside N's band.
+    fs, n = 50.0, 20_000
+    opts = {"terms": tuple(truth)}
+    repeated = np.array([
+        [imunoise.fit(imunoise.adev(imunoise.simulate(n, fs, seed=s, **truth), fs),
+                      **opts).value(t)[0] for t in truth]
+        for s in range(100, 140)
+    ])
+    spread = repeated.std(axis=0, ddof=1)
+    x = imunoise.simulate(n, fs, seed=7, **truth)
+    model = imunoise.fit(imunoise.adev(x, fs), uncertainty="bootstrap", replicates=40, seed=3,
+                         **opts)
+    bands = {"N": (0.82, 1.25), "K": (0.6, 1.6)}
+    for i, term in enumerate(truth):
+        ratio = model.std(term)[0] / spread[i]
+        assert bands[term][0] < ratio < bands[term][1], (term, ratio)
+
+
+def test_bootstrap_is_reproducible_and_keeps_unsupported_terms_nan():
+    x = imunoise.simulate(20_000, 50.0, N=1e-3, seed=2)
+    r = imunoise.adev(x, 50.0)
+    a = imunoise.fit(r, uncertainty="bootstrap", replicates=10, seed=5)
+    b = imunoise.fit(r, uncertainty="bootstrap", replicates=10, seed=5)
+    c = imunoise.fit(r, uncertainty="bootstrap", replicates=10, seed=6)
+    assert a.N_std == b.N_std and a.N_std != c.N_std
+    assert a.N == imunoise.fit(r).N  # the estimate itself does not change
+    assert not a.supported["R"] and np.isnan(a.R_std)
+
+
+def test_bootstrap_on_several_channels_and_non_overlapping_adev():
+    x = imunoise.simulate(12_000, 20.0, N=1e-3, channels=2, seed=4)
+    x[:, 1] *= 10.0
+    r = imunoise.adev(x, 20.0, overlapping=False)
+    model = imunoise.fit(r, uncertainty="bootstrap", replicates=12, seed=1)
+    assert model.N_std.shape == (2,)
+    np.testing.assert_allclose(model.N_std[1] / model.N_std[0], 10.0, rtol=0.6)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "error", "match"),
+    [
+        ({"uncertainty": "mc"}, ValueError, "uncertainty must be 'independent' or 'bootstrap'"),
+        ({"uncertainty": "bootstrap", "replicates": 2}, ValueError, "replicates must be >= 5"),
+        ({"uncertainty": "bootstrap", "replicates": 7.5}, TypeError, "replicates must be an"),
+    ],
+)
+def test_bootstrap_bad_arguments(kwargs, error, match):
+    r = imunoise.adev(imunoise.simulate(2000, 10.0, N=1e-3, seed=1), 10.0)
+    with pytest.raises(error, match=match):
+        imunoise.fit(r, **kwargs)

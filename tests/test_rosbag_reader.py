@@ -21,7 +21,6 @@ SHARED = Path("/work/shared/data/vn100-ros")
 ROS1 = SHARED / "ros1_stationary.bag"
 DB3 = SHARED / "ros2_circle_0.db3"
 VN_RTOL = vn_helpers.VN_RTOL
-vn_parser = vn_helpers.vn_parser  # fixture: stand-in VN parser, then the real one
 
 # The lab driver's message in ros2_circle_0.db3, read off its serialized bytes (the
 # bag carries no definitions): a header, a sensor_msgs Imu, a MagneticField, the sentence.
@@ -57,7 +56,7 @@ def _check_ends(log, sentences, times):
 # -- real bags -------------------------------------------------------------------------
 
 
-def test_mcap_lab_driver_schema_from_bag(vn_parser):
+def test_mcap_lab_driver_schema_from_bag():
     stamps, _t, sentences = _oracle(MCAP, "/imu", "raw")
     log = read_rosbag(MCAP)
     # 414 messages in the bag's metadata.yaml; the custom type came from the MCAP schema
@@ -73,7 +72,7 @@ def test_mcap_lab_driver_schema_from_bag(vn_parser):
 
 
 @pytest.mark.skipif(not ROS1.exists(), reason="../shared/data (unlicensed ROS 1 bag) absent")
-def test_ros1_bag_custom_type_from_connection_header(vn_parser):
+def test_ros1_bag_custom_type_from_connection_header():
     stamps, _t, sentences = _oracle(ROS1, "/imu", "VNYMR")
     log = read_rosbag(ROS1)
     assert len(log) == 2732 == len(sentences)
@@ -85,7 +84,7 @@ def test_ros1_bag_custom_type_from_connection_header(vn_parser):
 
 
 @pytest.mark.skipif(not DB3.exists(), reason="../shared/data (unlicensed ROS 2 bag) absent")
-def test_ros2_db3_without_definitions(vn_parser):
+def test_ros2_db3_without_definitions():
     store = get_typestore(Stores.ROS2_HUMBLE)
     store.register(get_types_from_msg(IMUMSG, "imu_msg/msg/IMUmsg"))
     stamps, times, sentences = _oracle(DB3, "/imu", "raw_imu_string", default_typestore=store)
@@ -235,7 +234,7 @@ def test_imu_without_orientation_and_topic_errors(tmp_path):
 
 
 @pytest.mark.parametrize("batch", [20_000, 7])
-def test_custom_vn_message_bad_sentences(tmp_path, vn_parser, batch, monkeypatch):
+def test_custom_vn_message_bad_sentences(tmp_path, batch, monkeypatch):
     monkeypatch.setattr(rosbag_reader, "_BATCH", batch)
     store = _store()
     Raw = store.types["lab/msg/Raw"]

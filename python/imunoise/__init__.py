@@ -16,6 +16,8 @@ from imunoise.allan import (
     mtotdev,
     tdev,
     theo1,
+    theobr,
+    theoh,
     totdev,
     ttotdev,
 )
@@ -51,6 +53,8 @@ __all__ = [
     "simulate_log",
     "tdev",
     "theo1",
+    "theobr",
+    "theoh",
     "totdev",
     "ttotdev",
     "units",

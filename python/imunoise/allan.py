@@ -56,6 +56,8 @@ __all__ = [
     "ttotdev",
     "htotdev",
     "theo1",
+    "theobr",
+    "theoh",
     "ONE_SIGMA",
 ]
 
@@ -71,13 +73,14 @@ class AllanResult:
     ----------
     kind : str
         ``"adev"``, ``"mdev"``, ``"hdev"``, ``"tdev"``, ``"totdev"``, ``"mtotdev"``,
-        ``"ttotdev"``, ``"htotdev"`` or ``"theo1"``.
+        ``"ttotdev"``, ``"htotdev"``, ``"theo1"``, ``"theobr"`` or ``"theoh"``.
     overlapping : bool
         Whether the estimator uses every start sample (stride 1) or stride m.
     taus : ndarray, (T,)
         Averaging times in seconds, ``m / fs``.
     m : ndarray of int, (T,)
-        Averaging factors.
+        Averaging factors (ThêoBR points of ``"theobr"``/``"theoh"``: Theo1's even m,
+        at ``taus = 0.75 * m / fs``).
     dev, var : ndarray
         The deviation and its square, in the input's units (TDEV: units × s).
     n : ndarray of int, (T,)
@@ -336,6 +339,153 @@ def theo1(x, fs, taus="octave", *, confidence: float = ONE_SIGMA, bias_correctio
     )
 
 
+def theobr(x, fs, taus="octave", *, confidence: float = ONE_SIGMA):
+    r"""ThêoBR deviation: Theo1 with its bias relative to the Allan variance removed
+    by the data's own AVAR/Theo1 ratio (Howe & Tasset 2004; Howe 2006; SP 1065
+    §5.2.15). An estimate of the Allan deviation out to τ ≈ 0.75·T (T the record
+    length) without knowing the noise type.
+
+    .. math::
+
+        \mathrm{Th\hat eoBR}(m) = \Big[\frac{1}{n+1}\sum_{i=0}^{n}
+        \frac{\mathrm{AVAR}(9+3i)}{\mathrm{Theo1}(12+4i)}\Big]\,\mathrm{Theo1}(m),
+        \qquad n = \lfloor 0.1\,N/3\rfloor - 3,
+
+    over the N = n_samples + 1 phase points (so at least 89 samples), AVAR the
+    overlapping Allan variance and Theo1 as in :func:`theo1`; each ratio compares
+    the two at the same τ = (9 + 3i)/fs, from 9/fs to 10 % of the record. Even
+    10 ≤ m ≤ N − 1, the range SP 1065 gives.
+
+    Tau convention: unlike :func:`theo1`, ``r.taus`` is the averaging time the
+    value belongs to, τ = 0.75·m/fs, so the curve lies on the Allan deviation's
+    axis; ``r.m`` holds Theo1's even m. Named grids pick the even m ≥ 10 of the
+    grid; an array of taus (seconds of averaging time) is rounded to the nearest
+    even m. ``r.n`` counts Theo1's (N − m)·m/2 terms. Noise identification at
+    0.75·m.
+
+    EDF: Theo1's (SP 1065, Howe & Tasset, r = 0.75·m) combined with the bias
+    ratio's, 1/ν = 1/ν_Theo1 + 1/ν_κ. Every tau is multiplied by the same
+    estimated ratio κ, whose relative scatter (≈ 11 % for white FM) does not
+    shrink with the record length; ν_κ by noise type (white PM … random-walk FM:
+    10⁴, 400, 150, 250, 340) was measured by simulation. Stable32 and Howe's papers
+    use Theo1's EDF alone, whose 68 % intervals then hold the true white-FM
+    deviation in only 30–60 % of records at short taus.
+
+    Cost: the bias ratio needs Theo1 at n + 1 ≈ N/30 factors up to ≈ 0.13·N, about
+    N²/30·log²N with the O(N log² m) Theo1 kernel, whatever taus are asked for:
+    0.26 s at 10⁴ samples, 44 s at 10⁵, about 2 hours at 10⁶ (a warning says so
+    beforehand). The ratios are computed in parallel. For long records average
+    blocks of samples first (NIST's advice for ThêoBR: the bias ratio barely
+    changes).
+
+    Parameters
+    ----------
+    x, fs, taus, confidence
+        As for :func:`adev` (taus: see the tau convention above).
+
+    Returns
+    -------
+    AllanResult
+        ``kind == "theobr"``.
+    """
+    data, one_d = _as_samples(x)
+    fs = _check_fs(fs)
+    confidence = _check_confidence(confidence)
+    n = data.shape[0]
+    _check_theo_length("theobr", n)
+    m, user_given = _theo1_factors(taus, fs, n)
+    m = _keep_theobr(m, n, fs, user_given, "theobr", lower=0.0)
+    if m.size == 0:
+        raise ValueError(f"none of the taus is in range for theobr; got {taus!r}")
+    _warn_theobr_cost("theobr", n, m, data.shape[1])
+    var, terms, alpha, identified, edf = _core.analyse(data, "theobr", m.astype(np.uint64))
+    return _assemble(
+        "theobr", True, 0.75 * m / fs, m, var, terms, alpha, identified, edf, fs,
+        confidence, one_d,
+    )
+
+
+def theoh(x, fs, taus="octave", *, confidence: float = ONE_SIGMA):
+    r"""ThêoH deviation: the overlapping Allan deviation at short taus and ThêoBR
+    (:func:`theobr`) at long ones (Howe, "ThêoH: a hybrid, high-confidence
+    statistic that improves on the Allan deviation", Metrologia 43, 2006; SP 1065
+    §5.2.16). One curve from τ0 to ≈ 0.75·T with the Allan deviation's meaning and
+    ThêoBR's confidence at long taus.
+
+    .. math::
+
+        \mathrm{Th\hat eoH}(\tau) = \begin{cases}
+        \mathrm{AVAR}(\tau), & \tau \le k \\
+        \mathrm{Th\hat eoBR}(m),\ \tau = 0.75\,m/f_s, & \tau > k
+        \end{cases}
+
+    with k the largest tau of the grid at most 10 % of the record length
+    T = n_samples/fs. For ``taus="all"`` this is SP 1065's definition, where k is
+    the largest τ ≤ 10 % T (SP 1065 puts τ = k itself on the ThêoBR side when
+    0.75·m hits it exactly; here k stays an AVAR point, so a grid's last AVAR tau
+    is never lost). Named grids: AVAR at the grid's m ≤ 0.1·n, ThêoBR at its even
+    m ≥ 10 with 0.75·m/fs > k. An array of taus (seconds) is split the same way:
+    taus ≤ 10 % T are AVAR taus (rounded to whole samples), the others are
+    rounded to the nearest ThêoBR tau 0.75·(even m)/fs.
+
+    ``r.taus`` is the averaging time of every point; ``r.m`` the estimator's own
+    averaging factor (AVAR's m, then Theo1's even m: the ThêoBR points are those
+    with ``r.taus * r.fs < r.m``); ``r.n`` its number of terms. EDF: Greenhall's
+    for the overlapping AVAR, ThêoBR's (see :func:`theobr`); the noise type is identified
+    over the whole curve (the longest taus take it from the nearest identified
+    ones, as elsewhere). Needs at least 89 samples; cost: that of :func:`theobr`
+    (the bias ratio), which a warning announces when it is long.
+
+    Parameters
+    ----------
+    x, fs, taus, confidence
+        As for :func:`adev`.
+
+    Returns
+    -------
+    AllanResult
+        ``kind == "theoh"``.
+    """
+    data, one_d = _as_samples(x)
+    fs = _check_fs(fs)
+    confidence = _check_confidence(confidence)
+    n = data.shape[0]
+    _check_theo_length("theoh", n)
+    # Validates taus and gives the AVAR candidates (rounded to whole samples).
+    m_avar, user_given = averaging_factors(taus, fs, n)
+    short = m_avar <= 0.1 * n
+    if user_given:
+        arr = np.asarray(taus, dtype=np.float64)
+        long_taus = arr[~short]
+        dropped = int(np.count_nonzero(short & (m_avar < 1)))
+        m_avar = m_avar[short & (m_avar >= 1)]
+        if dropped:
+            warnings.warn(
+                f"{dropped} of {arr.size} taus dropped: theoh needs tau >= 1/fs = {1 / fs:g} s",
+                stacklevel=2,
+            )
+        m_avar = np.unique(m_avar)
+        k = int(m_avar.max()) if m_avar.size else 0
+        m_theo = _theo1_factors(long_taus, fs, n)[0] if long_taus.size else m_avar[:0]
+    else:
+        m_avar = m_avar[short]
+        k = int(m_avar.max())
+        m_theo, _ = _theo1_factors(taus, fs, n)
+    m_theo = _keep_theobr(m_theo, n, fs, user_given, "theoh", lower=k)
+    if m_avar.size + m_theo.size == 0:
+        raise ValueError(f"none of the taus is in range for theoh; got {taus!r}")
+    _warn_theobr_cost("theoh", n, m_theo, data.shape[1])
+    m = np.concatenate([m_avar, m_theo]).astype(np.int64)
+    statistics = ["oadev"] * m_avar.size + ["theobr"] * m_theo.size
+    var, terms, alpha, identified, edf = _core.analyse_plan(
+        data, statistics, m.astype(np.uint64)
+    )
+    tau = np.concatenate([m_avar / fs, 0.75 * m_theo / fs])
+    return _assemble(
+        "theoh", True, tau, m, var, terms, alpha, identified, edf, fs, confidence, one_d
+    )
+
+
 def _bias_factor(kind, alpha, m):
     """Multiplier of the variance that removes the published bias; alpha (T, ch)."""
     if kind in ("mtotdev", "ttotdev"):
@@ -372,13 +522,21 @@ def _deviation(
             f"x has {n} samples, too few for any tau of {kind} "
             f"(the shortest tau needs at least {_minimum_samples(statistic)})"
         )
-    _warn_if_quadratic_cost(statistic, n, m, data.shape[1])
     var, terms, alpha, identified, edf = _core.analyse(data, statistic, m.astype(np.uint64))
     tau = m / fs
     if bias_correction:
         var = var * _bias_factor(kind, alpha, m)
     if kind in ("tdev", "ttotdev"):
         var = var * (tau**2 / 3.0)[:, None]
+    return _assemble(
+        kind, overlapping, tau, m, var, terms, alpha, identified, edf, fs, confidence, one_d
+    )
+
+
+def _assemble(
+    kind, overlapping, tau, m, var, terms, alpha, identified, edf, fs, confidence, one_d
+) -> AllanResult:
+    """The result object from the core's (T, channels) arrays."""
     dev = np.sqrt(var)
     ci_low, ci_high = chi2_interval(dev, edf, confidence)
     squeeze = (lambda a: a[:, 0]) if one_d else (lambda a: a)
@@ -410,24 +568,64 @@ def chi2_interval(dev, edf, confidence):
     return low, high
 
 
-#: Statistics whose exact evaluation costs O(n·m) per tau rather than O(n).
-_QUADRATIC_COST = ("mtotdev", "htotdev", "theo1")
-#: Roughly what this machine class does per second in those kernels (inner steps).
-_QUADRATIC_STEPS_PER_SECOND = 1e9
+#: Theo1 kernel rates, release build, 2 shared cores: direct multiply-adds per second
+#: (m < 256) and N·log2(m)² units per second of the fast expansion (measured).
+_THEO1_DIRECT_PER_SECOND = 1.2e9
+_THEO1_FAST_PER_SECOND = 1.1e9
+#: Fewest samples for which ThêoBR's bias ratio exists (N = n + 1 ≥ 90 phase points).
+_THEO_MIN_SAMPLES = 89
 
 
-def _warn_if_quadratic_cost(statistic: str, n: int, m: np.ndarray, channels: int) -> None:
-    """A long record at long taus makes the total family slow: say so up front."""
-    if statistic not in _QUADRATIC_COST:
+def _check_theo_length(kind: str, n: int) -> None:
+    if n < _THEO_MIN_SAMPLES:
+        raise ValueError(
+            f"x has {n} samples, too few for {kind}: its bias ratio averages "
+            f"n = floor(0.1·N/3) − 3 + 1 terms over the N = samples + 1 phase points, "
+            f"which needs at least {_THEO_MIN_SAMPLES} samples"
+        )
+
+
+def _theo1_factors(taus, fs: float, n: int) -> tuple[np.ndarray, bool]:
+    """Theo1's even averaging factors for a tau specification of ThêoBR: the even m
+    of a named grid, or each tau in seconds (an averaging time, 0.75·m/fs) rounded
+    to the nearest even m."""
+    m, user_given = averaging_factors(taus, fs, n)  # validates taus
+    if not user_given:
+        return m[m % 2 == 0], False
+    half = np.round(np.asarray(taus, dtype=np.float64) * fs / 1.5)
+    return 2 * np.clip(half, 0, n + 1).astype(np.int64), True
+
+
+def _keep_theobr(m, n: int, fs: float, user_given: bool, kind: str, lower: float):
+    """Even m in ThêoBR's range (10 ≤ m ≤ N − 1) with 0.75·m > ``lower`` (in
+    samples), unique and sorted; warns when explicit taus are dropped."""
+    m = np.asarray(m, dtype=np.int64)
+    terms = _core.estimator_terms("theobr", n + 1, m.astype(np.uint64)).astype(np.int64)
+    keep = (terms > 1) & (0.75 * m > lower)
+    dropped = int(np.count_nonzero(~keep))
+    if dropped and user_given:
+        above = f", above the last AVAR tau {lower / fs:g} s" if lower > 0 else ""
+        warnings.warn(
+            f"{dropped} of {m.size} taus dropped: {kind}'s ThêoBR taus are 0.75·m/fs for "
+            f"even 10 <= m <= {n} (here {7.5 / fs:g} s to {0.75 * n / fs:g} s{above})",
+            stacklevel=3,
+        )
+    return np.unique(m[keep])
+
+
+def _warn_theobr_cost(kind: str, n: int, m: np.ndarray, channels: int) -> None:
+    """The bias ratio needs Theo1 at N/30 averaging factors: say so up front when
+    that is long."""
+    if m.size == 0:
         return
-    steps = 9.0 * n * float(np.sum(m)) * channels
-    seconds = steps / _QUADRATIC_STEPS_PER_SECOND
+    direct, fast = _core.theobr_work(n + 1, [int(v) for v in m])
+    seconds = channels * (direct / _THEO1_DIRECT_PER_SECOND + fast / _THEO1_FAST_PER_SECOND)
     if seconds > 60:
         warnings.warn(
-            f"{statistic} costs O(n·m) per tau: {n} samples up to m = {int(m.max())} "
-            f"will take roughly {seconds / 60:.0f} minutes; pass taus= with shorter taus "
-            "(e.g. an array of seconds) to limit it",
-            stacklevel=4,
+            f"{kind}'s bias ratio needs Theo1 at N/30 averaging factors (cost ~N² log²N): "
+            f"{n} samples will take roughly {seconds / 60:.0f} minutes; average blocks of "
+            "samples first (x.reshape(-1, b).mean(axis=1) at fs/b) to shorten it",
+            stacklevel=3,
         )
 
 

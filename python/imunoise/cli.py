@@ -16,7 +16,8 @@ import numpy as np
 __all__ = ["main"]
 
 SENSORS = ("gyro", "accel", "mag")
-KINDS = ("adev", "mdev", "hdev", "tdev", "totdev")
+KINDS = ("adev", "mdev", "hdev", "tdev", "totdev", "mtotdev", "ttotdev", "htotdev", "theo1",
+         "theobr", "theoh")
 _AXES = ("X", "Y", "Z")
 
 class _Parser(argparse.ArgumentParser):
@@ -83,6 +84,9 @@ def _build_parser() -> argparse.ArgumentParser:
     _fs_arg(f)
     f.add_argument("--sensor", choices=("gyro", "accel"), default=None,
                    help="one sensor (default: gyro and accel)")
+    f.add_argument("--bootstrap", type=int, default=0, metavar="REPLICATES",
+                   help="uncertainties by parametric bootstrap with this many simulated "
+                   "records (>= 5; default: from the fit, taus treated as independent)")
 
     s = sub.add_parser("stats", help="print sample statistics and distribution fits",
                        description="Per channel mean, std, variance, min, max, drift per hour; "
@@ -216,15 +220,22 @@ def _cmd_adev(args) -> int:
 
 
 def _cmd_fit(args) -> int:
-    from imunoise import report
+    from imunoise import fit, report
 
     log = _read(args)
     sensors = [args.sensor] if args.sensor else [s for s in ("gyro", "accel")
                                                   if getattr(log, s) is not None]
     if not sensors or any(getattr(log, s) is None for s in sensors):
         _fail(f"{args.log}: no {' or '.join(sensors or ['gyro/accel'])} channel in the log")
+    if args.bootstrap and args.bootstrap < 5:
+        _fail(f"--bootstrap must be >= 5 replicates; got {args.bootstrap}")
     for s in sensors:
-        model = report._fit(report._allan(getattr(log, s), log.fs))
+        result = report._allan(getattr(log, s), log.fs)
+        if args.bootstrap:
+            model = fit(result, uncertainty="bootstrap", replicates=args.bootstrap,
+                                 seed=0)
+        else:
+            model = report._fit(result)
         head, rows = report._datasheet_rows(model, s)
         print(f"# {s}")
         _print_table(head, rows)

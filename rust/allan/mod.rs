@@ -5,7 +5,13 @@ pub mod blocked;
 pub mod edf;
 pub mod noise_id;
 pub mod phase;
+pub mod reflected;
+pub mod sliding;
 pub mod sum;
+#[cfg(test)]
+mod test_signals;
+pub mod theo;
+pub mod theo1;
 pub mod total;
 pub mod variance;
 
@@ -83,6 +89,15 @@ fn transform_in_parallel(gathered: Vec<Vec<f64>>) -> CoreResult<Vec<Vec<f64>>> {
 /// identifies the noise type and computes the EDF. Work is spread over
 /// (channel, tau) pairs.
 pub fn analyse(phases: &[Vec<f64>], statistic: Statistic, ms: &[usize]) -> CoreResult<Analysis> {
+    let plan: Vec<(Statistic, usize)> = ms.iter().map(|&m| (statistic, m)).collect();
+    analyse_plan(phases, &plan)
+}
+
+/// [`analyse`] with a statistic per tau: `plan[t]` = (statistic, m). ThêoH is
+/// the plan of overlapping AVAR at its short taus and ThêoBR at its long ones.
+/// Noise types missing at some taus are filled from the nearest identified taus
+/// of the whole plan, so order the plan by τ.
+pub fn analyse_plan(phases: &[Vec<f64>], plan: &[(Statistic, usize)]) -> CoreResult<Analysis> {
     let channels = phases.len();
     if channels == 0 {
         return Err(CoreError::InvalidArgument(
@@ -95,34 +110,66 @@ pub fn analyse(phases: &[Vec<f64>], statistic: Statistic, ms: &[usize]) -> CoreR
             "all channels must have the same length".into(),
         ));
     }
-    let terms: Vec<usize> = ms.iter().map(|&m| statistic.terms(n_phase, m)).collect();
+    let terms: Vec<usize> = plan.iter().map(|&(s, m)| s.terms(n_phase, m)).collect();
     if let Some(pos) = terms.iter().position(|&t| t == 0) {
         return Err(CoreError::InvalidArgument(format!(
             "tau of {} samples does not fit in {} samples for this statistic",
-            ms[pos],
+            plan[pos].1,
             n_phase.saturating_sub(1)
         )));
     }
-    let pairs: Vec<(usize, usize)> = (0..ms.len())
+    let pairs: Vec<(usize, usize)> = (0..plan.len())
         .flat_map(|t| (0..channels).map(move |c| (t, c)))
         .collect();
-    let (dmax, estimator) = noise_model_of(statistic);
-    // The overlapping Allan and Hadamard variances sweep all taus of a channel at
-    // once (see `blocked`); every other statistic goes tau by tau.
-    let swept: Option<Vec<Vec<f64>>> = statistic.blocked_difference().map(|difference| {
-        phases
+    // The overlapping Allan and Hadamard variances sweep all their taus of a
+    // channel at once (see `blocked`); every other statistic goes tau by tau.
+    let mut swept: Vec<Option<f64>> = vec![None; pairs.len()];
+    let mut blocked: Vec<Statistic> = Vec::new();
+    for &(s, _) in plan {
+        if s.blocked_difference().is_some() && !blocked.contains(&s) {
+            blocked.push(s);
+        }
+    }
+    for statistic in blocked {
+        let Some(difference) = statistic.blocked_difference() else {
+            continue;
+        };
+        let taus: Vec<usize> = (0..plan.len())
+            .filter(|&t| plan[t].0 == statistic)
+            .collect();
+        let ms: Vec<usize> = taus.iter().map(|&t| plan[t].1).collect();
+        let sums: Vec<Vec<f64>> = phases
             .par_iter()
-            .map(|c| blocked::sums_of_squares(c, ms, difference))
-            .collect()
-    });
+            .map(|c| blocked::sums_of_squares(c, &ms, difference))
+            .collect();
+        for (k, &t) in taus.iter().enumerate() {
+            for (c, channel_sums) in sums.iter().enumerate() {
+                swept[t * channels + c] =
+                    Some(statistic.variance_from_sum(channel_sums[k], plan[t].1, terms[t]));
+            }
+        }
+    }
+    // ThêoBR's bias ratio belongs to a channel, not a tau: computed once each.
+    let ratios: Option<Vec<f64>> = if plan.iter().any(|(s, _)| *s == Statistic::TheoBR) {
+        let refs: Vec<&[f64]> = phases.iter().map(|p| p.as_slice()).collect();
+        theo::bias_ratios(&refs)
+    } else {
+        None
+    };
     let per_pair: Vec<(f64, Option<i32>)> = pairs
         .par_iter()
-        .map(|&(t, c)| {
-            let var = match &swept {
-                Some(sums) => statistic.variance_from_sum(sums[c][t], ms[t], terms[t]),
-                None => statistic.estimate(&phases[c], ms[t]).var,
+        .enumerate()
+        .map(|(i, &(t, c))| {
+            let (statistic, m) = plan[t];
+            let var = match (swept[i], statistic, &ratios) {
+                (Some(v), _, _) => v,
+                (None, Statistic::TheoBR, Some(r)) => {
+                    r[c] * Statistic::Theo1.estimate(&phases[c], m).var
+                }
+                (None, _, _) => statistic.estimate(&phases[c], m).var,
             };
-            let id_m = statistic.noise_id_factor(ms[t]);
+            let id_m = statistic.noise_id_factor(m);
+            let (dmax, _) = noise_model_of(statistic);
             (var, noise_id::identify_alpha(&phases[c], id_m, dmax))
         })
         .collect();
@@ -136,7 +183,7 @@ pub fn analyse(phases: &[Vec<f64>], statistic: Statistic, ms: &[usize]) -> CoreR
             return Err(CoreError::Numerical(format!(
                 "x is too large in magnitude: the variance at m = {} overflows double \
                  precision (channel {c}); rescale x",
-                ms[t]
+                plan[t].1
             )));
         }
         var.push(v);
@@ -146,17 +193,21 @@ pub fn analyse(phases: &[Vec<f64>], statistic: Statistic, ms: &[usize]) -> CoreR
         }
     }
     for c in 0..channels {
-        fill_from_nearest(&mut alpha, &alpha_identified, c, channels, ms.len());
+        fill_from_nearest(&mut alpha, &alpha_identified, c, channels, plan.len());
     }
     let n_samples = n_phase - 1;
     let edf = pairs
         .iter()
         .enumerate()
-        .map(|(i, &(t, _))| match estimator {
-            EdfModel::Greenhall(est) => edf::greenhall_edf(alpha[i], est, ms[t], n_phase),
-            EdfModel::Total => edf::totvar_edf(alpha[i], ms[t], n_samples),
-            EdfModel::ModifiedTotal => edf::mtotvar_edf(alpha[i], ms[t], n_samples),
-            EdfModel::Theo1 => edf::theo1_edf(alpha[i], ms[t], n_phase),
+        .map(|(i, &(t, _))| {
+            let (statistic, m) = plan[t];
+            match noise_model_of(statistic).1 {
+                EdfModel::Greenhall(est) => edf::greenhall_edf(alpha[i], est, m, n_phase),
+                EdfModel::Total => edf::totvar_edf(alpha[i], m, n_samples),
+                EdfModel::ModifiedTotal => edf::mtotvar_edf(alpha[i], m, n_samples),
+                EdfModel::Theo1 => edf::theo1_edf(alpha[i], m, n_phase),
+                EdfModel::TheoBR => theo::theobr_edf(alpha[i], m, n_phase),
+            }
         })
         .collect();
     Ok(Analysis {
@@ -180,6 +231,8 @@ enum EdfModel {
     ModifiedTotal,
     /// SP 1065 Theo1 formulas (Howe & Tasset).
     Theo1,
+    /// Theo1's EDF combined with the scatter of ThêoBR's bias ratio.
+    TheoBR,
 }
 
 /// Maximum differencing for noise identification and the EDF model.
@@ -221,6 +274,7 @@ fn noise_model_of(statistic: Statistic) -> (u32, EdfModel) {
         // lower bound (HTOT is OHVAR with extra, reflected terms) and exact at m = 1.
         Statistic::HadamardTotal => (3, EdfModel::Greenhall(ohvar)),
         Statistic::Theo1 => (2, EdfModel::Theo1),
+        Statistic::TheoBR => (2, EdfModel::TheoBR),
     }
 }
 
@@ -283,6 +337,25 @@ mod tests {
         let known = vec![true, true, true, false, false];
         fill_from_nearest(&mut alpha, &known, 0, 1, 5);
         assert_eq!(alpha, vec![-2, -2, -2, -2, -2]);
+    }
+
+    #[test]
+    fn a_plan_equals_its_statistics_run_alone() {
+        let y: Vec<f64> = (0..400).map(|k| ((k * 7919 + 13) % 101) as f64).collect();
+        let z: Vec<f64> = y.iter().rev().map(|v| v * v).collect();
+        let phases = column_phases(vec![y.iter().copied(), z.iter().copied()]).unwrap();
+        let oadev = Statistic::Allan { overlapping: true };
+        let plan = [(oadev, 1), (oadev, 8), (Statistic::TheoBR, 16)];
+        let mixed = analyse_plan(&phases, &plan).unwrap();
+        let avar = analyse(&phases, oadev, &[1, 8]).unwrap();
+        let theobr = analyse(&phases, Statistic::TheoBR, &[16]).unwrap();
+        assert_eq!(mixed.var[..4], avar.var[..]);
+        assert_eq!(mixed.edf[..4], avar.edf[..]);
+        assert_eq!(mixed.var[4..], theobr.var[..]);
+        assert_eq!(mixed.terms, vec![399, 385, 385 * 8]);
+        // The slow single-tau path gives the same ThêoBR.
+        let alone = Statistic::TheoBR.estimate(&phases[1], 16).var;
+        assert!((alone - mixed.var[5]).abs() <= 1e-14 * alone);
     }
 
     #[test]

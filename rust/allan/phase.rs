@@ -59,6 +59,29 @@ pub fn into_cumulative_phase(mut phase: Vec<f64>) -> CoreResult<Vec<f64>> {
     Ok(phase)
 }
 
+/// Mean and least-squares slope of f(t), t < count (slope about t = (count − 1)/2).
+/// The block expansions of the total family re-centre their data on this line.
+pub fn least_squares_line(f: impl Fn(usize) -> f64, count: usize) -> (f64, f64) {
+    let mut sum = Neumaier::new();
+    for t in 0..count {
+        sum.add(f(t));
+    }
+    let mean = sum.value() / count as f64;
+    let centre = (count as f64 - 1.0) / 2.0;
+    let (mut cov, mut var) = (Neumaier::new(), Neumaier::new());
+    for t in 0..count {
+        let dt = t as f64 - centre;
+        cov.add(dt * (f(t) - mean));
+        var.add(dt * dt);
+    }
+    let slope = if var.value() > 0.0 {
+        cov.value() / var.value()
+    } else {
+        0.0
+    };
+    (mean, slope)
+}
+
 /// Sum of a slice: blocks of 256 in eight plain lanes, blocks added with compensation.
 fn compensated_sum(values: &[f64]) -> f64 {
     let mut total = Neumaier::new();

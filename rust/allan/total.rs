@@ -27,7 +27,9 @@
 
 use rayon::prelude::*;
 
+use super::reflected::{reflected_sum, DIRECT_BELOW};
 use super::sum::Neumaier;
+use super::theo1;
 
 /// Subsequences per parallel work item: large enough to amortise the scratch
 /// buffer, small enough to balance two to sixteen threads.
@@ -130,7 +132,11 @@ pub fn mtot_var(c: &[f64], m: usize) -> f64 {
         }
         reflected_second_differences(zp, m, p)
     };
-    let total = sum_over_subsequences(terms, m, 15 * m, inner);
+    let total = if m < DIRECT_BELOW {
+        sum_over_subsequences(terms, m, 15 * m, inner)
+    } else {
+        reflected_sum(|k| c[k], n, m)
+    };
     let mf = m as f64;
     total / (12.0 * mf.powi(5) * terms as f64)
 }
@@ -155,7 +161,11 @@ pub fn htot_var(c: &[f64], m: usize) -> f64 {
         }
         reflected_second_differences(zp, m, p)
     };
-    let total = sum_over_subsequences(terms, m, 15 * m, inner);
+    let total = if m < DIRECT_BELOW {
+        sum_over_subsequences(terms, m, 15 * m, inner)
+    } else {
+        reflected_sum(|k| c[k + 1] - c[k], n, m)
+    };
     let mf = m as f64;
     total / (36.0 * mf.powi(3) * terms as f64)
 }
@@ -187,8 +197,12 @@ pub fn theo1_var(c: &[f64], m: usize) -> f64 {
         }
         lanes.iter().sum::<f64>()
     };
-    // Scratch buffers are unused here: ask for the smallest.
-    let total = sum_over_subsequences(outer, 0, h.max(1), inner);
+    let total = if m < theo1::DIRECT_BELOW {
+        // Scratch buffers are unused here: ask for the smallest.
+        sum_over_subsequences(outer, 0, h.max(1), inner)
+    } else {
+        theo1::theo1_sum(c, m)
+    };
     let mf = m as f64;
     total / (0.75 * outer as f64 * mf * mf)
 }

@@ -5,6 +5,7 @@
 
 use super::blocked::Difference;
 use super::sum::{sum_of_squared_combinations, sum_of_squares, Neumaier};
+use super::theo;
 use super::total;
 
 /// A variance estimate and the number of terms it averages.
@@ -38,6 +39,9 @@ pub enum Statistic {
     HadamardTotal,
     /// Theo1 (SP 1065 eq. 30), even m only; effective τ = 0.75·m·τ0.
     Theo1,
+    /// ThêoBR (SP 1065 §5.2.15): Theo1 times the data's AVAR/Theo1 bias ratio
+    /// (`theo::bias_ratio`); even 10 ≤ m < N and N ≥ 90 phase points.
+    TheoBR,
 }
 
 impl Statistic {
@@ -88,6 +92,15 @@ impl Statistic {
                     0
                 }
             }
+            // Theo1's terms, over SP 1065's range 10 ≤ m ≤ N − 1, where the bias
+            // ratio exists.
+            Statistic::TheoBR => {
+                if m >= 10 && theo::ratio_count(n_phase).is_some() {
+                    Statistic::Theo1.terms(n_phase, m)
+                } else {
+                    0
+                }
+            }
         }
     }
 
@@ -95,7 +108,7 @@ impl Statistic {
     /// for Theo1 whose estimate belongs to τ = 0.75·m·τ0.
     pub fn noise_id_factor(self, m: usize) -> usize {
         match self {
-            Statistic::Theo1 => ((3 * m) / 4).max(1),
+            Statistic::Theo1 | Statistic::TheoBR => ((3 * m) / 4).max(1),
             _ => m,
         }
     }
@@ -170,6 +183,12 @@ impl Statistic {
             }
             Statistic::HadamardTotal => total::htot_var(c, m),
             Statistic::Theo1 => total::theo1_var(c, m),
+            // One tau alone pays for the whole bias ratio; `analyse` computes the
+            // ratio once per channel instead.
+            Statistic::TheoBR => match theo::bias_ratio(c) {
+                Some(ratio) => ratio * total::theo1_var(c, m),
+                None => return Estimate::EMPTY,
+            },
         };
         Estimate { var, terms }
     }

@@ -18,10 +18,11 @@ fn parse_statistic(name: &str) -> PyResult<Statistic> {
         "mtotdev" => Statistic::ModifiedTotal,
         "htotdev" => Statistic::HadamardTotal,
         "theo1" => Statistic::Theo1,
+        "theobr" => Statistic::TheoBR,
         other => {
             return Err(PyValueError::new_err(format!(
                 "statistic must be one of adev, oadev, mdev, hdev, ohdev, totdev, mtotdev, \
-                 htotdev, theo1; got {other:?}"
+                 htotdev, theo1, theobr; got {other:?}"
             )))
         }
     })
@@ -47,8 +48,45 @@ fn analyse<'py>(
     ms: PyReadonlyArray1<'py, u64>,
 ) -> PyResult<AnalysisArrays<'py>> {
     let statistic = parse_statistic(statistic)?;
+    let plan: Vec<(Statistic, usize)> = ms
+        .as_array()
+        .iter()
+        .map(|&m| (statistic, m as usize))
+        .collect();
+    run_plan(py, x, plan)
+}
+
+/// analyse_plan(x, statistics, ms) -> as `analyse`, with one statistic per tau
+/// (`statistics[t]` at `ms[t]`; ThêoH is oadev then theobr, ordered by tau).
+#[pyfunction]
+fn analyse_plan<'py>(
+    py: Python<'py>,
+    x: PyReadonlyArray2<'py, f64>,
+    statistics: Vec<String>,
+    ms: PyReadonlyArray1<'py, u64>,
+) -> PyResult<AnalysisArrays<'py>> {
+    let ms = ms.as_array();
+    if statistics.len() != ms.len() {
+        return Err(PyValueError::new_err(format!(
+            "statistics and ms must have the same length; got {} and {}",
+            statistics.len(),
+            ms.len()
+        )));
+    }
+    let plan = statistics
+        .iter()
+        .zip(ms.iter())
+        .map(|(s, &m)| Ok((parse_statistic(s)?, m as usize)))
+        .collect::<PyResult<Vec<_>>>()?;
+    run_plan(py, x, plan)
+}
+
+fn run_plan<'py>(
+    py: Python<'py>,
+    x: PyReadonlyArray2<'py, f64>,
+    plan: Vec<(Statistic, usize)>,
+) -> PyResult<AnalysisArrays<'py>> {
     let view = x.as_array();
-    let ms: Vec<usize> = ms.as_array().iter().map(|&m| m as usize).collect();
     let result = py.detach(|| {
         // A C-ordered array with several channels is scattered row by row in one
         // pass; anything else (one channel, Fortran order, strided views) is
@@ -64,9 +102,9 @@ fn analyse<'py>(
                 allan::column_phases(columns)?
             }
         };
-        allan::analyse(&phases, statistic, &ms)
+        allan::analyse_plan(&phases, &plan)
     })?;
-    let shape = (ms.len(), result.channels);
+    let shape = (plan.len(), result.channels);
     let reshape_err = |e: numpy::ndarray::ShapeError| PyValueError::new_err(e.to_string());
     let to2 = |v: Vec<f64>| numpy::ndarray::Array2::from_shape_vec(shape, v).map_err(reshape_err);
     let var = to2(result.var)?.into_pyarray(py);
@@ -79,6 +117,13 @@ fn analyse<'py>(
         .into_pyarray(py);
     let terms: Vec<u64> = result.terms.iter().map(|&t| t as u64).collect();
     Ok((var, terms.into_pyarray(py), alpha, identified, edf))
+}
+
+/// theobr_work(n_phase, ms) -> (direct steps, fast units) of ThêoBR's bias ratio and
+/// Theo1 at `ms`, per channel (see `allan::theo::theo1_work`)
+#[pyfunction]
+fn theobr_work(n_phase: usize, ms: Vec<usize>) -> (f64, f64) {
+    allan::theo::theobr_work(n_phase, &ms)
 }
 
 /// estimator_terms(statistic, n_phase, ms) -> terms per averaging factor (0: does not fit)
@@ -101,5 +146,7 @@ fn estimator_terms<'py>(
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(analyse, m)?)?;
     m.add_function(wrap_pyfunction!(estimator_terms, m)?)?;
+    m.add_function(wrap_pyfunction!(analyse_plan, m)?)?;
+    m.add_function(wrap_pyfunction!(theobr_work, m)?)?;
     Ok(())
 }
