@@ -7,6 +7,7 @@
 pub mod allan;
 pub mod error;
 pub mod fit;
+mod memory;
 pub mod vn;
 
 #[cfg(feature = "python")]

@@ -58,7 +58,14 @@ pub fn row_major_phases(data: &[f64], channels: usize) -> CoreResult<Vec<Vec<f64
         )));
     }
     let n = data.len() / channels;
-    let mut phases: Vec<Vec<f64>> = (0..channels).map(|_| vec![0.0; n + 1]).collect();
+    let mut phases: Vec<Vec<f64>> = (0..channels)
+        .map(|_| {
+            let mut phase = Vec::with_capacity(n + 1);
+            crate::memory::advise_huge_pages(&phase);
+            phase.resize(n + 1, 0.0);
+            phase
+        })
+        .collect();
     for (i, row) in data.chunks_exact(channels).enumerate() {
         for (phase, &value) in phases.iter_mut().zip(row) {
             phase[i + 1] = value;

@@ -5,6 +5,8 @@
 //! offset (9.81 m/s² on an accelerometer z axis) costs no digits, and both the
 //! mean and the running sum use compensated summation.
 
+use rayon::prelude::*;
+
 use super::sum::Neumaier;
 use crate::error::{CoreError, CoreResult};
 
@@ -24,13 +26,24 @@ where
     I: Iterator<Item = f64>,
 {
     let mut phase = Vec::with_capacity(samples.size_hint().0 + 1);
+    crate::memory::advise_huge_pages(&phase);
     phase.push(0.0);
     phase.extend(samples);
     phase
 }
 
+/// Samples per chunk of the parallel passes. Fixed (not derived from the thread
+/// count), so the result is the same on any machine; a record of one chunk is
+/// transformed exactly as by a single sequential pass.
+const CHUNK: usize = 1 << 16;
+
 /// The same transformation for samples already gathered behind a leading slot:
 /// `phase[0]` is overwritten with 0 and `phase[1..]` holds y_0 … y_{n−1}.
+///
+/// Long records use all cores: chunk totals of the mean-removed samples are
+/// accumulated with two-sum in parallel, their prefix gives each chunk its
+/// starting (sum, error) pair, and the chunks then run the same compensated
+/// running sum in parallel.
 pub fn into_cumulative_phase(mut phase: Vec<f64>) -> CoreResult<Vec<f64>> {
     let n = phase.len().saturating_sub(1);
     if n == 0 {
@@ -43,20 +56,55 @@ pub fn into_cumulative_phase(mut phase: Vec<f64>) -> CoreResult<Vec<f64>> {
         )));
     }
     phase[0] = 0.0;
-    let mean = compensated_sum(&phase[1..]) / n as f64;
-    // Knuth's branch-free two-sum keeps the rounding error of every addition; the
-    // running sum and its error term form two independent dependency chains.
-    let mut sum = 0.0f64;
-    let mut comp = 0.0f64;
-    for value in phase[1..].iter_mut() {
-        let v = *value - mean;
-        let t = sum + v;
-        let bp = t - sum;
-        comp += (sum - (t - bp)) + (v - bp);
-        sum = t;
-        *value = sum + comp;
+    let chunk_sums: Vec<f64> = phase[1..].par_chunks(CHUNK).map(compensated_sum).collect();
+    let mut total = Neumaier::new();
+    for s in chunk_sums {
+        total.add(s);
     }
+    let mean = total.value() / n as f64;
+    // Each chunk's total as (sum, error), then the running pair at each chunk start.
+    let totals: Vec<(f64, f64)> = phase[1..]
+        .par_chunks(CHUNK)
+        .map(|chunk| {
+            chunk
+                .iter()
+                .fold((0.0, 0.0), |acc, &v| compensated_step(acc, v - mean))
+        })
+        .collect();
+    let mut starts = Vec::with_capacity(totals.len());
+    let mut at = (0.0f64, 0.0f64);
+    for (sum, comp) in totals {
+        starts.push(at);
+        let (t, err) = two_sum(at.0, sum);
+        at = (t, at.1 + err + comp);
+    }
+    phase[1..]
+        .par_chunks_mut(CHUNK)
+        .zip(starts)
+        .for_each(|(chunk, start)| {
+            let mut acc = start;
+            for value in chunk.iter_mut() {
+                acc = compensated_step(acc, *value - mean);
+                *value = acc.0 + acc.1;
+            }
+        });
     Ok(phase)
+}
+
+/// Knuth's branch-free two-sum: a + b = t + err exactly.
+#[inline(always)]
+fn two_sum(a: f64, b: f64) -> (f64, f64) {
+    let t = a + b;
+    let bp = t - a;
+    (t, (a - (t - bp)) + (b - bp))
+}
+
+/// One step of the compensated running sum: the sum and the accumulated rounding
+/// errors form two independent dependency chains.
+#[inline(always)]
+fn compensated_step((sum, comp): (f64, f64), v: f64) -> (f64, f64) {
+    let (t, err) = two_sum(sum, v);
+    (t, comp + err)
 }
 
 /// Mean and least-squares slope of f(t), t < count (slope about t = (count − 1)/2).

@@ -1011,7 +1011,7 @@ pub fn parse_reader_with<R: Read + Send>(
     let mut cur: Vec<u8> = Vec::with_capacity(GAP + chunk);
     let mut next: Vec<u8> = Vec::with_capacity(GAP + chunk);
     for b in [&mut cur, &mut next] {
-        crate::vn::advise_huge_pages(b);
+        crate::memory::advise_huge_pages(b);
         b.resize(GAP, 0);
     }
     let (mut got, mut eof) = fill(&mut reader, &mut cur, chunk)?;
