@@ -1,4 +1,5 @@
-//! Deterministic test signals for the Allan kernels' unit tests.
+//! Deterministic test signals and reference transcriptions for the Allan kernels'
+//! unit tests.
 
 /// Uniform noise in [−0.5, 0.5) from a 64-bit LCG (reproducible, no dependency).
 pub fn noise(n: usize, seed: u64) -> Vec<f64> {
@@ -22,4 +23,19 @@ pub fn integrate(v: &[f64]) -> Vec<f64> {
             run
         })
         .collect()
+}
+
+/// Theo1 variance by its definition (SP 1065 eq. 30) on phase values x, as
+/// allantools computes it: the reference the kernels are checked against.
+pub fn naive_theo1(x: &[f64], m: usize) -> f64 {
+    let n = x.len();
+    let h = m / 2;
+    let mut s = 0.0;
+    for i in 0..n - m {
+        for d in 0..h {
+            let a = x[i] - x[i + h - d] + x[i + m] - x[i + d + h];
+            s += a * a / (h - d) as f64;
+        }
+    }
+    s / (0.75 * (n - m) as f64 * (m * m) as f64)
 }

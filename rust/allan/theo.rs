@@ -141,6 +141,7 @@ pub fn theobr_work(n_phase: usize, ms: &[usize]) -> (f64, f64) {
 mod tests {
     use super::*;
     use crate::allan::phase::cumulative_phase;
+    use crate::allan::test_signals::naive_theo1;
 
     /// Direct transcriptions of the definitions on phase values.
     fn naive_oavar(x: &[f64], m: usize) -> f64 {
@@ -149,19 +150,6 @@ mod tests {
             .map(|i| (x[i + 2 * m] - 2.0 * x[i + m] + x[i]).powi(2))
             .sum();
         s / (2.0 * (m * m) as f64 * (n - 2 * m) as f64)
-    }
-
-    fn naive_theo1(x: &[f64], m: usize) -> f64 {
-        let n = x.len();
-        let h = m / 2;
-        let mut s = 0.0;
-        for i in 0..n - m {
-            for d in 0..h {
-                let a = x[i] - x[i + h - d] + x[i + m] - x[i + d + h];
-                s += a * a / (h - d) as f64;
-            }
-        }
-        s / (0.75 * (n - m) as f64 * (m * m) as f64)
     }
 
     fn sample(n: usize) -> Vec<f64> {

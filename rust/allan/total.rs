@@ -211,6 +211,7 @@ pub fn theo1_var(c: &[f64], m: usize) -> f64 {
 mod tests {
     use super::*;
     use crate::allan::phase::cumulative_phase;
+    use crate::allan::test_signals::naive_theo1;
 
     /// Direct transcription of the definitions (as allantools computes them),
     /// on phase values, without any of the tricks above.
@@ -242,19 +243,6 @@ mod tests {
             dev += s / (6 * m) as f64;
         }
         dev / (2.0 * (m * m) as f64 * (n + 1 - l) as f64)
-    }
-
-    fn naive_theo1(x: &[f64], m: usize) -> f64 {
-        let n = x.len();
-        let h = m / 2;
-        let mut s = 0.0;
-        for i in 0..n - m {
-            for d in 0..h {
-                let a = x[i] - x[i + h - d] + x[i + m] - x[i + d + h];
-                s += a * a / (h - d) as f64;
-            }
-        }
-        s / (0.75 * (n - m) as f64 * (m * m) as f64)
     }
 
     fn sample() -> Vec<f64> {
