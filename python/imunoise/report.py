@@ -282,10 +282,8 @@ class _Progress:
             enabled = sys.stderr.isatty()
         self.bar = None
         if enabled:
-            try:
-                from tqdm import tqdm
-            except ImportError:  # pragma: no cover - tqdm is optional
-                return
+            from tqdm import tqdm
+
             self.bar = tqdm(total=total, file=sys.stderr, unit="step", leave=False)
 
     def step(self, what: str) -> None:

@@ -792,10 +792,8 @@ def _bar(enabled: bool | None, total: int):
         enabled = sys.stderr.isatty()
     if not enabled:
         return None
-    try:
-        from tqdm import tqdm
-    except ImportError:  # pragma: no cover - tqdm is optional
-        return None
+    from tqdm import tqdm
+
     return tqdm(total=total, file=sys.stderr, unit="log", desc="imunoise batch")
 
 
