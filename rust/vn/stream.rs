@@ -1150,15 +1150,21 @@ $VNERR,12*72\r\n";
         assert!(accounted(&d, s.len()));
     }
 
-    #[test]
-    fn chunked_reader_equals_whole() {
+    /// `records` ASCII sentences with a binary packet before every `every`-th one.
+    fn interleaved(records: usize, every: usize) -> Vec<u8> {
         let mut s = Vec::new();
-        for k in 0..5000 {
-            if k % 7 == 0 {
+        for k in 0..records {
+            if k % every == 0 {
                 s.extend_from_slice(&B1);
             }
             s.extend_from_slice(A1);
         }
+        s
+    }
+
+    #[test]
+    fn chunked_reader_equals_whole() {
+        let s = interleaved(5000, 7);
         let whole = parse_bytes(&s, false).unwrap();
         struct Slow<'a>(&'a [u8], usize);
         impl std::io::Read for Slow<'_> {
@@ -1182,13 +1188,7 @@ $VNERR,12*72\r\n";
 
     #[test]
     fn prefixes_add_up_to_the_whole() {
-        let mut s = Vec::new();
-        for k in 0..3000 {
-            if k % 5 == 0 {
-                s.extend_from_slice(&B1);
-            }
-            s.extend_from_slice(A1);
-        }
+        let s = interleaved(3000, 5);
         let whole = parse_bytes(&s, false).unwrap();
         for piece in [61usize, 1000, 4096] {
             let (mut pos, mut rows, mut packets, mut total) = (0usize, 0usize, 0u64, 0u64);
