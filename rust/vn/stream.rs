@@ -1150,6 +1150,22 @@ $VNERR,12*72\r\n";
         assert!(accounted(&d, s.len()));
     }
 
+    /// Mutates `s` by (position, byte, operation) edits: 0 inserts the byte, 1
+    /// removes one, 2 overwrites one (positions wrap around the current length).
+    fn apply_edits(s: &mut Vec<u8>, edits: &[(u16, u8, u8)]) {
+        for &(pos, byte, op) in edits {
+            let i = pos as usize % (s.len() + 1);
+            match op {
+                0 => s.insert(i, byte),
+                1 if i < s.len() => {
+                    s.remove(i);
+                }
+                _ if i < s.len() => s[i] = byte,
+                _ => {}
+            }
+        }
+    }
+
     /// `records` ASCII sentences with a binary packet before every `every`-th one.
     fn interleaved(records: usize, every: usize) -> Vec<u8> {
         let mut s = Vec::new();
@@ -1381,15 +1397,7 @@ $VNERR,12*72\r\n";
                     _ => s.extend_from_slice(b"\xfa\x01noise\n"),
                 }
             }
-            for (pos, byte, op) in edits {
-                let i = pos as usize % (s.len() + 1);
-                match op {
-                    0 => s.insert(i, byte),
-                    1 if i < s.len() => { s.remove(i); }
-                    _ if i < s.len() => s[i] = byte,
-                    _ => {}
-                }
-            }
+            apply_edits(&mut s, &edits);
             let text = |d: CoreResult<VnData>| match d {
                 Ok(d) => format!("{d:?}"),
                 Err(e) => e.to_string(),
@@ -1465,15 +1473,7 @@ $VNERR,12*72\r\n";
                 s.extend_from_slice(A1);
                 s.extend_from_slice(&B1);
             }
-            for (pos, byte, op) in edits {
-                let i = pos as usize % (s.len() + 1);
-                match op {
-                    0 => s.insert(i, byte),
-                    1 if i < s.len() => { s.remove(i); }
-                    _ if i < s.len() => s[i] = byte,
-                    _ => {}
-                }
-            }
+            apply_edits(&mut s, &edits);
             let d = parse_bytes(&s, false).unwrap();
             prop_assert!(accounted(&d, s.len()));
             let _ = parse_bytes(&s, true);
