@@ -95,20 +95,30 @@ def write_vn_binary(
     selection: list[tuple[int, int]], columns: dict[str, npt.NDArray[np.float64]]
 ) -> bytes:
     """Binary packets for ``selection`` from columns named as in vn_binary_columns."""
-def fit_wls(
+
+def fit_noise(
     taus: npt.NDArray[np.float64],
     var: npt.NDArray[np.float64],
     edf: npt.NDArray[np.float64],
+    fs: float,
     terms: list[bool],
-    reweight: int = 3,
-    min_share: float = 0.25,
-    min_z: float = 2.0,
+    gm: int = 3,
+    select: bool = True,
 ) -> tuple[
     npt.NDArray[np.float64],  # (Q², N², B², K², R²)
-    npt.NDArray[np.float64],  # (5, 5) covariance of the squares
-    npt.NDArray[np.bool_],  # supported
-    float,  # chi2
-    int,  # dof
+    npt.NDArray[np.float64],  # (k, 2): (q², τc) per Gauss–Markov term
+    npt.NDArray[np.float64],  # (11, 11) covariance of (Q²…R², then q², ln τc per GM term)
+    float,  # discrepancy δ
+    float,  # chi2 (sampling variance only, octave-weighted)
+    float,  # n_eff (octaves of evidence)
+    int,  # free parameters
+    float,  # BIC
 ]:
-    """(Q², N², B², K², R²), their (5, 5) covariance, supported flags, χ², dof of
-    the EDF-weighted NNLS noise-model fit of one channel."""
+    """Log-space, octave-weighted fit of the noise model (IEEE terms and up to
+    ``gm`` Gauss–Markov terms) to one channel; structure chosen by BIC when
+    ``select``."""
+
+def noise_terms(
+    taus: npt.NDArray[np.float64], fs: float, ieee: list[float], gm: list[tuple[float, float]]
+) -> npt.NDArray[np.float64]:
+    """Allan variance of each model term at ``taus``: (len(taus), 5 + len(gm))."""

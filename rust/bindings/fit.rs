@@ -1,68 +1,113 @@
 //! Bindings for the noise-model fit: one channel per call (the problem has one
-//! row per tau, so the cost is negligible next to the Allan computation).
+//! row per tau, so it is small next to the Allan computation), and the model's
+//! per-term curves for plots and predictions.
 
+use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
-use crate::fit::{self, FitOptions, TERMS};
+use crate::fit::{self, Options, IEEE_TERMS, PARAMETERS};
 
-type FitArrays<'py> = (
+/// (ieee, gm, cov, discrepancy, chi2, n_eff, parameters, bic)
+type FitTuple<'py> = (
     Bound<'py, PyArray1<f64>>,
     Bound<'py, PyArray2<f64>>,
-    Bound<'py, PyArray1<bool>>,
+    Bound<'py, PyArray2<f64>>,
+    f64,
+    f64,
     f64,
     usize,
+    f64,
 );
 
-/// fit_wls(taus, var, edf, terms, reweight, min_share, min_z) -> (coef, cov, supported, chi2, dof)
+fn ieee_flags(terms: &[bool]) -> PyResult<[bool; IEEE_TERMS]> {
+    if terms.len() != IEEE_TERMS {
+        return Err(PyValueError::new_err(format!(
+            "terms must have {IEEE_TERMS} flags (Q, N, B, K, R); got {}",
+            terms.len()
+        )));
+    }
+    let mut mask = [false; IEEE_TERMS];
+    mask.copy_from_slice(terms);
+    Ok(mask)
+}
+
+fn to_matrix(rows: Vec<Vec<f64>>, cols: usize) -> PyResult<Array2<f64>> {
+    let n = rows.len();
+    Array2::from_shape_vec((n, cols), rows.into_iter().flatten().collect())
+        .map_err(|e| PyValueError::new_err(e.to_string()))
+}
+
+/// fit_noise(taus, var, edf, fs, terms, gm, select) -> (ieee, gm, cov, discrepancy, chi2, n_eff, parameters, bic)
 ///
-/// `coef` holds (Q², N², B², K², R²), `cov` their 5 × 5 covariance.
+/// `ieee` holds (Q², N², B², K², R²); `gm` is (k, 2) rows of (q², τc); `cov`
+/// the PARAMETERS × PARAMETERS covariance of (Q²…R², then q², ln τc per term).
 #[pyfunction]
 #[allow(clippy::too_many_arguments)] // mirrors the Python keyword arguments
-#[pyo3(signature = (taus, var, edf, terms, reweight=3, min_share=0.25, min_z=2.0))]
-fn fit_wls<'py>(
+#[pyo3(signature = (taus, var, edf, fs, terms, gm=3, select=true))]
+fn fit_noise<'py>(
     py: Python<'py>,
     taus: PyReadonlyArray1<'py, f64>,
     var: PyReadonlyArray1<'py, f64>,
     edf: PyReadonlyArray1<'py, f64>,
+    fs: f64,
     terms: Vec<bool>,
-    reweight: usize,
-    min_share: f64,
-    min_z: f64,
-) -> PyResult<FitArrays<'py>> {
-    if terms.len() != TERMS {
-        return Err(PyValueError::new_err(format!(
-            "terms must have {TERMS} flags (Q, N, B, K, R); got {}",
-            terms.len()
-        )));
-    }
-    let mut mask = [false; TERMS];
-    mask.copy_from_slice(&terms);
-    let opts = FitOptions {
-        terms: mask,
-        reweight,
-        min_share,
-        min_z,
+    gm: usize,
+    select: bool,
+) -> PyResult<FitTuple<'py>> {
+    let opts = Options {
+        ieee: ieee_flags(&terms)?,
+        gm,
+        select,
     };
-    let taus: Vec<f64> = taus.as_array().iter().copied().collect();
-    let var: Vec<f64> = var.as_array().iter().copied().collect();
-    let edf: Vec<f64> = edf.as_array().iter().copied().collect();
-    let result = py.detach(|| fit::fit_wls(&taus, &var, &edf, &opts))?;
-    let cov: Vec<f64> = result.cov.iter().flatten().copied().collect();
-    let cov = numpy::ndarray::Array2::from_shape_vec((TERMS, TERMS), cov)
-        .map_err(|e| PyValueError::new_err(e.to_string()))?
-        .into_pyarray(py);
+    let taus = taus.as_array().to_vec();
+    let var = var.as_array().to_vec();
+    let edf = edf.as_array().to_vec();
+    let r = py.detach(|| fit::fit_noise(&taus, &var, &edf, fs, &opts))?;
+    let gm_rows: Vec<Vec<f64>> = r.gm.iter().map(|&(q2, tc)| vec![q2, tc]).collect();
     Ok((
-        result.coef.to_vec().into_pyarray(py),
-        cov,
-        result.supported.to_vec().into_pyarray(py),
-        result.chi2,
-        result.dof,
+        r.ieee.to_vec().into_pyarray(py),
+        to_matrix(gm_rows, 2)?.into_pyarray(py),
+        to_matrix(r.cov, PARAMETERS)?.into_pyarray(py),
+        r.discrepancy,
+        r.chi2,
+        r.n_eff,
+        r.parameters,
+        r.bic,
     ))
 }
 
+/// noise_terms(taus, fs, ieee, gm) -> (len(taus), 5 + k) Allan variance of each term
+#[pyfunction]
+fn noise_terms<'py>(
+    py: Python<'py>,
+    taus: PyReadonlyArray1<'py, f64>,
+    fs: f64,
+    ieee: Vec<f64>,
+    gm: Vec<(f64, f64)>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    if ieee.len() != IEEE_TERMS {
+        return Err(PyValueError::new_err(format!(
+            "ieee must have {IEEE_TERMS} values (Q², N², B², K², R²); got {}",
+            ieee.len()
+        )));
+    }
+    if !(fs.is_finite() && fs > 0.0) {
+        return Err(PyValueError::new_err(format!(
+            "fs must be finite and > 0; got {fs}"
+        )));
+    }
+    let mut coef = [0.0; IEEE_TERMS];
+    coef.copy_from_slice(&ieee);
+    let cols = IEEE_TERMS + gm.len();
+    let taus = taus.as_array().to_vec();
+    let rows = fit::terms(&taus, fs, &coef, &gm);
+    Ok(to_matrix(rows, cols)?.into_pyarray(py))
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    m.add_function(wrap_pyfunction!(fit_wls, m)?)?;
+    m.add_function(wrap_pyfunction!(fit_noise, m)?)?;
+    m.add_function(wrap_pyfunction!(noise_terms, m)?)?;
     Ok(())
 }

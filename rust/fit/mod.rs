@@ -1,0 +1,400 @@
+//! The noise model of an inertial sensor, fitted to its Allan variance.
+//!
+//! ```text
+//! σ²(τ) = 3Q²/τ² + N²/τ + (2 ln2/π)·B² + K²τ/3 + R²τ²/2 + Σₖ qₖ²·g(τ; τcₖ)
+//! ```
+//!
+//! the IEEE Std 952 / 1293 terms plus up to two first-order Gauss–Markov bias
+//! terms of variance qₖ² and correlation time τcₖ (up to three: a MEMS sensor's
+//! own filter, a bump of correlated bias, and slow wander) (`basis`). The estimator
+//! (`estimate`) is a weighted least-squares fit of ln σ̂² with weights from the
+//! EDF, the share of an octave each tau stands for, and a model-discrepancy
+//! variance fitted by maximum likelihood; the structure (`search`) is chosen by
+//! BIC, the correlation times by grid and golden-section search (variable
+//! projection). The covariance of the parameters is the inverse Fisher
+//! information of that loss, (JᵀWJ)⁻¹, in the variances and ln τc.
+//!
+//! References: IEEE Std 952-1997, Annex C; Guerrier, Skaloud, Stebler,
+//! Victoria-Feser, "Wavelet-variance-based estimation for composite stochastic
+//! processes", JASA 108 (2013) (the AR1 moments and why taus are not
+//! independent); Paule & Mandel (1982) for a fitted between-"study" variance;
+//! Lawson & Hanson (1974) for NNLS.
+
+pub mod basis;
+pub mod estimate;
+pub mod nnls;
+pub mod search;
+pub mod special;
+
+pub use basis::{FLICKER_FACTOR, IEEE_TERMS};
+
+use crate::error::{CoreError, CoreResult};
+use estimate::Data;
+use search::Candidate;
+
+/// Most Gauss–Markov terms a model may have.
+pub const MAX_GM: usize = 3;
+
+/// Slots of the parameter covariance: Q², N², B², K², R², then (q², ln τc) per
+/// Gauss–Markov term.
+pub const PARAMETERS: usize = IEEE_TERMS + 2 * MAX_GM;
+
+/// What [`fit_noise`] may use.
+#[derive(Debug, Clone, Copy)]
+pub struct Options {
+    /// Which of Q, N, B, K, R may enter the model.
+    pub ieee: [bool; IEEE_TERMS],
+    /// Gauss–Markov terms: the most allowed (`select`) or the exact number.
+    pub gm: usize,
+    /// Choose the structure by BIC (`true`), or fit exactly the terms given.
+    pub select: bool,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Options {
+            ieee: [true; IEEE_TERMS],
+            gm: MAX_GM,
+            select: true,
+        }
+    }
+}
+
+/// One channel's fitted model.
+#[derive(Debug, Clone, PartialEq)]
+pub struct NoiseFit {
+    /// (Q², N², B², K², R²), each ≥ 0 (0: not in the model).
+    pub ieee: [f64; IEEE_TERMS],
+    /// Variance q² and correlation time τc (s) of each Gauss–Markov term in the
+    /// model, by increasing τc.
+    pub gm: Vec<(f64, f64)>,
+    /// Covariance over [`PARAMETERS`] slots (0 for parameters not in the model).
+    pub cov: Vec<Vec<f64>>,
+    /// Model discrepancy δ: relative standard deviation of the Allan variance
+    /// that the model does not explain beyond the estimates' own scatter.
+    pub discrepancy: f64,
+    /// Σ ωᵢ rᵢ²/vᵢ: the weighted residual sum with the sampling variance alone.
+    pub chi2: f64,
+    /// Σ ωᵢ: octaves of independent evidence.
+    pub n_eff: f64,
+    /// Free parameters of the model.
+    pub parameters: usize,
+    /// Bayesian information criterion of the chosen structure.
+    pub bic: f64,
+}
+
+/// Fit one channel: `taus` (s, increasing), `var` (σ̂² > 0) and `edf` (> 0) per
+/// tau, `fs` the sample rate of the data behind them.
+pub fn fit_noise(
+    taus: &[f64],
+    var: &[f64],
+    edf: &[f64],
+    fs: f64,
+    opts: &Options,
+) -> CoreResult<NoiseFit> {
+    if opts.gm > MAX_GM {
+        return Err(CoreError::InvalidArgument(format!(
+            "at most {MAX_GM} Gauss-Markov terms; got {}",
+            opts.gm
+        )));
+    }
+    let data = Data::new(taus, var, edf, fs)?;
+    let chosen = if opts.select {
+        let best = search::select(&data, fs, opts.ieee, opts.gm)?;
+        prune_insignificant(&data, fs, best)?
+    } else {
+        let base = search::fit_structure(&data, fs, opts.ieee, 0, 0.0)?;
+        if opts.gm == 0 {
+            base
+        } else {
+            search::fit_structure(&data, fs, opts.ieee, opts.gm, base.solution.d2)?
+        }
+    };
+    Ok(summarise(&data, fs, &chosen))
+}
+
+/// Smallest z = variance / standard uncertainty a selected term may have.
+const MIN_Z: f64 = 2.0;
+
+/// Remove, one at a time, the selected term whose variance is least
+/// distinguishable from 0 while any is below [`MIN_Z`]: BIC weighs the fit, this
+/// makes every reported term one that the data constrain.
+fn prune_insignificant(data: &Data, fs: f64, mut best: Candidate) -> CoreResult<Candidate> {
+    // The last term always stays: a model of nothing describes nothing.
+    loop {
+        let fit = summarise(data, fs, &best);
+        // A Gauss–Markov term goes before any IEEE term: where the two explain
+        // the same part of the curve (a fast one looks white, a slow one like a
+        // walk), the datasheet term is the one to keep.
+        let z = |slot: usize, value: f64| value / fit.cov[slot][slot].sqrt();
+        let weakest_of = |slots: Vec<(usize, f64)>| {
+            slots
+                .into_iter()
+                .map(|(slot, v)| (slot, z(slot, v)))
+                .filter(|(_, z)| z.is_finite() && *z < MIN_Z)
+                .min_by(|a, b| a.1.total_cmp(&b.1))
+        };
+        let gm_slots = fit
+            .gm
+            .iter()
+            .enumerate()
+            .map(|(k, g)| (IEEE_TERMS + 2 * k, g.0))
+            .collect();
+        let ieee_slots = (0..IEEE_TERMS)
+            .filter(|&j| fit.ieee[j] > 0.0)
+            .map(|j| (j, fit.ieee[j]))
+            .collect();
+        let weakest = weakest_of(gm_slots).or_else(|| weakest_of(ieee_slots));
+        let active = fit.ieee.iter().filter(|v| **v > 0.0).count() + fit.gm.len();
+        let Some((slot, _)) = weakest.filter(|_| active > 1) else {
+            return Ok(best);
+        };
+        let mut ieee = best.ieee;
+        let mut times: Vec<f64> = fit.gm.iter().map(|g| g.1).collect();
+        if slot < IEEE_TERMS {
+            ieee[slot] = false;
+        } else {
+            times.remove((slot - IEEE_TERMS) / 2);
+        }
+        match search::refit(data, fs, ieee, times, best.solution.d2) {
+            Ok(next) => best = next,
+            Err(_) => return Ok(best),
+        }
+    }
+}
+
+fn summarise(data: &Data, fs: f64, c: &Candidate) -> NoiseFit {
+    let theta = &c.solution.theta;
+    let mut ieee = [0.0; IEEE_TERMS];
+    ieee.copy_from_slice(&theta[..IEEE_TERMS]);
+    let gm: Vec<(f64, f64)> = c
+        .gm_tau
+        .iter()
+        .enumerate()
+        .filter(|(k, _)| theta[IEEE_TERMS + k] > 0.0)
+        .map(|(k, &t)| (theta[IEEE_TERMS + k], t))
+        .collect();
+    let chi2 = (0..data.len())
+        .map(|i| data.omega[i] * (data.y[i] - c.solution.model[i].ln()).powi(2) / data.v[i])
+        .sum();
+    NoiseFit {
+        cov: covariance(data, fs, &ieee, &gm, c.solution.d2),
+        ieee,
+        gm,
+        discrepancy: c.solution.d2.sqrt(),
+        chi2,
+        n_eff: data.n_eff(),
+        parameters: search::parameters(theta),
+        bic: c.bic,
+    }
+}
+
+/// Model Allan variance of every term at `taus`: row i holds the five IEEE
+/// terms, then one value per Gauss–Markov term.
+pub fn terms(taus: &[f64], fs: f64, ieee: &[f64; IEEE_TERMS], gm: &[(f64, f64)]) -> Vec<Vec<f64>> {
+    taus.iter()
+        .map(|&t| {
+            let b = basis::ieee(t);
+            let mut row: Vec<f64> = (0..IEEE_TERMS).map(|j| b[j] * ieee[j]).collect();
+            row.extend(
+                gm.iter()
+                    .map(|&(q2, tc)| q2 * basis::gauss_markov(t * fs, basis::gm_rate(tc, fs))),
+            );
+            row
+        })
+        .collect()
+}
+
+/// Inverse Fisher information of the loss at the solution.
+fn covariance(
+    data: &Data,
+    fs: f64,
+    ieee: &[f64; IEEE_TERMS],
+    gm: &[(f64, f64)],
+    d2: f64,
+) -> Vec<Vec<f64>> {
+    // Parameter slots in use and, per tau, ∂M/∂p.
+    let mut slots: Vec<usize> = (0..IEEE_TERMS).filter(|&j| ieee[j] > 0.0).collect();
+    for k in 0..gm.len() {
+        slots.push(IEEE_TERMS + 2 * k);
+        slots.push(IEEE_TERMS + 2 * k + 1);
+    }
+    let h: f64 = 1e-4;
+    let rows: Vec<(f64, Vec<f64>)> = (0..data.len())
+        .map(|i| {
+            let t = data.taus[i];
+            let b = basis::ieee(t);
+            let gmv =
+                |q2: f64, tc: f64| q2 * basis::gauss_markov(data.m[i], basis::gm_rate(tc, fs));
+            let model: f64 = (0..IEEE_TERMS).map(|j| b[j] * ieee[j]).sum::<f64>()
+                + gm.iter().map(|&(q2, tc)| gmv(q2, tc)).sum::<f64>();
+            let grad = slots
+                .iter()
+                .map(|&s| {
+                    if s < IEEE_TERMS {
+                        b[s]
+                    } else {
+                        let (q2, tc) = gm[(s - IEEE_TERMS) / 2];
+                        if (s - IEEE_TERMS).is_multiple_of(2) {
+                            gmv(1.0, tc)
+                        } else {
+                            (gmv(q2, tc * h.exp()) - gmv(q2, tc * (-h).exp())) / (2.0 * h)
+                        }
+                    }
+                })
+                .map(|d| d / model)
+                .collect();
+            (data.omega[i] / (data.v[i] + d2), grad)
+        })
+        .collect();
+    let k = slots.len();
+    let fisher: Vec<Vec<f64>> = (0..k)
+        .map(|a| {
+            (0..k)
+                .map(|b| rows.iter().map(|(w, g)| w * g[a] * g[b]).sum())
+                .collect()
+        })
+        .collect();
+    let mut cov = vec![vec![0.0; PARAMETERS]; PARAMETERS];
+    match nnls::invert_spd(&fisher) {
+        Some(inv) => {
+            for (a, &sa) in slots.iter().enumerate() {
+                for (b, &sb) in slots.iter().enumerate() {
+                    cov[sa][sb] = inv[a][b];
+                }
+            }
+        }
+        None => {
+            for &s in &slots {
+                cov[s][s] = f64::NAN;
+            }
+        }
+    }
+    cov
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const FS: f64 = 100.0;
+
+    fn grid(per_decade: f64, lo: f64, hi: f64) -> Vec<f64> {
+        let (a, b) = (
+            (lo.log10() * per_decade).ceil() as i64,
+            (hi.log10() * per_decade).floor() as i64,
+        );
+        let mut t: Vec<f64> = (a..=b)
+            .map(|j| (10f64.powf(j as f64 / per_decade) * FS).round() / FS)
+            .collect();
+        t.dedup();
+        t
+    }
+
+    fn curve(taus: &[f64], ieee: &[f64; 5], gm: &[(f64, f64)]) -> Vec<f64> {
+        terms(taus, FS, ieee, gm)
+            .iter()
+            .map(|r| r.iter().sum())
+            .collect()
+    }
+
+    fn edf_white(taus: &[f64], n: f64) -> Vec<f64> {
+        taus.iter().map(|t| (n / (t * FS)).max(2.0)).collect()
+    }
+
+    #[test]
+    fn exact_five_term_curve_is_recovered_without_gm() {
+        let truth = [0.0, 4e-6, 1e-6, 1e-10, 0.0];
+        let taus = grid(10.0, 0.01, 2000.0);
+        let var = curve(&taus, &truth, &[]);
+        let fit = fit_noise(
+            &taus,
+            &var,
+            &edf_white(&taus, 1e12),
+            FS,
+            &Options::default(),
+        )
+        .unwrap();
+        assert!(fit.gm.is_empty(), "{:?}", fit.gm);
+        for j in [1, 2, 3] {
+            assert!(
+                (fit.ieee[j] / truth[j] - 1.0).abs() < 1e-3,
+                "{j}: {:?}",
+                fit.ieee
+            );
+        }
+        assert_eq!(fit.ieee[0], 0.0);
+        assert_eq!(fit.ieee[4], 0.0);
+        assert!(fit.discrepancy < 1e-3);
+    }
+
+    #[test]
+    fn gauss_markov_terms_are_recovered() {
+        let truth_gm = [(1e-6, 0.3), (4e-8, 200.0)];
+        let ieee = [0.0, 1e-6, 0.0, 0.0, 0.0];
+        for per_decade in [3.0103, 5.0, 20.0, 50.0] {
+            let taus = grid(per_decade, 0.01, 1000.0);
+            let var = curve(&taus, &ieee, &truth_gm);
+            let fit = fit_noise(
+                &taus,
+                &var,
+                &edf_white(&taus, 1e12),
+                FS,
+                &Options::default(),
+            )
+            .unwrap();
+            assert_eq!(fit.gm.len(), 2, "{per_decade}: {fit:?}");
+            for (got, want) in fit.gm.iter().zip(truth_gm) {
+                assert!(
+                    (got.0 / want.0 - 1.0).abs() < 0.01,
+                    "{per_decade}: {got:?} vs {want:?}"
+                );
+                assert!(
+                    (got.1 / want.1 - 1.0).abs() < 0.01,
+                    "{per_decade}: {got:?} vs {want:?}"
+                );
+            }
+            assert!((fit.ieee[1] / ieee[1] - 1.0).abs() < 0.01);
+        }
+    }
+
+    #[test]
+    fn covariance_shrinks_with_edf() {
+        let truth = [0.0, 4e-6, 1e-6, 1e-10, 0.0];
+        let taus = grid(5.0, 0.01, 2000.0);
+        let mut var = curve(&taus, &truth, &[]);
+        // A deterministic wiggle so the discrepancy is not exactly zero.
+        for (i, v) in var.iter_mut().enumerate() {
+            *v *= 1.0 + 1e-3 * ((i % 3) as f64 - 1.0);
+        }
+        let opts = Options {
+            select: false,
+            gm: 0,
+            ieee: [false, true, true, true, false],
+        };
+        let lo = fit_noise(&taus, &var, &edf_white(&taus, 1e4), FS, &opts).unwrap();
+        let hi = fit_noise(&taus, &var, &edf_white(&taus, 1e6), FS, &opts).unwrap();
+        for j in [1, 2, 3] {
+            assert!(lo.cov[j][j] > hi.cov[j][j], "{j}");
+        }
+    }
+
+    #[test]
+    fn bad_inputs_are_errors_not_panics() {
+        let o = Options::default();
+        assert!(fit_noise(&[], &[], &[], FS, &o).is_err());
+        assert!(fit_noise(&[1.0], &[1.0, 2.0], &[1.0], FS, &o).is_err());
+        assert!(fit_noise(&[1.0, f64::NAN], &[1.0, 2.0], &[1.0, 1.0], FS, &o).is_err());
+        assert!(fit_noise(&[1.0, 2.0], &[1.0, -2.0], &[1.0, 1.0], FS, &o).is_err());
+        assert!(fit_noise(&[2.0, 1.0], &[1.0, 2.0], &[1.0, 1.0], FS, &o).is_err());
+        assert!(fit_noise(&[1.0, 2.0], &[1.0, 2.0], &[0.0, 1.0], FS, &o).is_err());
+        assert!(fit_noise(&[1.0, 2.0], &[1.0, 2.0], &[1.0, 1.0], 0.0, &o).is_err());
+        let too_many = Options {
+            gm: MAX_GM + 1,
+            ..o
+        };
+        assert!(fit_noise(&[1.0, 2.0], &[1.0, 2.0], &[1.0, 1.0], FS, &too_many).is_err());
+        let one = fit_noise(&[1.0], &[1.0], &[5.0], FS, &o).unwrap();
+        assert!(one.ieee.iter().all(|c| c.is_finite() && *c >= 0.0));
+    }
+}

@@ -1,0 +1,194 @@
+//! Lawson–Hanson non-negative least squares on a small dense system.
+//!
+//! Every unconstrained sub-problem is solved by a faer QR factorisation of the
+//! passive columns; callers scale the columns first (τ spans many decades, so
+//! raw columns differ by up to 10²⁰ in norm). Reference: Lawson & Hanson,
+//! *Solving Least Squares Problems* (1974), ch. 23.
+
+use faer::linalg::solvers::SolveLstsq;
+use faer::Mat;
+
+use crate::error::{CoreError, CoreResult};
+
+/// Least squares restricted to the columns in `passive`; `None` when that
+/// sub-problem is not numerically full rank.
+fn solve_passive(a: &Mat<f64>, b: &[f64], passive: &[bool]) -> Option<Vec<f64>> {
+    let k = a.ncols();
+    let cols: Vec<usize> = (0..k).filter(|&j| passive[j]).collect();
+    let mut out = vec![0.0; k];
+    if cols.is_empty() {
+        return Some(out);
+    }
+    let n = a.nrows();
+    if n < cols.len() {
+        return None;
+    }
+    let sub = Mat::from_fn(n, cols.len(), |i, c| a[(i, cols[c])]);
+    let rhs = Mat::from_fn(n, 1, |i, _| b[i]);
+    let qr = sub.qr();
+    let r = qr.thin_R();
+    let rmax = (0..cols.len()).map(|c| r[(c, c)].abs()).fold(0.0, f64::max);
+    if rmax.is_nan() || rmax <= 0.0 || (0..cols.len()).any(|c| r[(c, c)].abs() <= 1e-12 * rmax) {
+        return None;
+    }
+    let x = qr.solve_lstsq(&rhs);
+    for (c, &j) in cols.iter().enumerate() {
+        let v = x[(c, 0)];
+        if !v.is_finite() {
+            return None;
+        }
+        out[j] = v;
+    }
+    Some(out)
+}
+
+/// Minimise ‖a x − b‖ subject to x ≥ 0 and x_j = 0 where `!allowed[j]`.
+pub fn nnls(a: &Mat<f64>, b: &[f64], allowed: &[bool]) -> CoreResult<Vec<f64>> {
+    let (n, k) = (a.nrows(), a.ncols());
+    let mut x = vec![0.0; k];
+    let mut passive = vec![false; k];
+    let gradient = |x: &[f64]| -> Vec<f64> {
+        let mut w = vec![0.0; k];
+        for i in 0..n {
+            let mut r = b[i];
+            for (j, xj) in x.iter().enumerate() {
+                r -= a[(i, j)] * xj;
+            }
+            for (j, wj) in w.iter_mut().enumerate() {
+                *wj += a[(i, j)] * r;
+            }
+        }
+        w
+    };
+    let scale = b
+        .iter()
+        .map(|v| v * v)
+        .sum::<f64>()
+        .sqrt()
+        .max(f64::MIN_POSITIVE);
+    let tol = 1e-12 * scale * (n as f64).sqrt();
+    let limit = 3 * k + 10;
+    for _ in 0..limit {
+        let w = gradient(&x);
+        let candidate = (0..k)
+            .filter(|&j| allowed[j] && !passive[j] && w[j] > tol)
+            .max_by(|&i, &j| w[i].total_cmp(&w[j]));
+        let Some(j) = candidate else {
+            return Ok(x);
+        };
+        passive[j] = true;
+        let mut inner = 0;
+        loop {
+            inner += 1;
+            if inner > limit {
+                return Err(CoreError::Numerical(
+                    "noise-model NNLS did not converge (inner loop)".into(),
+                ));
+            }
+            let Some(z) = solve_passive(a, b, &passive) else {
+                // The new column is (numerically) dependent on the others.
+                passive[j] = false;
+                if passive.iter().all(|p| !p) {
+                    return Ok(x);
+                }
+                break;
+            };
+            if (0..k).all(|c| !passive[c] || z[c] > 0.0) {
+                x = z;
+                break;
+            }
+            // Step from x towards z as far as feasibility allows.
+            let mut alpha = f64::INFINITY;
+            for c in 0..k {
+                if passive[c] && z[c] <= 0.0 {
+                    let denom = x[c] - z[c];
+                    alpha = alpha.min(if denom > 0.0 { x[c] / denom } else { 0.0 });
+                }
+            }
+            if !alpha.is_finite() {
+                alpha = 0.0;
+            }
+            for c in 0..k {
+                x[c] += alpha * (z[c] - x[c]);
+                if passive[c] && x[c] <= 1e-15 * (x[c].abs() + z[c].abs()).max(f64::MIN_POSITIVE) {
+                    x[c] = 0.0;
+                    passive[c] = false;
+                }
+            }
+            if passive.iter().all(|p| !p) {
+                break;
+            }
+        }
+    }
+    Err(CoreError::Numerical(
+        "noise-model NNLS did not converge".into(),
+    ))
+}
+
+/// Invert the symmetric positive definite k × k matrix `m` (row-major);
+/// `None` when it is singular.
+pub fn invert_spd(m: &[Vec<f64>]) -> Option<Vec<Vec<f64>>> {
+    let k = m.len();
+    if k == 0 {
+        return Some(Vec::new());
+    }
+    // Scale to unit diagonal so the pivots compare, then invert by QR solves.
+    let d: Vec<f64> = (0..k).map(|i| m[i][i].abs().sqrt()).collect();
+    if d.iter().any(|v| *v == 0.0 || !v.is_finite()) {
+        return None;
+    }
+    let a = Mat::from_fn(k, k, |i, j| m[i][j] / (d[i] * d[j]));
+    let qr = a.qr();
+    let r = qr.thin_R();
+    let rmax = (0..k).map(|c| r[(c, c)].abs()).fold(0.0, f64::max);
+    if rmax.is_nan() || rmax <= 0.0 || (0..k).any(|c| r[(c, c)].abs() <= 1e-13 * rmax) {
+        return None;
+    }
+    let eye = Mat::from_fn(k, k, |i, j| if i == j { 1.0 } else { 0.0 });
+    let inv = qr.solve_lstsq(&eye);
+    Some(
+        (0..k)
+            .map(|i| (0..k).map(|j| inv[(i, j)] / (d[i] * d[j])).collect())
+            .collect(),
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn clamps_the_negative_direction() {
+        // b = 1·col0 − 0.5·col1: the constrained optimum has x1 = 0.
+        let a = Mat::from_fn(4, 2, |i, j| if j == 0 { 1.0 } else { i as f64 });
+        let b: Vec<f64> = (0..4).map(|i| 1.0 - 0.5 * i as f64).collect();
+        let x = nnls(&a, &b, &[true, true]).unwrap();
+        assert_eq!(x[1], 0.0);
+        assert!(x[0] >= 0.0);
+    }
+
+    #[test]
+    fn exact_positive_solution() {
+        let a = Mat::from_fn(5, 3, |i, j| ((i + 1) as f64).powi(j as i32));
+        let truth = [2.0, 0.5, 0.25];
+        let b: Vec<f64> = (0..5)
+            .map(|i| (0..3).map(|j| a[(i, j)] * truth[j]).sum())
+            .collect();
+        let x = nnls(&a, &b, &[true; 3]).unwrap();
+        for j in 0..3 {
+            assert!((x[j] - truth[j]).abs() < 1e-10);
+        }
+        let none = nnls(&a, &b, &[false; 3]).unwrap();
+        assert_eq!(none, vec![0.0; 3]);
+    }
+
+    #[test]
+    fn inverse_of_spd() {
+        let m = vec![vec![4.0, 1.0], vec![1.0, 3.0]];
+        let inv = invert_spd(&m).unwrap();
+        let det = 11.0;
+        assert!((inv[0][0] - 3.0 / det).abs() < 1e-14);
+        assert!((inv[0][1] + 1.0 / det).abs() < 1e-14);
+        assert!(invert_spd(&[vec![1.0, 1.0], vec![1.0, 1.0]]).is_none());
+    }
+}
