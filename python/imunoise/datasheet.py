@@ -216,11 +216,11 @@ def compare(models, spec="vn100", *, sensor: str = "gyro", input_units: dict | N
             continue
         info = _units.unit_info(item.term, item.unit, item.sensor)
         iu = input_units.get(item.sensor)
-        values = _units.convert(model.value(item.term), item.term, info.name,
-                                sensor=item.sensor, input_unit=iu)
-        stds = _units.convert(model.std(item.term), item.term, info.name,
-                              sensor=item.sensor, input_unit=iu)
-        sup = np.atleast_1d(model.supported[item.term])
+        # The model's datasheet equivalents: what a datasheet quotes from a curve.
+        eq, eq_std = model.equivalent(item.term), model.equivalent_std(item.term)
+        values = _units.convert(eq, item.term, info.name, sensor=item.sensor, input_unit=iu)
+        stds = _units.convert(eq_std, item.term, info.name, sensor=item.sensor, input_unit=iu)
+        sup = (eq > 0) & np.isfinite(eq)
         for i, ax in enumerate(_axis_names(model.channels, axes)):
             measured = float(values[i])
             ok = bool(sup[i])

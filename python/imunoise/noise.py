@@ -12,21 +12,36 @@ with Q the quantization noise (rate·s), N the angle/velocity random walk
 σ_flat = √(2 ln2/π)·B ≈ 0.6643·B), K the rate random walk (rate/√s, slope +½)
 and R the rate ramp (rate/s, slope +1).
 
+Real sensors are not five terms: their own low-pass filter bends the short
+taus and slowly wandering biases put bumps in the curve. The model therefore
+also has up to three first-order Gauss–Markov (exponentially correlated) bias
+terms, each with a standard deviation σ and a correlation time τc, whose Allan
+variance is the discrete AR1 form of IEEE 952 Annex C (slope +½ for τ ≪ τc, a
+peak near 1.9 τc, slope −½ for τ ≫ τc).
+
 :func:`fit` offers two estimators:
 
 ``"wls"`` (default)
-    Weighted non-negative least squares on σ²(τ) with weights from the
-    equivalent degrees of freedom: var(σ̂²) ≈ 2σ⁴/edf. Solved in Rust with faer
-    (Lawson–Hanson active set, QR, column scaling, reweighting from the model
-    curve). Every term gets a standard uncertainty; a term that never reaches
-    ``min_share`` (25 %) of the model at any fitted τ, or whose square is less
-    than ``min_z`` (2) standard uncertainties above 0, is set to 0 and flagged.
+    Weighted least squares on ln σ̂²(τ) (Rust, faer). Each tau weighs
+    ω/(var(ln σ̂²) + δ²): ω is the share of an octave of τ it stands for (so
+    octave, 5, 10, 20 or 50 taus per decade carry the same evidence and give the
+    same coefficients), var(ln σ̂²) = ψ′(edf/2) its sampling variance, and δ² a
+    model-discrepancy variance fitted by maximum likelihood (so a tau with an
+    EDF of 10⁶, where the model is only approximately right, cannot outweigh the
+    rest). For fixed correlation times every term is linear in its variance:
+    non-negative Gauss–Newton steps, a grid and golden-section search over the
+    times, and, with ``terms="auto"``, the structure with the lowest BIC.
+    Details and the reasons for each choice: ``docs/noise.md``.
 ``"slopes"``
     The IEEE 952 Annex C / MATLAB example read-off: find the τ where the
     log-log slope of the curve is closest to the term's slope, draw the line
     with the exact slope through that point and read it at the term's τ:
     N at τ = 1 s (slope −½), K at τ = 3 s (slope +½), Q at τ = √3 s (slope −1),
     R at τ = √2 s (slope +1), and B = σ_flat/√(2 ln2/π) at the point of slope 0.
+
+Whatever the method, :attr:`NoiseModel.readoff` holds the datasheet read-offs
+of the data (N at 1 s, K at 3 s, B = σ_min/0.6643) next to the model, and
+:attr:`NoiseModel.coverage` says how well the model follows the curve.
 
 Two classic mistakes the code cannot make: B is σ_flat/0.6643 (not 0.664·σ²),
 and the +½ slope is rate random walk K (white noise is the −½ slope).
@@ -44,8 +59,10 @@ from __future__ import annotations
 
 import math
 import numbers
+import os
 import warnings
 from collections.abc import Sequence
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -75,12 +92,23 @@ _SENSOR_NAMES = {
 # straight line is read (IEEE 952 Annex C).
 _SLOPE = {"Q": -1.0, "N": -0.5, "B": 0.0, "K": 0.5, "R": 1.0}
 _READ_TAU = {"Q": math.sqrt(3.0), "N": 1.0, "K": 3.0, "R": math.sqrt(2.0)}
-MIN_SHARE = 0.25
-MIN_Z = 2.0
+GM_MAX = 3
+"""Most first-order Gauss–Markov terms a model may have."""
+
+_PARAMS = 5 + 2 * GM_MAX
+"""Parameter slots of the covariance: five IEEE variances, (σ², ln τc) per GM term."""
+
+
+def _is_log_time(slot: int) -> bool:
+    return slot >= 5 and (slot - 5) % 2 == 1
+
+
+_CLOSE = 0.05
+"""A model within this relative distance of the measured deviation follows it."""
 
 
 def _basis(taus: np.ndarray) -> np.ndarray:
-    """Model variance per unit squared coefficient, shape (len(taus), 5)."""
+    """IEEE model variance per unit squared coefficient, shape (len(taus), 5)."""
     t = np.asarray(taus, dtype=float)
     return np.stack(
         [3.0 / t**2, 1.0 / t, np.full_like(t, FLICKER**2), t / 3.0, t**2 / 2.0], axis=-1
@@ -88,7 +116,7 @@ def _basis(taus: np.ndarray) -> np.ndarray:
 
 
 def model_variance(taus, Q=0.0, N=0.0, B=0.0, K=0.0, R=0.0) -> np.ndarray:
-    """Allan variance of the five-term model at ``taus`` (scalar coefficients)."""
+    """Allan variance of the five-term IEEE model at ``taus`` (scalar coefficients)."""
     return _basis(taus) @ np.array([Q * Q, N * N, B * B, K * K, R * R], dtype=float)
 
 
@@ -97,7 +125,8 @@ class Prediction:
     """Model Allan deviation: the total curve and each term's curve.
 
     ``dev`` and every ``terms[name]`` have shape (len(taus),) for a one-channel
-    model and (len(taus), channels) otherwise.
+    model and (len(taus), channels) otherwise. ``terms`` has ``Q``…``R`` and,
+    when a channel has Gauss–Markov terms, ``GM1`` and ``GM2`` (0 where absent).
     """
 
     taus: np.ndarray
@@ -114,15 +143,22 @@ class NoiseModel:
     Attributes
     ----------
     Q, N, B, K, R : ndarray
-        Coefficients: rate·s, rate·√s, rate, rate/√s, rate/s. Shape () for a
-        one-channel result, (channels,) otherwise. An unsupported term is 0.
+        IEEE 952 coefficients: rate·s, rate·√s, rate, rate/√s, rate/s. Shape ()
+        for a one-channel result, (channels,) otherwise. A term not in the
+        model is 0.
     Q_std, N_std, B_std, K_std, R_std : ndarray
-        Standard uncertainties (NaN where the term is unsupported).
+        Standard uncertainties (NaN where the term is not in the model).
+    gm_sigma, gm_tau : ndarray
+        First-order Gauss–Markov bias terms: standard deviation (rate) and
+        correlation time (s), shape (2,) or (channels, 2), by increasing τc;
+        NaN where a channel has fewer than two.
+    gm_sigma_std, gm_tau_std : ndarray
+        Their standard uncertainties.
     supported : dict[str, ndarray of bool]
-        Whether the data support each term (``False``: the value is 0 and
+        Whether each IEEE term is in the model (``False``: the value is 0 and
         means "not resolved", not "absent").
     tau_range : dict[str, ndarray]
-        For each term, (..., 2) array of the smallest and largest fitted τ
+        For each IEEE term, (..., 2) array of the smallest and largest fitted τ
         where the term is at least 25 % of the model (``"wls"``) or the
         tangent τ (``"slopes"``); NaN when unsupported.
     method : str
@@ -131,8 +167,29 @@ class NoiseModel:
         Copied from the Allan result.
     taus : ndarray
         The averaging times used by the fit.
-    chi2, dof : ndarray
-        Weighted residual sum of squares and its degrees of freedom (``"wls"``).
+    coverage : ndarray
+        Share of the fitted taus where the model lies inside the measured 95 %
+        confidence interval or within 5 % of the measured deviation, whichever
+        is wider: how well the model follows the curve (1 = everywhere).
+    discrepancy : ndarray
+        ``"wls"``: δ, the relative standard deviation of the Allan variance that
+        the model leaves unexplained beyond the estimates' own scatter
+        (0 when it describes the curve to within its noise).
+    chi2, n_eff : ndarray
+        ``"wls"``: Σ ω r²/var(ln σ̂²), the residual sum with the sampling
+        variance alone and each tau weighted by its share ω of an octave, and
+        n_eff = Σ ω, the octaves of evidence (χ²/n_eff ≈ 1 for a model that
+        describes the curve).
+    readoff : dict[str, dict[str, ndarray]]
+        The datasheet read-offs of the measured curve, whatever the method:
+        ``"N"`` (slope −½ line at τ = 1 s), ``"K"`` (slope +½ line at τ = 3 s)
+        and ``"B"`` (σ_min/0.6643 at the curve's minimum), each with
+        ``value``, ``std`` and ``tau`` (the tau read), NaN where the curve has
+        no such part; ``"B"`` also has ``low``/``high`` (95 % interval).
+    cov : ndarray
+        ``"wls"``: covariance of (Q², N², B², K², R², then σ², ln τc of each
+        Gauss–Markov slot), shape (11, 11) or (channels, 11, 11); NaN for
+        ``"slopes"``.
     """
 
     Q: np.ndarray
@@ -145,6 +202,10 @@ class NoiseModel:
     B_std: np.ndarray
     K_std: np.ndarray
     R_std: np.ndarray
+    gm_sigma: np.ndarray
+    gm_tau: np.ndarray
+    gm_sigma_std: np.ndarray
+    gm_tau_std: np.ndarray
     supported: dict[str, np.ndarray]
     tau_range: dict[str, np.ndarray]
     method: str
@@ -152,8 +213,12 @@ class NoiseModel:
     fs: float
     overlapping: bool
     taus: np.ndarray
+    coverage: np.ndarray
+    discrepancy: np.ndarray = field(repr=False)
     chi2: np.ndarray = field(repr=False)
-    dof: np.ndarray = field(repr=False)
+    n_eff: np.ndarray = field(repr=False)
+    readoff: dict[str, dict[str, np.ndarray]] = field(repr=False)
+    cov: np.ndarray = field(repr=False)
 
     # -- shape --------------------------------------------------------------
     @property
@@ -176,30 +241,124 @@ class NoiseModel:
         _check_term(term)
         return np.atleast_1d(getattr(self, term + "_std"))
 
+    def gauss_markov(self, channel: int = 0) -> list[tuple[float, float]]:
+        """The (sigma, tau_c) of each Gauss–Markov term of ``channel``."""
+        sig = np.reshape(self.gm_sigma, (-1, GM_MAX))[channel]
+        tau = np.reshape(self.gm_tau, (-1, GM_MAX))[channel]
+        return [(float(s), float(t)) for s, t in zip(sig, tau, strict=True) if np.isfinite(s)]
+
     # -- curves -------------------------------------------------------------
     def predict(self, taus=None) -> Prediction:
         """Model Allan deviation at ``taus`` (default: the fitted taus).
 
         Returns the total curve σ(τ) and each term's own curve, e.g.
-        ``terms["N"] = N/√τ``.
+        ``terms["N"] = N/√τ``, ``terms["GM1"]`` for the first Gauss–Markov term.
         """
+        from imunoise import _core
+
         t = self.taus if taus is None else np.asarray(taus, dtype=float)
         if t.ndim != 1 or t.size == 0 or not np.all(np.isfinite(t)) or np.any(t <= 0):
             raise ValueError(f"taus must be a non-empty 1-D array of finite values > 0; got {t!r}")
-        basis = _basis(t)  # (T, 5)
-        coef = np.stack([self.value(k) ** 2 for k in TERMS], axis=0)  # (5, C)
-        parts = basis[:, :, None] * coef[None, :, :]  # (T, 5, C)
+        t = np.ascontiguousarray(t)
+        names = [*TERMS, *(f"GM{k + 1}" for k in range(GM_MAX))]
+        parts = np.zeros((t.size, len(names), self.channels))
+        for c in range(self.channels):
+            ieee = [float(self.value(k)[c]) ** 2 for k in TERMS]
+            gm = [(s * s, tc) for s, tc in self.gauss_markov(c)]
+            var = _core.noise_terms(t, self.fs, ieee, gm)
+            parts[:, : var.shape[1], c] = var
         total = np.sqrt(parts.sum(axis=1))
-        terms = {k: np.sqrt(parts[:, i, :]) for i, k in enumerate(TERMS)}
+        used = names[: len(TERMS) + max(len(self.gauss_markov(c)) for c in
+                                         range(self.channels))]
+        terms = {k: np.sqrt(parts[:, i, :]) for i, k in enumerate(used)}
         if self.one_channel:
             total = total[:, 0]
             terms = {k: v[:, 0] for k, v in terms.items()}
         return Prediction(taus=t, dev=total, terms=terms)
 
+    def equivalent(self, term: str) -> np.ndarray:
+        """The datasheet value of ``term`` that the whole model implies, per channel.
+
+        ``"N"``: the white-noise density of the model, N together with every
+        Gauss–Markov term faster than 1 s (white at the τ = 1 s read-off:
+        σ²(1+φ)/((1−φ)·fs)); what a filter's white-noise input should be.
+        ``"K"``: K together with every slower Gauss–Markov term's short-τ
+        random-walk rate √(2σ²/τc) (its +½ slope; a random walk that bounds
+        the bias over times shorter than τc). ``"B"``: the minimum of the model's
+        deviation over the fitted taus divided by 0.6643, the bias instability
+        a datasheet would quote from this curve (0 when the curve still falls
+        at the longest tau with a slope below −¼: no flat part). Other terms, and ``method="slopes"``: the
+        coefficient. Shape (channels,).
+        """
+        return self._equivalents(term)[0]
+
+    def equivalent_std(self, term: str) -> np.ndarray:
+        """Standard uncertainty of :meth:`equivalent`, propagated from the fit's
+        covariance (linearised: a numerical gradient), shape (channels,)."""
+        return self._equivalents(term)[1]
+
+    def _equivalents(self, term: str) -> tuple[np.ndarray, np.ndarray]:
+        _check_term(term)
+        if self.method != "wls" or term not in ("N", "B", "K"):
+            return self.value(term).astype(float), self.std(term).astype(float)
+        values = np.zeros(self.channels)
+        stds = np.full(self.channels, np.nan)
+        cov = np.reshape(self.cov, (self.channels, _PARAMS, _PARAMS))
+        for c in range(self.channels):
+            p = self._parameters(c)
+            f0 = self._equivalent_of(term, p)
+            values[c] = f0
+            if not f0 > 0:
+                continue
+            active = np.flatnonzero(np.diag(cov[c]) > 0)
+            grad = np.zeros(_PARAMS)
+            for j in active:
+                h = 1e-4 if _is_log_time(j) else 1e-4 * p[j]
+                up, down = p.copy(), p.copy()
+                up[j] += h
+                down[j] = max(down[j] - h, 0.0) if not _is_log_time(j) else down[j] - h
+                grad[j] = (self._equivalent_of(term, up) - self._equivalent_of(term, down)) / (
+                    up[j] - down[j])
+            stds[c] = math.sqrt(max(float(grad @ cov[c] @ grad), 0.0))
+        return values, stds
+
+    def _parameters(self, channel: int) -> np.ndarray:
+        """(Q², N², B², K², R², then σ², ln τc per Gauss–Markov slot) of a channel."""
+        p = np.zeros(_PARAMS)
+        p[:5] = [float(self.value(t)[channel]) ** 2 for t in TERMS]
+        for k, (sigma, tau_c) in enumerate(self.gauss_markov(channel)):
+            p[5 + 2 * k], p[6 + 2 * k] = sigma**2, math.log(tau_c)
+        return p
+
+    def _equivalent_of(self, term: str, p: np.ndarray) -> float:
+        gm = [(p[5 + 2 * k], math.exp(p[6 + 2 * k])) for k in range(GM_MAX) if p[5 + 2 * k] > 0]
+        if term == "B":
+            from imunoise import _core
+
+            grid = np.geomspace(self.taus[0], self.taus[-1], 200)
+            dev = np.sqrt(_core.noise_terms(grid, self.fs, list(p[:5]), gm).sum(axis=1))
+            i = int(np.argmin(dev))
+            # A minimum at the longest tau is a floor only where the curve has
+            # flattened (log-log slope above −¼ there); else it is still falling.
+            slope = np.log(dev[-1] / dev[-2]) / np.log(grid[-1] / grid[-2])
+            if i == grid.size - 1 and slope < -0.25:
+                return 0.0
+            return float(dev[i] / FLICKER)
+        total = p[1] if term == "N" else p[3]
+        for q2, tau_c in gm:
+            if term == "N" and tau_c <= 1.0:
+                phi = math.exp(-1.0 / (self.fs * tau_c))
+                total += q2 * (1 + phi) / ((1 - phi) * self.fs)
+            elif term == "K" and tau_c > 1.0:
+                total += 2.0 * q2 / tau_c
+        return math.sqrt(max(total, 0.0))
+
     # -- units and tables ---------------------------------------------------
     def in_units(self, sensor: str = "gyro", units: dict[str, str] | None = None,
                  input_unit: str | None = None) -> dict[str, dict]:
-        """Coefficients in datasheet units.
+        """Datasheet values in datasheet units: N, B, K are the model's
+        :meth:`equivalent` values (what a datasheet quotes from this curve, with
+        the Gauss–Markov terms included), Q and R the coefficients.
 
         Parameters
         ----------
@@ -225,14 +384,17 @@ class NoiseModel:
         for term in TERMS:
             info = _units.unit_info(term, units.get(term), sensor)
             conv = _units.convert
+            value, std = self._equivalents(term)
+            supported = (value > 0) & np.isfinite(value)
+            shape = np.shape(self.N)
             out[term] = {
-                "value": conv(getattr(self, term), term, info.name, sensor=sensor,
+                "value": conv(np.reshape(value, shape), term, info.name, sensor=sensor,
                               input_unit=input_unit),
-                "std": conv(getattr(self, term + "_std"), term, info.name, sensor=sensor,
-                            input_unit=input_unit),
+                "std": conv(np.reshape(np.where(supported, std, np.nan), shape), term,
+                            info.name, sensor=sensor, input_unit=input_unit),
                 "unit": info.name,
                 "label": info.label,
-                "supported": self.supported[term],
+                "supported": np.reshape(supported, shape),
             }
         return out
 
@@ -313,6 +475,17 @@ class NoiseModel:
                     for pair in np.reshape(self.tau_range[term], (-1, 2))
                 ],
             }
+        d["gauss_markov"] = [
+            [{"sigma": sg, "tau_c": tc} for sg, tc in self.gauss_markov(c)]
+            for c in range(self.channels)
+        ]
+        d["coverage"] = np.atleast_1d(self.coverage).tolist()
+        d["discrepancy"] = np.atleast_1d(self.discrepancy).tolist()
+        d["readoff"] = {
+            term: {k: [None if not np.isfinite(v) else float(v) for v in np.atleast_1d(a)]
+                   for k, a in parts.items()}
+            for term, parts in self.readoff.items()
+        }
         return d
 
 
@@ -436,20 +609,25 @@ def _edf_cap(result, taus):
     return np.where(np.isfinite(cap) & (cap > 1.0), cap, 1.0)
 
 
-def _terms_mask(terms) -> np.ndarray:
-    if isinstance(terms, str):
-        terms = tuple(terms)
-    terms = tuple(terms)
-    bad = [t for t in terms if t not in TERMS]
-    if bad or not terms:
-        raise ValueError(f"terms must be a non-empty subset of {TERMS}; got {terms!r}")
-    return np.array([t in terms for t in TERMS])
+def _parse_terms(terms) -> tuple[np.ndarray, int, bool]:
+    """``terms`` → (IEEE mask, Gauss–Markov count, select by BIC)."""
+    if isinstance(terms, str) and terms == "auto":
+        return np.ones(len(TERMS), dtype=bool), GM_MAX, True
+    names = tuple(terms) if not isinstance(terms, str) else tuple(terms)
+    allowed = (*TERMS, "GM")
+    bad = [t for t in names if t not in allowed]
+    gm = names.count("GM")
+    if bad or not names or gm > GM_MAX:
+        raise ValueError(
+            f"terms must be 'auto' or a non-empty sequence of {allowed} with 'GM' at most "
+            f"{GM_MAX} times; got {terms!r}"
+        )
+    return np.array([t in names for t in TERMS]), gm, False
 
 
-def fit(result, method: str = "wls", terms: Sequence[str] = TERMS, tau_range=None,
-        min_share: float = MIN_SHARE, min_z: float = MIN_Z, *,
+def fit(result, method: str = "wls", terms: str | Sequence[str] = "auto", tau_range=None, *,
         uncertainty: str = "independent", replicates: int = 30, seed=None) -> NoiseModel:
-    """Fit the IEEE 952 noise model to an Allan deviation.
+    """Fit the noise model to an Allan deviation.
 
     Parameters
     ----------
@@ -458,28 +636,24 @@ def fit(result, method: str = "wls", terms: Sequence[str] = TERMS, tau_range=Non
         ``"adev"``. Taus with a non-finite or non-positive variance or EDF are
         ignored.
     method : {"wls", "slopes"}
-        Weighted non-negative least squares (default) or the IEEE 952 / MATLAB
+        Log-space weighted least squares (default) or the IEEE 952 / MATLAB
         slope read-off (see the module docstring).
-    terms : sequence of {"Q", "N", "B", "K", "R"}
-        Terms allowed in the model; the others are 0 and unsupported.
+    terms : "auto" or sequence of {"Q", "N", "B", "K", "R", "GM"}
+        ``"auto"`` (default): the IEEE terms and up to three Gauss–Markov terms,
+        the structure with the lowest BIC (the fewest terms that describe the
+        curve). A sequence fits exactly those terms (``"GM"`` once or twice for
+        Gauss–Markov terms); a term the data push below zero is still 0.
     tau_range : (float, float), optional
         Only use taus in [min, max] seconds.
-    min_share : float
-        ``"wls"``: a term must reach this fraction of the model variance at
-        some fitted τ to be kept (default 0.25).
-    min_z : float
-        ``"wls"``: a squared coefficient must be at least this many standard
-        uncertainties above zero to be kept (default 2, i.e. N ≥ 4·u(N)).
     uncertainty : {"independent", "bootstrap"}
         How the ``*_std`` are obtained. ``"independent"`` (default, instant):
-        from the fit's covariance, treating the taus as independent (somewhat
-        optimistic, see Notes). ``"bootstrap"``: parametric bootstrap —
-        ``replicates`` records of the same length and rate are simulated from the
-        fitted model (:func:`imunoise.simulate`), analysed with the same taus and
-        fitted with the same options; each ``*_std`` is the standard deviation of
-        that coefficient over the replicates. It accounts for the correlation
-        between taus; it costs ``replicates`` simulations and Allan deviations
-        per channel (≈ 0.6 s each for a 5 h, 40 Hz record with flicker noise).
+        the inverse Fisher information of the fit, each octave of taus counted
+        as one independent piece of evidence and the model discrepancy δ
+        included. ``"bootstrap"``: parametric bootstrap — ``replicates`` records
+        of the same length and rate are simulated from the fitted model
+        (:func:`imunoise.simulate`), analysed with the same taus and refitted
+        with the same structure; each ``*_std`` is the standard deviation over
+        the replicates (≈ 0.6 s per replicate and channel for 5 h at 40 Hz).
     replicates : int
         ``"bootstrap"`` only: number of simulated records (≥ 5; default 30).
     seed : int, numpy.random.Generator or None
@@ -489,16 +663,20 @@ def fit(result, method: str = "wls", terms: Sequence[str] = TERMS, tau_range=Non
     -------
     NoiseModel
 
+    Warns
+    -----
+    RuntimeWarning
+        When the model follows the measured curve at fewer than 80 % of the
+        taus (:attr:`NoiseModel.coverage`): its coefficients then summarise a
+        curve they do not describe; look at the residual panel of
+        :func:`imunoise.plot.allan`.
+
     Notes
     -----
     The EDF of the result is capped at its white-rate-noise value (the largest
     for the α ≤ 0 noise types of an IMU) before weighting, see ``_edf_cap``.
-    The weights w = edf/(2σ⁴) treat the Allan variances at different taus as
-    independent; overlapping estimates at neighbouring octaves are mildly
-    correlated, so the uncertainties are approximate (they are inflated by
-    √(χ²/dof) when the model fits worse than the EDF predict). Standard
-    uncertainties of the coefficients follow from those of their squares:
-    u(N) = u(N²)/(2N).
+    Standard uncertainties of the coefficients follow from those of their
+    squares: u(N) = u(N²)/(2N); of a correlation time from that of ln τc.
     """
     if method not in ("wls", "slopes"):
         raise ValueError(f"method must be 'wls' or 'slopes'; got {method!r}")
@@ -511,19 +689,19 @@ def fit(result, method: str = "wls", terms: Sequence[str] = TERMS, tau_range=Non
             raise TypeError(f"replicates must be an integer; got {replicates!r}")
         if replicates < 5:
             raise ValueError(f"replicates must be >= 5; got {replicates}")
-    mask = _terms_mask(terms)
-    if not (0.0 <= min_share < 1.0):
-        raise ValueError(f"min_share must be in [0, 1); got {min_share!r}")
-    if not (math.isfinite(min_z) and min_z >= 0):
-        raise ValueError(f"min_z must be finite and >= 0; got {min_z!r}")
+    mask, gm_count, select = _parse_terms(terms)
     taus, var, edf, one = _extract(result, tau_range)
+    dev_all, edf_raw = _measured(result, taus)
     channels = var.shape[1]
     coef = np.zeros((channels, 5))
     std = np.full((channels, 5), np.nan)
     sup = np.zeros((channels, 5), dtype=bool)
     rng = np.full((channels, 5, 2), np.nan)
-    chi2 = np.full(channels, np.nan)
-    dof = np.zeros(channels, dtype=int)
+    gm = np.full((channels, GM_MAX, 2), np.nan)
+    gm_std = np.full((channels, GM_MAX, 2), np.nan)
+    stats = np.full((channels, 3), np.nan)  # discrepancy, chi2, n_eff
+    cov = np.full((channels, _PARAMS, _PARAMS), np.nan)
+    usable = []
     for c in range(channels):
         ok = np.isfinite(var[:, c]) & (var[:, c] > 0) & np.isfinite(edf[:, c]) & (edf[:, c] > 0)
         if not ok.any():
@@ -535,23 +713,34 @@ def fit(result, method: str = "wls", terms: Sequence[str] = TERMS, tau_range=Non
                 f"result has {ok.sum()} usable tau for channel {c}; the fit needs at least 2 "
                 "(var and edf finite and > 0)"
             )
-        t, v, e = taus[ok], var[ok, c], edf[ok, c]
-        if method == "wls":
-            coef[c], std[c], sup[c], chi2[c], dof[c] = _fit_wls(t, v, e, mask, min_share, min_z)
-            rng[c] = _support_range(t, coef[c], sup[c], min_share)
-        else:
-            coef[c], std[c], sup[c], rng[c] = _fit_slopes(t, v, e, mask)
+        usable.append(ok)
+    if method == "wls":
+        # The Rust fit releases the GIL: channels run in parallel threads.
+        def fit_channel(c):
+            ok = usable[c]
+            return _fit_wls(taus[ok], var[ok, c], edf[ok, c], float(result.fs), mask,
+                            gm_count, select)
+
+        with ThreadPoolExecutor(max_workers=min(channels, os.cpu_count() or 1)) as pool:
+            fits = list(pool.map(fit_channel, range(channels)))
+        for c, out in enumerate(fits):
+            coef[c], std[c], sup[c], gm[c], gm_std[c], stats[c], cov[c] = out
+            rng[c] = _support_range(taus[usable[c]], coef[c], sup[c])
+    else:
+        for c in range(channels):
+            ok = usable[c]
+            coef[c], std[c], sup[c], rng[c] = _fit_slopes(taus[ok], var[ok, c], edf[ok, c], mask)
     if uncertainty == "bootstrap":
         generator = np.random.default_rng(seed)
         for c in range(channels):
-            # Replicates refit the kept terms without the keep/drop thresholds: a
-            # term dropped in some replicates would mix zeros into its spread.
             kept = [t for t, keep in zip(TERMS, sup[c], strict=True) if keep]
-            if not kept:
+            markov = [(float(a), float(b)) for a, b in gm[c] if np.isfinite(a)]
+            if not kept and not markov:
                 continue
-            options = dict(method=method, terms=kept, tau_range=tau_range, min_share=0.0,
-                           min_z=0.0)
-            std[c] = _bootstrap_std(result, coef[c], int(replicates), generator, options)
+            options = dict(method=method, terms=[*kept, *["GM"] * len(markov)],
+                           tau_range=tau_range)
+            std[c], gm_std[c] = _bootstrap_std(result, coef[c], markov, int(replicates),
+                                               generator, options)
     std[~sup] = np.nan
 
     def shaped(a):
@@ -561,9 +750,13 @@ def fit(result, method: str = "wls", terms: Sequence[str] = TERMS, tau_range=Non
 
     values = {k: shaped(coef[:, i]) for i, k in enumerate(TERMS)}
     stds = {k + "_std": shaped(std[:, i]) for i, k in enumerate(TERMS)}
-    return NoiseModel(
+    model = NoiseModel(
         **values,
         **stds,
+        gm_sigma=shaped(gm[:, :, 0]),
+        gm_tau=shaped(gm[:, :, 1]),
+        gm_sigma_std=shaped(gm_std[:, :, 0]),
+        gm_tau_std=shaped(gm_std[:, :, 1]),
         supported={k: shaped(sup[:, i]) for i, k in enumerate(TERMS)},
         tau_range={k: shaped(rng[:, i, :]) for i, k in enumerate(TERMS)},
         method=method,
@@ -571,9 +764,88 @@ def fit(result, method: str = "wls", terms: Sequence[str] = TERMS, tau_range=Non
         fs=float(result.fs),
         overlapping=bool(getattr(result, "overlapping", True)),
         taus=_readonly(taus),
-        chi2=shaped(chi2),
-        dof=shaped(dof),
+        coverage=shaped(np.zeros(channels)),
+        discrepancy=shaped(stats[:, 0]),
+        chi2=shaped(stats[:, 1]),
+        n_eff=shaped(stats[:, 2]),
+        readoff=_readoffs(taus, dev_all, edf_raw, shaped),
+        cov=shaped(cov),
     )
+    cover = _coverage(model, taus, dev_all, edf_raw)
+    object.__setattr__(model, "coverage", shaped(cover))
+    for c in np.flatnonzero(cover < 0.8) if method == "wls" else ():
+        warnings.warn(
+            f"the noise model follows the Allan deviation of channel {c} at only "
+            f"{cover[c]:.0%} of the taus (inside the 95 % interval or within 5 %); its "
+            "coefficients summarise a curve they do not describe: plot it with "
+            "imunoise.plot.allan(result, model=model)",
+            RuntimeWarning, stacklevel=2,
+        )
+    return model
+
+
+def _measured(result, taus):
+    """Measured deviation and uncapped EDF at ``taus``, shape (T, C)."""
+    all_taus = np.asarray(result.taus, dtype=float)
+    idx = np.searchsorted(all_taus, taus)
+    var = np.asarray(result.var if hasattr(result, "var") else np.square(result.dev), float)
+    edf = np.asarray(result.edf, dtype=float)
+    var = var.reshape(len(all_taus), -1)[idx]
+    edf = edf.reshape(len(all_taus), -1)[idx]
+    return np.sqrt(var), edf
+
+
+def _interval95(dev, edf):
+    """95 % χ² interval of a deviation with ``edf`` degrees of freedom."""
+    from scipy.stats import chi2
+
+    e = np.where(np.isfinite(edf) & (edf > 0), edf, np.nan)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        lo = dev * np.sqrt(e / chi2.ppf(0.975, e))
+        hi = dev * np.sqrt(e / chi2.ppf(0.025, e))
+    return lo, hi
+
+
+def _coverage(model, taus, dev, edf):
+    """Share of taus where the model is inside the 95 % interval or within 5 %."""
+    pred = np.reshape(model.predict(taus).dev, dev.shape)
+    lo, hi = _interval95(dev, edf)
+    inside = (pred >= lo) & (pred <= hi)
+    close = np.abs(pred / dev - 1.0) <= _CLOSE
+    ok = np.isfinite(dev) & (dev > 0)
+    hits = np.where(ok, inside | close, False).sum(axis=0)
+    return hits / np.maximum(ok.sum(axis=0), 1)
+
+
+def _readoffs(taus, dev, edf, shaped):
+    """Datasheet read-offs of the measured curve, per channel."""
+    channels = dev.shape[1]
+    out = {k: {f: np.full(channels, np.nan) for f in ("value", "std", "tau")}
+           for k in ("N", "K", "B")}
+    out["B"]["low"] = np.full(channels, np.nan)
+    out["B"]["high"] = np.full(channels, np.nan)
+    for c in range(channels):
+        ok = np.isfinite(dev[:, c]) & (dev[:, c] > 0) & np.isfinite(edf[:, c]) & (edf[:, c] > 0)
+        t, d, e = taus[ok], dev[ok, c], edf[ok, c]
+        if t.size < 2:
+            continue
+        coef, std, sup, rng = _fit_slopes(t, d**2, e, np.array([False, True, False, True, False]))
+        for i, k in ((1, "N"), (3, "K")):
+            if sup[i]:
+                out[k]["value"][c], out[k]["std"][c], out[k]["tau"][c] = coef[i], std[i], rng[i, 0]
+        # The minimum among the estimates with at least 10 degrees of freedom: a
+        # scattered long-tau estimate that happens to lie low is no flat part.
+        steady = np.flatnonzero(e >= 10)
+        if steady.size < 3:
+            continue
+        j = int(steady[np.argmin(d[steady])])
+        if 0 < j < steady[-1]:  # a minimum at an end is no flat part
+            lo, hi = _interval95(d[j], e[j])
+            out["B"]["value"][c] = d[j] / FLICKER
+            out["B"]["std"][c] = d[j] / FLICKER / math.sqrt(2.0 * e[j])
+            out["B"]["tau"][c] = t[j]
+            out["B"]["low"][c], out["B"]["high"][c] = lo / FLICKER, hi / FLICKER
+    return {k: {f: shaped(a) for f, a in parts.items()} for k, parts in out.items()}
 
 
 def _record_length(result) -> int:
@@ -591,19 +863,23 @@ def _record_length(result) -> int:
     return n0 + 2 * m0 - 1 if overlapping else (n0 + 1) * m0
 
 
-def _bootstrap_std(result, coef, replicates, rng, options) -> np.ndarray:
-    """Standard deviation of each coefficient over fits to records simulated from
-    ``coef`` (Q, N, B, K, R) with the length, rate and taus of ``result``."""
+def _bootstrap_std(result, coef, markov, replicates, rng, options):
+    """Standard deviation of each coefficient (and Gauss–Markov σ, τc) over fits to
+    records simulated from the model with the length, rate and taus of ``result``."""
     from imunoise.allan import adev
     from imunoise.simulate import simulate
 
     n = _record_length(result)
-    sims = simulate(n, result.fs, *coef, channels=replicates, seed=rng)
+    sims = simulate(n, result.fs, *coef, channels=replicates, seed=rng, gm=markov)
     again = adev(sims, result.fs, taus=np.asarray(result.taus), overlapping=result.overlapping,
                  confidence=result.confidence)
-    refit = fit(again, **options)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        refit = fit(again, **options)
     values = np.stack([np.atleast_1d(refit.value(t)) for t in TERMS], axis=1)
-    return values.std(axis=0, ddof=1)
+    gm = np.stack([np.reshape(refit.gm_sigma, (-1, GM_MAX)),
+                   np.reshape(refit.gm_tau, (-1, GM_MAX))], axis=-1)
+    return values.std(axis=0, ddof=1), np.nanstd(gm, axis=0, ddof=1)
 
 
 def _readonly(a):
@@ -612,25 +888,34 @@ def _readonly(a):
     return out
 
 
-def _fit_wls(t, v, e, mask, min_share, min_z):
+def _fit_wls(t, v, e, fs, mask, gm_count, select):
     from imunoise import _core
 
     try:
-        sq, cov, supported, chi2, dof = _core.fit_wls(
-            np.ascontiguousarray(t), np.ascontiguousarray(v), np.ascontiguousarray(e),
-            [bool(m) for m in mask], 3, float(min_share), float(min_z),
+        sq, gm, cov, delta, chi2, n_eff, _params, _bic = _core.fit_noise(
+            np.ascontiguousarray(t), np.ascontiguousarray(v), np.ascontiguousarray(e), fs,
+            [bool(m) for m in mask], gm_count, select,
         )
     except ValueError as exc:
         raise ValueError(f"cannot fit the noise model to result: {exc}") from None
+    supported = sq > 0
     coef = np.sqrt(np.maximum(sq, 0.0))
-    var_sq = np.diag(cov)
+    var_sq = np.diag(cov)[:5]
     with np.errstate(divide="ignore", invalid="ignore"):
         std = np.where(supported, np.sqrt(np.maximum(var_sq, 0.0)) / (2.0 * coef), np.nan)
-    coef = np.where(supported, coef, 0.0)
-    return coef, std, supported, chi2, dof
+    markov = np.full((GM_MAX, 2), np.nan)
+    markov_std = np.full((GM_MAX, 2), np.nan)
+    for k, (q2, tau_c) in enumerate(gm):
+        sigma = math.sqrt(q2)
+        markov[k] = sigma, tau_c
+        u_q2, u_log_tau = cov[5 + 2 * k, 5 + 2 * k], cov[6 + 2 * k, 6 + 2 * k]
+        markov_std[k] = math.sqrt(max(u_q2, 0.0)) / (2 * sigma), tau_c * math.sqrt(
+            max(u_log_tau, 0.0))
+    return (np.where(supported, coef, 0.0), std, supported, markov, markov_std,
+            (delta, chi2, n_eff), cov)
 
 
-def _support_range(t, coef, sup, min_share):
+def _support_range(t, coef, sup, min_share=0.25):
     basis = _basis(t) * coef**2
     total = basis.sum(axis=1)
     out = np.full((5, 2), np.nan)

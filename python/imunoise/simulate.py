@@ -41,6 +41,7 @@ from __future__ import annotations
 
 import math
 import numbers
+from collections.abc import Sequence
 
 import numpy as np
 from scipy import fft as _fft
@@ -107,7 +108,8 @@ def flicker(n: int, scale: float, rng: np.random.Generator, taps: int = _FLICKER
 
 
 def simulate(n: int, fs: float, Q: float = 0.0, N: float = 0.0, B: float = 0.0,
-             K: float = 0.0, R: float = 0.0, channels: int = 1, seed=None) -> np.ndarray:
+             K: float = 0.0, R: float = 0.0, channels: int = 1, seed=None, *,
+             gm: Sequence[tuple[float, float]] = ()) -> np.ndarray:
     """Rate noise with the given IEEE 952 coefficients.
 
     Parameters
@@ -123,6 +125,11 @@ def simulate(n: int, fs: float, Q: float = 0.0, N: float = 0.0, B: float = 0.0,
         Independent channels (same coefficients).
     seed : int, numpy.random.Generator or None
         Seed for :func:`numpy.random.default_rng`.
+    gm : sequence of (sigma, tau_c)
+        First-order Gauss–Markov bias terms: each a stationary AR1
+        x[t] = φ·x[t−1] + w[t] with standard deviation ``sigma`` (rate) and
+        correlation time ``tau_c`` (s), φ = exp(−1/(fs·tau_c)) — the process whose
+        Allan variance :func:`imunoise.fit` models.
 
     Returns
     -------
@@ -145,6 +152,7 @@ def simulate(n: int, fs: float, Q: float = 0.0, N: float = 0.0, B: float = 0.0,
     if not (math.isfinite(fs) and fs > 0):
         raise ValueError(f"fs must be finite and > 0; got {fs!r}")
     Q, N, B, K, R = (_check_coef(k, v) for k, v in zip("QNBKR", (Q, N, B, K, R), strict=True))
+    markov = _check_gm(gm)
     rng = np.random.default_rng(seed)
     out = np.zeros((n, channels))
     sqfs = math.sqrt(fs)
@@ -173,4 +181,30 @@ def simulate(n: int, fs: float, Q: float = 0.0, N: float = 0.0, B: float = 0.0,
                 seg += (R / fs) * np.arange(s, s + m, dtype=float)
         if B:
             flicker(n, B, rng, out=col)
+        for sigma, tau_c in markov:
+            col += gauss_markov(n, fs, sigma, tau_c, rng)
     return out[:, 0].copy() if channels == 1 else out
+
+
+def _check_gm(gm) -> list[tuple[float, float]]:
+    try:
+        pairs = [(float(a), float(b)) for a, b in gm]
+    except (TypeError, ValueError):
+        raise TypeError(f"gm must be a sequence of (sigma, tau_c) pairs; got {gm!r}") from None
+    for sigma, tau_c in pairs:
+        if not (math.isfinite(sigma) and sigma >= 0):
+            raise ValueError(f"gm sigma must be finite and >= 0; got {sigma!r}")
+        if not (math.isfinite(tau_c) and tau_c > 0):
+            raise ValueError(f"gm tau_c must be finite and > 0; got {tau_c!r}")
+    return pairs
+
+
+def gauss_markov(n: int, fs: float, sigma: float, tau_c: float,
+                 rng: np.random.Generator) -> np.ndarray:
+    """Stationary AR1 with standard deviation ``sigma`` and correlation time ``tau_c``."""
+    from scipy.signal import lfilter
+
+    phi = math.exp(-1.0 / (fs * tau_c))
+    w = rng.standard_normal(n) * (sigma * math.sqrt(-math.expm1(-2.0 / (fs * tau_c))))
+    w[0] = rng.standard_normal() * sigma  # start in the stationary distribution
+    return lfilter([1.0], [1.0, -phi], w)
