@@ -12,7 +12,12 @@ key                            noise-model coefficient  unit
 ``accelerometer_random_walk``  K of the accelerometer   m/s³/√Hz
 =============================  =======================  ====================
 
-(N in rad/√s is numerically rad/s/√Hz, K in rad/s/√s is rad/s²/√Hz.) The
+(N in rad/√s is numerically rad/s/√Hz, K in rad/s/√s is rad/s²/√Hz.) Kalibr's
+model has no Gauss–Markov state, so the values written are the model's
+datasheet equivalents (:meth:`NoiseModel.equivalent`): Gauss–Markov terms
+faster than 1 s are folded into the white noise, slower ones into the random
+walk (the walk that bounds them over times shorter than τc). The
+:func:`ekf_dict` export keeps them as bias states instead. The
 files hold one number per sensor, so the axes are combined: ``combine="max"``
 (default, the worst axis: conservative, what Kalibr's authors recommend when in
 doubt) or ``"rms"`` (√ of the mean square over axes). Kalibr's documentation
@@ -42,6 +47,9 @@ import numpy as np
 from imunoise import units as _units
 
 __all__ = [
+    "ekf_dict",
+    "ekf_yaml",
+    "write_ekf",
     "kalibr_dict",
     "kalibr_yaml",
     "openvins_yaml",
@@ -74,8 +82,10 @@ def write_atomic(path, text: str) -> Path:
 
 
 def _combine(model, term: str, combine: str, sensor: str, input_unit) -> float:
-    values = model.value(term)
-    sup = np.atleast_1d(model.supported[term])
+    # The model's datasheet equivalent: Kalibr's white + random-walk model has no
+    # Gauss–Markov state, so fast ones count as white noise and slow ones as walk.
+    values = np.atleast_1d(model.equivalent(term))
+    sup = values > 0
     scale = _units.input_scale(sensor, input_unit)
     if not sup.any():
         warnings.warn(
@@ -206,6 +216,104 @@ def model_json(model=None, **models) -> str:
     else:
         raise ValueError("model_json needs a NoiseModel")
     return json.dumps(payload, indent=2, allow_nan=False) + "\n"
+
+
+def _ekf_axes(model, sensor: str, input_unit, min_samples: float) -> dict:
+    scale = _units.input_scale(sensor, input_unit)
+    axes = {}
+    names = ["x", "y", "z"] if model.channels == 3 else [f"ch{i}" for i in range(model.channels)]
+    for c, name in enumerate(names):
+        white2 = float(model.value("N")[c]) ** 2
+        states = []
+        for sigma, tau_c in model.gauss_markov(c):
+            if tau_c * model.fs < min_samples:
+                # Too fast to be a filter state at the IMU rate: white noise.
+                phi = math.exp(-1.0 / (model.fs * tau_c))
+                white2 += sigma**2 * (1 + phi) / ((1 - phi) * model.fs)
+                continue
+            states.append({
+                "sigma": sigma * scale,
+                "correlation_time": tau_c,
+                "driving_noise_density": sigma * math.sqrt(2.0 / tau_c) * scale,
+            })
+        axes[name] = {
+            "white_noise_density": math.sqrt(white2) * scale,
+            "random_walk": float(model.value("K")[c]) * scale,
+            "bias_instability": float(model.value("B")[c]) * scale,
+            "gauss_markov": states,
+        }
+    return axes
+
+
+def ekf_dict(gyro=None, accel=None, *, gyro_unit: str | None = None,
+             accel_unit: str | None = None, min_samples: float = 10.0) -> dict:
+    """A Gauss–Markov bias model per axis for an extended Kalman filter (SI units).
+
+    Per sensor and axis: ``white_noise_density`` (rad/s/√Hz or m/s²/√Hz: the
+    continuous-time density of the measurement noise), ``random_walk`` (K,
+    rad/s²/√Hz or m/s³/√Hz: driving noise of a random-walk bias state),
+    ``bias_instability`` (B, the flicker term, rad/s or m/s²; no finite state
+    models it exactly) and ``gauss_markov``: one bias state per Gauss–Markov
+    term, ḃ = −b/τc + w with ``sigma`` (steady-state standard deviation),
+    ``correlation_time`` τc (s) and ``driving_noise_density`` √(2σ²/τc) (the
+    density of w). Discretised at step Δt: b[k+1] = e^(−Δt/τc)·b[k] + w[k],
+    var w[k] = σ²(1 − e^(−2Δt/τc)). A Gauss–Markov term faster than
+    ``min_samples`` samples cannot be a state at the IMU rate and is folded
+    into the white noise.
+    """
+    if gyro is None and accel is None:
+        raise ValueError("gyro and accel are both None; pass at least one NoiseModel")
+    if not (math.isfinite(min_samples) and min_samples >= 0):
+        raise ValueError(f"min_samples must be finite and >= 0; got {min_samples!r}")
+    out: dict = {}
+    if gyro is not None:
+        out["gyroscope"] = {
+            "units": {"white_noise_density": "rad/s/sqrt(Hz)", "random_walk":
+                      "rad/s^2/sqrt(Hz)", "bias_instability": "rad/s", "sigma": "rad/s",
+                      "correlation_time": "s", "driving_noise_density": "rad/s/sqrt(s)"},
+            "axes": _ekf_axes(gyro, "gyro", gyro_unit, min_samples),
+        }
+    if accel is not None:
+        out["accelerometer"] = {
+            "units": {"white_noise_density": "m/s^2/sqrt(Hz)", "random_walk":
+                      "m/s^3/sqrt(Hz)", "bias_instability": "m/s^2", "sigma": "m/s^2",
+                      "correlation_time": "s", "driving_noise_density": "m/s^2/sqrt(s)"},
+            "axes": _ekf_axes(accel, "accel", accel_unit, min_samples),
+        }
+    out["update_rate"] = float((gyro if gyro is not None else accel).fs)
+    return out
+
+
+def ekf_yaml(gyro=None, accel=None, **kwargs) -> str:
+    """YAML text of :func:`ekf_dict`."""
+    d = ekf_dict(gyro, accel, **kwargs)
+    lines = ["# IMU bias model for an EKF (continuous time, SI units), written by imunoise"]
+    for sensor in ("gyroscope", "accelerometer"):
+        if sensor not in d:
+            continue
+        lines.append(f"{sensor}:")
+        lines.append("  units: {" + ", ".join(f"{k}: {v}" for k, v in d[sensor]["units"].items())
+                     + "}")
+        lines.append("  axes:")
+        for axis, a in d[sensor]["axes"].items():
+            lines.append(f"    {axis}:")
+            for key in ("white_noise_density", "random_walk", "bias_instability"):
+                lines.append(f"      {key}: {_scalar(a[key])}")
+            if not a["gauss_markov"]:
+                lines.append("      gauss_markov: []")
+                continue
+            lines.append("      gauss_markov:")
+            for g in a["gauss_markov"]:
+                lines.append(f"        - {{sigma: {_scalar(g['sigma'])}, correlation_time: "
+                             f"{_scalar(g['correlation_time'])}, driving_noise_density: "
+                             f"{_scalar(g['driving_noise_density'])}}}")
+    lines.append(f"update_rate: {d['update_rate']:.1f}")
+    return "\n".join(lines) + "\n"
+
+
+def write_ekf(path, gyro=None, accel=None, **kwargs) -> Path:
+    """Write :func:`ekf_yaml` atomically; returns the path."""
+    return write_atomic(path, ekf_yaml(gyro, accel, **kwargs))
 
 
 def write_kalibr(path, gyro=None, accel=None, **kwargs) -> Path:

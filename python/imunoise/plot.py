@@ -224,13 +224,28 @@ def _curves(coeffs: Mapping[str, float], taus: np.ndarray) -> dict[str, np.ndarr
     return out
 
 
+def _model_curves(model, grid: np.ndarray, channel: int) -> dict[str, np.ndarray]:
+    """Deviation of each term of a fitted model and its total at ``grid``."""
+    pred = model.predict(grid)
+    out = {name: np.reshape(v, (grid.size, -1))[:, channel] for name, v in pred.terms.items()}
+    out["total"] = np.reshape(pred.dev, (grid.size, -1))[:, channel]
+    return out
+
+
+def _readoff_points(model, channel: int) -> dict[str, float]:
+    """The model's datasheet equivalents N (τ = 1 s), K (τ = 3 s), B for the marks."""
+    return {t: float(np.atleast_1d(model.equivalent(t))[channel]) for t in ("N", "K", "B")}
+
+
 def allan(
     result,
+    model=None,
     *,
     coefficients: Sequence[Mapping[str, float]] | None = None,
     title: str = "",
     unit: str = "",
     names: Sequence[str] | None = None,
+    residuals: bool = True,
 ):
     r"""Allan deviation of a sensor's axes on log-log axes, one panel per axis.
 
@@ -238,11 +253,18 @@ def allan(
     ----------
     result : AllanResult
         1-D or 2-D result; the error bars are its ``ci_low``/``ci_high``.
+    model : NoiseModel, optional
+        A fit of ``result`` (:func:`imunoise.fit`). The model total and each of
+        its terms are drawn (Gauss–Markov terms included), the datasheet
+        read-off points of the model are marked — N at τ = 1 s, K at τ = 3 s and
+        the floor :math:`B\sqrt{2\ln2/\pi}` (≈ 0.664 B) at the total's minimum —
+        and, with ``residuals``, a panel below each axis shows data/model with the
+        measured interval and the ±5 % band.
     coefficients : sequence of mapping, optional
-        Per axis, the fitted ``{"Q", "N", "B", "K", "R"}`` in the result's units.
-        When given, the model total and each non-zero term are drawn and the
-        read-off points are marked: N at τ = 1 s, K at τ = 3 s and
-        :math:`B\sqrt{2\ln2/\pi}` (the flat floor, ≈ 0.664 B) at the total's minimum.
+        Instead of ``model``: per axis, IEEE coefficients ``{"Q", "N", "B", "K",
+        "R"}`` in the result's units (no Gauss–Markov terms, no residuals).
+    residuals : bool
+        Draw the data/model panel when a model is given (default True).
     """
     Figure = _plt()
     from matplotlib.ticker import NullFormatter
@@ -255,9 +277,18 @@ def allan(
     names = list(names) if names is not None else list(AXIS_NAMES[:k])
     kind = getattr(result, "kind", "adev").upper()
     grid = np.geomspace(taus[0], taus[-1], 200)
+    show_res = model is not None and residuals
     with style():
-        fig = Figure(figsize=(3.6 * k, 3.9))
-        axes = fig.subplots(1, k, squeeze=False, sharey=True)[0]
+        fig = Figure(figsize=(3.6 * k, 3.9 + (1.3 if show_res else 0.0)))
+        if show_res:
+            gs = fig.add_gridspec(2, k, height_ratios=(3, 1), hspace=0.08)
+            axes = [fig.add_subplot(gs[0, j]) for j in range(k)]
+            for ax in axes[1:]:
+                ax.sharey(axes[0])
+            res_axes = [fig.add_subplot(gs[1, j], sharex=axes[j]) for j in range(k)]
+        else:
+            axes = list(fig.subplots(1, k, squeeze=False, sharey=True)[0])
+            res_axes = []
         lims: list[tuple[float, float]] = []
         for j, ax in enumerate(axes):
             color = AXIS_COLORS[j % 4]
@@ -266,41 +297,70 @@ def allan(
                 taus, dev[:, j], yerr=yerr, fmt="o", ms=2.5, color=color,
                 elinewidth=0.8, capsize=1.5, label=f"{kind} ({result.confidence:.1%} CI)",
             )
-            if coefficients is not None:
+            marks: dict[str, float] = {}
+            if model is not None:
+                curves = _model_curves(model, grid, j)
+                marks = _readoff_points(model, j)
+            elif coefficients is not None:
+                curves = _curves(coefficients[j], grid)
                 c = coefficients[j]
-                curves = _curves(c, grid)
+                marks = {t: c.get(t, 0.0) for t in ("N", "K", "B")}
+            if model is not None or coefficients is not None:
                 ax.plot(grid, curves["total"], color="k", linewidth=1.2, label="model")
                 for term, (label, ls) in TERM_STYLES.items():
-                    if c.get(term, 0.0) > 0:
+                    if term in curves and np.any(curves[term] > 0):
                         ax.plot(grid, curves[term], color="0.45", linestyle=ls,
                                 linewidth=0.9, label=f"{label}")
-                if c.get("N", 0.0) > 0:
-                    ax.plot([1.0], [c["N"]], marker="s", color="crimson", ms=5,
+                for g, ls in (("GM1", (0, (1, 1))), ("GM2", (0, (3, 1, 1, 1)))):
+                    if g in curves and np.any(curves[g] > 0):
+                        ax.plot(grid, curves[g], color="tab:brown", linestyle=ls,
+                                linewidth=0.9, label="Gauss–Markov bias")
+                if marks.get("N", 0.0) > 0:
+                    ax.plot([1.0], [marks["N"]], marker="s", color="crimson", ms=5,
                             linestyle="none", label="N at τ=1 s")
-                if c.get("K", 0.0) > 0:
-                    ax.plot([3.0], [c["K"]], marker="^", color="purple", ms=5,
+                if marks.get("K", 0.0) > 0:
+                    ax.plot([3.0], [marks["K"]], marker="^", color="purple", ms=5,
                             linestyle="none", label="K at τ=3 s")
-                if c.get("B", 0.0) > 0:
+                if marks.get("B", 0.0) > 0:
                     imin = int(np.argmin(curves["total"]))
-                    ax.plot([grid[imin]], [c["B"] * math.sqrt(_B_FACTOR)], marker="D",
+                    ax.plot([grid[imin]], [marks["B"] * math.sqrt(_B_FACTOR)], marker="D",
                             color="darkgreen", ms=5, linestyle="none",
                             label="B·0.664 floor")
             ax.set_xscale("log")
             ax.set_yscale("log")
-            ax.set_xlabel("τ [s]")
+            if not show_res:
+                ax.set_xlabel("τ [s]")
             ax.set_title(names[j])
             ax.grid(True, which="both", alpha=0.25)
             ymin = np.nanmin(np.where(lo[:, j] > 0, lo[:, j], np.nan))
             ymax = np.nanmax(hi[:, j])
-            if coefficients is not None:
-                # keep the read-off points (N at 1 s, K at 3 s) inside the axes
-                marks = [coefficients[j].get(t, 0.0) for t in ("N", "K")]
-                marks = [v for v in marks if v > 0]
-                if marks:
-                    ymin = min(ymin, min(marks) / 1.5)
-                    ymax = max(ymax, max(marks) * 1.5)
+            shown = [marks.get(t, 0.0) for t in ("N", "K")]
+            shown = [v for v in shown if v > 0]
+            if shown:  # keep the read-off points (N at 1 s, K at 3 s) inside the axes
+                ymin = min(ymin, min(shown) / 1.5)
+                ymax = max(ymax, max(shown) * 1.5)
             ax.yaxis.set_minor_formatter(NullFormatter())
             lims.append((ymin, ymax))
+        for j, ax in enumerate(res_axes):
+            pred = np.reshape(model.predict(taus).dev, dev.shape)[:, j]
+            ratio = dev[:, j] / pred
+            ax.axhspan(0.95, 1.05, color="0.88", zorder=0, label="±5 %")
+            ax.axhline(1.0, color="k", linewidth=0.8)
+            ax.errorbar(taus, ratio, yerr=np.vstack([(dev[:, j] - lo[:, j]) / pred,
+                                                     (hi[:, j] - dev[:, j]) / pred]),
+                        fmt="o", ms=2, color=AXIS_COLORS[j % 4], elinewidth=0.6)
+            ax.set_xscale("log")
+            ax.set_xlabel("τ [s]")
+            ax.grid(True, which="both", alpha=0.25)
+            finite = ratio[np.isfinite(ratio)]
+            span = max(0.1, float(np.max(np.abs(finite - 1)))) if finite.size else 0.1
+            ax.set_ylim(1 - 1.15 * span, 1 + 1.15 * span)
+            cover = np.atleast_1d(model.coverage)[j]
+            ax.text(0.02, 0.06, f"follows {cover:.0%} of taus", transform=ax.transAxes,
+                    fontsize=7)
+            if j == 0:
+                ax.set_ylabel("data/model")
+            axes[j].tick_params(labelbottom=False)
         ymin = np.nanmin([a for a, _ in lims])
         ymax = np.nanmax([b for _, b in lims])
         if np.isfinite(ymin) and np.isfinite(ymax) and ymin > 0:

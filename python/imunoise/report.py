@@ -8,6 +8,7 @@
     figures/       every figure as PNG and SVG
     noise.json     fitted noise model (when the noise model is available)
     imu.yaml       Kalibr IMU noise file (when the noise model is available)
+    ekf_bias_model.yaml  white noise, random walk and Gauss–Markov bias states per axis
 
 With one log both analyses run on it. Sections follow a lab report: recording
 summary (duration, rate, what the reader skipped), sample statistics, distribution
@@ -15,7 +16,7 @@ fits, Allan deviation per sensor, noise coefficients per axis in datasheet units
 with uncertainties, datasheet comparison.
 
 The report reaches the rest of the package through a handful of small functions
-(``_read_log``, ``_allan``, ``_fit``, ``_coefficients``, ``_datasheet_rows``,
+(``_read_log``, ``_allan``, ``_fit``, ``_model_sentences``, ``_datasheet_rows``,
 ``_compare_rows``, ``_write_model_files``); each is the single place that knows
 the API it calls.
 """
@@ -75,10 +76,43 @@ def _fit(result):
     return imunoise.fit(result)
 
 
-def _coefficients(model) -> list[dict[str, float]]:
-    """Per channel ``{"Q", "N", "B", "K", "R"}`` in the input's units (for plots)."""
-    values = {t: np.atleast_1d(model.value(t)) for t in "QNBKR"}
-    return [{t: float(values[t][j]) for t in "QNBKR"} for j in range(len(values["N"]))]
+def _model_sentences(model, sensor: str) -> list[str]:
+    """Per axis, in words: the terms, how well the model follows the curve, the
+    Gauss–Markov terms, and whether model and datasheet read-offs agree."""
+    from imunoise import units as _units
+
+    b_unit = _units.unit_info("B", None, sensor)
+    n_unit = _units.unit_info("N", None, sensor)
+    out = []
+    for c, axis in enumerate(_AXES[: model.channels]):
+        terms = [t for t in ("N", "B", "K", "Q", "R") if np.atleast_1d(model.supported[t])[c]]
+        gm = model.gauss_markov(c)
+        parts = [f"{axis}: {' + '.join(terms + [f'{len(gm)} Gauss–Markov'] * bool(gm))}"]
+        cover = float(np.atleast_1d(model.coverage)[c])
+        delta = float(np.atleast_1d(model.discrepancy)[c])
+        parts.append(f"follows {cover:.0%} of the taus (inside the 95 % interval or within 5 %)"
+                     + (f", residual discrepancy {delta / 2:.1%} in σ" if delta > 0.01 else ""))
+        if cover < 0.8:
+            parts.append("**the model does not describe this curve: read its coefficients "
+                         "as a summary only** (see the data/model panel)")
+        for sigma, tau_c in gm:
+            value = _units.convert(sigma, "B", b_unit.name, sensor=sensor)
+            parts.append(f"Gauss–Markov bias σ = {_num(value)} {b_unit.label}, "
+                         f"τc = {_num(tau_c)} s")
+        for term, unit in (("N", n_unit), ("B", b_unit)):
+            read = float(np.atleast_1d(model.readoff[term]["value"])[c])
+            std = float(np.atleast_1d(model.readoff[term]["std"])[c])
+            eq = float(np.atleast_1d(model.equivalent(term))[c])
+            if not (np.isfinite(read) and eq > 0):
+                continue
+            conv = _units.convert(np.array([read, eq, std]), term, unit.name, sensor=sensor)
+            diff = abs(read - eq) / max(std, 1e-300)
+            verdict = ("agree" if diff <= 2 or abs(read / eq - 1) <= 0.05 else
+                       "differ: the curve is not the ideal slope there (filter, bumps)")
+            parts.append(f"{term} read-off {_num(conv[0])} vs model {_num(conv[1])} "
+                         f"{unit.label} ({verdict})")
+        out.append("; ".join(parts) + ".")
+    return out
 
 
 def _datasheet_rows(model, sensor: str) -> tuple[list[str], list[list[str]]]:
@@ -113,14 +147,16 @@ def _compare_rows(models: dict, spec: str) -> tuple[list[str], list[list[str]]]:
 
 
 def _write_model_files(models: dict, out_dir: Path, fs: float) -> list[Path]:
-    """noise.json and Kalibr imu.yaml through :mod:`imunoise.export`."""
+    """noise.json, Kalibr imu.yaml and the EKF bias model through :mod:`imunoise.export`."""
     from imunoise import export
 
     json_path, yaml_path = out_dir / "noise.json", out_dir / "imu.yaml"
+    ekf_path = out_dir / "ekf_bias_model.yaml"
     export.write_json(json_path, **models)
     export.write_kalibr(yaml_path, gyro=models.get("gyro"), accel=models.get("accel"),
                         update_rate=fs)
-    return [json_path, yaml_path]
+    export.write_ekf(ekf_path, gyro=models.get("gyro"), accel=models.get("accel"))
+    return [json_path, yaml_path, ekf_path]
 
 
 # ---------------------------------------------------------------------------
@@ -475,14 +511,14 @@ def _build(short, long, out: Path, spec, fs, bar: _Progress) -> Report:
           "EDF)." if allan else "The log has no gyro or accelerometer channel.")
     for sensor, r in allan.items():
         unit = CHANNELS[sensor][1]
-        coeffs = _coefficients(models[sensor]) if sensor in models else None
-        fig = _plot.allan(r, coefficients=coeffs, title=f"{sensor} Allan deviation", unit=unit)
+        model = models.get(sensor)
+        fig = _plot.allan(r, model, title=f"{sensor} Allan deviation", unit=unit)
         figures += _plot.save(fig, figdir / f"adev_{sensor}")
         doc.h(3, sensor)
         doc.figure(figdir / f"adev_{sensor}.png",
                    f"Allan deviation of {sensor} [{unit}]"
-                   + (" with the fitted model, its terms and the read-off points"
-                      if coeffs else ""))
+                   + (" with the fitted model, its terms, the read-off points and the "
+                      "data/model ratio" if model is not None else ""))
         rows = []
         for i, tau in enumerate(r.taus):
             row = [_num(tau), str(int(r.n[i]))]
@@ -496,11 +532,15 @@ def _build(short, long, out: Path, spec, fs, bar: _Progress) -> Report:
 
     doc.h(2, "5. Noise coefficients")
     model_files: list[Path] = []
-    doc.p("Weighted least-squares fit of σ²(τ) = 3Q²/τ² + N²/τ + (2 ln2/π)B² + K²τ/3 + "
-          "R²τ²/2 (IEEE Std 952), standard uncertainties from the fit.")
+    doc.p("Fit of σ²(τ) = 3Q²/τ² + N²/τ + (2 ln2/π)B² + K²τ/3 + R²τ²/2 (IEEE Std 952) "
+          "plus up to three first-order Gauss–Markov bias terms, on ln σ², each octave of τ "
+          "weighted alike, the terms chosen by BIC; standard uncertainties from the fit "
+          "(docs/noise.md). Read-offs: N on the −½ line at τ = 1 s, B = σ_min/0.664.")
     for sensor, m in models.items():
         header, rows = _datasheet_rows(m, sensor)
         doc.table(header, rows, caption=f"{sensor} noise coefficients per axis")
+        for sentence in _model_sentences(m, sensor):
+            doc.p(sentence)
     model_files = _write_model_files(models, out, long_log.fs)
 
     doc.h(2, "6. Datasheet comparison")
