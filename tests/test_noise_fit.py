@@ -43,7 +43,7 @@ def vn_like():
         ("B", 1e-4, HOURS5 // 2, 0.15),
         ("K", 1e-5, HOURS5 // 4, 0.30),
         ("Q", 1e-4, HOURS5 // 8, 0.03),
-        ("R", 1e-6, HOURS5 // 8, 1e-6),
+        ("R", 1e-6, HOURS5 // 8, 1e-3),  # deterministic: only the log-bias shift
     ],
 )
 def test_single_term_recovered_and_others_unsupported(term, value, n, tol):
@@ -69,9 +69,13 @@ def test_all_terms_together(vn_like):
     assert model.N.shape == (3,)
     for term, tol in (("N", 0.02), ("B", 0.25)):
         est = model.value(term)
-        assert np.all(model.supported[term]), term
+        assert np.sum(model.supported[term]) >= 2, term
         rel = np.abs(est / truth[term] - 1)
         assert np.median(rel) < tol, (term, est, truth[term])
+    # A flicker realisation can look like a Gauss–Markov bump: the flat part is
+    # always carried by one of the two.
+    for c in range(3):
+        assert model.supported["B"][c] or model.gauss_markov(c), c
     # At long tau a random-walk realisation can look like a ramp: on every axis
     # the long-tau rise is carried by K or R, never by nothing.
     assert np.all(model.supported["K"] | model.supported["R"])
@@ -100,11 +104,12 @@ def test_predict_is_the_model(vn_like):
     taus = np.logspace(-2, 4, 13)
     p = model.predict(taus)
     assert p.dev.shape == (13, 3)
-    parts = sum(p.terms[k] ** 2 for k in "QNBKR")
+    parts = sum(v**2 for v in p.terms.values())
     np.testing.assert_allclose(p.dev**2, parts, rtol=1e-12)
     for c in range(3):
         expect = model_variance(taus, **{k: float(model.value(k)[c]) for k in "QNBKR"})
-        np.testing.assert_allclose(p.dev[:, c] ** 2, expect, rtol=1e-12)
+        gm = sum(p.terms[k][:, c] ** 2 for k in p.terms if k.startswith("GM"))
+        np.testing.assert_allclose(p.dev[:, c] ** 2, expect + gm, rtol=1e-12)
     np.testing.assert_allclose(p.terms["N"][:, 0], model.N[0] / np.sqrt(taus), rtol=1e-12)
     np.testing.assert_allclose(p.terms["B"][:, 1], FLICKER * model.B[1], rtol=1e-12)
 
@@ -162,7 +167,9 @@ def test_slopes_on_vn100_like_curve():
     wls = imunoise.fit(_exact_result(TAUS, **coef), method="wls")
     for k, v in coef.items():
         assert float(getattr(slopes, k)) == pytest.approx(v, rel=0.25), k
-        assert float(getattr(wls, k)) == pytest.approx(v, rel=1e-6), k
+        # exact curves carry no χ² scatter; the fit's log-bias correction for
+        # edf = 1000 (E ln χ²/ν ≈ −1/ν) shifts them by ~1e-3
+        assert float(getattr(wls, k)) == pytest.approx(v, rel=3e-3), k
     # B from the flat part: sigma_min / 0.6643, never 0.6643 * sigma^2
     dev = np.sqrt(model_variance(TAUS, **coef))
     assert float(slopes.B) >= dev.min() / FLICKER * 0.99
@@ -192,8 +199,8 @@ def test_wls_agrees_with_allan_variance_on_an_exact_curve():
     params, _ = allan_variance.estimate_parameters(r.taus, r.var)
     names = {"Q": "quantization", "N": "white", "B": "flicker", "K": "walk", "R": "ramp"}
     for k, v in coef.items():
-        assert float(getattr(ours, k)) == pytest.approx(v, rel=1e-6), k
-        assert float(getattr(ours, k)) == pytest.approx(params[names[k]], rel=1e-4), k
+        assert float(getattr(ours, k)) == pytest.approx(v, rel=3e-3), k
+        assert float(getattr(ours, k)) == pytest.approx(params[names[k]], rel=3e-3), k
 
 
 @pytest.fixture(scope="module")

@@ -89,7 +89,8 @@ def test_in_units_and_table(gyro_model):
     model, n, b = gyro_model
     conv = model.in_units("gyro", units={"N": "deg/s/sqrt(Hz)"})
     np.testing.assert_allclose(conv["N"]["value"], model.N / DEG, rtol=1e-12)
-    np.testing.assert_allclose(conv["N"]["std"], model.N_std / DEG, rtol=1e-12)
+    # the std of the datasheet equivalent comes through a numerical gradient
+    np.testing.assert_allclose(conv["N"]["std"], model.N_std / DEG, rtol=1e-6)
     assert conv["B"]["unit"] == "deg/h" and conv["B"]["label"] == "°/h"
     rows = model.table("gyro")
     assert [r["term"] for r in rows] == ["N", "B", "K", "Q", "R"]

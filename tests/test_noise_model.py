@@ -1,0 +1,194 @@
+"""The noise model on curves five IEEE terms cannot follow: Gauss–Markov terms,
+model selection, tau-grid stability, goodness of fit, read-offs, EKF export.
+
+Oracles: the parameters put into the simulator (an exact AR1 for each
+Gauss–Markov term, whose Allan variance is checked against the autocovariance
+sum in the Rust tests), and a real VN-100 still log that nobody here recorded.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from pathlib import Path
+
+import imunoise
+import numpy as np
+import pytest
+from imunoise import export
+
+FS = 50.0
+REAL_LOG = Path(imunoise.__file__).parent / "data" / "vn100_stationary_5min.txt"
+
+
+def _quiet_fit(result, **kwargs):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        return imunoise.fit(result, **kwargs)
+
+
+@pytest.fixture(scope="module")
+def white_plus_gm():
+    """Two channels of white noise + one Gauss–Markov bias (τc = 20 s), 2 h at 50 Hz."""
+    truth = {"N": 2e-3, "sigma": 4e-3, "tau_c": 20.0}
+    x = imunoise.simulate(int(2 * 3600 * FS), FS, N=truth["N"], channels=2, seed=21,
+                          gm=[(truth["sigma"], truth["tau_c"])])
+    return truth, imunoise.adev(x, FS, taus=10)
+
+
+def test_gauss_markov_term_is_recovered_and_selected(white_plus_gm):
+    truth, r = white_plus_gm
+    model = imunoise.fit(r)
+    for c in range(2):
+        gm = model.gauss_markov(c)
+        assert len(gm) == 1, gm
+        sigma, tau_c = gm[0]
+        assert sigma == pytest.approx(truth["sigma"], rel=0.10)
+        assert tau_c == pytest.approx(truth["tau_c"], rel=0.20)
+        assert abs(tau_c - truth["tau_c"]) < 4 * np.reshape(model.gm_tau_std, (2, -1))[c, 0]
+        # The true structure: white noise and the bias, nothing else.
+        assert model.supported["N"][c]
+        assert not any(model.supported[t][c] for t in ("Q", "K", "R"))
+    assert np.all(model.coverage >= 0.9)
+
+
+def test_explicit_terms_fit_exactly_those(white_plus_gm):
+    _, r = white_plus_gm
+    only = imunoise.fit(r, terms=["N", "GM"])
+    assert all(len(only.gauss_markov(c)) == 1 for c in range(2))
+    assert not np.any(only.supported["B"])
+    with pytest.raises(ValueError, match="terms must be 'auto' or"):
+        imunoise.fit(r, terms=["N", "GM", "GM", "GM", "GM"])
+    with pytest.raises(ValueError, match="terms must be 'auto' or"):
+        imunoise.fit(r, terms=["X"])
+
+
+def test_five_term_data_selects_no_gauss_markov():
+    x = imunoise.simulate(int(3600 * FS), FS, N=1e-3, K=2e-5, channels=2, seed=8)
+    model = imunoise.fit(imunoise.adev(x, FS, taus=10))
+    for c in range(2):
+        assert model.gauss_markov(c) == []
+        assert model.N[c] == pytest.approx(1e-3, rel=0.01)
+        assert not model.supported["Q"][c] and not model.supported["R"][c]
+    # One hour of one random-walk realisation can look flat at its longest taus
+    # (B); the other channel shows the walk.
+    assert np.any(model.supported["K"])
+
+
+@pytest.mark.parametrize("seed", [3, 4])
+def test_coefficients_do_not_depend_on_the_tau_grid(seed):
+    """Octave, 5, 10, 20 and 50 taus per decade: the same terms, and N, B, K
+    within two standard uncertainties."""
+    x = imunoise.simulate(int(2 * 3600 * FS), FS, N=1e-3, B=2e-4, K=1e-5, seed=seed)
+    fits = {g: _quiet_fit(imunoise.adev(x, FS, taus=g)) for g in ("octave", 5, 10, 20, 50)}
+    structures = {(tuple(bool(m.supported[t]) for t in "QNBKR"), len(m.gauss_markov()))
+                  for m in fits.values()}
+    assert len(structures) == 1, structures
+    for term in ("N", "B", "K"):
+        vals = np.array([float(m.value(term)[0]) for m in fits.values()])
+        stds = np.array([float(m.std(term)[0]) for m in fits.values()])
+        if np.all(vals == 0):
+            continue
+        assert vals.max() - vals.min() <= 2 * stds.max(), (term, vals, stds)
+    beq = np.array([float(m.equivalent("B")[0]) for m in fits.values()])
+    assert np.all(beq == 0) or beq.max() / beq.min() - 1 < 0.05, beq
+
+
+def test_real_vn100_log_is_followed_on_every_grid():
+    """The bundled real VN-100 still log: the model follows its curves, and the
+    white-noise density does not depend on the grid."""
+    log = imunoise.read(REAL_LOG)
+    n_eq = []
+    for grid in ("octave", 5, 10, 20, 50):
+        model = _quiet_fit(imunoise.adev(log.gyro, log.fs, taus=grid))
+        assert np.all(model.coverage >= 0.8), (grid, model.coverage)
+        n_eq.append(model.equivalent("N"))
+    n_eq = np.array(n_eq)
+    assert np.all(n_eq.max(axis=0) / n_eq.min(axis=0) - 1 < 0.03), n_eq
+
+
+def test_goodness_of_fit_warns_only_when_the_model_misses():
+    rng = np.random.default_rng(5)
+    n = 400_000
+    t = np.arange(n) / FS
+    good = rng.standard_normal(n)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        model = imunoise.fit(imunoise.adev(good, FS, taus=10))
+    assert float(model.coverage) > 0.95
+    # A strong 0.05 Hz tone: the Allan deviation has nulls at τ = k·20 s that
+    # no noise term can follow.
+    tone = good + 3.0 * np.sin(2 * np.pi * 0.05 * t)
+    with pytest.warns(RuntimeWarning, match="follows the Allan deviation of channel 0"):
+        missed = imunoise.fit(imunoise.adev(tone, FS, taus=20))
+    assert float(missed.coverage) < 0.8
+    assert float(missed.discrepancy) > 0.1
+
+
+def test_readoffs_agree_with_the_model_on_ideal_noise():
+    x = imunoise.simulate(int(3 * 3600 * FS), FS, N=1e-3, B=1e-4, K=3e-6, seed=12)
+    model = imunoise.fit(imunoise.adev(x, FS, taus=10))
+    for term in ("N", "B"):
+        read = float(model.readoff[term]["value"])
+        std = float(model.readoff[term]["std"])
+        eq = float(model.equivalent(term)[0])
+        eq_std = float(model.equivalent_std(term)[0])
+        assert eq > 0, term
+        assert abs(read - eq) <= max(3 * math.hypot(std, eq_std), 0.05 * eq), (
+            term, read, eq, std, eq_std)
+    assert float(model.readoff["N"]["value"]) == pytest.approx(1e-3, rel=0.05)
+    # B read-off is σ_min/0.6643, never below the flicker coefficient.
+    assert float(model.readoff["B"]["value"]) >= 1e-4 * 0.95
+    lo, hi = float(model.readoff["B"]["low"]), float(model.readoff["B"]["high"])
+    assert lo < float(model.readoff["B"]["value"]) < hi
+
+
+def test_equivalent_white_noise_folds_fast_gauss_markov(white_plus_gm):
+    truth, r = white_plus_gm
+    model = imunoise.fit(r, terms=["N", "GM"])
+    sigma, tau_c = model.gauss_markov(0)[0]
+    # τc = 20 s > 1 s: the slow term goes to the walk, not to the white noise.
+    assert float(model.equivalent("N")[0]) == pytest.approx(float(model.N[0]), rel=1e-12)
+    assert float(model.equivalent("K")[0]) == pytest.approx(
+        math.sqrt(2 * sigma**2 / tau_c), rel=1e-12)
+
+
+def test_ekf_export(tmp_path, white_plus_gm):
+    _, r = white_plus_gm
+    model = imunoise.fit(r)
+    d = export.ekf_dict(gyro=model)
+    axes = d["gyroscope"]["axes"]
+    assert list(axes) == ["ch0", "ch1"]
+    state = axes["ch0"]["gauss_markov"][0]
+    sigma, tau_c = model.gauss_markov(0)[0]
+    assert state["sigma"] == pytest.approx(sigma)
+    assert state["correlation_time"] == pytest.approx(tau_c)
+    assert state["driving_noise_density"] == pytest.approx(sigma * math.sqrt(2 / tau_c))
+    assert axes["ch0"]["white_noise_density"] == pytest.approx(float(model.N[0]))
+    path = export.write_ekf(tmp_path / "ekf.yaml", gyro=model)
+    text = path.read_text(encoding="utf-8")
+    assert "correlation_time" in text and text.endswith("update_rate: 50.0\n")
+    with pytest.raises(ValueError, match="min_samples must be"):
+        export.ekf_dict(gyro=model, min_samples=-1)
+    with pytest.raises(ValueError, match="pass at least one NoiseModel"):
+        export.ekf_dict()
+
+
+def test_simulate_gauss_markov_is_the_ar1():
+    x = imunoise.simulate(400_000, 10.0, gm=[(2.0, 1.0)], seed=3)
+    phi = math.exp(-1 / 10.0)
+    assert np.std(x) == pytest.approx(2.0, rel=0.05)
+    rho = np.corrcoef(x[:-1], x[1:])[0, 1]
+    assert rho == pytest.approx(phi, abs=0.01)
+    with pytest.raises(ValueError, match="gm tau_c must be finite and > 0"):
+        imunoise.simulate(10, 1.0, gm=[(1.0, 0.0)])
+    with pytest.raises(TypeError, match="gm must be a sequence"):
+        imunoise.simulate(10, 1.0, gm=[1.0])
+
+
+def test_model_json_carries_gauss_markov(white_plus_gm):
+    _, r = white_plus_gm
+    d = imunoise.fit(r).to_dict()
+    assert len(d["gauss_markov"]) == 2 and d["gauss_markov"][0][0]["tau_c"] > 0
+    assert 0 < d["coverage"][0] <= 1
+    assert set(d["readoff"]) == {"N", "K", "B"}
