@@ -287,8 +287,8 @@ class NoiseModel:
         the bias over times shorter than τc). ``"B"``: the minimum of the model's
         deviation over the fitted taus divided by 0.6643, the bias instability
         a datasheet would quote from this curve (0 when the curve still falls
-        at the longest tau with a slope below −¼: no flat part). Other terms, and ``method="slopes"``: the
-        coefficient. Shape (channels,).
+        at the longest tau with a slope below −¼: no flat part). Other terms,
+        and ``method="slopes"``: the coefficient. Shape (channels,).
         """
         return self._equivalents(term)[0]
 
