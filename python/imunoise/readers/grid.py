@@ -109,8 +109,9 @@ def _phase(pos: np.ndarray) -> np.ndarray:
 
 
 def _line(slot: np.ndarray, t: np.ndarray, dt0: float) -> tuple[float, float]:
-    """Least-squares ``t = a + dt * slot`` (centred); ``dt0`` when the fit is off
-    by more than a factor 2 or agrees with it to :data:`SAME_STEP`."""
+    """Least-squares ``t = a + dt * slot`` (centred); ``dt0`` (the median step)
+    when the fit is off by more than a factor 2 or agrees with it to
+    :data:`SAME_STEP`."""
     sc, tc = slot - slot.mean(), t - t.mean()
     denom = float(sc @ sc)
     dt = float(sc @ tc) / denom if denom > 0 else dt0
@@ -273,15 +274,15 @@ class TimeGrid:
             return cls.identity(n)
         if n < 3 or len(pos) < 2:  # too short to find gaps; the rate of what is there
             return cls(np.arange(n, dtype=np.int64), n, fs=1.0 / float(np.median(pos)))
-        dt0 = float(np.median(pos))
+        dt0 = median = float(np.median(pos))
         single = np.rint(steps / dt0) == 1
         if single.sum() >= 2:  # the mean single step: jitter only at the ends of runs
             dt0 = float(steps[single].mean())
         prov = np.concatenate(([0.0], np.cumsum(np.rint(steps / dt0))))
-        a, dt = _line(prov, t, dt0)
+        a, dt = _line(prov, t, median)
         for _ in range(REFITS):  # slots of the tracked clock, and the line through them
             pos_slot = (t - a) / dt
-            a, dt = _line(np.rint(pos_slot - _phase(pos_slot)), t, dt0)
+            a, dt = _line(np.rint(pos_slot - _phase(pos_slot)), t, median)
         pos_slot = (t - a) / dt
         pos_slot -= _phase(pos_slot)
         span = float(pos_slot.max() - pos_slot.min())
@@ -350,30 +351,23 @@ class TimeGrid:
         out[self.slot[keep]] = values[keep]
         return out
 
-    def place_time(
-        self, time: np.ndarray | None, fs: float, before: float | None = None
-    ) -> np.ndarray | None:
+    def place_time(self, time: np.ndarray | None, before: float | None = None) -> np.ndarray | None:
         """Timestamps on the grid: measured where a sample is; in a missing row,
-        the time of the last sample before it plus the rows between over ``fs``.
+        interpolated between the samples on either side (a gap never ends the grid).
 
         ``before`` is the time of the row just before row 0 (a piece of a stream);
         without it, row 0 holds a sample."""
         if time is None or self.is_identity:
             return time
         keep = self.slot >= 0
+        rows = np.arange(self.n)
         have = np.zeros(self.n, dtype=bool)
         have[self.slot[keep]] = True
-        base = np.full(self.n, np.nan)
-        base[self.slot[keep]] = np.asarray(time, dtype=np.float64)[keep]
-        rows = np.arange(self.n)
-        prev = np.maximum.accumulate(np.where(have, rows, -1))
-        out = base
-        gap = ~have
-        if before is None:
-            out[gap] = base[prev[gap]] + (rows[gap] - prev[gap]) / fs
-        else:
-            known = gap & (prev >= 0)
-            out[known] = base[prev[known]] + (rows[known] - prev[known]) / fs
-            lead = gap & (prev < 0)
-            out[lead] = before + (rows[lead] + 1) / fs
+        out = np.full(self.n, np.nan)
+        out[self.slot[keep]] = np.asarray(time, dtype=np.float64)[keep]
+        gap = np.flatnonzero(~have)
+        prev = np.maximum.accumulate(np.where(have, rows, -1))[gap]
+        nxt = np.flatnonzero(have)[np.searchsorted(np.flatnonzero(have), gap)]
+        t_prev = np.where(prev >= 0, out[np.maximum(prev, 0)], np.nan if before is None else before)
+        out[gap] = t_prev + (out[nxt] - t_prev) * (gap - prev) / (nxt - prev)
         return out

@@ -139,8 +139,8 @@ class ImuLog:
     The rows are the log's **uniform time grid**: a sample lost in the recording
     (a dropout between timestamps, a damaged record of the main stream) is a row
     of NaN in every channel, never spliced over. ``time`` holds the measured
-    timestamp of every sample that is there and, in a missing row, the time of
-    the last sample before it plus ``rows between / fs``. ``len(log)`` counts
+    timestamp of every sample that is there and, in a missing row, the time
+    interpolated between the samples around the gap. ``len(log)`` counts
     grid rows, missing ones included, and ``duration`` is ``len(log) / fs``: the
     true length of the recording. ``gaps`` lists the dropouts and ``valid`` marks the rows present;
     ``issues`` repeats the totals (samples missing, share, number of gaps).
@@ -329,7 +329,7 @@ def log_on_grid(
         source=source,
         format=format,
         issues=issues,
-        time=grid.place_time(time, rate),
+        time=grid.place_time(time),
         messages=messages or {},
         **{name: grid.place(values) for name, values in channels.items()},
     )
