@@ -359,3 +359,77 @@ def test_gapped_csv_adev_within_ci_of_full_record():
     gapped = imunoise.adev(log.gyro[:, 0], log.fs, taus="decade")
     assert np.all(gapped.dev >= full.ci_low[: len(gapped.dev)] * 0.9)
     assert np.all(gapped.dev <= full.ci_high[: len(gapped.dev)] * 1.1)
+
+
+# -- command line, convert, report ------------------------------------------------------
+
+
+def _gapped_csv(tmp_path, n=2000, fs=40.0, hole=slice(500, 700)):
+    rng = np.random.default_rng(6)
+    gyro = rng.normal(0, 0.01, (n, 3))
+    keep = np.ones(n, dtype=bool)
+    keep[hole] = False
+    path = tmp_path / "gapped.csv"
+    path.write_bytes(_csv(np.arange(n)[keep] / fs, gyro[keep]))
+    return path, gyro, keep
+
+
+@pytest.mark.parametrize("suffix", [".csv", ".npz", ".npy", ".parquet"])
+def test_convert_keeps_grid_and_notes_the_gap(tmp_path, capsys, suffix):
+    from imunoise import scale
+    from imunoise.cli import main
+
+    if suffix == ".parquet":
+        pytest.importorskip("pyarrow")
+    src, gyro, keep = _gapped_csv(tmp_path)
+    out = tmp_path / f"out{suffix}"
+    assert main(["convert", str(src), "-o", str(out)]) == 0
+    _out, err = capsys.readouterr()
+    notes = [ln for ln in err.splitlines() if ln.startswith("imunoise: note: ")]
+    assert len(notes) == 1 and "200 (10 %) in 1 gap" in notes[0], err
+    if suffix == ".csv":
+        back = imunoise.read(out)
+    elif suffix == ".npz":
+        z = np.load(out)
+        np.testing.assert_array_equal(z["valid"], keep)
+        back = ImuLog.from_arrays(float(z["fs"]), gyro=np.column_stack(
+            [z["gyro_x"], z["gyro_y"], z["gyro_z"]]))
+    else:
+        back = scale.load(out)
+    assert len(back) == 2000 and _gap_list(back.gaps) == [(500, 200)]
+    np.testing.assert_allclose(back.gyro[keep], gyro[keep], atol=1e-6)
+    assert back.issues.counts["malformed_field"] == 0
+
+
+def test_streaming_convert_of_damaged_vn_ascii_matches_read(tmp_path):
+    from imunoise import scale
+
+    lines = _ymr_lines(400)
+    for k in (50, 51, 300):
+        lines[k] = lines[k][:30]
+    src = tmp_path / "cut.txt"
+    src.write_bytes(("\r\n".join(lines) + "\r\n").encode())
+    ref = imunoise.read(src, fs=40.0)
+    done = scale.convert(src, tmp_path / "cols", fs=40.0, chunk_bytes=4096)
+    got = scale.load(done.out)
+    assert _gap_list(ref.gaps) == _gap_list(got.gaps) == [(50, 2), (300, 1)]
+    assert done.issues.samples_missing == 3
+    np.testing.assert_array_equal(got.gyro, ref.gyro)
+
+
+def test_report_shows_gaps(tmp_path):
+    if not _adev_takes_nan():
+        pytest.skip("imunoise.adev does not accept NaN (missing samples) in this build")
+    from imunoise import report
+
+    n = 24_000
+    gyro = np.random.default_rng(7).normal(0, 1e-3, (n, 3))
+    gyro[10_000:11_000] = np.nan
+    accel = np.random.default_rng(8).normal(0, 1e-2, (n, 3))
+    accel[10_000:11_000] = np.nan
+    log = ImuLog.from_arrays(40.0, gyro=gyro, accel=accel, source="<gapped>")
+    rep = report.build(log, None, tmp_path, progress=False, spec=None)
+    md = rep.markdown.read_text()
+    assert "1000 (4.17 %) in 1 gap" in md
+    assert "**Warning**: 4.17 % of the log is missing" in md
+    assert "Largest gaps" in md and "| 250 | 25 | 1000 |" in md

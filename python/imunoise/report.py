@@ -426,16 +426,18 @@ def _build(short, long, out: Path, spec, fs, bar: _Progress) -> Report:
     if long is None:
         doc.p("One log given: the statistics and the Allan analysis both use it.")
     for label, log in logs:
+        which = "the log" if label == "both" else f"the {label} log"
         if log.issues.share_missing > GAP_WARN_SHARE:
-            doc.p(f"**Warning**: {100 * log.issues.share_missing:.3g} % of the {label} log is "
-                  f"missing ({log.issues.samples_missing} samples in {log.issues.gaps} gaps).")
+            doc.p(f"**Warning**: {100 * log.issues.share_missing:.3g} % of {which} is "
+                  f"missing ({_missing(log.issues)}); the statistics use the samples "
+                  "that are there.")
         if len(log.gaps):
             top = log.gaps.largest(GAP_ROWS)
             t0 = log.gaps.t0
             doc.table(
                 ["start [s from first sample]", "duration [s]", "samples"],
                 [[_num(a - t0), _num(d), str(k)] for a, d, k in top.rows()],
-                caption=f"Largest gaps ({label} log; {len(log.gaps)} in all)",
+                caption=f"Largest gaps of {which} ({len(log.gaps)} in all)",
             )
     for label, log in logs:
         shade = [(a - log.gaps.t0, d) for a, d, _k in log.gaps.largest(GAP_SHADE).rows()]
