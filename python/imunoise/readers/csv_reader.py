@@ -603,4 +603,5 @@ class _Reader:
             channels=channels,
             time=time,
             messages=messages,
+            values_may_be_nan=True,
         )

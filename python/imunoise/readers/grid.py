@@ -13,8 +13,9 @@ From timestamps (:meth:`TimeGrid.from_timestamps`)
        before: this absorbs a rate error of ``dt0`` (coarse clock resolution), a
        linear drift between the stamping clock and the sensor's, and the slips of
        step 2 under heavy jitter.
-    4. The phase of the samples against that line is tracked in blocks of
-       :data:`PHASE_BLOCK` samples (:func:`_phase`): a host clock that wanders
+    4. When a sample sits more than :data:`PHASE_TRIGGER` steps off that line, the
+       phase of the samples against it is tracked in blocks of :data:`PHASE_BLOCK`
+       samples (:func:`_phase`) and the line refitted: a host clock that wanders
        against the sensor's by more than the jitter allows does not slip a slot.
     5. Every sample goes to slot ``round((t - t0) / dt - phase)``. A step longer
        than 1.5 nominal steps is a gap (one missing sample per further nominal
@@ -55,6 +56,9 @@ MAX_GRID_RATIO = 100
 REFITS = 2
 #: Samples per block of the phase tracker (:func:`_phase`).
 PHASE_BLOCK = 64
+#: Largest distance (steps) of a sample from its slot on the fitted line that
+#: needs no phase tracking (a sensor's own clock stays far below it).
+PHASE_TRIGGER = 0.25
 #: Relative difference below which the fitted step is taken to be the median step.
 SAME_STEP = 1e-6
 
@@ -276,15 +280,22 @@ class TimeGrid:
             return cls(np.arange(n, dtype=np.int64), n, fs=1.0 / float(np.median(pos)))
         dt0 = median = float(np.median(pos))
         single = np.rint(steps / dt0) == 1
+        if single.all():  # the common case: nothing missing, nothing out of order
+            span = float(t[-1] - t[0]) / (n - 1)
+            dt = median if abs(span - median) <= SAME_STEP * median else span
+            return cls(np.arange(n, dtype=np.int64), n, fs=1.0 / dt, t0=float(t[0]))
         if single.sum() >= 2:  # the mean single step: jitter only at the ends of runs
             dt0 = float(steps[single].mean())
         prov = np.concatenate(([0.0], np.cumsum(np.rint(steps / dt0))))
         a, dt = _line(prov, t, median)
-        for _ in range(REFITS):  # slots of the tracked clock, and the line through them
-            pos_slot = (t - a) / dt
-            a, dt = _line(np.rint(pos_slot - _phase(pos_slot)), t, median)
+        for _ in range(REFITS):  # the slots of the line, and the line through them
+            a, dt = _line(np.rint((t - a) / dt), t, median)
         pos_slot = (t - a) / dt
-        pos_slot -= _phase(pos_slot)
+        if np.abs(pos_slot - np.rint(pos_slot)).max() > PHASE_TRIGGER:
+            # a wandering (host) clock or heavy jitter: follow the phase, refit
+            a, dt = _line(np.rint(pos_slot - _phase(pos_slot)), t, median)
+            pos_slot = (t - a) / dt
+            pos_slot -= _phase(pos_slot)
         span = float(pos_slot.max() - pos_slot.min())
         if span > MAX_GRID_RATIO * n:
             raise ValueError(
