@@ -386,7 +386,7 @@ def test_convert_keeps_grid_and_notes_the_gap(tmp_path, capsys, suffix):
     assert main(["convert", str(src), "-o", str(out)]) == 0
     _out, err = capsys.readouterr()
     notes = [ln for ln in err.splitlines() if ln.startswith("imunoise: note: ")]
-    assert len(notes) == 1 and "200 (10 %) in 1 gap" in notes[0], err
+    assert len(notes) == 1 and "200 samples (10 %) missing in 1 gap" in notes[0], err
     if suffix == ".csv":
         back = imunoise.read(out)
     elif suffix == ".npz":

@@ -329,7 +329,9 @@ def gap_note(source: str, issues, gaps) -> str | None:
     if not len(gaps):
         return None
     (start, length, _k), = gaps.largest(1).rows()
-    return (f"{source}: {_missing(issues)} missing (largest {_duration(length)} at "
+    plural = "s" if issues.gaps != 1 else ""
+    return (f"{source}: {issues.samples_missing} samples ({100 * issues.share_missing:.3g} %) "
+            f"missing in {issues.gaps} gap{plural} (largest {_duration(length)} at "
             f"{_duration(start - gaps.t0)}); left out of the statistics, not spliced over")
 
 
