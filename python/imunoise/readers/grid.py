@@ -4,8 +4,11 @@ Every reader goes through this module, so that all formats agree on what a gap i
 
 From timestamps (:meth:`TimeGrid.from_timestamps`)
     1. ``dt0`` = median of the positive timestamp steps (robust to jitter and to a
-       minority of dropouts), then the mean of the steps that round to one ``dt0``
-       (within a run of such steps the jitter cancels but at its ends).
+       minority of dropouts). When every step rounds to one ``dt0`` nothing is
+       missing or out of order: one row per sample, ``dt`` the mean step (the
+       median when both agree to :data:`SAME_STEP`), and the steps below are
+       skipped. Otherwise ``dt0`` becomes the mean of the steps that round to one
+       ``dt0`` (within a run of such steps the jitter cancels but at its ends).
     2. Provisional slots: the cumulative sum of ``round(step / dt0)``, which follows
        bursts (a late sample followed by early ones) without drifting.
     3. The nominal step ``dt`` and origin are the least-squares line through
@@ -26,10 +29,9 @@ From timestamps (:meth:`TimeGrid.from_timestamps`)
        sample and an early one) are separated when the slot beside the one further
        from its centre, on its side, is free. A sample whose slot is still taken
        (an exact duplicate timestamp, or a third sample) is dropped and counted as
-       ``duplicate_time``; a
-       timestamp smaller than its predecessor's is counted as ``time_reversed`` and
-       the sample placed at its slot. Nothing is sorted silently: both counts are in
-       :class:`~imunoise.readers.log.ParseIssues`.
+       ``duplicate_time``; a timestamp smaller than its predecessor's is counted
+       as ``time_reversed`` and the sample placed at its slot. Nothing is sorted
+       silently: both counts are in :class:`~imunoise.readers.log.ParseIssues`.
 
 From damaged-record positions (:meth:`TimeGrid.from_missing`)
     A log without timestamps (plain ``$VNYMR`` at a set rate) has one record per
