@@ -187,3 +187,43 @@ def test_fit_with_bootstrap_uncertainties(capsys, read):
 
     code, _, err = _run(args[:-1] + ["3"], capsys)
     assert code == 2 and "--bootstrap must be >= 5" in _one_line_error(err)
+
+
+@pytest.mark.parametrize("suffix", [".csv", ".npz", ".parquet"])
+def test_convert_quaternion_columns_round_trip(tmp_path, capsys, suffix):
+    """Readers store the quaternion x, y, z, w: every writer names its columns so."""
+    from imunoise import scale
+
+    if suffix == ".parquet":
+        pytest.importorskip("pyarrow")
+    n = 50
+    q = np.random.default_rng(3).normal(size=(n, 4))
+    q /= np.linalg.norm(q, axis=1, keepdims=True)
+    src = tmp_path / "q.csv"
+    rows = np.column_stack([np.arange(n) / 10.0, np.zeros((n, 3)), q])
+    np.savetxt(src, rows, delimiter=",", header="time,gx,gy,gz,qx,qy,qz,qw", comments="",
+               fmt="%.9f")
+    log = imunoise.read(src)
+    np.testing.assert_allclose(log.quaternion, q, atol=1e-9)
+    out = tmp_path / f"q{suffix}"
+    assert main(["convert", str(src), "-o", str(out)]) == 0
+    capsys.readouterr()
+    if suffix == ".npz":
+        z = np.load(out)
+        cols = {a: z[f"quaternion_{a}"] for a in "xyzw"}
+    elif suffix == ".parquet":
+        import pyarrow.parquet as pq
+
+        table = pq.read_table(out)
+        cols = {a: table.column(f"quaternion_{a}").to_numpy() for a in "xyzw"}
+        np.testing.assert_allclose(scale.load(out).quaternion, q, atol=1e-9)
+    else:
+        back = imunoise.read(out)
+        np.testing.assert_allclose(back.quaternion, q, atol=1e-9)
+        import csv
+
+        header = next(csv.reader(open(out)))
+        data = np.loadtxt(out, delimiter=",", skiprows=1)
+        cols = {a: data[:, header.index(f"quaternion_{a}")] for a in "xyzw"}
+    for j, a in enumerate("xyzw"):
+        np.testing.assert_allclose(cols[a], q[:, j], atol=1e-9, err_msg=a)

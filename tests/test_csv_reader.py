@@ -62,15 +62,16 @@ def test_vn_csv_bad_sentences_counted_at_their_lines():
     text[20] = text[20].split(",")[0] + ",oops"  # wrong number of fields
     data = ("\n".join(text) + "\n").encode()
     log = read_csv(data)
-    assert len(log) == 13223 - 3
+    # the damaged rows are missing samples at their place on the time grid
+    assert len(log) == 13223 and list(log.gaps.index) == [3, 8, 19]
     assert log.issues.counts["bad_checksum"] == 1
     assert log.issues.first["bad_checksum"] == (5,)
     assert log.issues.counts["malformed_field"] == 2
     assert log.issues.first["malformed_field"] == (10, 21)
     # samples stay with their own row's timestamp after the dropped ones
     row = list(csv.reader([text[5]]))[0]
-    assert log.time[3] == pytest.approx(float(row[1]), abs=1e-6)
-    np.testing.assert_allclose(log.gyro[3], ymr_fields(row[-1])[9:12], rtol=VN_RTOL)
+    assert log.time[4] == pytest.approx(float(row[1]), abs=1e-6)
+    np.testing.assert_allclose(log.gyro[4], ymr_fields(row[-1])[9:12], rtol=VN_RTOL)
     with pytest.raises(ValueError, match=r"line 5\b"):
         read_csv(data, strict=True)
 
@@ -224,12 +225,16 @@ def test_corrupted_real_csv_every_line_accounted(chunk, monkeypatch):
         lines[i] = lines[i][:cut]  # truncated line
     data = ("\n".join(lines) + "\n").encode()
     log = read_csv(data, columns={"gyro": [2, 3, 4]}, time_column="ros_t")
-    assert len(log) == len(lines) - 1 - 25
+    # every truncated line is a missing sample (NaN row) at its place on the grid
+    assert len(log) == len(lines) - 1
+    assert list(log.gaps.index) == [int(i) - 1 for i in bad]
     assert log.issues.counts["malformed_field"] == 25
     assert log.issues.first["malformed_field"] == tuple(int(i) + 1 for i in bad[:10])
     good = [ln.split(",") for k, ln in enumerate(lines) if k and k not in set(bad)]
-    np.testing.assert_array_equal(log.gyro, [[float(v) for v in g[2:5]] for g in good])
-    np.testing.assert_array_equal(log.time, [float(g[1]) for g in good])
+    np.testing.assert_array_equal(
+        log.gyro[log.valid], [[float(v) for v in g[2:5]] for g in good]
+    )
+    np.testing.assert_array_equal(log.time[log.valid], [float(g[1]) for g in good])
 
 
 _token = st.one_of(

@@ -63,3 +63,17 @@ def test_model_curves_follow_ieee952():
     np.testing.assert_allclose(curves["B"], c["B"] * np.sqrt(2 * np.log(2) / np.pi))
     total2 = sum(curves[t] ** 2 for t in "QNBKR")
     np.testing.assert_allclose(curves["total"] ** 2, total2)
+
+
+def test_missing_samples_leave_a_hole_and_are_shaded():
+    y = np.random.default_rng(2).normal(size=100_000)
+    y[40_000:60_000] = np.nan
+    y[10] = np.nan  # a single missing sample does not blank its bucket
+    start, lo, hi = plot.decimate_minmax(y, 100)
+    assert np.isfinite(lo[0]) and np.isfinite(hi[0])
+    assert np.isnan(lo[45]) and np.isnan(hi[45])
+    fig = plot.time_series(y, 100.0, gaps=[(400.0, 200.0)])
+    ax = fig.axes[0]
+    shaded = [p for p in ax.patches if p.get_facecolor()[:3] == pytest.approx(
+        tuple(int(plot.GAP_COLOR[i:i + 2], 16) / 255 for i in (1, 3, 5)))]
+    assert len(shaded) == 1

@@ -23,7 +23,7 @@ from imunoise.allan import (
 )
 from imunoise.datasheet import compare
 from imunoise.noise import NoiseModel, fit
-from imunoise.readers import ImuLog, ParseIssues
+from imunoise.readers import Gaps, ImuLog, ParseIssues
 from imunoise.readers.read import read
 from imunoise.readers.vn_write import write_vn_ascii, write_vn_binary
 from imunoise.scale import batch
@@ -34,6 +34,7 @@ from imunoise.stats import describe, distribution
 __all__ = [
     "__version__",
     "AllanResult",
+    "Gaps",
     "ImuLog",
     "NoiseModel",
     "ParseIssues",

@@ -60,7 +60,9 @@ def parse_vn(
     Keys: ``tables`` {message: {column: float64 array}}, ``messages`` {message: count},
     ``issues`` {kind: count}, ``first`` {kind: [(byte_offset, line), ...]},
     ``bytes_total``, ``bytes_parsed``, ``bytes_in_bad_records``, ``bytes_skipped``,
-    ``ascii_records``, ``binary_records``. ``progress(done, total)`` after every chunk.
+    ``ascii_records``, ``binary_records``, ``missing`` {message: uint64 array of the
+    good rows before each damaged record of that type}. ``progress(done, total)``
+    after every chunk.
     """
 
 def parse_vn_chunk(data: bytes, strict: bool = False, fin: bool = False) -> dict[str, Any]:

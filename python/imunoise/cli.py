@@ -176,7 +176,18 @@ def _positive_float(text: str) -> float:
 def _read(args):
     from imunoise.report import _load, _Progress
 
-    return _load(args.log, "input", _Progress(False, 0), args.fs)
+    log = _load(args.log, "input", _Progress(False, 0), args.fs)
+    _note_gaps(log.source, log)
+    return log
+
+
+def _note_gaps(source: str, done) -> None:
+    """One line on stderr when a log (or a conversion) has missing samples."""
+    from imunoise.report import gap_note
+
+    note = gap_note(source, done.issues, done.gaps)
+    if note:
+        print(f"imunoise: note: {note}", file=sys.stderr)
 
 
 # --- commands ------------------------------------------------------------------------
@@ -188,6 +199,8 @@ def _cmd_report(args) -> int:
     spec = None if args.spec.lower() == "none" else args.spec
     rep = report.build(args.short_log, args.long_log, args.output, spec=spec, fs=args.fs,
                        progress=args.progress)
+    for log in rep.logs:
+        _note_gaps(log.source, log)
     print(f"report written to {rep.html}")
     return 0
 
@@ -275,20 +288,15 @@ def _columns(log) -> tuple[list[str], list[np.ndarray]]:
     if log.time is not None:
         names.append("time")
         cols.append(np.asarray(log.time))
-    from imunoise.readers.log import CHANNELS
+    from imunoise.readers.log import column_names
 
-    for ch in CHANNELS:
+    for ch in log.channels:
         arr = getattr(log, ch)
-        if arr is None:
-            continue
-        if arr.ndim == 1:
-            names.append(ch)
-            cols.append(arr)
-        else:
-            axes = ("w", "x", "y", "z") if ch == "quaternion" else ("x", "y", "z")
-            for j in range(arr.shape[1]):
-                names.append(f"{ch}_{axes[j]}")
-                cols.append(arr[:, j])
+        names.extend(column_names(ch))
+        cols.extend([arr] if arr.ndim == 1 else [arr[:, j] for j in range(arr.shape[1])])
+    if len(log.gaps):
+        names.append("valid")
+        cols.append(log.valid.astype(np.float64))
     return names, cols
 
 
@@ -336,6 +344,7 @@ def _convert_streaming(args, out: Path) -> int:
         _fail(str(exc))
     finally:
         bar.close()
+    _note_gaps(str(args.log), done)
     print(f"wrote {done.samples} samples ({', '.join(done.channels)}) at {done.fs:.6g} Hz to "
           f"{done.out}; parse issues: {done.issues}")
     return 0

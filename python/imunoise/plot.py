@@ -29,6 +29,8 @@ __all__ = [
 ]
 
 AXIS_COLORS = ("#1f77b4", "#ff7f0e", "#2ca02c", "#9467bd")
+#: Shading of missing samples (gaps) on time plots.
+GAP_COLOR = "#d62728"
 AXIS_NAMES = ("X", "Y", "Z", "W")
 TERM_STYLES = {
     "Q": ("quantization Q", ":"),
@@ -98,8 +100,10 @@ def decimate_minmax(y: np.ndarray, columns: int) -> tuple[np.ndarray, np.ndarray
     Returns
     -------
     start, lo, hi : ndarray
-        Index of the first sample of each bucket and the bucket's min and max.
-        With ``n <= columns`` every sample is its own bucket.
+        Index of the first sample of each bucket and the bucket's min and max
+        over its valid samples (NaN, a missing sample, is ignored; a bucket of
+        missing samples only is NaN, so the plot shows a hole). With
+        ``n <= columns`` every sample is its own bucket.
     """
     y = np.asarray(y, dtype=np.float64)
     n = len(y)
@@ -110,7 +114,8 @@ def decimate_minmax(y: np.ndarray, columns: int) -> tuple[np.ndarray, np.ndarray
         return idx, y.copy(), y.copy()
     start = (np.arange(columns, dtype=np.int64) * n) // columns
     start = np.unique(start)
-    return start, np.minimum.reduceat(y, start), np.maximum.reduceat(y, start)
+    with np.errstate(invalid="ignore"):  # NaN (missing samples) only where a bucket is all NaN
+        return start, np.fmin.reduceat(y, start), np.fmax.reduceat(y, start)
 
 
 def _draw_series(ax, t0: float, fs: float, y: np.ndarray, color: str, columns: int) -> None:
@@ -131,6 +136,7 @@ def time_series(
     unit: str = "",
     names: Sequence[str] | None = None,
     columns: int = 1600,
+    gaps: Sequence[tuple[float, float]] = (),
 ):
     """Time series of a sensor's axes, one panel per axis, min/max decimated.
 
@@ -146,6 +152,8 @@ def time_series(
         Axis names; default X, Y, Z.
     columns : int
         Buckets per panel (≈ pixel width of the saved figure).
+    gaps : sequence of (start, duration)
+        Missing samples, in seconds from the first sample, shaded on every panel.
     """
     Figure = _plt()
     y = np.asarray(y, dtype=np.float64).reshape(len(y), -1)
@@ -160,6 +168,11 @@ def time_series(
         axes = fig.subplots(k, 1, sharex=True, squeeze=False)[:, 0]
         for j, ax in enumerate(axes):
             _draw_series(ax, 0.0, fs * scale, y[:, j], AXIS_COLORS[j % 4], columns)
+            for start, length in gaps:
+                # at least a visible sliver, however short the gap
+                width = max(length, duration / columns) / scale
+                ax.axvspan(start / scale, start / scale + width, color=GAP_COLOR, alpha=0.35,
+                           linewidth=0)
             ax.set_ylabel(f"{names[j]} [{unit}]" if unit else names[j])
             ax.margins(x=0)
         axes[-1].set_xlabel(f"time [{tunit}]")

@@ -297,6 +297,8 @@ class Report:
         ``{"gyro": AllanResult, "accel": AllanResult}`` of the long log.
     models : dict
         ``{"gyro": NoiseModel, "accel": NoiseModel}`` (empty without the noise model).
+    logs : tuple of ImuLog
+        The logs analysed (short, then long when it is another log).
     """
 
     out_dir: Path
@@ -308,6 +310,7 @@ class Report:
     distributions: dict
     allan: dict
     models: dict
+    logs: tuple = ()
 
 
 class _Progress:
@@ -348,6 +351,33 @@ class _Progress:
     def close(self) -> None:
         if self.bar is not None:
             self.bar.close()
+
+
+#: Share of missing samples above which the report prints a warning line.
+GAP_WARN_SHARE = 0.01
+#: Gaps listed in the summary table / shaded on the time plots (the largest).
+GAP_ROWS = 10
+GAP_SHADE = 200
+
+
+def gap_note(source: str, issues, gaps) -> str | None:
+    """One line saying that (and how much of) a log is missing, or None without gaps."""
+    if not len(gaps):
+        return None
+    (start, length, _k), = gaps.largest(1).rows()
+    plural = "s" if issues.gaps != 1 else ""
+    return (f"{source}: {issues.samples_missing} samples ({100 * issues.share_missing:.3g} %) "
+            f"missing in {issues.gaps} gap{plural} (largest {_duration(length)} at "
+            f"{_duration(start - gaps.t0)}); left out of the statistics, not spliced over")
+
+
+def _missing(issues) -> str:
+    """``"30000 (15 %) in 1 gap"`` or ``"0"``."""
+    if not issues.samples_missing:
+        return "0"
+    plural = "s" if issues.gaps != 1 else ""
+    return (f"{issues.samples_missing} ({100 * issues.share_missing:.3g} %) in "
+            f"{issues.gaps} gap{plural}")
 
 
 def _load(source, label: str, progress: _Progress, fs: float | None = None) -> ImuLog:
@@ -422,23 +452,41 @@ def _build(short, long, out: Path, spec, fs, bar: _Progress) -> Report:
         rows.append([
             label, log.source if log.source.startswith("<") else Path(log.source).name,
             log.format, str(len(log)), _duration(log.duration), f"{log.fs:.6g}",
-            ", ".join(log.channels), str(log.issues.total), str(log.issues),
+            ", ".join(log.channels), _missing(log.issues), str(log.issues.total), str(log.issues),
         ])
     doc.table(
         ["log", "source", "format", "samples", "duration", "rate [Hz]", "channels",
-         "records skipped", "parse issues"],
+         "samples missing", "records skipped", "parse issues"],
         rows,
     )
+    doc.p("Duration is the true length of the recording (grid rows, missing samples "
+          "included); a missing sample is left out of every statistic, never spliced over.")
     if long is None:
         doc.p("One log given: the statistics and the Allan analysis both use it.")
     for label, log in logs:
+        which = "the log" if label == "both" else f"the {label} log"
+        if log.issues.share_missing > GAP_WARN_SHARE:
+            doc.p(f"**Warning**: {100 * log.issues.share_missing:.3g} % of {which} is "
+                  f"missing ({_missing(log.issues)}); the statistics use the samples "
+                  "that are there.")
+        if len(log.gaps):
+            top = log.gaps.largest(GAP_ROWS)
+            t0 = log.gaps.t0
+            doc.table(
+                ["start [s from first sample]", "duration [s]", "samples"],
+                [[_num(a - t0), _num(d), str(k)] for a, d, k in top.rows()],
+                caption=f"Largest gaps of {which} ({len(log.gaps)} in all)",
+            )
+    for label, log in logs:
+        shade = [(a - log.gaps.t0, d) for a, d, _k in log.gaps.largest(GAP_SHADE).rows()]
         for sensor in SAMPLE_SENSORS:
             y = getattr(log, sensor)
             if y is None:
                 continue
             unit = CHANNELS[sensor][1]
             which = "the log" if label == "both" else f"the {label} log"
-            fig = _plot.time_series(y, log.fs, title=f"{sensor} ({which})", unit=unit)
+            fig = _plot.time_series(y, log.fs, title=f"{sensor} ({which})", unit=unit,
+                                    gaps=shade)
             figures += _plot.save(fig, figdir / f"timeseries_{label}_{sensor}")
             doc.figure(figdir / f"timeseries_{label}_{sensor}.png",
                        f"Time series of {which}: {sensor} [{unit}] (min/max per pixel)")
@@ -565,6 +613,7 @@ def _build(short, long, out: Path, spec, fs, bar: _Progress) -> Report:
         distributions=dists,
         allan=allan,
         models=models,
+        logs=tuple(log for _label, log in logs),
     )
 
 

@@ -46,13 +46,21 @@ import shutil
 import sys
 import warnings
 from collections.abc import Callable, Iterable, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
 
 from imunoise import _core
-from imunoise.readers.log import CHANNELS, ISSUE_KINDS, ImuLog, ParseIssues, fs_from_median_step
+from imunoise.readers.grid import Gaps, TimeGrid
+from imunoise.readers.log import (
+    CHANNELS,
+    ISSUE_KINDS,
+    ImuLog,
+    ParseIssues,
+    column_names,
+    fs_from_median_step,
+)
 
 __all__ = ["Conversion", "batch", "convert", "load", "BATCH_SENSORS"]
 
@@ -61,7 +69,6 @@ CHUNK_BYTES = 64 << 20
 #: First locations kept per issue kind (as the Rust reader keeps).
 _FIRST_KEEP = 5
 _META_VERSION = 1
-_AXES = ("x", "y", "z")
 
 
 # ---------------------------------------------------------------------------
@@ -86,9 +93,11 @@ class Conversion:
     fs : float
         Sample rate in Hz, resolved as :func:`imunoise.read` does.
     issues : ParseIssues
-        What the reader skipped, summed over the pieces.
+        What the reader skipped, summed over the pieces, with the gap totals.
     bytes_read : int
         Size of the input.
+    gaps : Gaps
+        The missing samples: NaN rows of the output (and ``load(...).gaps``).
     """
 
     out: Path
@@ -98,15 +107,7 @@ class Conversion:
     fs: float
     issues: ParseIssues
     bytes_read: int
-
-
-def _column_names(channel: str) -> list[str]:
-    """Parquet column names of a channel: ``gyro_x`` ..., ``quaternion_w`` ..., ``time``."""
-    cols = 1 if channel == "time" else CHANNELS[channel][0]
-    if cols == 1:
-        return [channel]
-    axes = ("w", "x", "y", "z") if channel == "quaternion" else _AXES
-    return [f"{channel}_{a}" for a in axes[:cols]]
+    gaps: Gaps
 
 
 def _width(channel: str) -> int:
@@ -260,7 +261,7 @@ class _ParquetSink(_Sink):
         import pyarrow.parquet as pq
 
         self.pa = pa
-        self.names = [n for ch in channels for n in _column_names(ch)]
+        self.names = [n for ch in channels for n in column_names(ch)]
         self.schema = pa.schema([(n, pa.float64()) for n in self.names])
         self.writer = pq.ParquetWriter(staging, self.schema)
 
@@ -394,6 +395,91 @@ class _Steps:
         return float(lo) if total % 2 else float(np.mean(np.array([lo, hi])))
 
 
+class _GridStream:
+    """One table's rows put on its time grid piece by piece, as :func:`imunoise.read`
+    does for the whole log (:mod:`imunoise.readers.grid`).
+
+    With timestamps, the nominal step is the median positive step of the first
+    piece that has two, and every sample goes ``round(step / dt)`` rows after the
+    one before; a sample that does not advance the grid (a duplicate, or a
+    timestamp that goes back) is dropped and counted. Without timestamps, every
+    damaged record of the table is a NaN row at its place; damaged records after
+    the last good one of a piece wait for the next piece (at the end they are the
+    capture's edge, not a gap).
+    """
+
+    def __init__(self):
+        self.rows = 0
+        self.dt: float | None = None
+        self.last_t: float | None = None
+        self.pending = 0
+        self.gaps: list[list[int]] = []  # [first row, rows] of NaN runs, merged
+        self.duplicate_time = 0
+        self.time_reversed = 0
+
+    def place(self, chans: dict[str, np.ndarray], missing) -> dict[str, np.ndarray]:
+        n = len(next(iter(chans.values())))
+        t = chans.get("time")
+        grid = self._time_grid(t) if t is not None else self._missing_grid(n, missing)
+        if grid is None or grid.is_identity:
+            self.rows += n
+            if t is not None and n:
+                self.last_t = float(t[-1])
+            return chans
+        before = self.last_t
+        out = {c: grid.place(a) for c, a in chans.items() if c != "time"}
+        if t is not None:
+            keep = grid.slot >= 0
+            out["time"] = grid.place_time(t, before)
+            self.last_t = float(np.asarray(t)[keep][-1]) if keep.any() else self.last_t
+        runs = Gaps.from_valid(grid.valid, 1.0)
+        for run_start, run in zip(runs.index, runs.samples, strict=True):
+            start = self.rows + int(run_start)
+            if self.gaps and self.gaps[-1][0] + self.gaps[-1][1] == start:
+                self.gaps[-1][1] += int(run)
+            else:
+                self.gaps.append([start, int(run)])
+        self.rows += grid.n
+        return out
+
+    def _time_grid(self, t: np.ndarray) -> TimeGrid | None:
+        t = np.asarray(t, dtype=np.float64)
+        if self.dt is None:
+            pos = np.diff(t)[np.diff(t) > 0]
+            if len(pos) < 2:
+                return None
+            self.dt = float(np.median(pos))
+        if not len(t):
+            return None
+        first = [t[0] - self.dt] if self.last_t is None else [self.last_t]
+        steps = np.diff(t, prepend=first)
+        k = np.rint(steps / self.dt).astype(np.int64)
+        drop = k < 1
+        self.time_reversed += int((steps < 0).sum())
+        self.duplicate_time += int((drop & (steps >= 0)).sum())
+        k[drop] = 0
+        slot = np.cumsum(k) - 1
+        slot[drop] = -1
+        n_out = int(slot.max()) + 1 if (~drop).any() else 0
+        return TimeGrid(slot=slot, n=n_out)
+
+    def _missing_grid(self, n: int, missing) -> TimeGrid | None:
+        p = np.sort(np.asarray(missing if missing is not None else (), dtype=np.int64))
+        if not n:
+            if self.rows:
+                self.pending += len(p)
+            return None
+        inner = p[p < n]
+        if not self.rows:
+            inner = inner[inner > 0]  # before the first good record: the capture's edge
+        inner = np.concatenate([np.zeros(self.pending, dtype=np.int64), inner])
+        self.pending = int((p >= n).sum())
+        if not len(inner):
+            return None
+        shift = np.searchsorted(inner, np.arange(n), side="right")
+        return TimeGrid(slot=np.arange(n, dtype=np.int64) + shift, n=n + len(inner))
+
+
 class _Tally:
     """Issues, message counts and record counts summed over pieces."""
 
@@ -445,6 +531,7 @@ def _primary(rows: Mapping[str, tuple[int, int]]) -> str | None:
 def _stream_vn(path: Path, writer: _Writer, chunk_bytes: int, progress) -> tuple:
     """Parse ``path`` piece by piece into ``writer``; returns (tally, steps per table, rows)."""
     tally = _Tally()
+    grids: dict[str, _GridStream] = {}
     steps: dict[str, _Steps] = {}
     shape: dict[str, tuple[int, int]] = {}
     total = path.stat().st_size
@@ -464,15 +551,17 @@ def _stream_vn(path: Path, writer: _Writer, chunk_bytes: int, progress) -> tuple
                 chans = _table_channels(cols)
                 if not chans:
                     continue
+                grid = grids.setdefault(name, _GridStream())
                 n = len(next(iter(chans.values())))
                 if n == 0:
+                    grid.place(chans, raw["missing"].get(name))  # damaged records only
                     continue
                 filled = sum(1 for k in chans if k != "time")
                 prev = shape.get(name, (filled, 0))
                 shape[name] = (filled, prev[1] + n)
                 if "time" in chans:
                     steps.setdefault(name, _Steps()).add(chans["time"])
-                writer.append(name, chans)
+                writer.append(name, grid.place(chans, raw["missing"].get(name)))
             del raw
             lines += data.count(b"\n", 0, used)
             offset += used
@@ -482,10 +571,11 @@ def _stream_vn(path: Path, writer: _Writer, chunk_bytes: int, progress) -> tuple
                 progress(done, max(total, done))
             if fin:
                 break
-    return tally, steps, shape
+    return tally, steps, shape, grids
 
 
-def _meta(*, fs, source, fmt, issues: ParseIssues, messages, samples, channels, table) -> dict:
+def _meta(*, fs, source, fmt, issues: ParseIssues, messages, samples, channels, table,
+          gaps: Gaps) -> dict:
     return {
         "imunoise_columnar": _META_VERSION,
         "fs": fs,
@@ -500,6 +590,7 @@ def _meta(*, fs, source, fmt, issues: ParseIssues, messages, samples, channels, 
             "first": {k: list(v) for k, v in issues.first.items()},
             "location": issues.location,
         },
+        "gaps": {"index": gaps.index.tolist(), "samples": gaps.samples.tolist()},
     }
 
 
@@ -566,13 +657,18 @@ def convert(
     writer = _Writer(out, layout)
     try:
         if format in ("vn-ascii", "vn-binary") and path.is_file():
-            tally, steps, shape = _stream_vn(path, writer, int(chunk_bytes), progress)
+            tally, steps, shape, grids = _stream_vn(path, writer, int(chunk_bytes), progress)
             primary = _primary(shape)
             step_histogram = steps.get(primary) if primary else None
             rate = fs_from_median_step(
                 step_histogram.median() if step_histogram is not None else None, fs, str(path)
             )
+            grid = grids[primary] if primary else _GridStream()
+            tally.counts["duplicate_time"] += grid.duplicate_time
+            tally.counts["time_reversed"] += grid.time_reversed
             issues, messages, fmt = tally.issues(), tally.messages, tally.format
+            gaps = Gaps(index=[g[0] for g in grid.gaps], samples=[g[1] for g in grid.gaps],
+                        fs=rate)
         else:
             from imunoise.readers.read import read
 
@@ -586,19 +682,21 @@ def convert(
                 for i in range(0, len(log), step):
                     writer.append(primary, {c: a[i:i + step] for c, a in chans.items()})
             rate, issues, messages, fmt = log.fs, log.issues, log.messages, log.format
+            gaps = log.gaps
         if primary is None:
             raise ValueError(f"{path}: no usable records ({issues})")
         sink = writer.sinks[primary]
         meta = _meta(fs=rate, source=str(path), fmt=fmt, issues=issues, messages=messages,
-                     samples=sink.rows, channels=sink.channels, table=primary)
+                     samples=sink.rows, channels=sink.channels, table=primary, gaps=gaps)
         _remove(out, layout)
         files = writer.finish(primary, meta)
     except BaseException:
         writer.abort()
         raise
+    issues = replace(issues, samples_missing=gaps.total, gaps=len(gaps), samples=sink.rows)
     return Conversion(out=out, files=tuple(files), samples=sink.rows,
                       channels=tuple(sink.channels), fs=rate, issues=issues,
-                      bytes_read=path.stat().st_size)
+                      bytes_read=path.stat().st_size, gaps=gaps)
 
 
 def _remove(out: Path, layout: str) -> None:
@@ -664,14 +762,18 @@ def load(out) -> ImuLog:
         table = pq.read_table(out)
         arrays = {}
         for ch in channels:
-            cols = [table.column(n).to_numpy() for n in _column_names(ch)]
+            cols = [table.column(n).to_numpy() for n in column_names(ch)]
             arrays[ch] = cols[0] if len(cols) == 1 else np.column_stack(cols)
     iss = meta["issues"]
     issues = ParseIssues(counts=iss["counts"], first={k: tuple(v) for k, v in
                                                       iss["first"].items()},
                          location=iss["location"])
-    return ImuLog(fs=float(meta["fs"]), source=meta["source"], format=meta["format"],
-                  issues=issues, messages=meta["messages"], **arrays)
+    fs = float(meta["fs"])
+    # the gaps as convert found them: no pass over memory-mapped channels for NaN
+    gaps = meta.get("gaps")
+    gaps = None if gaps is None else Gaps(gaps["index"], gaps["samples"], fs)
+    return ImuLog(fs=fs, source=meta["source"], format=meta["format"],
+                  issues=issues, messages=meta["messages"], gaps=gaps, **arrays)
 
 
 # ---------------------------------------------------------------------------

@@ -17,7 +17,11 @@ use crate::vn::{stream, IssueKind, VnData};
 fn to_dict<'py>(py: Python<'py>, data: VnData) -> PyResult<Bound<'py, PyDict>> {
     let out = PyDict::new(py);
     let tables = PyDict::new(py);
+    let missing = PyDict::new(py);
     for (name, table) in data.tables {
+        if !table.missing.is_empty() {
+            missing.set_item(&name, table.missing.into_pyarray(py))?;
+        }
         let cols = PyDict::new(py);
         // One (rows, columns) array, handed over without a copy; every column is
         // a strided view of it, so adjacent columns (x, y, z) form (n, 3) views.
@@ -35,6 +39,7 @@ fn to_dict<'py>(py: Python<'py>, data: VnData) -> PyResult<Bound<'py, PyDict>> {
         tables.set_item(name, cols)?;
     }
     out.set_item("tables", tables)?;
+    out.set_item("missing", missing)?;
     let messages = PyDict::new(py);
     for (name, n) in data.messages {
         messages.set_item(name, n)?;
@@ -65,7 +70,8 @@ fn to_dict<'py>(py: Python<'py>, data: VnData) -> PyResult<Bound<'py, PyDict>> {
 ///
 /// `source` is `bytes` (parsed in memory) or a path (read in chunks). Returns
 /// tables of float64 columns per message type, message counts, issue counts and
-/// first locations, and byte accounting. `progress(done, total)` is called after
+/// first locations, byte accounting, and `missing`: per message type, the good
+/// rows before each damaged record of that type (uint64). `progress(done, total)` is called after
 /// every chunk of a file.
 #[pyfunction]
 #[pyo3(signature = (source, strict=false, progress=None))]

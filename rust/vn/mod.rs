@@ -109,13 +109,16 @@ impl Issues {
 /// while parsing, and one array that the bindings hand to numpy without a copy
 /// (columns and channel triples are views of it). `extra` columns (the appended
 /// `T`/`S` fields of ASCII sentences) are created when first seen and hold NaN
-/// for records that lack them.
+/// for records that lack them. `missing` holds, for every damaged record of this
+/// type (bad checksum or CRC, malformed field, truncated), the number of good
+/// rows before it: where a sample of this stream was lost.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Table {
     pub names: Vec<String>,
     pub values: Vec<f64>,
     pub extra: Vec<(String, Vec<f64>)>,
     pub len: usize,
+    pub missing: Vec<u64>,
 }
 
 impl Table {
@@ -125,7 +128,13 @@ impl Table {
             values: Vec::new(),
             extra: Vec::new(),
             len: 0,
+            missing: Vec::new(),
         }
+    }
+
+    /// Note a damaged record of this type after the rows pushed so far.
+    pub(crate) fn note_missing(&mut self) {
+        self.missing.push(self.len as u64);
     }
 
     /// Fields per record.
@@ -242,6 +251,8 @@ impl Table {
             self.reserve(other.len.max(self.len));
         }
         self.values.append(&mut other.values);
+        let shift = self.len as u64;
+        self.missing.extend(other.missing.iter().map(|r| r + shift));
         self.finish();
         other.finish();
         for (name, col) in other.extra {

@@ -457,9 +457,29 @@ impl Parser {
             }
             Decoded::Malformed(reason) => {
                 self.issue(buf, i, IssueKind::MalformedField, &reason);
+                self.note_ascii_missing(buf, i);
                 self.data.bytes_in_bad_records += len as u64;
             }
         }
+    }
+
+    /// A damaged sentence at `buf[i] == b'$'`: when its message type can still be
+    /// read (`$VNxxx` then `,` or `*`), one sample of that stream is missing here.
+    fn note_ascii_missing(&mut self, buf: &[u8], i: usize) {
+        let Some(head) = buf.get(i + 1..i + 7) else {
+            return;
+        };
+        if head[5] != b',' && head[5] != b'*' {
+            return;
+        }
+        let Some(spec) = ascii::spec_by_id(&head[..5]) else {
+            return;
+        };
+        self.data
+            .tables
+            .entry(spec.id.to_string())
+            .or_insert_with(|| Table::new(spec.fields.iter().map(|s| s.to_string()).collect()))
+            .note_missing();
     }
 
     fn layout_index(&mut self, buf: &[u8], i: usize) -> Result<usize, bool> {
@@ -524,6 +544,7 @@ impl Parser {
                             }
                             Outcome::Issue(kind, reason) => {
                                 self.issue(buf, i, kind, &reason);
+                                self.note_ascii_missing(buf, i);
                                 self.data.bytes_in_bad_records += len as u64;
                             }
                         }
@@ -611,6 +632,7 @@ impl Parser {
                     IssueKind::TruncatedRecord,
                     "input ends inside a binary packet",
                 );
+                self.layouts[k].2.note_missing();
                 self.data.bytes_in_bad_records += (n - i) as u64;
                 return Some(n);
             }
@@ -622,6 +644,7 @@ impl Parser {
                 let reason = "binary packet CRC mismatch";
                 // The record is counted; its bytes are re-scanned (resync one byte).
                 self.issue(buf, i, IssueKind::BadChecksum, reason);
+                self.layouts[k].2.note_missing();
             } else if self.pending.len() < MAX_PENDING {
                 let loc = self.location(buf, i);
                 self.pending.push((k, loc));
@@ -1148,6 +1171,44 @@ $VNERR,12*72\r\n";
         assert_eq!(d.binary_records, 2);
         assert_eq!(d.issues.count(IssueKind::BadChecksum), 1);
         assert!(accounted(&d, s.len()));
+    }
+
+    #[test]
+    fn damaged_records_mark_missing_rows() {
+        // Good, bad checksum, good, truncated, malformed, good, unknown type, good:
+        // three samples of the $VNYMR stream lost, after rows 1, 2 and 2.
+        let mut bad_sum = A1.to_vec();
+        bad_sum[10] = b'9';
+        let malformed = b"$VNYMR,1,2*XX\r\n";
+        let parts: [&[u8]; 9] = [
+            A1,
+            &bad_sum,
+            A1,
+            &A1[..40],
+            b"\r\n",
+            malformed,
+            A1,
+            b"$VNXYZ,1*00\r\n",
+            A1,
+        ];
+        let s = parts.concat();
+        let whole = parse_bytes(&s, false).unwrap();
+        let ymr = &whole.tables["VNYMR"];
+        assert_eq!(ymr.len, 4);
+        assert_eq!(ymr.missing, vec![1, 2, 2]);
+        // The same in pieces on all cores.
+        let par = parse_bytes_with(Parser::new(false).with_parallel_min(64), &s).unwrap();
+        assert_eq!(par.tables["VNYMR"].missing, ymr.missing);
+        // A binary packet with a bad CRC between good ones of its configuration.
+        let mut b = Vec::new();
+        b.extend_from_slice(&B1);
+        let mut broken = B1;
+        broken[20] ^= 1;
+        b.extend_from_slice(&broken);
+        b.extend_from_slice(&B1);
+        let d = parse_bytes(&b, false).unwrap();
+        let table = d.tables.values().find(|t| t.len == 2).unwrap();
+        assert_eq!(table.missing, vec![1]);
     }
 
     /// Mutates `s` by (position, byte, operation) edits: 0 inserts the byte, 1

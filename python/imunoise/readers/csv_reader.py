@@ -21,7 +21,7 @@ from collections.abc import Callable, Mapping, Sequence
 import numpy as np
 
 from imunoise.readers._sentences import IssueTally, sentence_rows
-from imunoise.readers.log import CHANNELS, ImuLog, resolve_fs
+from imunoise.readers.log import CHANNELS, ImuLog, log_on_grid
 
 __all__ = ["UNITS", "read_csv"]
 
@@ -285,13 +285,18 @@ def read_csv(
     Returns
     -------
     ImuLog
-        ``format="csv"``; ``fs`` from the time column where present.
+        ``format="csv"``; ``fs`` from the time column where present. With a time
+        column the rows are put on the time grid: lines missing from the file
+        become NaN rows and ``log.gaps`` (:mod:`imunoise.readers.grid`); a
+        malformed line is one missing sample only then.
 
     Notes
     -----
     Blank lines and ``#`` comment lines before the header are not data. A data line
     with a different number of fields than the header (or first line), a field that
-    is not a number, or a non-finite value in a used column is ``malformed_field``.
+    is not a number, an infinite value in a used column or a NaN time is
+    ``malformed_field``. ``nan`` in a channel column is a missing value (as
+    ``imunoise convert`` writes the rows of missing samples).
     Fields with quoted line breaks are not supported.
     """
     units = dict(units or {})
@@ -418,6 +423,8 @@ class _Reader:
         self.names = names
         self.used = sorted({i for idx in numeric.values() for i in idx})
         self.pos = {i: k for k, i in enumerate(self.used)}
+        # NaN is a missing sample in a channel column, but a time must be a number
+        self.time_pos = self.pos[numeric["time"][0]] if "time" in numeric else None
         self.conv = {}
         for ch in numeric:
             unit = self.user_units.get(ch, header_units.get(ch))
@@ -477,7 +484,9 @@ class _Reader:
         if arr.shape != (len(line_idx), self.ncols):
             return False
         arr = arr[:, self.used]
-        if not np.isfinite(arr).all():
+        if np.isinf(arr).any() or (
+            self.time_pos is not None and np.isnan(arr[:, self.time_pos]).any()
+        ):
             return False
         self._append(arr, len(text))
         return True
@@ -505,7 +514,7 @@ class _Reader:
                     self._bad(line_no, f"column {col + 1} is not a number: {text[:40]!r}")
                     ok = False
                     break
-                if not math.isfinite(value):
+                if math.isinf(value) or (math.isnan(value) and j == self.time_pos):
                     self._bad(line_no, f"column {col + 1} is not finite: {text[:40]!r}")
                     ok = False
                     break
@@ -586,13 +595,13 @@ class _Reader:
             channels[ch] = values[:, 0] if CHANNELS[ch][0] == 1 else values
         if time is None:
             time = vn_time
-        issues = self.tally.issues("line")
-        return ImuLog(
-            fs=resolve_fs(time, fs, self.name),
+        return log_on_grid(
+            fs=fs,
             source=self.name,
             format="csv",
-            issues=issues,
+            issues=self.tally.issues("line"),
+            channels=channels,
             time=time,
             messages=messages,
-            **channels,
+            values_may_be_nan=True,
         )

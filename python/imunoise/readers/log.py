@@ -4,10 +4,12 @@ from __future__ import annotations
 
 import warnings
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from types import MappingProxyType
 
 import numpy as np
+
+from imunoise.readers.grid import Gaps, TimeGrid
 
 #: Sample rate assumed when neither timestamps nor ``fs=`` tell it (the VN-100's
 #: factory default asynchronous output rate).
@@ -21,7 +23,12 @@ ISSUE_KINDS = (
     "truncated_record",  # a record cut short (end of file, or next record started)
     "bytes_skipped",  # bytes that belong to no record (noise between records)
     "device_error",  # $VNERR replies, recorded not decoded
+    "duplicate_time",  # a sample whose grid slot was taken (same or too-close timestamp): dropped
+    "time_reversed",  # a timestamp smaller than the one before: kept, placed by its time
 )
+
+#: Kinds that count something other than a skipped record.
+_NOT_RECORDS = ("bytes_skipped", "time_reversed")
 
 
 @dataclass(frozen=True)
@@ -39,11 +46,20 @@ class ParseIssues:
         for bags.
     location : str
         ``"line"``, ``"byte"`` or ``"message"``: what the numbers in ``first`` are.
+    samples_missing : int
+        Samples missing on the time grid (the NaN rows of the log).
+    gaps : int
+        Runs of consecutive missing samples (rows of ``ImuLog.gaps``).
+    samples : int
+        Rows of the grid, missing ones included (``len(log)``).
     """
 
     counts: Mapping[str, int]
     first: Mapping[str, tuple[int, ...]] = field(default_factory=dict)
     location: str = "line"
+    samples_missing: int = 0
+    gaps: int = 0
+    samples: int = 0
 
     def __post_init__(self) -> None:
         counts = {kind: int(self.counts.get(kind, 0)) for kind in ISSUE_KINDS}
@@ -56,8 +72,14 @@ class ParseIssues:
 
     @property
     def total(self) -> int:
-        """Records skipped (``bytes_skipped`` counts bytes, so it is not included)."""
-        return sum(v for k, v in self.counts.items() if k != "bytes_skipped")
+        """Records skipped (``bytes_skipped`` counts bytes and ``time_reversed`` kept
+        samples, so neither is included)."""
+        return sum(v for k, v in self.counts.items() if k not in _NOT_RECORDS)
+
+    @property
+    def share_missing(self) -> float:
+        """Fraction of the grid's samples that are missing (0 for an empty log)."""
+        return self.samples_missing / self.samples if self.samples else 0.0
 
     @classmethod
     def none(cls) -> ParseIssues:
@@ -65,6 +87,11 @@ class ParseIssues:
 
     def __str__(self) -> str:
         parts = [f"{k}={v}" for k, v in self.counts.items() if v]
+        if self.samples_missing:
+            parts.append(
+                f"{self.samples_missing} samples missing ({100 * self.share_missing:.3g} %) "
+                f"in {self.gaps} gap{'s' if self.gaps != 1 else ''}"
+            )
         return "no issues" if not parts else ", ".join(parts)
 
 
@@ -84,6 +111,22 @@ CHANNELS: Mapping[str, tuple[int, str]] = MappingProxyType(
 )
 
 
+#: Column suffixes of the multi-column channels. The quaternion is stored as the
+#: readers decode it (VN-100 and ROS order): vector part first, scalar ``w`` last.
+_AXES: Mapping[int, tuple[str, ...]] = MappingProxyType(
+    {3: ("x", "y", "z"), 4: ("x", "y", "z", "w")}
+)
+
+
+def column_names(channel: str) -> list[str]:
+    """Flat column names of a channel, as every writer (``imunoise convert`` to
+    CSV/NPZ/Parquet, :mod:`imunoise.scale`) names them: ``gyro_x`` ...,
+    ``quaternion_x, quaternion_y, quaternion_z, quaternion_w``; one-column channels
+    (and ``"time"``, ``"valid"``) keep their name."""
+    cols = CHANNELS[channel][0] if channel in CHANNELS else 1
+    return [channel] if cols == 1 else [f"{channel}_{a}" for a in _AXES[cols]]
+
+
 @dataclass(frozen=True)
 class ImuLog:
     """An IMU recording: uniform-rate channels plus the record of what was skipped.
@@ -92,6 +135,15 @@ class ImuLog:
     row per sample: ``gyro``, ``accel``, ``mag``, ``ypr``, ``delta_theta``,
     ``delta_velocity`` are (n, 3); ``quaternion`` (n, 4); ``temperature`` and
     ``pressure`` (n,). ``time`` (n,) in seconds when the log carries timestamps.
+
+    The rows are the log's **uniform time grid**: a sample lost in the recording
+    (a dropout between timestamps, a damaged record of the main stream) is a row
+    of NaN in every channel, never spliced over. ``time`` holds the measured
+    timestamp of every sample that is there and, in a missing row, the time
+    interpolated between the samples around the gap. ``len(log)`` counts
+    grid rows, missing ones included, and ``duration`` is ``len(log) / fs``: the
+    true length of the recording. ``gaps`` lists the dropouts and ``valid`` marks the rows present;
+    ``issues`` repeats the totals (samples missing, share, number of gaps).
 
     Attributes
     ----------
@@ -106,6 +158,9 @@ class ImuLog:
         Counts of skipped records by kind.
     messages : Mapping[str, int]
         Records decoded per message type (e.g. ``{"VNYMR": 30178}``).
+    gaps : Gaps
+        Runs of missing samples (grid row, samples; start time, duration). When
+        not given, the rows with a NaN in any channel.
     """
 
     fs: float
@@ -123,6 +178,7 @@ class ImuLog:
     delta_velocity: np.ndarray | None = None
     time: np.ndarray | None = None
     messages: Mapping[str, int] = field(default_factory=dict)
+    gaps: Gaps | None = None
 
     def __post_init__(self) -> None:
         if not (np.isfinite(self.fs) and self.fs > 0):
@@ -148,6 +204,35 @@ class ImuLog:
         if len(set(lengths.values())) > 1:
             raise ValueError(f"channels must have equal lengths; got {lengths}")
         object.__setattr__(self, "messages", MappingProxyType(dict(self.messages)))
+        gaps = self.gaps
+        if gaps is None:
+            gaps = Gaps.from_valid(self._rows_without_nan(), self.fs)
+        elif not isinstance(gaps, Gaps):
+            raise TypeError(f"gaps must be a Gaps table or None; got {type(gaps).__name__}")
+        object.__setattr__(self, "gaps", gaps)
+        n = len(self)
+        if (self.issues.samples_missing, self.issues.gaps, self.issues.samples) != (
+            gaps.total,
+            len(gaps),
+            n,
+        ):
+            issues = replace(self.issues, samples_missing=gaps.total, gaps=len(gaps), samples=n)
+            object.__setattr__(self, "issues", issues)
+
+    def _rows_without_nan(self) -> np.ndarray:
+        """Rows with no NaN in any channel (column by column: fast on strided views)."""
+        nan = np.zeros(len(self), dtype=bool)
+        scratch = np.empty(len(self), dtype=bool)
+        for name in self.channels:
+            values = getattr(self, name)
+            for col in [values] if values.ndim == 1 else values.T:
+                nan |= np.isnan(col, out=scratch)
+        return ~nan
+
+    @property
+    def valid(self) -> np.ndarray:
+        """Boolean (n,) mask: ``True`` where the sample is there, ``False`` in gaps."""
+        return self.gaps.valid(len(self))
 
     @property
     def channels(self) -> tuple[str, ...]:
@@ -161,7 +246,7 @@ class ImuLog:
 
     @property
     def duration(self) -> float:
-        """Length of the record in seconds (samples / fs)."""
+        """Length of the record in seconds: grid rows (missing samples included) / fs."""
         return len(self) / self.fs
 
     @classmethod
@@ -181,7 +266,11 @@ class ImuLog:
         time=None,
         source: str = "<arrays>",
     ) -> ImuLog:
-        """Wrap arrays already in memory (SI units as in :data:`CHANNELS`)."""
+        """Wrap arrays already in memory (SI units as in :data:`CHANNELS`).
+
+        The arrays are taken to be on a uniform grid at ``fs``: a row with NaN in
+        any channel is a missing sample, and runs of them are the log's ``gaps``.
+        """
         return cls(
             fs=float(fs),
             source=source,
@@ -200,15 +289,55 @@ class ImuLog:
         )
 
 
-def resolve_fs(time: np.ndarray | None, fs: float | None, source: str) -> float:
-    """The sample rate: median timestamp step, else ``fs``, else the default with a warning."""
-    median_step = None
-    if time is not None and len(time) > 1:
-        steps = np.diff(np.asarray(time, dtype=np.float64))
-        steps = steps[steps > 0]
-        if len(steps):
-            median_step = float(np.median(steps))
-    return fs_from_median_step(median_step, fs, source, stacklevel=4)
+def log_on_grid(
+    *,
+    fs: float | None,
+    source: str,
+    format: str,
+    issues: ParseIssues,
+    channels: Mapping[str, np.ndarray],
+    time: np.ndarray | None = None,
+    messages: Mapping[str, int] | None = None,
+    grid: TimeGrid | None = None,
+    values_may_be_nan: bool = False,
+) -> ImuLog:
+    """The :class:`ImuLog` of a reader: one value per decoded sample, put on the grid.
+
+    Every reader ends here, so that rate, gaps and timestamp problems are decided
+    in one place (:mod:`imunoise.readers.grid`). ``grid`` defaults to the grid of
+    ``time`` (or, without timestamps, every sample in its own row); the rate is the
+    grid's where it has one, else ``fs``, else :data:`DEFAULT_FS` with a warning.
+    Duplicate and reversed timestamps are added to ``issues``. The gaps are the
+    grid's missing rows; with ``values_may_be_nan`` (a CSV, where ``nan`` marks a
+    missing value) every row with a NaN, found by one scan of the channels.
+    """
+    n = len(time) if time is not None else len(next(iter(channels.values()), ()))
+    if grid is None and time is not None:
+        try:
+            grid = TimeGrid.from_timestamps(time)
+        except ValueError as exc:
+            warnings.warn(
+                f"{source}: {exc}; samples kept one per row, gaps not detected",
+                stacklevel=3,
+            )
+    if grid is None:
+        grid = TimeGrid.identity(n)
+    rate = grid.fs if grid.fs is not None else fs_from_median_step(None, fs, source, stacklevel=4)
+    if grid.duplicate_time or grid.time_reversed:
+        counts = dict(issues.counts)
+        counts["duplicate_time"] += grid.duplicate_time
+        counts["time_reversed"] += grid.time_reversed
+        issues = replace(issues, counts=counts)
+    return ImuLog(
+        fs=rate,
+        source=source,
+        format=format,
+        issues=issues,
+        time=grid.place_time(time),
+        messages=messages or {},
+        gaps=None if values_may_be_nan else grid.gaps(rate),
+        **{name: grid.place(values) for name, values in channels.items()},
+    )
 
 
 def fs_from_median_step(

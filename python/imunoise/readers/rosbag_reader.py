@@ -35,7 +35,7 @@ from pathlib import Path
 import numpy as np
 
 from imunoise.readers._sentences import IssueTally, sentence_rows
-from imunoise.readers.log import ImuLog, resolve_fs
+from imunoise.readers.log import ImuLog, log_on_grid
 
 __all__ = ["read_rosbag"]
 
@@ -135,6 +135,8 @@ def read_rosbag(
     ImuLog
         ``format="rosbag"``; ``messages`` counts the decoded records by type and
         lists the topics that were not read as ``"ignored <topic> [<type>]"``.
+        Rows are on the grid of the header stamps (the receive time where a
+        message has none): dropped messages are NaN rows and ``log.gaps``.
     """
     from rosbags.highlevel import AnyReader, AnyReaderError
 
@@ -352,14 +354,14 @@ def _read(reader, name, total, strict, fs, progress, topic) -> ImuLog:
     if len(time_ns) and np.all(time_ns > 0):
         sec0 = int(time_ns[0]) // 1_000_000_000
         time = sec0 + (time_ns - sec0 * 1_000_000_000) * 1e-9
-    return ImuLog(
-        fs=resolve_fs(time, fs, name),
+    return log_on_grid(
+        fs=fs,
         source=name,
         format="rosbag",
         issues=tally.issues("message"),
+        channels=channels,
         time=time,
         messages=messages,
-        **channels,
     )
 
 

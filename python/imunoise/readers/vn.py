@@ -18,8 +18,19 @@ Units are the sensor's (spec §3.1, §5.3), which are already those of
 :data:`~imunoise.readers.log.CHANNELS`: gyro rad/s, accel m/s², mag Gauss, yaw/
 pitch/roll deg, temperature °C, pressure kPa, delta-theta deg, delta-velocity m/s.
 Where a message carries compensated and uncompensated values, the compensated
-ones are used. ``time`` is the binary ``TimeStartup`` (s since power-up) when a
-packet carries it; ASCII sentences carry no timestamps.
+ones are used.
+
+Time grid and gaps
+------------------
+``time`` is the binary ``TimeStartup`` (s since power-up) when the packets carry
+it, else ``TimeGps``, else ``TimeSyncIn`` (only when it never runs backwards, i.e.
+no SyncIn pulse reset it); the grid, the rate and the dropouts come from it
+(:mod:`imunoise.readers.grid`). ASCII sentences with an appended ``T`` counter
+(register 30) that only increases are placed by that counter (its unit is not
+known, so the rate is ``fs=``). Otherwise the log has no timestamps, and every
+damaged record of the main message stream (bad checksum or CRC, malformed field,
+truncated) whose message type can still be read stands for one missing sample at
+its place in the sequence.
 """
 
 from __future__ import annotations
@@ -27,13 +38,14 @@ from __future__ import annotations
 import errno
 import os
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from types import MappingProxyType
 
 import numpy as np
 
 from imunoise import _core
-from imunoise.readers.log import ISSUE_KINDS, ImuLog, ParseIssues, resolve_fs
+from imunoise.readers.grid import TimeGrid
+from imunoise.readers.log import ISSUE_KINDS, ImuLog, ParseIssues, log_on_grid
 
 #: channel -> candidate column triples (compensated first), names without group prefix.
 _CHANNEL_COLUMNS: Mapping[str, tuple[tuple[str, ...], ...]] = {
@@ -75,6 +87,10 @@ class VnTables:
         bytes_total`` for every input.
     ascii_records, binary_records : int
         Decoded records of each framing.
+    missing : Mapping[str, numpy.ndarray]
+        Per message type, for every damaged record of that type (bad checksum or
+        CRC, malformed field, truncated record, whose type could still be read):
+        the number of good records of the type before it (int64, increasing).
     """
 
     tables: Mapping[str, Mapping[str, np.ndarray]]
@@ -86,6 +102,7 @@ class VnTables:
     bytes_skipped: int
     ascii_records: int
     binary_records: int
+    missing: Mapping[str, np.ndarray] = field(default_factory=dict)
 
     @property
     def format(self) -> str:
@@ -147,6 +164,9 @@ def read_vn_tables(
         bytes_skipped=int(raw["bytes_skipped"]),
         ascii_records=int(raw["ascii_records"]),
         binary_records=int(raw["binary_records"]),
+        missing=MappingProxyType(
+            {k: np.asarray(v, dtype=np.int64) for k, v in raw.get("missing", {}).items()}
+        ),
     )
 
 
@@ -194,37 +214,61 @@ def table_channels(cols: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
             if found is not None:
                 out[channel] = found[0] if len(found) == 1 else _stack(found)
                 break
-    time = _lookup(cols, ("time_startup",))
-    if time is not None:
-        out["time"] = time[0]
+    for name in ("time_startup", "time_gps", "time_syncin"):
+        time = _lookup(cols, (name,))
+        if time is not None and (name != "time_syncin" or np.all(np.diff(time[0]) >= 0)):
+            out["time"] = time[0]
+            break
     return out
 
 
-def _primary(tables: Mapping[str, Mapping[str, np.ndarray]]) -> dict[str, np.ndarray]:
+def _primary(tables: Mapping[str, Mapping[str, np.ndarray]]) -> tuple[str, dict[str, np.ndarray]]:
     best: tuple[int, int] = (-1, -1)
-    chosen: dict[str, np.ndarray] = {}
-    for cols in tables.values():
+    chosen: tuple[str, dict[str, np.ndarray]] = ("", {})
+    for name, cols in tables.items():
         channels = table_channels(cols)
         n = len(next(iter(cols.values()))) if cols else 0
         filled = sum(1 for k in channels if k != "time")
         if filled and (filled, n) > best:
-            best, chosen = (filled, n), channels
+            best, chosen = (filled, n), (name, channels)
     return chosen
 
 
-def vn_log(tables: VnTables, *, fs: float | None, source: str) -> ImuLog:
-    """Build the :class:`ImuLog` from decoded tables (channels from the richest table)."""
-    channels = _primary(tables.tables)
+def _grid(tables: VnTables, name: str, time: np.ndarray | None, n: int) -> TimeGrid | None:
+    """The grid of the main table: ``None`` when it has timestamps (the grid is
+    theirs), else from its ``T`` counter, else from the places of its damaged
+    records (see the module docstring)."""
+    if time is not None:
+        return None
+    counter = tables.tables[name].get("serial_count") if name else None
+    if counter is not None and len(counter) > 2 and np.all(np.diff(counter) > 0):
+        try:
+            grid = TimeGrid.from_timestamps(counter)
+        except ValueError:
+            pass  # not a sample counter
+        else:
+            return TimeGrid(grid.slot, grid.n, duplicate_time=grid.duplicate_time)
+    return TimeGrid.from_missing(n, tables.missing.get(name, ()))
+
+
+def vn_log(tables: VnTables, *, fs: float | None, source: str, grid: bool = True) -> ImuLog:
+    """Build the :class:`ImuLog` from decoded tables (channels from the richest table).
+
+    ``grid=False`` keeps one row per decoded record (for sentences embedded in a
+    container that has its own timestamps).
+    """
+    name, channels = _primary(tables.tables)
     time = channels.pop("time", None)
-    rate = resolve_fs(time, fs, source)
-    return ImuLog(
-        fs=rate,
+    n = len(next(iter(channels.values()))) if channels else 0
+    return log_on_grid(
+        fs=fs,
         source=source,
         format=tables.format,
         issues=tables.issues,
+        channels=channels,
         time=time,
         messages=tables.messages,
-        **channels,
+        grid=_grid(tables, name, time, n) if grid else TimeGrid.identity(n),
     )
 
 
@@ -254,4 +298,4 @@ def parse_vn_sentences(
     """
     if not isinstance(data, (bytes, bytearray, memoryview)):
         raise TypeError(f"data must be bytes; got {type(data).__name__}")
-    return vn_log(read_vn_tables(bytes(data), strict=strict), fs=fs, source=source)
+    return vn_log(read_vn_tables(bytes(data), strict=strict), fs=fs, source=source, grid=False)
