@@ -13,20 +13,10 @@ from __future__ import annotations
 import argparse
 import os
 import platform
-import statistics
-import time
 
 import imunoise
 import numpy as np
-
-
-def median_time(fn, repeats: int, *args, **kwargs) -> float:
-    times = []
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        fn(*args, **kwargs)
-        times.append(time.perf_counter() - t0)
-    return statistics.median(times)
+from bench_allan import median_time
 
 
 def with_gaps(y: np.ndarray, gaps: int, share: float, rng) -> np.ndarray:

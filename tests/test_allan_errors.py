@@ -117,3 +117,8 @@ def test_no_input_escapes_as_anything_but_value_or_type_error(x, fs, func, taus)
         return
     assert np.all(np.isfinite(r.dev) | (r.dev == 0))
     assert r.dev.shape[0] == len(r.taus)
+
+
+def test_tdev_that_overflows_is_an_error():
+    with pytest.raises(ValueError, match="fs is too small.*overflows"):
+        imunoise.tdev(np.array([0.0, 1.0, 1.0]), 6.7e-258)

@@ -221,6 +221,8 @@ def test_fit_takes_a_gapped_result():
     r = imunoise.adev(two, 100.0)
     assert r.n.ndim == 2
     assert np.all(np.isfinite(imunoise.fit(r).N))
+    boot = imunoise.fit(r, uncertainty="bootstrap", replicates=5, seed=0)
+    assert np.all(np.isfinite(boot.N_std))
 
 
 def test_describe_and_distribution_use_the_valid_samples():

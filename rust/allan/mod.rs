@@ -156,17 +156,23 @@ pub fn analyse_plan(phases: &[Phase], plan: &[(Statistic, usize)]) -> CoreResult
     let pairs: Vec<(usize, usize)> = (0..plan.len())
         .flat_map(|t| (0..channels).map(move |c| (t, c)))
         .collect();
-    let terms: Vec<usize> = pairs
+    // With gaps: how many runs have each length (in phase points) that holds a term.
+    let runs: Vec<Option<BTreeMap<usize, usize>>> = pairs
         .iter()
         .map(|&(t, c)| {
             let (s, m) = plan[t];
-            match &phases[c].gaps {
+            let g = phases[c].gaps.as_ref()?;
+            Some(segment_lengths(s, &phases[c].c, &g.segments, m))
+        })
+        .collect();
+    let terms: Vec<usize> = pairs
+        .iter()
+        .zip(&runs)
+        .map(|(&(t, _), lengths)| {
+            let (s, m) = plan[t];
+            match lengths {
                 None => full_terms[t],
-                Some(g) => g
-                    .segments
-                    .iter()
-                    .map(|seg| s.terms(s.segment_phase(&phases[c].c, seg, m).len(), m))
-                    .sum(),
+                Some(lengths) => lengths.iter().map(|(&l, &n)| n * s.terms(l, m)).sum(),
             }
         })
         .collect();
@@ -259,12 +265,11 @@ pub fn analyse_plan(phases: &[Phase], plan: &[(Statistic, usize)]) -> CoreResult
     let edf = pairs
         .iter()
         .enumerate()
-        .map(|(i, &(t, c))| {
+        .map(|(i, &(t, _))| {
             let (statistic, m) = plan[t];
-            match (noise_model_of(statistic).1, &phases[c].gaps) {
-                (EdfModel::Greenhall(est), Some(g)) => {
-                    let lengths = segment_lengths(statistic, &phases[c].c, &g.segments, m);
-                    edf_over_segments(&lengths, terms[i], statistic, m, |len| {
+            match (noise_model_of(statistic).1, &runs[i]) {
+                (EdfModel::Greenhall(est), Some(lengths)) => {
+                    edf_over_segments(lengths, terms[i], statistic, m, |len| {
                         edf::greenhall_edf(alpha[i], est, m, len)
                     })
                 }
