@@ -15,7 +15,7 @@ GOOD = np.random.default_rng(0).normal(size=100)
 @pytest.mark.parametrize(
     "x, exc, words",
     [
-        (np.array([1.0, np.nan, 2.0, 3.0]), ValueError, ["x must be finite", "sample 1 is NaN"]),
+        (np.array([1.0, np.nan, 2.0, -np.inf]), ValueError, ["must be finite", "3 is -inf"]),
         (np.array([1.0, 2.0, np.inf, 3.0]), ValueError, ["x must be finite", "sample 2 is inf"]),
         (np.array([]), ValueError, ["x must not be empty"]),
         (np.zeros((4, 2, 2)), ValueError, ["x must be 1-D", "3-D"]),
@@ -34,10 +34,10 @@ def test_bad_samples(func, x, exc, words):
         assert word in str(info.value)
 
 
-def test_nan_in_a_later_channel_names_the_channel():
+def test_inf_in_a_later_channel_names_the_channel():
     x = np.zeros((50, 3))
     x[:, :] = GOOD[:50, None]
-    x[20, 2] = np.nan
+    x[20, 2] = np.inf
     with pytest.raises(ValueError, match="channel 2"):
         imunoise.adev(x, 1.0)
 
@@ -117,3 +117,8 @@ def test_no_input_escapes_as_anything_but_value_or_type_error(x, fs, func, taus)
         return
     assert np.all(np.isfinite(r.dev) | (r.dev == 0))
     assert r.dev.shape[0] == len(r.taus)
+
+
+def test_tdev_that_overflows_is_an_error():
+    with pytest.raises(ValueError, match="fs is too small.*overflows"):
+        imunoise.tdev(np.array([0.0, 1.0, 1.0]), 6.7e-258)

@@ -45,8 +45,9 @@ def test_describe_array_and_table():
     assert "drift/h" in text and "7200" in text
     with pytest.raises(ValueError, match="fs"):
         imunoise.describe(x, fs=-1)
+    assert list(imunoise.describe([1.0, np.nan, 2.0]).missing) == [1]
     with pytest.raises(ValueError, match="finite"):
-        imunoise.describe([1.0, np.nan, 2.0])
+        imunoise.describe([1.0, np.inf, 2.0])
     with pytest.raises(TypeError, match="dtype"):
         imunoise.describe(np.array(["a", "b"]))
 

@@ -20,10 +20,14 @@ def analyse(
     npt.NDArray[np.int32],
     npt.NDArray[np.bool_],
     npt.NDArray[np.float64],
+    npt.NDArray[np.uint64],
 ]:
-    """(var, terms, alpha, alpha_identified, edf) for x (n, channels) at averaging
-    factors ms; 2-D outputs are (len(ms), channels). statistic: adev, oadev, mdev,
-    hdev, ohdev, totdev, mtotdev, htotdev, theo1, theobr."""
+    """(var, terms, alpha, alpha_identified, edf, missing) for x (n, channels) at
+    averaging factors ms; 2-D outputs are (len(ms), channels), ``missing`` (channels,)
+    counts each channel's NaN. NaN marks a missing sample: adev, oadev, mdev, hdev and
+    ohdev leave out the terms touching one (``terms`` counts those used; var and edf
+    are NaN where none is left), the others raise ValueError. statistic: adev, oadev,
+    mdev, hdev, ohdev, totdev, mtotdev, htotdev, theo1, theobr."""
 
 def analyse_plan(
     x: npt.NDArray[np.float64],
@@ -35,6 +39,7 @@ def analyse_plan(
     npt.NDArray[np.int32],
     npt.NDArray[np.bool_],
     npt.NDArray[np.float64],
+    npt.NDArray[np.uint64],
 ]:
     """As :func:`analyse` with one statistic per tau (``statistics[t]`` at ``ms[t]``,
     ordered by tau); ThêoH is oadev at its short taus, then theobr."""

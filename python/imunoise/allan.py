@@ -21,6 +21,31 @@ equivalent degrees of freedom follow Greenhall's algorithm (TOTVAR: SP 1065
 Table 7), and the bounds are the χ² quantiles
 :math:`\sigma^2\,\nu/\chi^2_{\nu}(1-p/2) \le \sigma^2 \le \sigma^2\,\nu/\chi^2_{\nu}(p/2)`.
 
+Gaps
+----
+A missing sample is NaN on the uniform time grid (±∞ stays an error). Every
+function takes ``gaps=``:
+
+- ``"skip"`` (default): a term whose window touches a missing sample is left
+  out and ``r.n`` counts the terms used; the mean removed is that of the valid
+  samples. ADEV (overlapping or not), MDEV, TDEV and HDEV (overlapping or not)
+  support it. Taus at which no channel keeps two terms are dropped; a channel
+  with fewer than two terms at a kept tau gets NaN there. The noise type is
+  identified on the longest gap-free run, and the EDF pools the runs: run s,
+  with Greenhall's EDF ν_s for its length, carries the share w_s of the terms
+  used, and 1/ν = Σ w_s²/ν_s (the runs treated as independent; exactly
+  Greenhall's EDF when there is no gap). The total family (TOTDEV, MTOTDEV,
+  TTOTDEV, HTOTDEV, Theo1, ThêoBR, ThêoH) reflects or detrends the record around
+  every point and cannot skip gaps: with NaN in ``x`` it raises ValueError.
+- ``"longest"``: the longest run of rows without NaN (in any channel) is
+  analysed, with a warning saying what share of the record that is.
+- ``"splice"``: rows with NaN are dropped and the rest joined, as if the gaps
+  had not happened (the behaviour of tools that ignore time stamps), with a
+  warning saying how many samples were spliced over. Splicing joins stretches
+  of the record that were not adjacent in time and biases the long taus.
+
+A record without NaN gives the same result, bit for bit, whatever ``gaps`` is.
+
 References
 ----------
 W. J. Riley, *Handbook of Frequency Stability Analysis*, NIST SP 1065 (2008).
@@ -59,7 +84,13 @@ __all__ = [
     "theobr",
     "theoh",
     "ONE_SIGMA",
+    "GAPS",
 ]
+
+#: Values of the ``gaps=`` keyword (see the module notes).
+GAPS = ("skip", "longest", "splice")
+#: Statistics (core names) that can leave out the terms touching a missing sample.
+_SKIPS_GAPS = frozenset({"adev", "oadev", "mdev", "hdev", "ohdev"})
 
 
 @dataclass(frozen=True)
@@ -83,8 +114,10 @@ class AllanResult:
         at ``taus = 0.75 * m / fs``).
     dev, var : ndarray
         The deviation and its square, in the input's units (TDEV: units × s).
-    n : ndarray of int, (T,)
-        Number of terms in each estimate (Stable32's N).
+    n : ndarray of int, (T,) or (T, channels)
+        Number of terms in each estimate (Stable32's N); with ``gaps="skip"`` the
+        terms actually used. Shape (T,) unless the channels' gaps differ so that
+        they used different numbers of terms; then (T, channels).
     edf : ndarray
         Equivalent degrees of freedom.
     ci_low, ci_high : ndarray
@@ -99,6 +132,10 @@ class AllanResult:
         Sample rate in Hz.
     confidence : float
         Two-sided confidence level of ``ci_low``/``ci_high``.
+    missing : int or ndarray of int, (channels,)
+        Missing samples (NaN) in ``x`` per channel (int for 1-D input).
+    gaps : str
+        How missing samples were treated: ``"skip"``, ``"longest"`` or ``"splice"``.
     """
 
     kind: str
@@ -115,6 +152,8 @@ class AllanResult:
     alpha_identified: np.ndarray
     fs: float
     confidence: float
+    missing: int | np.ndarray = 0
+    gaps: str = "skip"
 
     def __post_init__(self) -> None:
         for name in (
@@ -130,6 +169,8 @@ class AllanResult:
             "alpha_identified",
         ):
             getattr(self, name).flags.writeable = False
+        if isinstance(self.missing, np.ndarray):
+            self.missing.flags.writeable = False
 
     @property
     def channels(self) -> int:
@@ -140,7 +181,15 @@ class AllanResult:
         return len(self.taus)
 
 
-def adev(x, fs, taus="octave", *, overlapping: bool = True, confidence: float = ONE_SIGMA):
+def adev(
+    x,
+    fs,
+    taus="octave",
+    *,
+    overlapping: bool = True,
+    confidence: float = ONE_SIGMA,
+    gaps: str = "skip",
+):
     """Allan deviation, overlapping by default.
 
     Parameters
@@ -157,6 +206,10 @@ def adev(x, fs, taus="octave", *, overlapping: bool = True, confidence: float = 
         classic non-overlapping one (stride m).
     confidence : float, optional
         Two-sided confidence level of the interval, default one sigma (68.3 %).
+    gaps : {"skip", "longest", "splice"}, optional
+        How NaN (missing samples) in ``x`` are treated, see the module notes:
+        leave out the terms touching one (default), analyse the longest gap-free
+        segment, or drop them and join the rest (both with a warning).
 
     Returns
     -------
@@ -172,36 +225,45 @@ def adev(x, fs, taus="octave", *, overlapping: bool = True, confidence: float = 
     """
     _check_bool("overlapping", overlapping)
     return _deviation(
-        "adev", "oadev" if overlapping else "adev", x, fs, taus, confidence, overlapping
+        "adev", "oadev" if overlapping else "adev", x, fs, taus, confidence, overlapping, gaps
     )
 
 
-def mdev(x, fs, taus="octave", *, confidence: float = ONE_SIGMA):
+def mdev(x, fs, taus="octave", *, confidence: float = ONE_SIGMA, gaps: str = "skip"):
     """Modified Allan deviation (SP 1065 eq. 14); see :func:`adev` for the parameters."""
-    return _deviation("mdev", "mdev", x, fs, taus, confidence, True)
+    return _deviation("mdev", "mdev", x, fs, taus, confidence, True, gaps)
 
 
-def tdev(x, fs, taus="octave", *, confidence: float = ONE_SIGMA):
+def tdev(x, fs, taus="octave", *, confidence: float = ONE_SIGMA, gaps: str = "skip"):
     """Time deviation, τ·MDEV/√3 (SP 1065 eq. 16), in input units × seconds;
     see :func:`adev` for the parameters."""
-    return _deviation("tdev", "mdev", x, fs, taus, confidence, True)
+    return _deviation("tdev", "mdev", x, fs, taus, confidence, True, gaps)
 
 
-def hdev(x, fs, taus="octave", *, overlapping: bool = True, confidence: float = ONE_SIGMA):
+def hdev(
+    x,
+    fs,
+    taus="octave",
+    *,
+    overlapping: bool = True,
+    confidence: float = ONE_SIGMA,
+    gaps: str = "skip",
+):
     """Hadamard deviation (SP 1065 eqs. 17–20), overlapping by default; insensitive
     to a linear drift of the rate. See :func:`adev` for the parameters."""
     _check_bool("overlapping", overlapping)
     return _deviation(
-        "hdev", "ohdev" if overlapping else "hdev", x, fs, taus, confidence, overlapping
+        "hdev", "ohdev" if overlapping else "hdev", x, fs, taus, confidence, overlapping, gaps
     )
 
 
-def totdev(x, fs, taus="octave", *, confidence: float = ONE_SIGMA):
+def totdev(x, fs, taus="octave", *, confidence: float = ONE_SIGMA, gaps: str = "skip"):
     """Total deviation (SP 1065 eq. 25): the overlapping Allan deviation of the
     phase extended by reflection at both ends, better confidence at long taus.
     No bias correction is applied (it is small for white and flicker FM).
+    Cannot skip gaps: NaN in ``x`` needs ``gaps="longest"`` or ``"splice"``.
     See :func:`adev` for the parameters."""
-    return _deviation("totdev", "totdev", x, fs, taus, confidence, True)
+    return _deviation("totdev", "totdev", x, fs, taus, confidence, True, gaps)
 
 
 #: SP 1065 (Riley 2008) / Riley, "Confidence intervals and bias corrections for the
@@ -219,7 +281,15 @@ _THEO1_BIAS = {
 }
 
 
-def mtotdev(x, fs, taus="octave", *, confidence: float = ONE_SIGMA, bias_correction=False):
+def mtotdev(
+    x,
+    fs,
+    taus="octave",
+    *,
+    confidence: float = ONE_SIGMA,
+    bias_correction=False,
+    gaps: str = "skip",
+):
     r"""Modified total deviation (SP 1065 eq. 27; Howe & Vernotte 1999).
 
     Each of the N − 3m + 1 phase subsequences of 3m points (N = n + 1) has its
@@ -232,8 +302,9 @@ def mtotdev(x, fs, taus="octave", *, confidence: float = ONE_SIGMA, bias_correct
 
     Parameters
     ----------
-    x, fs, taus, confidence
-        As for :func:`adev`.
+    x, fs, taus, confidence, gaps
+        As for :func:`adev`; cannot skip gaps (``gaps="longest"`` or ``"splice"``
+        for data with NaN).
     bias_correction : bool, optional
         Divide the variance by the published bias factor for the noise type
         identified at each tau (``alpha`` in the result). Default False: the
@@ -250,20 +321,36 @@ def mtotdev(x, fs, taus="octave", *, confidence: float = ONE_SIGMA, bias_correct
     AllanResult
     """
     return _deviation(
-        "mtotdev", "mtotdev", x, fs, taus, confidence, True, bias_correction=bias_correction
+        "mtotdev", "mtotdev", x, fs, taus, confidence, True, gaps, bias_correction=bias_correction
     )
 
 
-def ttotdev(x, fs, taus="octave", *, confidence: float = ONE_SIGMA, bias_correction=False):
+def ttotdev(
+    x,
+    fs,
+    taus="octave",
+    *,
+    confidence: float = ONE_SIGMA,
+    bias_correction=False,
+    gaps: str = "skip",
+):
     r"""Time total deviation, τ·MTOTDEV/√3 (SP 1065 eq. 28, with τ² in the variance;
     the τ³ printed there is a typo), in input units × seconds. Parameters, EDF and
     bias correction as for :func:`mtotdev`."""
     return _deviation(
-        "ttotdev", "mtotdev", x, fs, taus, confidence, True, bias_correction=bias_correction
+        "ttotdev", "mtotdev", x, fs, taus, confidence, True, gaps, bias_correction=bias_correction
     )
 
 
-def htotdev(x, fs, taus="octave", *, confidence: float = ONE_SIGMA, bias_correction=False):
+def htotdev(
+    x,
+    fs,
+    taus="octave",
+    *,
+    confidence: float = ONE_SIGMA,
+    bias_correction=False,
+    gaps: str = "skip",
+):
     r"""Hadamard total deviation (SP 1065 eq. 29; Howe, Beard, Greenhall, Riley 2005).
 
     The MTOT construction applied to the *rate* samples: each of the n − 3m + 1
@@ -276,8 +363,9 @@ def htotdev(x, fs, taus="octave", *, confidence: float = ONE_SIGMA, bias_correct
 
     Parameters
     ----------
-    x, fs, taus, confidence
-        As for :func:`adev`.
+    x, fs, taus, confidence, gaps
+        As for :func:`adev`; cannot skip gaps (``gaps="longest"`` or ``"splice"``
+        for data with NaN).
     bias_correction : bool, optional
         Divide the variance by the published bias factor for the noise type
         identified at each tau (``alpha`` in the result). Default False: the
@@ -295,11 +383,19 @@ def htotdev(x, fs, taus="octave", *, confidence: float = ONE_SIGMA, bias_correct
     AllanResult
     """
     return _deviation(
-        "htotdev", "htotdev", x, fs, taus, confidence, True, bias_correction=bias_correction
+        "htotdev", "htotdev", x, fs, taus, confidence, True, gaps, bias_correction=bias_correction
     )
 
 
-def theo1(x, fs, taus="octave", *, confidence: float = ONE_SIGMA, bias_correction=False):
+def theo1(
+    x,
+    fs,
+    taus="octave",
+    *,
+    confidence: float = ONE_SIGMA,
+    bias_correction=False,
+    gaps: str = "skip",
+):
     r"""Theo1 deviation (SP 1065 eq. 30; Howe & Peppler 2003), even m only.
 
     :math:`\mathrm{Theo1}(m) = \frac{1}{0.75\,(N-m)(m\tau_0)^2}\sum_{i=0}^{N-m-1}
@@ -316,8 +412,9 @@ def theo1(x, fs, taus="octave", *, confidence: float = ONE_SIGMA, bias_correctio
 
     Parameters
     ----------
-    x, fs, taus, confidence
-        As for :func:`adev`.
+    x, fs, taus, confidence, gaps
+        As for :func:`adev`; cannot skip gaps (``gaps="longest"`` or ``"splice"``
+        for data with NaN).
     bias_correction : bool, optional
         Divide the variance by the published bias factor for the noise type
         identified at each tau (``alpha`` in the result). Default False: the
@@ -335,11 +432,11 @@ def theo1(x, fs, taus="octave", *, confidence: float = ONE_SIGMA, bias_correctio
     AllanResult
     """
     return _deviation(
-        "theo1", "theo1", x, fs, taus, confidence, True, bias_correction=bias_correction
+        "theo1", "theo1", x, fs, taus, confidence, True, gaps, bias_correction=bias_correction
     )
 
 
-def theobr(x, fs, taus="octave", *, confidence: float = ONE_SIGMA):
+def theobr(x, fs, taus="octave", *, confidence: float = ONE_SIGMA, gaps: str = "skip"):
     r"""ThêoBR deviation: Theo1 with its bias relative to the Allan variance removed
     by the data's own AVAR/Theo1 ratio (Howe & Tasset 2004; Howe 2006; SP 1065
     §5.2.15). An estimate of the Allan deviation out to τ ≈ 0.75·T (T the record
@@ -380,15 +477,16 @@ def theobr(x, fs, taus="octave", *, confidence: float = ONE_SIGMA):
 
     Parameters
     ----------
-    x, fs, taus, confidence
-        As for :func:`adev` (taus: see the tau convention above).
+    x, fs, taus, confidence, gaps
+        As for :func:`adev` (taus: see the tau convention above); cannot skip gaps
+        (``gaps="longest"`` or ``"splice"`` for data with NaN).
 
     Returns
     -------
     AllanResult
         ``kind == "theobr"``.
     """
-    data, one_d = _as_samples(x)
+    data, one_d, missing = _gapped_samples(x, gaps, "theobr", False, stacklevel=3)
     fs = _check_fs(fs)
     confidence = _check_confidence(confidence)
     n = data.shape[0]
@@ -398,14 +496,14 @@ def theobr(x, fs, taus="octave", *, confidence: float = ONE_SIGMA):
     if m.size == 0:
         raise ValueError(f"none of the taus is in range for theobr; got {taus!r}")
     _warn_theobr_cost("theobr", n, m, data.shape[1])
-    var, terms, alpha, identified, edf = _core.analyse(data, "theobr", m.astype(np.uint64))
+    var, terms, alpha, identified, edf, _ = _core.analyse(data, "theobr", m.astype(np.uint64))
     return _assemble(
         "theobr", True, 0.75 * m / fs, m, var, terms, alpha, identified, edf, fs,
-        confidence, one_d,
+        confidence, one_d, missing, gaps,
     )
 
 
-def theoh(x, fs, taus="octave", *, confidence: float = ONE_SIGMA):
+def theoh(x, fs, taus="octave", *, confidence: float = ONE_SIGMA, gaps: str = "skip"):
     r"""ThêoH deviation: the overlapping Allan deviation at short taus and ThêoBR
     (:func:`theobr`) at long ones (Howe, "ThêoH: a hybrid, high-confidence
     statistic that improves on the Allan deviation", Metrologia 43, 2006; SP 1065
@@ -438,15 +536,16 @@ def theoh(x, fs, taus="octave", *, confidence: float = ONE_SIGMA):
 
     Parameters
     ----------
-    x, fs, taus, confidence
-        As for :func:`adev`.
+    x, fs, taus, confidence, gaps
+        As for :func:`adev`; cannot skip gaps (``gaps="longest"`` or ``"splice"``
+        for data with NaN).
 
     Returns
     -------
     AllanResult
         ``kind == "theoh"``.
     """
-    data, one_d = _as_samples(x)
+    data, one_d, missing = _gapped_samples(x, gaps, "theoh", False, stacklevel=3)
     fs = _check_fs(fs)
     confidence = _check_confidence(confidence)
     n = data.shape[0]
@@ -477,12 +576,13 @@ def theoh(x, fs, taus="octave", *, confidence: float = ONE_SIGMA):
     _warn_theobr_cost("theoh", n, m_theo, data.shape[1])
     m = np.concatenate([m_avar, m_theo]).astype(np.int64)
     statistics = ["oadev"] * m_avar.size + ["theobr"] * m_theo.size
-    var, terms, alpha, identified, edf = _core.analyse_plan(
+    var, terms, alpha, identified, edf, _ = _core.analyse_plan(
         data, statistics, m.astype(np.uint64)
     )
     tau = np.concatenate([m_avar / fs, 0.75 * m_theo / fs])
     return _assemble(
-        "theoh", True, tau, m, var, terms, alpha, identified, edf, fs, confidence, one_d
+        "theoh", True, tau, m, var, terms, alpha, identified, edf, fs, confidence, one_d,
+        missing, gaps,
     )
 
 
@@ -504,9 +604,9 @@ def _bias_factor(kind, alpha, m):
 
 
 def _deviation(
-    kind, statistic, x, fs, taus, confidence, overlapping, *, bias_correction=False
+    kind, statistic, x, fs, taus, confidence, overlapping, gaps, *, bias_correction=False
 ) -> AllanResult:
-    data, one_d = _as_samples(x)
+    data, one_d, missing = _gapped_samples(x, gaps, kind, statistic in _SKIPS_GAPS)
     fs = _check_fs(fs)
     confidence = _check_confidence(confidence)
     _check_bool("bias_correction", bias_correction)
@@ -522,24 +622,69 @@ def _deviation(
             f"x has {n} samples, too few for any tau of {kind} "
             f"(the shortest tau needs at least {_minimum_samples(statistic)})"
         )
-    var, terms, alpha, identified, edf = _core.analyse(data, statistic, m.astype(np.uint64))
+    var, terms, alpha, identified, edf, core_missing = _core.analyse(
+        data, statistic, m.astype(np.uint64)
+    )
+    if missing is None:
+        missing = core_missing.astype(np.int64)
+        if missing.any():
+            m, var, terms, alpha, identified, edf = _keep_gapped(
+                kind, m, var, terms, alpha, identified, edf, fs, user_given
+            )
     tau = m / fs
     if bias_correction:
         var = var * _bias_factor(kind, alpha, m)
     if kind in ("tdev", "ttotdev"):
-        var = var * (tau**2 / 3.0)[:, None]
+        with np.errstate(over="ignore", invalid="ignore"):
+            scaled = var * (tau**2 / 3.0)[:, None]
+        if np.any(np.isfinite(var) & ~np.isfinite(scaled)):
+            raise ValueError(
+                f"fs is too small ({fs!r} Hz): {kind} = tau·deviation/√3 overflows double "
+                f"precision at tau = {tau.max():g} s"
+            )
+        var = scaled
     return _assemble(
-        kind, overlapping, tau, m, var, terms, alpha, identified, edf, fs, confidence, one_d
+        kind, overlapping, tau, m, var, terms, alpha, identified, edf, fs, confidence, one_d,
+        missing, gaps,
+    )
+
+
+def _keep_gapped(kind, m, var, terms, alpha, identified, edf, fs, user_given):
+    """Drops the taus at which the gaps leave no channel two terms (warning when
+    they were asked for explicitly); NaN where one channel has fewer than two."""
+    enough = terms >= 2
+    keep = enough.any(axis=1)
+    if not keep.any():
+        raise ValueError(
+            f"x's gaps leave {kind} fewer than 2 terms at every tau: no gap-free run is "
+            f"long enough (pass gaps='splice' to join the runs)"
+        )
+    if user_given and not keep.all():
+        warnings.warn(
+            f"{int(np.count_nonzero(~keep))} of {len(m)} taus dropped: the gaps in x leave "
+            f"{kind} fewer than 2 terms there (largest usable tau {m[keep].max() / fs:g} s)",
+            stacklevel=4,
+        )
+    enough = enough[keep]
+    return (
+        m[keep],
+        np.where(enough, var[keep], np.nan),
+        terms[keep],
+        alpha[keep],
+        identified[keep],
+        np.where(enough, edf[keep], np.nan),
     )
 
 
 def _assemble(
-    kind, overlapping, tau, m, var, terms, alpha, identified, edf, fs, confidence, one_d
+    kind, overlapping, tau, m, var, terms, alpha, identified, edf, fs, confidence, one_d,
+    missing, gaps,
 ) -> AllanResult:
     """The result object from the core's (T, channels) arrays."""
     dev = np.sqrt(var)
     ci_low, ci_high = chi2_interval(dev, edf, confidence)
     squeeze = (lambda a: a[:, 0]) if one_d else (lambda a: a)
+    same_terms = one_d or bool(np.all(terms == terms[:, :1]))
     return AllanResult(
         kind=kind,
         overlapping=overlapping,
@@ -547,7 +692,7 @@ def _assemble(
         m=m,
         dev=squeeze(dev),
         var=squeeze(var),
-        n=terms.astype(np.int64),
+        n=(terms[:, 0] if same_terms else terms).astype(np.int64),
         edf=squeeze(edf),
         ci_low=squeeze(ci_low),
         ci_high=squeeze(ci_high),
@@ -555,6 +700,8 @@ def _assemble(
         alpha_identified=squeeze(identified),
         fs=fs,
         confidence=confidence,
+        missing=int(missing[0]) if one_d else np.asarray(missing, dtype=np.int64),
+        gaps=gaps,
     )
 
 
@@ -634,6 +781,56 @@ def _minimum_samples(statistic: str) -> int:
         if _core.estimator_terms(statistic, n + 1, np.array([1], dtype=np.uint64))[0] > 1:
             return n
     return 16
+
+
+def _gapped_samples(x, gaps, kind: str, skips: bool, stacklevel: int = 4):
+    """float64 (n, channels) samples ready for the core, whether x was 1-D, and the
+    missing samples per channel (None when the core counts them: ``gaps="skip"``
+    for a statistic that skips gaps, without a scan here)."""
+    data, one_d = _as_samples(x)
+    if not isinstance(gaps, str) or gaps not in GAPS:
+        error = ValueError if isinstance(gaps, str) else TypeError
+        raise error(f"gaps must be one of 'skip', 'longest', 'splice'; got {gaps!r}")
+    if gaps == "skip" and skips:
+        return data, one_d, None
+    nan = np.isnan(data)
+    missing = nan.sum(axis=0)
+    if not missing.any():
+        return data, one_d, missing
+    bad = nan.any(axis=1)
+    n, dropped = len(bad), int(np.count_nonzero(bad))
+    infinite = np.argwhere(np.isinf(data))
+    if infinite.size:
+        k, c = infinite[0]
+        raise ValueError(
+            f"x must be finite or NaN (a missing sample); sample {k} is {data[k, c]}"
+            + (f" (channel {c})" if data.shape[1] > 1 else "")
+        )
+    if gaps == "skip":
+        raise ValueError(
+            f"x has {dropped} missing samples (NaN); {kind} cannot skip gaps: "
+            "pass gaps='longest' or gaps='splice'"
+        )
+    if dropped == n:
+        raise ValueError(f"x has no valid samples: all {n} are NaN")
+    if gaps == "longest":
+        edges = np.diff(np.concatenate(([0], (~bad).astype(np.int8), [0])))
+        starts, ends = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
+        i = int(np.argmax(ends - starts))
+        a, b = int(starts[i]), int(ends[i])
+        warnings.warn(
+            f"x has {dropped} missing samples (NaN): {kind} analyses the longest gap-free "
+            f"segment, samples {a} to {b - 1}, {b - a} of {n} samples ({100 * (b - a) / n:.3g} %)",
+            stacklevel=stacklevel,
+        )
+        return data[a:b], one_d, missing
+    warnings.warn(
+        f"x has {dropped} missing samples (NaN): {kind} splices over them, joining the "
+        f"{n - dropped} valid samples as if they were contiguous ({100 * dropped / n:.3g} % "
+        "of the record spliced out); this biases long taus",
+        stacklevel=stacklevel,
+    )
+    return data[~bad], one_d, missing
 
 
 def _as_samples(x) -> tuple[np.ndarray, bool]:

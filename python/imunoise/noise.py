@@ -849,9 +849,10 @@ def _readoffs(taus, dev, edf, shaped):
 
 
 def _record_length(result) -> int:
-    """Samples behind an Allan result, from its terms at the shortest tau."""
+    """Samples behind an Allan result, from its terms at the shortest tau. With
+    gaps, the gap-free length with as many terms (the most of any channel)."""
     try:
-        m0, n0 = int(np.asarray(result.m)[0]), int(np.asarray(result.n)[0])
+        m0, n0 = int(np.asarray(result.m)[0]), int(np.max(np.asarray(result.n)[0]))
         overlapping = bool(result.overlapping)
     except (AttributeError, IndexError, TypeError):
         raise TypeError(

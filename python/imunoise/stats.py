@@ -27,6 +27,14 @@ spacing as the bin unit (``level_spacing``); inner edges that would cut a
 cluster move to the middle of the nearest gap between occupied values, so every
 sensor level sits in one bin (bin widths may then differ slightly; the density
 accounts for it).
+
+Missing samples
+---------------
+NaN marks a missing sample (an :class:`imunoise.ImuLog` holds NaN where the
+log has a gap on its uniform time grid). Every statistic is computed over the
+valid samples of each channel, the drift against the valid samples' times, and
+histograms and fits use the valid samples only; ``missing`` in the result says
+how many were left out. ±∞ is an error.
 """
 
 from __future__ import annotations
@@ -72,13 +80,16 @@ class Description:
     sensors, units : tuple of str
         Sensor each channel belongs to and its unit.
     n : int
-        Samples per channel.
+        Samples per channel, missing ones included (the length of the record).
     fs : float or None
         Sample rate in Hz (None when unknown: then ``drift_per_hour`` is NaN).
     mean, std, var, min, max : ndarray
         ``std``/``var`` with ``ddof=1``.
     drift_per_hour : ndarray
         Least-squares slope of the channel against time, in unit per hour.
+    missing : ndarray of int
+        Missing samples (NaN) per channel; the statistics use the other
+        ``n - missing``.
     """
 
     names: tuple[str, ...]
@@ -92,13 +103,15 @@ class Description:
     min: np.ndarray
     max: np.ndarray
     drift_per_hour: np.ndarray
+    missing: np.ndarray
 
     def __post_init__(self) -> None:
-        for name in ("mean", "std", "var", "min", "max", "drift_per_hour"):
+        for name in ("mean", "std", "var", "min", "max", "drift_per_hour", "missing"):
             getattr(self, name).flags.writeable = False
 
     def rows(self) -> list[dict]:
-        """One dict per channel: name, unit, mean, std, var, min, max, drift_per_hour."""
+        """One dict per channel: name, unit, mean, std, var, min, max, drift_per_hour,
+        missing."""
         return [
             {
                 "name": self.names[i],
@@ -109,6 +122,7 @@ class Description:
                 "min": float(self.min[i]),
                 "max": float(self.max[i]),
                 "drift_per_hour": float(self.drift_per_hour[i]),
+                "missing": int(self.missing[i]),
             }
             for i in range(len(self.names))
         ]
@@ -164,7 +178,9 @@ def describe(log_or_array, fs: float | None = None) -> Description:
     ``std`` and ``var`` use ``ddof=1``. The drift is the ordinary least-squares
     slope of :math:`x_i` against :math:`t_i = i/f_s`,
     :math:`\hat b = \sum (t_i-\bar t)(x_i-\bar x) / \sum (t_i-\bar t)^2`,
-    times 3600 (unit per hour).
+    times 3600 (unit per hour). NaN samples are missing: each channel's
+    statistics use its valid samples (and their times), ``missing`` counts the
+    others; a channel with fewer than two valid samples gets NaN.
     """
     from imunoise.readers.log import CHANNELS, ImuLog
 
@@ -203,16 +219,22 @@ def describe(log_or_array, fs: float | None = None) -> Description:
     n = x.shape[0]
     if n < 2:
         raise ValueError(f"log_or_array needs at least 2 samples; got {n}")
-    if not np.all(np.isfinite(x)):
-        raise ValueError("log_or_array must be finite; it contains NaN or inf")
-    mean = x.mean(axis=0)
-    var = x.var(axis=0, ddof=1)
-    if fs is None:
-        drift = np.full(x.shape[1], np.nan)
+    nan = np.isnan(x)
+    missing = nan.sum(axis=0)
+    if np.isinf(x).any():
+        raise ValueError("log_or_array must be finite or NaN (a missing sample); it contains inf")
+    t = None if fs is None else np.arange(n, dtype=np.float64) / fs
+    if missing.any():
+        columns = [
+            _describe_valid(x[~nan[:, j], j], None if t is None else t[~nan[:, j]])
+            for j in range(x.shape[1])
+        ]
+        mean, var, lo, hi, drift = np.array(columns, dtype=np.float64).T
     else:
-        t = np.arange(n, dtype=np.float64) / fs
-        tc = t - t.mean()
-        drift = (tc @ (x - mean)) / (tc @ tc) * 3600.0
+        mean = x.mean(axis=0)
+        var = x.var(axis=0, ddof=1)
+        lo, hi = x.min(axis=0), x.max(axis=0)
+        drift = np.full(x.shape[1], np.nan) if t is None else _drift(t, x, mean)
     return Description(
         names=tuple(names),
         sensors=tuple(sensors),
@@ -222,10 +244,28 @@ def describe(log_or_array, fs: float | None = None) -> Description:
         mean=mean,
         std=np.sqrt(var),
         var=var,
-        min=x.min(axis=0),
-        max=x.max(axis=0),
+        min=lo,
+        max=hi,
         drift_per_hour=np.asarray(drift, dtype=np.float64),
+        missing=missing.astype(np.int64),
     )
+
+
+def _drift(t: np.ndarray, x: np.ndarray, mean) -> np.ndarray:
+    """Least-squares slope of x (rows at times t) per hour."""
+    tc = t - t.mean()
+    return (tc @ (x - mean)) / (tc @ tc) * 3600.0
+
+
+def _describe_valid(v: np.ndarray, t: np.ndarray | None) -> tuple:
+    """(mean, var, min, max, drift/h) of one channel's valid samples ``v`` at
+    times ``t``; NaN where too few samples define them."""
+    if len(v) == 0:
+        return (np.nan,) * 5
+    mean = v.mean()
+    var = v.var(ddof=1) if len(v) > 1 else np.nan
+    drift = np.nan if t is None or len(v) < 2 else _drift(t, v, mean)
+    return mean, var, v.min(), v.max(), drift
 
 
 def _as_samples(x, name: str) -> np.ndarray:
@@ -288,7 +328,7 @@ class Distribution:
     Attributes
     ----------
     n : int
-        Number of samples.
+        Number of valid samples (NaN left out).
     counts : ndarray of int, (B,)
     edges : ndarray, (B + 1,)
         Histogram bin edges.
@@ -310,6 +350,8 @@ class Distribution:
         Sample skewness and Fisher (excess) kurtosis, biased estimators.
     qq_theoretical, qq_sample : ndarray
         Q–Q data: standard normal quantiles and the matching sample quantiles.
+    missing : int
+        Missing samples (NaN) in ``x``, left out of everything above.
     """
 
     n: int
@@ -328,6 +370,7 @@ class Distribution:
     excess_kurtosis: float
     qq_theoretical: np.ndarray
     qq_sample: np.ndarray
+    missing: int = 0
 
     def __post_init__(self) -> None:
         for name in (
@@ -356,7 +399,7 @@ def distribution(x, bins="auto", *, qq_points: int = 1001) -> Distribution:
     Parameters
     ----------
     x : array_like, 1-D
-        Samples of one channel.
+        Samples of one channel; NaN marks a missing sample and is left out.
     bins : "auto", str, int or array_like
         ``"auto"`` (or any rule of :func:`numpy.histogram_bin_edges`) gives that
         rule's bin width, rounded up to a whole number of quantization steps
@@ -393,10 +436,15 @@ def distribution(x, bins="auto", *, qq_points: int = 1001) -> Distribution:
     arr = arr.astype(np.float64, copy=False)
     if arr.ndim != 1:
         raise ValueError(f"x must be 1-D; got shape {arr.shape}")
+    if np.isinf(arr).any():
+        raise ValueError("x must be finite or NaN (a missing sample); it contains inf")
+    nan = np.isnan(arr)
+    missing = int(np.count_nonzero(nan))
+    if missing:
+        arr = arr[~nan]
     if len(arr) < 3:
-        raise ValueError(f"x needs at least 3 samples; got {len(arr)}")
-    if not np.all(np.isfinite(arr)):
-        raise ValueError("x must be finite; it contains NaN or inf")
+        extra = f" ({missing} NaN left out)" if missing else ""
+        raise ValueError(f"x needs at least 3 valid samples; got {len(arr)}{extra}")
     if not (isinstance(qq_points, int | np.integer) and qq_points >= 2):
         raise ValueError(f"qq_points must be an integer >= 2; got {qq_points!r}")
 
@@ -460,6 +508,7 @@ def distribution(x, bins="auto", *, qq_points: int = 1001) -> Distribution:
         excess_kurtosis=kurt,
         qq_theoretical=_sstats.norm.ppf(p),
         qq_sample=xs[lo] + (h - lo) * (xs[hi] - xs[lo]),
+        missing=missing,
     )
 
 

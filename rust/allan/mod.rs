@@ -1,5 +1,14 @@
 //! The Allan family over cumulative sums: estimates, noise identification and
 //! equivalent degrees of freedom for many channels and taus at once.
+//!
+//! Missing samples (NaN) are gaps. The difference estimators (Allan, modified
+//! Allan, Hadamard; [`Statistic::skips_gaps`]) leave out every term whose window
+//! touches a missing sample and count only the terms used; the total family
+//! refuses gapped records. With gaps, the noise type is identified on the longest
+//! gap-free run and the EDF pools the runs: each run's estimate has Greenhall's
+//! EDF ν_s for its length and carries the share w_s of the terms, so, treating
+//! the runs as independent, 1/ν = Σ w_s²/ν_s (ν of the whole record when there is
+//! no gap). A record without NaN takes exactly the gap-free code path.
 
 pub mod blocked;
 pub mod edf;
@@ -15,9 +24,13 @@ pub mod theo1;
 pub mod total;
 pub mod variance;
 
+use std::collections::BTreeMap;
+use std::ops::Range;
+
 use rayon::prelude::*;
 
 use crate::error::{CoreError, CoreResult};
+pub use phase::{Gaps, Phase};
 pub use variance::{Estimate, Statistic};
 
 /// Results for `taus.len()` taus × `channels` channels, tau-major
@@ -25,8 +38,9 @@ pub use variance::{Estimate, Statistic};
 #[derive(Clone, Debug, PartialEq)]
 pub struct Analysis {
     pub channels: usize,
+    /// NaN where a channel's gaps leave no term at that tau.
     pub var: Vec<f64>,
-    /// Terms per tau (the same for every channel).
+    /// Terms used per tau and channel (the same for every channel without gaps).
     pub terms: Vec<usize>,
     /// Noise type α used for the EDF at each tau and channel.
     pub alpha: Vec<i32>,
@@ -34,11 +48,13 @@ pub struct Analysis {
     /// where it was, or white FM, α = 0, when no tau could be identified).
     pub alpha_identified: Vec<bool>,
     pub edf: Vec<f64>,
+    /// Missing samples per channel.
+    pub missing: Vec<usize>,
 }
 
 /// Cumulative phases of several channels, computed in parallel. Each item yields
 /// one channel's samples.
-pub fn column_phases<I>(columns: Vec<I>) -> CoreResult<Vec<Vec<f64>>>
+pub fn column_phases<I>(columns: Vec<I>) -> CoreResult<Vec<Phase>>
 where
     I: Iterator<Item = f64> + Send,
 {
@@ -50,7 +66,7 @@ where
 /// its row-major data: one pass over the rows scatters the samples into the
 /// channels' phase vectors (each column gathered separately would stream the whole
 /// array once per channel), then the channels are transformed in parallel.
-pub fn row_major_phases(data: &[f64], channels: usize) -> CoreResult<Vec<Vec<f64>>> {
+pub fn row_major_phases(data: &[f64], channels: usize) -> CoreResult<Vec<Phase>> {
     if channels == 0 || !data.len().is_multiple_of(channels) {
         return Err(CoreError::InvalidArgument(format!(
             "x has {} values, not a whole number of rows of {channels} channels",
@@ -76,7 +92,7 @@ pub fn row_major_phases(data: &[f64], channels: usize) -> CoreResult<Vec<Vec<f64
 
 /// Turns gathered samples (behind a leading slot) into cumulative phases, one
 /// channel per task; errors name the channel when there are several.
-fn transform_in_parallel(gathered: Vec<Vec<f64>>) -> CoreResult<Vec<Vec<f64>>> {
+fn transform_in_parallel(gathered: Vec<Vec<f64>>) -> CoreResult<Vec<Phase>> {
     let several = gathered.len() > 1;
     gathered
         .into_par_iter()
@@ -95,7 +111,7 @@ fn transform_in_parallel(gathered: Vec<Vec<f64>>) -> CoreResult<Vec<Vec<f64>>> {
 /// Estimates the statistic at every averaging factor in `ms` for every phase,
 /// identifies the noise type and computes the EDF. Work is spread over
 /// (channel, tau) pairs.
-pub fn analyse(phases: &[Vec<f64>], statistic: Statistic, ms: &[usize]) -> CoreResult<Analysis> {
+pub fn analyse(phases: &[Phase], statistic: Statistic, ms: &[usize]) -> CoreResult<Analysis> {
     let plan: Vec<(Statistic, usize)> = ms.iter().map(|&m| (statistic, m)).collect();
     analyse_plan(phases, &plan)
 }
@@ -104,21 +120,33 @@ pub fn analyse(phases: &[Vec<f64>], statistic: Statistic, ms: &[usize]) -> CoreR
 /// the plan of overlapping AVAR at its short taus and ThêoBR at its long ones.
 /// Noise types missing at some taus are filled from the nearest identified taus
 /// of the whole plan, so order the plan by τ.
-pub fn analyse_plan(phases: &[Vec<f64>], plan: &[(Statistic, usize)]) -> CoreResult<Analysis> {
+pub fn analyse_plan(phases: &[Phase], plan: &[(Statistic, usize)]) -> CoreResult<Analysis> {
     let channels = phases.len();
     if channels == 0 {
         return Err(CoreError::InvalidArgument(
             "x must have at least one channel".into(),
         ));
     }
-    let n_phase = phases[0].len();
-    if phases.iter().any(|p| p.len() != n_phase) {
+    let n_phase = phases[0].c.len();
+    if phases.iter().any(|p| p.c.len() != n_phase) {
         return Err(CoreError::InvalidArgument(
             "all channels must have the same length".into(),
         ));
     }
-    let terms: Vec<usize> = plan.iter().map(|&(s, m)| s.terms(n_phase, m)).collect();
-    if let Some(pos) = terms.iter().position(|&t| t == 0) {
+    if let Some((c, gaps)) = phases
+        .iter()
+        .enumerate()
+        .find_map(|(c, p)| p.gaps.as_ref().map(|g| (c, g)))
+    {
+        if let Some(&(s, _)) = plan.iter().find(|(s, _)| !s.skips_gaps()) {
+            return Err(CoreError::InvalidArgument(format!(
+                "x has {} missing samples (NaN) in channel {c}; {s:?} cannot skip gaps",
+                gaps.missing
+            )));
+        }
+    }
+    let full_terms: Vec<usize> = plan.iter().map(|&(s, m)| s.terms(n_phase, m)).collect();
+    if let Some(pos) = full_terms.iter().position(|&t| t == 0) {
         return Err(CoreError::InvalidArgument(format!(
             "tau of {} samples does not fit in {} samples for this statistic",
             plan[pos].1,
@@ -128,8 +156,29 @@ pub fn analyse_plan(phases: &[Vec<f64>], plan: &[(Statistic, usize)]) -> CoreRes
     let pairs: Vec<(usize, usize)> = (0..plan.len())
         .flat_map(|t| (0..channels).map(move |c| (t, c)))
         .collect();
+    // With gaps: how many runs have each length (in phase points) that holds a term.
+    let runs: Vec<Option<BTreeMap<usize, usize>>> = pairs
+        .iter()
+        .map(|&(t, c)| {
+            let (s, m) = plan[t];
+            let g = phases[c].gaps.as_ref()?;
+            Some(segment_lengths(s, &phases[c].c, &g.segments, m))
+        })
+        .collect();
+    let terms: Vec<usize> = pairs
+        .iter()
+        .zip(&runs)
+        .map(|(&(t, _), lengths)| {
+            let (s, m) = plan[t];
+            match lengths {
+                None => full_terms[t],
+                Some(lengths) => lengths.iter().map(|(&l, &n)| n * s.terms(l, m)).sum(),
+            }
+        })
+        .collect();
     // The overlapping Allan and Hadamard variances sweep all their taus of a
-    // channel at once (see `blocked`); every other statistic goes tau by tau.
+    // channel at once (see `blocked`, run over each gap-free run); every other
+    // statistic goes tau by tau.
     let mut swept: Vec<Option<f64>> = vec![None; pairs.len()];
     let mut blocked: Vec<Statistic> = Vec::new();
     for &(s, _) in plan {
@@ -147,18 +196,21 @@ pub fn analyse_plan(phases: &[Vec<f64>], plan: &[(Statistic, usize)]) -> CoreRes
         let ms: Vec<usize> = taus.iter().map(|&t| plan[t].1).collect();
         let sums: Vec<Vec<f64>> = phases
             .par_iter()
-            .map(|c| blocked::sums_of_squares(c, &ms, difference))
+            .map(|p| match &p.gaps {
+                None => blocked::sums_of_squares(&p.c, &ms, difference),
+                Some(g) => sums_over_segments(&p.c, &g.segments, &ms, difference),
+            })
             .collect();
         for (k, &t) in taus.iter().enumerate() {
             for (c, channel_sums) in sums.iter().enumerate() {
-                swept[t * channels + c] =
-                    Some(statistic.variance_from_sum(channel_sums[k], plan[t].1, terms[t]));
+                let i = t * channels + c;
+                swept[i] = Some(statistic.variance_from_sum(channel_sums[k], plan[t].1, terms[i]));
             }
         }
     }
     // ThêoBR's bias ratio belongs to a channel, not a tau: computed once each.
     let ratios: Option<Vec<f64>> = if plan.iter().any(|(s, _)| *s == Statistic::TheoBR) {
-        let refs: Vec<&[f64]> = phases.iter().map(|p| p.as_slice()).collect();
+        let refs: Vec<&[f64]> = phases.iter().map(|p| p.c.as_slice()).collect();
         theo::bias_ratios(&refs)
     } else {
         None
@@ -168,16 +220,23 @@ pub fn analyse_plan(phases: &[Vec<f64>], plan: &[(Statistic, usize)]) -> CoreRes
         .enumerate()
         .map(|(i, &(t, c))| {
             let (statistic, m) = plan[t];
-            let var = match (swept[i], statistic, &ratios) {
-                (Some(v), _, _) => v,
-                (None, Statistic::TheoBR, Some(r)) => {
-                    r[c] * Statistic::Theo1.estimate(&phases[c], m).var
+            let phase = &phases[c];
+            let var = match (swept[i], statistic, &ratios, &phase.gaps) {
+                (Some(v), _, _, _) => v,
+                (None, Statistic::TheoBR, Some(r), _) => {
+                    r[c] * Statistic::Theo1.estimate(&phase.c, m).var
                 }
-                (None, _, _) => statistic.estimate(&phases[c], m).var,
+                (None, _, _, None) => statistic.estimate(&phase.c, m).var,
+                (None, _, _, Some(g)) => statistic
+                    .estimate_in_segments(&phase.c, &g.segments, m)
+                    .map_or(f64::NAN, |e| e.var),
             };
             let id_m = statistic.noise_id_factor(m);
             let (dmax, _) = noise_model_of(statistic);
-            (var, noise_id::identify_alpha(&phases[c], id_m, dmax))
+            (
+                var,
+                noise_id::identify_alpha(identification_phase(phase), id_m, dmax),
+            )
         })
         .collect();
 
@@ -185,7 +244,7 @@ pub fn analyse_plan(phases: &[Vec<f64>], plan: &[(Statistic, usize)]) -> CoreRes
     let mut alpha = vec![0; pairs.len()];
     let mut alpha_identified = vec![false; pairs.len()];
     for (i, &(v, a)) in per_pair.iter().enumerate() {
-        if !v.is_finite() {
+        if !v.is_finite() && terms[i] > 0 {
             let (t, c) = pairs[i];
             return Err(CoreError::Numerical(format!(
                 "x is too large in magnitude: the variance at m = {} overflows double \
@@ -208,12 +267,17 @@ pub fn analyse_plan(phases: &[Vec<f64>], plan: &[(Statistic, usize)]) -> CoreRes
         .enumerate()
         .map(|(i, &(t, _))| {
             let (statistic, m) = plan[t];
-            match noise_model_of(statistic).1 {
-                EdfModel::Greenhall(est) => edf::greenhall_edf(alpha[i], est, m, n_phase),
-                EdfModel::Total => edf::totvar_edf(alpha[i], m, n_samples),
-                EdfModel::ModifiedTotal => edf::mtotvar_edf(alpha[i], m, n_samples),
-                EdfModel::Theo1 => edf::theo1_edf(alpha[i], m, n_phase),
-                EdfModel::TheoBR => theo::theobr_edf(alpha[i], m, n_phase),
+            match (noise_model_of(statistic).1, &runs[i]) {
+                (EdfModel::Greenhall(est), Some(lengths)) => {
+                    edf_over_segments(lengths, terms[i], statistic, m, |len| {
+                        edf::greenhall_edf(alpha[i], est, m, len)
+                    })
+                }
+                (EdfModel::Greenhall(est), None) => edf::greenhall_edf(alpha[i], est, m, n_phase),
+                (EdfModel::Total, _) => edf::totvar_edf(alpha[i], m, n_samples),
+                (EdfModel::ModifiedTotal, _) => edf::mtotvar_edf(alpha[i], m, n_samples),
+                (EdfModel::Theo1, _) => edf::theo1_edf(alpha[i], m, n_phase),
+                (EdfModel::TheoBR, _) => theo::theobr_edf(alpha[i], m, n_phase),
             }
         })
         .collect();
@@ -224,7 +288,82 @@ pub fn analyse_plan(phases: &[Vec<f64>], plan: &[(Statistic, usize)]) -> CoreRes
         alpha,
         alpha_identified,
         edf,
+        missing: phases
+            .iter()
+            .map(|p| p.gaps.as_ref().map_or(0, |g| g.missing))
+            .collect(),
     })
+}
+
+/// [`blocked::sums_of_squares`] over the gap-free runs of a record: the terms
+/// inside one run are exactly those of the blocked sweep over its phase points.
+fn sums_over_segments(
+    c: &[f64],
+    segments: &[Range<usize>],
+    ms: &[usize],
+    difference: blocked::Difference,
+) -> Vec<f64> {
+    let partials: Vec<Vec<f64>> = segments
+        .par_iter()
+        .map(|s| blocked::sums_of_squares(&c[s.start..=s.end], ms, difference))
+        .collect();
+    let mut totals = vec![sum::Neumaier::new(); ms.len()];
+    for partial in &partials {
+        for (total, value) in totals.iter_mut().zip(partial) {
+            total.add(*value);
+        }
+    }
+    totals.iter().map(sum::Neumaier::value).collect()
+}
+
+/// The phase the noise type is identified on: the whole record, or with gaps
+/// its longest gap-free run (the lag-1 method needs an unbroken series).
+fn identification_phase(phase: &Phase) -> &[f64] {
+    match phase.gaps.as_ref().and_then(Gaps::longest) {
+        None => &phase.c,
+        Some(s) => &phase.c[s.start..=s.end],
+    }
+}
+
+/// Phase points → how many runs have that many, over the runs where the
+/// estimator has terms (see [`Statistic::segment_phase`]).
+fn segment_lengths(
+    statistic: Statistic,
+    c: &[f64],
+    segments: &[Range<usize>],
+    m: usize,
+) -> BTreeMap<usize, usize> {
+    let mut lengths = BTreeMap::new();
+    for s in segments {
+        let len = statistic.segment_phase(c, s, m).len();
+        if statistic.terms(len, m) > 0 {
+            *lengths.entry(len).or_insert(0) += 1;
+        }
+    }
+    lengths
+}
+
+/// The EDF of an estimate pooled over runs with `lengths` phase points (see the
+/// module notes): 1/ν = Σ_s (T_s/T)²/ν_s. NaN without terms.
+fn edf_over_segments(
+    lengths: &BTreeMap<usize, usize>,
+    terms: usize,
+    statistic: Statistic,
+    m: usize,
+    edf_of: impl Fn(usize) -> f64,
+) -> f64 {
+    if terms == 0 {
+        return f64::NAN;
+    }
+    let total = terms as f64;
+    let inverse: f64 = lengths
+        .iter()
+        .map(|(&len, &count)| {
+            let share = statistic.terms(len, m) as f64 / total;
+            count as f64 * share * share / edf_of(len)
+        })
+        .sum();
+    1.0 / inverse
 }
 
 /// How the EDF of an estimator is obtained.
@@ -326,7 +465,7 @@ mod tests {
         )
         .unwrap();
         assert_eq!(a.var.len(), 8);
-        assert_eq!(a.terms, vec![199, 197, 169, 73]);
+        assert_eq!(a.terms, vec![199, 199, 197, 197, 169, 169, 73, 73]);
         // m = 16 leaves 13 decimated points: not identified, taken from the
         // identified taus (m = 1 and 2; with two votes the nearest decides).
         assert!(!a.alpha_identified[4]);
@@ -359,9 +498,9 @@ mod tests {
         assert_eq!(mixed.var[..4], avar.var[..]);
         assert_eq!(mixed.edf[..4], avar.edf[..]);
         assert_eq!(mixed.var[4..], theobr.var[..]);
-        assert_eq!(mixed.terms, vec![399, 385, 385 * 8]);
+        assert_eq!(mixed.terms, vec![399, 399, 385, 385, 385 * 8, 385 * 8]);
         // The slow single-tau path gives the same ThêoBR.
-        let alone = Statistic::TheoBR.estimate(&phases[1], 16).var;
+        let alone = Statistic::TheoBR.estimate(&phases[1].c, 16).var;
         assert!((alone - mixed.var[5]).abs() <= 1e-14 * alone);
     }
 
@@ -392,7 +531,7 @@ mod tests {
         assert_eq!(rows, columns);
         assert!(row_major_phases(&data, 7).is_err());
         let mut bad = data.clone();
-        bad[4] = f64::NAN; // row 1, channel 1
+        bad[4] = f64::INFINITY; // row 1, channel 1
         let err = row_major_phases(&bad, 3).unwrap_err().to_string();
         assert!(
             err.contains("sample 1") && err.contains("channel 1"),
@@ -406,5 +545,130 @@ mod tests {
         let b = [1.0, f64::INFINITY];
         let err = column_phases(vec![a.iter().copied(), b.iter().copied()]).unwrap_err();
         assert!(err.to_string().contains("channel 1"), "{err}");
+    }
+
+    /// The SP 1065 terms straight from the samples, skipping every term whose
+    /// window touches a NaN: (variance, terms).
+    fn skipping_reference(y: &[f64], statistic: Statistic, m: usize) -> (f64, usize) {
+        let block = |k: usize| y[k..k + m].iter().sum::<f64>();
+        let mm = (m * m) as f64;
+        let (window, stride, norm) = match statistic {
+            Statistic::Allan { overlapping } => (2 * m, if overlapping { 1 } else { m }, 2.0 * mm),
+            Statistic::Hadamard { overlapping } => {
+                (3 * m, if overlapping { 1 } else { m }, 6.0 * mm)
+            }
+            _ => (3 * m - 1, 1, 2.0 * mm * mm),
+        };
+        let (mut sum, mut terms) = (0.0, 0);
+        for k in (0..(y.len() + 1).saturating_sub(window)).step_by(stride) {
+            if y[k..k + window].iter().any(|v| v.is_nan()) {
+                continue;
+            }
+            let t = match statistic {
+                Statistic::Allan { .. } => block(k + m) - block(k),
+                Statistic::Hadamard { .. } => block(k + 2 * m) - 2.0 * block(k + m) + block(k),
+                _ => (0..m).map(|i| block(k + i + m) - block(k + i)).sum(),
+            };
+            sum += t * t;
+            terms += 1;
+        }
+        (sum / (norm * terms as f64), terms)
+    }
+
+    #[test]
+    fn gapped_estimates_skip_every_term_touching_a_missing_sample() {
+        let mut y = test_signals::noise(3000, 5);
+        for k in [0, 17, 18, 19, 500, 1001, 1002, 2999] {
+            y[k] = f64::NAN;
+        }
+        y[1500..1700].fill(f64::NAN);
+        let phases = column_phases(vec![y.iter().copied()]).unwrap();
+        assert_eq!(phases[0].gaps.as_ref().unwrap().missing, 208);
+        let ms = [1, 2, 3, 7, 64, 300];
+        for statistic in [
+            Statistic::Allan { overlapping: true },
+            Statistic::Allan { overlapping: false },
+            Statistic::Hadamard { overlapping: true },
+            Statistic::Hadamard { overlapping: false },
+            Statistic::Modified,
+        ] {
+            let a = analyse(&phases, statistic, &ms).unwrap();
+            for (t, &m) in ms.iter().enumerate() {
+                let (var, terms) = skipping_reference(&y, statistic, m);
+                assert_eq!(a.terms[t], terms, "{statistic:?} m={m}");
+                assert!(
+                    (a.var[t] / var - 1.0).abs() < 1e-11,
+                    "{statistic:?} m={m}: {} vs {var}",
+                    a.var[t]
+                );
+                assert!(a.edf[t] > 0.0 && a.edf[t] < terms as f64 * 2.0);
+            }
+            assert_eq!(a.missing, vec![208]);
+        }
+    }
+
+    #[test]
+    fn a_gap_at_the_end_is_the_shorter_record() {
+        let y = test_signals::noise(2000, 9);
+        let mut gapped = y.clone();
+        gapped[1900..].fill(f64::NAN);
+        let full = column_phases(vec![y[..1900].iter().copied()]).unwrap();
+        let cut = column_phases(vec![gapped.iter().copied()]).unwrap();
+        assert_eq!(full[0].c[..], cut[0].c[..1901]);
+        for statistic in [Statistic::Allan { overlapping: true }, Statistic::Modified] {
+            let a = analyse(&full, statistic, &[1, 4, 32]).unwrap();
+            let b = analyse(&cut, statistic, &[1, 4, 32]).unwrap();
+            assert_eq!(a.var, b.var);
+            assert_eq!(a.terms, b.terms);
+            assert_eq!(a.alpha, b.alpha);
+            for (x, y) in a.edf.iter().zip(&b.edf) {
+                assert!((x / y - 1.0).abs() < 1e-12, "{x} vs {y}");
+            }
+        }
+    }
+
+    #[test]
+    fn edf_pools_the_runs_by_their_share_of_terms() {
+        // Two equal runs: each has half the terms, so ν = 2·ν_run.
+        let mut y = test_signals::noise(2001, 3);
+        y[1000] = f64::NAN;
+        let phases = column_phases(vec![y.iter().copied()]).unwrap();
+        let a = analyse(&phases, Statistic::Allan { overlapping: true }, &[4]).unwrap();
+        let est = edf::Estimator {
+            d: 2,
+            overlapping: true,
+            modified: false,
+        };
+        let run = edf::greenhall_edf(a.alpha[0], est, 4, 1001);
+        assert!((a.edf[0] / (2.0 * run) - 1.0).abs() < 1e-12);
+        assert_eq!(a.terms, vec![2 * (1001 - 8)]);
+    }
+
+    #[test]
+    fn gaps_longer_than_the_runs_leave_no_term() {
+        let mut y = test_signals::noise(400, 1);
+        for k in (0..400).step_by(10) {
+            y[k] = f64::NAN;
+        }
+        let phases = column_phases(vec![y.iter().copied()]).unwrap();
+        let a = analyse(&phases, Statistic::Allan { overlapping: true }, &[1, 4, 5]).unwrap();
+        // 40 runs of 9 samples: 8 terms each at m = 1, 2 at m = 4, none at m = 5.
+        assert_eq!(a.terms, vec![40 * 8, 40 * 2, 0]);
+        assert!(a.var[2].is_nan() && a.edf[2].is_nan());
+        assert!(a.var[1].is_finite());
+    }
+
+    #[test]
+    fn the_total_family_refuses_gaps() {
+        let mut y = test_signals::noise(400, 1);
+        y[7] = f64::NAN;
+        let phases = column_phases(vec![y.iter().copied()]).unwrap();
+        for statistic in [Statistic::Total, Statistic::ModifiedTotal, Statistic::Theo1] {
+            let err = analyse(&phases, statistic, &[2]).unwrap_err().to_string();
+            assert!(
+                err.contains("1 missing samples") && err.contains("cannot skip"),
+                "{err}"
+            );
+        }
     }
 }

@@ -4,20 +4,62 @@
 //! sample period (phase x = τ0·c). The mean is removed first so that a large
 //! offset (9.81 m/s² on an accelerometer z axis) costs no digits, and both the
 //! mean and the running sum use compensated summation.
+//!
+//! Missing samples (NaN) contribute nothing: ȳ is the mean of the valid samples
+//! and the running sum holds still across a gap, so a difference of c over a
+//! stretch without gaps is exactly the sum of its mean-removed samples. The
+//! gap-free runs are kept as [`Gaps::segments`]; the statistics use only terms
+//! that lie inside one of them.
+
+use std::ops::Range;
 
 use rayon::prelude::*;
 
 use super::sum::Neumaier;
 use crate::error::{CoreError, CoreResult};
 
-/// Cumulative sum of mean-removed samples. `samples` may be strided (a column of
-/// a C-ordered 2-D array); it is gathered once into the output vector, which is
-/// then transformed in place (one allocation, three sequential passes).
+/// The cumulative phase of one channel and where its samples are missing.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Phase {
+    /// c_0 … c_n.
+    pub c: Vec<f64>,
+    /// `None` when no sample is missing.
+    pub gaps: Option<Gaps>,
+}
+
+/// The missing samples of a channel.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Gaps {
+    /// Number of missing samples.
+    pub missing: usize,
+    /// Maximal runs of valid samples, as sample index ranges [a, b), in order.
+    /// The phase points of a run are c[a..=b].
+    pub segments: Vec<Range<usize>>,
+}
+
+impl Gaps {
+    /// The longest run of valid samples (the first of equally long ones).
+    pub fn longest(&self) -> Option<&Range<usize>> {
+        self.segments.iter().rev().max_by_key(|s| s.len())
+    }
+}
+
+/// Cumulative sum of mean-removed samples of a record without missing samples
+/// (NaN is an error here). `samples` may be strided (a column of a C-ordered 2-D
+/// array); it is gathered once into the output vector, which is then transformed
+/// in place (one allocation, three sequential passes).
 pub fn cumulative_phase<I>(samples: I) -> CoreResult<Vec<f64>>
 where
     I: Iterator<Item = f64>,
 {
-    into_cumulative_phase(gather(samples))
+    let phase = into_cumulative_phase(gather(samples))?;
+    match phase.gaps {
+        None => Ok(phase.c),
+        Some(gaps) => Err(CoreError::InvalidArgument(format!(
+            "x must be finite; sample {} is NaN",
+            gaps.segments.first().map_or(0, |s| s.end)
+        ))),
+    }
 }
 
 /// The samples behind one leading slot, the layout [`into_cumulative_phase`] takes.
@@ -38,30 +80,39 @@ where
 const CHUNK: usize = 1 << 16;
 
 /// The same transformation for samples already gathered behind a leading slot:
-/// `phase[0]` is overwritten with 0 and `phase[1..]` holds y_0 … y_{n−1}.
+/// `phase[0]` is overwritten with 0 and `phase[1..]` holds y_0 … y_{n−1}, NaN
+/// where a sample is missing (±∞ is an error).
 ///
 /// Long records use all cores: chunk totals of the mean-removed samples are
 /// accumulated with two-sum in parallel, their prefix gives each chunk its
 /// starting (sum, error) pair, and the chunks then run the same compensated
 /// running sum in parallel.
-pub fn into_cumulative_phase(mut phase: Vec<f64>) -> CoreResult<Vec<f64>> {
+pub fn into_cumulative_phase(mut phase: Vec<f64>) -> CoreResult<Phase> {
     let n = phase.len().saturating_sub(1);
     if n == 0 {
         return Err(CoreError::InvalidArgument("x must not be empty".into()));
     }
-    if let Some(k) = phase[1..].iter().position(|v| !v.is_finite()) {
-        return Err(CoreError::InvalidArgument(format!(
-            "x must be finite; sample {k} is {}",
-            phase[k + 1]
-        )));
-    }
+    // The one scan a record without gaps pays for them.
+    let gaps = match phase[1..].iter().position(|v| !v.is_finite()) {
+        None => None,
+        Some(first) => Some(find_gaps(&mut phase[1..], first)?),
+    };
     phase[0] = 0.0;
     let chunk_sums: Vec<f64> = phase[1..].par_chunks(CHUNK).map(compensated_sum).collect();
     let mut total = Neumaier::new();
     for s in chunk_sums {
         total.add(s);
     }
-    let mean = total.value() / n as f64;
+    let valid = n - gaps.as_ref().map_or(0, |g| g.missing);
+    let mean = total.value() / valid as f64;
+    if let Some(g) = &gaps {
+        // A missing sample becomes the mean: it then adds exactly 0 below.
+        let mut at = 0;
+        for s in g.segments.iter().chain(std::iter::once(&(n..n))) {
+            phase[1 + at..1 + s.start].fill(mean);
+            at = s.end;
+        }
+    }
     // Each chunk's total as (sum, error), then the running pair at each chunk start.
     let totals: Vec<(f64, f64)> = phase[1..]
         .par_chunks(CHUNK)
@@ -88,7 +139,40 @@ pub fn into_cumulative_phase(mut phase: Vec<f64>) -> CoreResult<Vec<f64>> {
                 *value = acc.0 + acc.1;
             }
         });
-    Ok(phase)
+    Ok(Phase { c: phase, gaps })
+}
+
+/// The runs of valid samples of `y`, whose first non-finite value is at `first`;
+/// missing samples are set to 0 (for the sum of the valid ones). ±∞ is an error,
+/// and so is a record with no valid sample.
+fn find_gaps(y: &mut [f64], first: usize) -> CoreResult<Gaps> {
+    let mut segments = Vec::new();
+    let mut missing = 0;
+    let mut start = 0;
+    for (k, v) in y.iter_mut().enumerate().skip(first) {
+        if v.is_nan() {
+            if start < k {
+                segments.push(start..k);
+            }
+            start = k + 1;
+            missing += 1;
+            *v = 0.0;
+        } else if v.is_infinite() {
+            return Err(CoreError::InvalidArgument(format!(
+                "x must be finite or NaN (a missing sample); sample {k} is {v}"
+            )));
+        }
+    }
+    if start < y.len() {
+        segments.push(start..y.len());
+    }
+    if segments.is_empty() {
+        return Err(CoreError::InvalidArgument(format!(
+            "x has no valid samples: all {} are NaN",
+            y.len()
+        )));
+    }
+    Ok(Gaps { missing, segments })
 }
 
 /// Knuth's branch-free two-sum: a + b = t + err exactly.
@@ -163,6 +247,25 @@ mod tests {
         let err = cumulative_phase([1.0, f64::NAN].iter().copied()).unwrap_err();
         assert!(err.to_string().contains("sample 1"));
         assert!(cumulative_phase(std::iter::empty()).is_err());
+        let err = into_cumulative_phase(gather([f64::NAN, f64::INFINITY].into_iter()));
+        assert!(err.unwrap_err().to_string().contains("sample 1 is inf"));
+        let err = into_cumulative_phase(gather([f64::NAN; 3].into_iter()));
+        assert!(err.unwrap_err().to_string().contains("all 3 are NaN"));
+    }
+
+    #[test]
+    fn missing_samples_add_nothing_and_are_located() {
+        let nan = f64::NAN;
+        let y = [nan, 1.0, 2.0, nan, nan, 3.0, 6.0, nan];
+        let p = into_cumulative_phase(gather(y.iter().copied())).unwrap();
+        // Mean of the valid samples is 3.
+        assert_eq!(p.c, vec![0.0, 0.0, -2.0, -3.0, -3.0, -3.0, -3.0, 0.0, 0.0]);
+        let gaps = p.gaps.unwrap();
+        assert_eq!(gaps.missing, 4);
+        assert_eq!(gaps.segments, vec![1..3, 5..7]);
+        assert_eq!(gaps.longest(), Some(&(1..3)));
+        let clean = into_cumulative_phase(gather([1.0, 2.0].into_iter())).unwrap();
+        assert_eq!(clean.gaps, None);
     }
 
     #[test]

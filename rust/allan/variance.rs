@@ -3,6 +3,8 @@
 //! τ = m·τ0 together with the number of terms in its sum, counted as Stable32
 //! and allantools count them. References: NIST SP 1065 (Riley 2008), eqs. 6–25.
 
+use std::ops::Range;
+
 use super::blocked::Difference;
 use super::sum::{sum_of_squared_combinations, sum_of_squares, Neumaier};
 use super::theo;
@@ -125,14 +127,114 @@ impl Statistic {
 
     /// The variance from a sum of squared differences (see `blocked_difference`).
     pub fn variance_from_sum(self, sum: f64, m: usize, terms: usize) -> f64 {
-        let divisor = match self {
-            Statistic::Hadamard { .. } => 6.0,
-            _ => 2.0,
-        };
-        sum / (divisor * (m as f64).powi(2) * terms as f64)
+        sum / (self.normaliser(m) * terms as f64)
     }
 
-    /// The variance at averaging factor `m` over the cumulative phase `c`.
+    /// Whether terms can be left out where samples are missing: the difference
+    /// estimators can; the total family, whose terms reflect or detrend the
+    /// record around each point, cannot.
+    pub fn skips_gaps(self) -> bool {
+        matches!(
+            self,
+            Statistic::Allan { .. } | Statistic::Modified | Statistic::Hadamard { .. }
+        )
+    }
+
+    /// The divisor of a sum of squared terms per term: 2m² (Allan), 6m²
+    /// (Hadamard), 2m⁴ (modified; its terms are sums of m second differences).
+    fn normaliser(self, m: usize) -> f64 {
+        let mf = m as f64;
+        match self {
+            Statistic::Hadamard { .. } => 6.0 * mf * mf,
+            Statistic::Modified => 2.0 * mf.powi(4),
+            _ => 2.0 * mf * mf,
+        }
+    }
+
+    /// The sum of the `terms` squared terms of a difference estimator
+    /// ([`Statistic::skips_gaps`]); `terms` = `self.terms(c.len(), m)` > 0.
+    fn sum_of_terms(self, c: &[f64], m: usize, terms: usize) -> f64 {
+        match self {
+            Statistic::Allan { overlapping: true } => sum_of_squared_combinations(
+                [&c[2 * m..2 * m + terms], &c[m..m + terms], &c[..terms]],
+                [1.0, -2.0, 1.0],
+            ),
+            Statistic::Hadamard { overlapping: true } => sum_of_squared_combinations(
+                [
+                    &c[3 * m..3 * m + terms],
+                    &c[2 * m..2 * m + terms],
+                    &c[m..m + terms],
+                    &c[..terms],
+                ],
+                [1.0, -3.0, 3.0, -1.0],
+            ),
+            Statistic::Allan { overlapping } => {
+                let s = stride(overlapping, m);
+                sum_of_squares(terms, |j| {
+                    let k = j * s;
+                    c[k + 2 * m] - 2.0 * c[k + m] + c[k]
+                })
+            }
+            Statistic::Hadamard { overlapping } => {
+                let s = stride(overlapping, m);
+                sum_of_squares(terms, |j| {
+                    let k = j * s;
+                    c[k + 3 * m] - 3.0 * c[k + 2 * m] + 3.0 * c[k + m] - c[k]
+                })
+            }
+            _ => modified_sum(c, m, terms),
+        }
+    }
+
+    /// The phase points of one gap-free run of samples (`segment`, see
+    /// [`super::phase::Gaps`]) on which this estimator's terms are exactly the
+    /// record's terms that lie inside the run: c[a..=b], for the non-overlapping
+    /// estimators from the first multiple of m on (their terms start at 0, m, 2m, …).
+    pub fn segment_phase<'a>(self, c: &'a [f64], segment: &Range<usize>, m: usize) -> &'a [f64] {
+        let start = match self {
+            Statistic::Allan { overlapping: false }
+            | Statistic::Hadamard { overlapping: false } => {
+                segment.start.next_multiple_of(m.max(1))
+            }
+            _ => segment.start,
+        };
+        if start > segment.end {
+            &[]
+        } else {
+            &c[start..=segment.end]
+        }
+    }
+
+    /// The estimate over the terms that lie inside the gap-free `segments` of a
+    /// record with missing samples ([`Statistic::skips_gaps`] statistics only:
+    /// `None` for the others). No term: NaN.
+    pub fn estimate_in_segments(
+        self,
+        c: &[f64],
+        segments: &[Range<usize>],
+        m: usize,
+    ) -> Option<Estimate> {
+        if !self.skips_gaps() {
+            return None;
+        }
+        let mut sum = Neumaier::new();
+        let mut terms = 0;
+        for segment in segments {
+            let part = self.segment_phase(c, segment, m);
+            let t = self.terms(part.len(), m);
+            if t > 0 {
+                sum.add(self.sum_of_terms(part, m, t));
+                terms += t;
+            }
+        }
+        Some(Estimate {
+            var: sum.value() / (self.normaliser(m) * terms as f64),
+            terms,
+        })
+    }
+
+    /// The variance at averaging factor `m` over the cumulative phase `c` of a
+    /// record without missing samples.
     pub fn estimate(self, c: &[f64], m: usize) -> Estimate {
         let terms = self.terms(c.len(), m);
         if terms == 0 {
@@ -140,42 +242,9 @@ impl Statistic {
         }
         let mf = m as f64;
         let var = match self {
-            Statistic::Allan { overlapping: true } => {
-                let ss = sum_of_squared_combinations(
-                    [&c[2 * m..2 * m + terms], &c[m..m + terms], &c[..terms]],
-                    [1.0, -2.0, 1.0],
-                );
-                ss / (2.0 * mf * mf * terms as f64)
+            Statistic::Allan { .. } | Statistic::Hadamard { .. } | Statistic::Modified => {
+                self.sum_of_terms(c, m, terms) / (self.normaliser(m) * terms as f64)
             }
-            Statistic::Hadamard { overlapping: true } => {
-                let ss = sum_of_squared_combinations(
-                    [
-                        &c[3 * m..3 * m + terms],
-                        &c[2 * m..2 * m + terms],
-                        &c[m..m + terms],
-                        &c[..terms],
-                    ],
-                    [1.0, -3.0, 3.0, -1.0],
-                );
-                ss / (6.0 * mf * mf * terms as f64)
-            }
-            Statistic::Allan { overlapping } => {
-                let s = stride(overlapping, m);
-                let ss = sum_of_squares(terms, |j| {
-                    let k = j * s;
-                    c[k + 2 * m] - 2.0 * c[k + m] + c[k]
-                });
-                ss / (2.0 * mf * mf * terms as f64)
-            }
-            Statistic::Hadamard { overlapping } => {
-                let s = stride(overlapping, m);
-                let ss = sum_of_squares(terms, |j| {
-                    let k = j * s;
-                    c[k + 3 * m] - 3.0 * c[k + 2 * m] + 3.0 * c[k + m] - c[k]
-                });
-                ss / (6.0 * mf * mf * terms as f64)
-            }
-            Statistic::Modified => modified_sum(c, m, terms) / (2.0 * mf.powi(4) * terms as f64),
             Statistic::Total => total_sum(c, m) / (2.0 * mf * mf * terms as f64),
             Statistic::ModifiedTotal => total::mtot_var(c, m),
             Statistic::HadamardTotal if m == 1 => {

@@ -30,16 +30,18 @@ fn parse_statistic(name: &str) -> PyResult<Statistic> {
 
 type AnalysisArrays<'py> = (
     Bound<'py, PyArray2<f64>>,
-    Bound<'py, PyArray1<u64>>,
+    Bound<'py, PyArray2<u64>>,
     Bound<'py, PyArray2<i32>>,
     Bound<'py, PyArray2<bool>>,
     Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray1<u64>>,
 );
 
-/// analyse(x, statistic, ms) -> (var, terms, alpha, alpha_identified, edf)
+/// analyse(x, statistic, ms) -> (var, terms, alpha, alpha_identified, edf, missing)
 ///
-/// `x` is a float64 array (n, channels) in any memory order; `ms` the averaging
-/// factors. 2-D outputs have shape (len(ms), channels).
+/// `x` is a float64 array (n, channels) in any memory order, NaN where a sample
+/// is missing; `ms` the averaging factors. 2-D outputs have shape (len(ms),
+/// channels); `missing` counts the NaN of each channel.
 #[pyfunction]
 fn analyse<'py>(
     py: Python<'py>,
@@ -117,7 +119,11 @@ fn run_plan<'py>(
         .map_err(reshape_err)?
         .into_pyarray(py);
     let terms: Vec<u64> = result.terms.iter().map(|&t| t as u64).collect();
-    Ok((var, terms.into_pyarray(py), alpha, identified, edf))
+    let terms = numpy::ndarray::Array2::from_shape_vec(shape, terms)
+        .map_err(reshape_err)?
+        .into_pyarray(py);
+    let missing: Vec<u64> = result.missing.iter().map(|&t| t as u64).collect();
+    Ok((var, terms, alpha, identified, edf, missing.into_pyarray(py)))
 }
 
 /// theobr_work(n_phase, ms) -> (direct steps, fast units) of ThêoBR's bias ratio and
