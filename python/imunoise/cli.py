@@ -207,6 +207,7 @@ def _cmd_report(args) -> int:
 
 def _cmd_adev(args) -> int:
     import imunoise
+    from imunoise import report
 
     log = _read(args)
     y = getattr(log, args.sensor)
@@ -222,7 +223,7 @@ def _cmd_adev(args) -> int:
         head += [f"{a}[{unit}]", f"{a}_ci_low", f"{a}_ci_high"]
     rows = []
     for i, tau in enumerate(r.taus):
-        row = [f"{tau:.6g}", str(int(r.n[i]))]
+        row = [f"{tau:.6g}", report.terms_used(r, i)]
         for j in range(r.dev.shape[1]):
             row += [f"{r.dev[i, j]:.6e}", f"{r.ci_low[i, j]:.6e}", f"{r.ci_high[i, j]:.6e}"]
         rows.append(row)

@@ -269,6 +269,13 @@ _HTML = """<!DOCTYPE html>
 """
 
 
+def terms_used(result, i: int) -> str:
+    """Terms behind tau ``i``: one count, or ``lo–hi`` over channels whose gaps differ."""
+    n = np.reshape(result.n, (len(result.taus), -1))[i]
+    lo, hi = int(n.min()), int(n.max())
+    return str(lo) if lo == hi else f"{lo}–{hi}"
+
+
 def _num(v: float) -> str:
     return "—" if not math.isfinite(v) else f"{v:.6g}"
 
@@ -569,7 +576,7 @@ def _build(short, long, out: Path, spec, fs, bar: _Progress) -> Report:
                       "data/model ratio" if model is not None else ""))
         rows = []
         for i, tau in enumerate(r.taus):
-            row = [_num(tau), str(int(r.n[i]))]
+            row = [_num(tau), terms_used(r, i)]
             for j in range(r.dev.shape[1]):
                 row += [_num(r.dev[i, j]), f"{_num(r.ci_low[i, j])} – {_num(r.ci_high[i, j])}"]
             rows.append(row)
