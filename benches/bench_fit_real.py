@@ -28,6 +28,7 @@ from pathlib import Path
 
 import allan_variance
 import imunoise
+import imunoise.plot
 import numpy as np
 
 HERE = Path(__file__).resolve().parent
@@ -63,7 +64,7 @@ def recordings():
         out["mti-g gyro x"] = (z["gyro_x"], float(z["sample_rate_hz"]))
     vn = DATA / "vn100-ascii" / "live_capture.txt"
     if vn.exists():
-        log = imunoise.read(vn)
+        log = imunoise.read(vn, fs=40.0)  # $VNWRG,07,40 (SOURCES.md)
         for i, ax in enumerate("xyz"):
             out[f"vn100 gyro {ax}"] = (log.gyro[:, i], log.fs)
             out[f"vn100 acc {ax}"] = (log.accel[:, i], log.fs)

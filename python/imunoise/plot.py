@@ -296,9 +296,12 @@ def allan(
         if show_res:
             gs = fig.add_gridspec(2, k, height_ratios=(3, 1), hspace=0.08)
             axes = [fig.add_subplot(gs[0, j]) for j in range(k)]
-            for ax in axes[1:]:
-                ax.sharey(axes[0])
             res_axes = [fig.add_subplot(gs[1, j], sharex=axes[j]) for j in range(k)]
+            for ax, res in zip(axes[1:], res_axes[1:], strict=True):
+                ax.sharey(axes[0])
+                res.sharey(res_axes[0])
+                ax.tick_params(labelleft=False)
+                res.tick_params(labelleft=False)
         else:
             axes = list(fig.subplots(1, k, squeeze=False, sharey=True)[0])
             res_axes = []
@@ -354,6 +357,7 @@ def allan(
                 ymax = max(ymax, max(shown) * 1.5)
             ax.yaxis.set_minor_formatter(NullFormatter())
             lims.append((ymin, ymax))
+        spans: list[float] = []
         for j, ax in enumerate(res_axes):
             pred = np.reshape(model.predict(taus).dev, dev.shape)[:, j]
             ratio = dev[:, j] / pred
@@ -366,14 +370,16 @@ def allan(
             ax.set_xlabel("τ [s]")
             ax.grid(True, which="both", alpha=0.25)
             finite = ratio[np.isfinite(ratio)]
-            span = max(0.1, float(np.max(np.abs(finite - 1)))) if finite.size else 0.1
-            ax.set_ylim(1 - 1.15 * span, 1 + 1.15 * span)
+            spans.append(max(0.1, float(np.max(np.abs(finite - 1)))) if finite.size else 0.1)
             cover = np.atleast_1d(model.coverage)[j]
             ax.text(0.02, 0.06, f"follows {cover:.0%} of taus", transform=ax.transAxes,
                     fontsize=7)
             if j == 0:
                 ax.set_ylabel("data/model")
             axes[j].tick_params(labelbottom=False)
+        if spans:
+            span = min(max(spans), 0.9)  # shared by the residual panels
+            res_axes[0].set_ylim(1 - 1.15 * span, 1 + 1.15 * span)
         ymin = np.nanmin([a for a, _ in lims])
         ymax = np.nanmax([b for _, b in lims])
         if np.isfinite(ymin) and np.isfinite(ymax) and ymin > 0:
