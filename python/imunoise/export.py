@@ -266,19 +266,17 @@ def ekf_dict(gyro=None, accel=None, *, gyro_unit: str | None = None,
     if not (math.isfinite(min_samples) and min_samples >= 0):
         raise ValueError(f"min_samples must be finite and >= 0; got {min_samples!r}")
     out: dict = {}
-    if gyro is not None:
-        out["gyroscope"] = {
-            "units": {"white_noise_density": "rad/s/sqrt(Hz)", "random_walk":
-                      "rad/s^2/sqrt(Hz)", "bias_instability": "rad/s", "sigma": "rad/s",
-                      "correlation_time": "s", "driving_noise_density": "rad/s/sqrt(s)"},
-            "axes": _ekf_axes(gyro, "gyro", gyro_unit, min_samples),
-        }
-    if accel is not None:
-        out["accelerometer"] = {
-            "units": {"white_noise_density": "m/s^2/sqrt(Hz)", "random_walk":
-                      "m/s^3/sqrt(Hz)", "bias_instability": "m/s^2", "sigma": "m/s^2",
-                      "correlation_time": "s", "driving_noise_density": "m/s^2/sqrt(s)"},
-            "axes": _ekf_axes(accel, "accel", accel_unit, min_samples),
+    for key, model, sensor, unit, rate, walk in (
+            ("gyroscope", gyro, "gyro", gyro_unit, "rad/s", "rad/s^2"),
+            ("accelerometer", accel, "accel", accel_unit, "m/s^2", "m/s^3")):
+        if model is None:
+            continue
+        out[key] = {
+            "units": {"white_noise_density": f"{rate}/sqrt(Hz)",
+                      "random_walk": f"{walk}/sqrt(Hz)", "bias_instability": rate,
+                      "sigma": rate, "correlation_time": "s",
+                      "driving_noise_density": f"{rate}/sqrt(s)"},
+            "axes": _ekf_axes(model, sensor, unit, min_samples),
         }
     out["update_rate"] = float((gyro if gyro is not None else accel).fs)
     return out

@@ -184,18 +184,8 @@ pub fn parameters(theta: &[f64]) -> usize {
     used + times
 }
 
-/// Refit a structure with given correlation times (no search).
-pub fn refit(
-    data: &Data,
-    fs: f64,
-    ieee: [bool; IEEE_TERMS],
-    gm_tau: Vec<f64>,
-    d2: f64,
-) -> CoreResult<Candidate> {
-    candidate(data, fs, ieee, gm_tau, d2)
-}
-
-fn candidate(
+/// Fit a structure with given correlation times (no search).
+pub fn candidate(
     data: &Data,
     fs: f64,
     ieee: [bool; IEEE_TERMS],
