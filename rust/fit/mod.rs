@@ -103,11 +103,11 @@ pub fn fit_noise(
         let best = search::select(&data, fs, opts.ieee, opts.gm)?;
         prune_insignificant(&data, fs, best)?
     } else {
-        let base = search::fit_structure(&data, fs, opts.ieee, 0, 0.0)?;
+        let base = search::fit_structure(&data, fs, opts.ieee, 0, 0.0, &[])?;
         if opts.gm == 0 {
             base
         } else {
-            search::fit_structure(&data, fs, opts.ieee, opts.gm, base.solution.d2)?
+            search::fit_structure(&data, fs, opts.ieee, opts.gm, base.solution.d2, &[])?
         }
     };
     Ok(summarise(&data, fs, &chosen))
@@ -116,50 +116,61 @@ pub fn fit_noise(
 /// Smallest z = variance / standard uncertainty a selected term may have.
 const MIN_Z: f64 = 2.0;
 
-/// Remove, one at a time, the selected term whose variance is least
-/// distinguishable from 0 while any is below [`MIN_Z`]: BIC weighs the fit, this
-/// makes every reported term one that the data constrain.
+/// A term below [`MIN_Z`] goes only if its removal raises the loss by less than
+/// this many BIC penalties: on a real sensor the fitted discrepancy inflates
+/// every uncertainty, and a term can be needed (removing it raises the loss by
+/// tens) while its z is small.
+const PRUNE_PENALTIES: f64 = 2.0;
+
+/// Remove, one at a time, a selected term whose variance is less than
+/// [`MIN_Z`] standard uncertainties above 0 and whose removal the fit barely
+/// notices: BIC admits a term that explains a correlated wiggle of a few
+/// long-tau estimates (they are less independent than an octave each), this
+/// keeps only terms the data constrain. Gauss–Markov terms are tried before
+/// IEEE terms (where a fast one looks white or a slow one like a walk, the
+/// datasheet term is kept), each group by increasing z. The last term stays.
 fn prune_insignificant(data: &Data, fs: f64, mut best: Candidate) -> CoreResult<Candidate> {
-    // The last term always stays: a model of nothing describes nothing.
-    loop {
+    let allowance = PRUNE_PENALTIES * data.n_eff().max(2.0).ln();
+    'outer: loop {
         let fit = summarise(data, fs, &best);
-        // A Gauss–Markov term goes before any IEEE term: where the two explain
-        // the same part of the curve (a fast one looks white, a slow one like a
-        // walk), the datasheet term is the one to keep.
-        let z = |slot: usize, value: f64| value / fit.cov[slot][slot].sqrt();
-        let weakest_of = |slots: Vec<(usize, f64)>| {
-            slots
+        let active = fit.ieee.iter().filter(|v| **v > 0.0).count() + fit.gm.len();
+        if active <= 1 {
+            return Ok(best);
+        }
+        let weak = |slots: Vec<(usize, f64)>| {
+            let mut out: Vec<(usize, f64)> = slots
                 .into_iter()
-                .map(|(slot, v)| (slot, z(slot, v)))
+                .map(|(slot, v)| (slot, v / fit.cov[slot][slot].sqrt()))
                 .filter(|(_, z)| z.is_finite() && *z < MIN_Z)
-                .min_by(|a, b| a.1.total_cmp(&b.1))
+                .collect();
+            out.sort_by(|a, b| a.1.total_cmp(&b.1));
+            out
         };
-        let gm_slots = fit
-            .gm
-            .iter()
-            .enumerate()
-            .map(|(k, g)| (IEEE_TERMS + 2 * k, g.0))
+        let gm_slots = (0..fit.gm.len())
+            .map(|k| (IEEE_TERMS + 2 * k, fit.gm[k].0))
             .collect();
         let ieee_slots = (0..IEEE_TERMS)
             .filter(|&j| fit.ieee[j] > 0.0)
             .map(|j| (j, fit.ieee[j]))
             .collect();
-        let weakest = weakest_of(gm_slots).or_else(|| weakest_of(ieee_slots));
-        let active = fit.ieee.iter().filter(|v| **v > 0.0).count() + fit.gm.len();
-        let Some((slot, _)) = weakest.filter(|_| active > 1) else {
-            return Ok(best);
-        };
-        let mut ieee = best.ieee;
-        let mut times: Vec<f64> = fit.gm.iter().map(|g| g.1).collect();
-        if slot < IEEE_TERMS {
-            ieee[slot] = false;
-        } else {
-            times.remove((slot - IEEE_TERMS) / 2);
+        let mut order = weak(gm_slots);
+        order.extend(weak(ieee_slots));
+        for (slot, _) in order {
+            let mut ieee = best.ieee;
+            let mut times: Vec<f64> = fit.gm.iter().map(|g| g.1).collect();
+            if slot < IEEE_TERMS {
+                ieee[slot] = false;
+            } else {
+                times.remove((slot - IEEE_TERMS) / 2);
+            }
+            if let Ok(next) = search::candidate(data, fs, ieee, times, best.solution.d2) {
+                if next.solution.loss - best.solution.loss < allowance {
+                    best = next;
+                    continue 'outer;
+                }
+            }
         }
-        match search::candidate(data, fs, ieee, times, best.solution.d2) {
-            Ok(next) => best = next,
-            Err(_) => return Ok(best),
-        }
+        return Ok(best);
     }
 }
 
@@ -302,9 +313,11 @@ mod tests {
         taus.iter().map(|t| (n / (t * FS)).max(2.0)).collect()
     }
 
-    /// Default fit of a noise-free curve (EDF so large the log bias vanishes).
+    /// Default fit of a noise-free curve: EDF 10⁶ at every tau (the log bias
+    /// 1e-6 is negligible, and BIC does not chase rounding-level differences).
     fn fit_exact(taus: &[f64], var: &[f64]) -> NoiseFit {
-        fit_noise(taus, var, &edf_white(taus, 1e12), FS, &Options::default()).unwrap()
+        let edf = vec![1e6; taus.len()];
+        fit_noise(taus, var, &edf, FS, &Options::default()).unwrap()
     }
 
     #[test]

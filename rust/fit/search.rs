@@ -22,6 +22,9 @@ use crate::error::CoreResult;
 /// Grid of candidate correlation times per decade.
 const PER_DECADE: f64 = 6.0;
 
+/// Smallest ratio between the correlation times of two Gauss–Markov terms.
+const MIN_RATIO: f64 = 2.0;
+
 /// The basis of a structure: IEEE columns, then one column per GM time.
 pub fn design(data: &Data, fs: f64, gm_tau: &[f64]) -> Mat<f64> {
     let k = IEEE_TERMS + gm_tau.len();
@@ -64,7 +67,7 @@ impl Searcher<'_> {
     fn loss(&self, times: &[f64]) -> f64 {
         let basis = design(self.data, self.fs, times);
         let allowed = allowed_with_gm(&self.ieee, times.len());
-        match estimate::solve_theta(self.data, &basis, &allowed, self.d2, None, 12) {
+        match estimate::solve_theta(self.data, &basis, &allowed, self.d2, None, 8) {
             Ok((_, model)) => estimate::loss(self.data, &model, self.d2),
             Err(_) => f64::INFINITY,
         }
@@ -83,7 +86,7 @@ impl Searcher<'_> {
         let mut d = a + g * (b - a);
         let mut fc = at(c, times);
         let mut fd = at(d, times);
-        while b - a > 2e-3 {
+        while b - a > 1e-2 {
             if fc < fd {
                 b = d;
                 d = c;
@@ -102,8 +105,9 @@ impl Searcher<'_> {
         times[which] = if f <= best_start.1 { x } else { best_start.0 }.exp();
     }
 
-    /// Best `count` correlation times (ascending).
-    fn times(&self, count: usize) -> Vec<f64> {
+    /// Best `count` correlation times (ascending); for three, `seed` is the best
+    /// pair found before (searched again when empty).
+    fn times(&self, count: usize, seed: &[f64]) -> Vec<f64> {
         let grid = time_grid(self.data, self.fs);
         if count == 0 || grid.len() < count {
             return Vec::new();
@@ -120,8 +124,9 @@ impl Searcher<'_> {
         let mut times = match count {
             1 => best_of(grid.iter().map(|&t| vec![t]).collect()),
             2 => {
-                // Pairs on every other grid point.
-                let coarse: Vec<f64> = grid.iter().copied().step_by(2).collect();
+                // Pairs on every third grid point (two per decade); the
+                // refinement below then searches ± a half decade around each.
+                let coarse: Vec<f64> = grid.iter().copied().step_by(3).collect();
                 let mut pairs = Vec::new();
                 for i in 0..coarse.len() {
                     for j in (i + 1)..coarse.len() {
@@ -132,10 +137,14 @@ impl Searcher<'_> {
             }
             _ => {
                 // One more time, scanned over the grid around the best smaller set.
-                let base = self.times(count - 1);
+                let base = if seed.len() == count - 1 {
+                    seed.to_vec()
+                } else {
+                    self.times(count - 1, &[])
+                };
                 let free = grid
                     .iter()
-                    .filter(|&&t| base.iter().all(|&b| (t / b).log10().abs() > 0.3))
+                    .filter(|&&t| base.iter().all(|&b| (t / b).max(b / t) >= MIN_RATIO))
                     .map(|&t| {
                         let mut v = base.clone();
                         v.push(t);
@@ -146,16 +155,17 @@ impl Searcher<'_> {
                 best_of(free)
             }
         };
-        let span = if count == 1 { step } else { step * step };
+        let span = if count == 2 { step * step * step } else { step };
         for _round in 0..2 {
             for which in 0..times.len() {
                 let mut lo = times[which] / span;
                 let mut hi = times[which] * span;
+                // Two terms closer than a factor of 2 in τc are one term.
                 if which > 0 {
-                    lo = lo.max(times[which - 1] * 1.01);
+                    lo = lo.max(times[which - 1] * MIN_RATIO);
                 }
                 if which + 1 < times.len() {
-                    hi = hi.min(times[which + 1] / 1.01);
+                    hi = hi.min(times[which + 1] / MIN_RATIO);
                 }
                 if lo < hi {
                     self.refine(&mut times, which, lo, hi);
@@ -204,26 +214,29 @@ pub fn candidate(
     })
 }
 
-/// Fit `gm` Gauss–Markov terms with the IEEE terms `ieee` (times searched).
+/// Fit `gm` Gauss–Markov terms with the IEEE terms `ieee` (times searched;
+/// `seed`: the best times of `gm − 1` terms, to extend).
 pub fn fit_structure(
     data: &Data,
     fs: f64,
     ieee: [bool; IEEE_TERMS],
     gm: usize,
     d2: f64,
+    seed: &[f64],
 ) -> CoreResult<Candidate> {
     let searcher = Searcher { data, fs, ieee, d2 };
-    let times = searcher.times(gm);
+    let times = searcher.times(gm, seed);
     let first = candidate(data, fs, ieee, times, d2)?;
-    if gm == 0 {
+    let settled = first.solution.d2;
+    if gm == 0 || (settled <= 2.0 * d2 && settled >= 0.5 * d2) {
         return Ok(first);
     }
     // Search again at the discrepancy this structure settles on.
     let again = Searcher {
-        d2: first.solution.d2,
+        d2: settled,
         ..searcher
     };
-    let times = again.times(gm);
+    let times = again.times(gm, seed);
     let second = candidate(data, fs, ieee, times, first.solution.d2)?;
     Ok(if second.solution.loss < first.solution.loss {
         second
@@ -263,10 +276,12 @@ pub fn select(
     ieee: [bool; IEEE_TERMS],
     max_gm: usize,
 ) -> CoreResult<Candidate> {
-    let base = fit_structure(data, fs, ieee, 0, 0.0)?;
+    let base = fit_structure(data, fs, ieee, 0, 0.0, &[])?;
     let mut best = eliminate(data, fs, base.clone())?;
+    let mut seed: Vec<f64> = Vec::new();
     for gm in 1..=max_gm {
-        let full = fit_structure(data, fs, ieee, gm, base.solution.d2)?;
+        let full = fit_structure(data, fs, ieee, gm, base.solution.d2, &seed)?;
+        seed = full.gm_tau.clone();
         let reduced = eliminate(data, fs, full)?;
         if reduced.bic < best.bic {
             best = reduced;
