@@ -253,6 +253,8 @@ def _cmd_fit(args) -> int:
         head, rows = report._datasheet_rows(model, s)
         print(f"# {s}")
         _print_table(head, rows)
+        for sentence in report._model_sentences(model, s):
+            print(sentence.replace("**", ""))
     return 0
 
 

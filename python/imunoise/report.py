@@ -72,8 +72,12 @@ def _allan(x: np.ndarray, fs: float):
 
 
 def _fit(result):
-    """Fit the noise model to an Allan result."""
-    return imunoise.fit(result)
+    """Fit the noise model to an Allan result (a poor fit is said in the report's
+    words, per axis, rather than warned about)."""
+    with warnings.catch_warnings():
+        warnings.filterwarnings("ignore", message="the noise model follows",
+                                category=RuntimeWarning)
+        return imunoise.fit(result)
 
 
 def _model_sentences(model, sensor: str) -> list[str]:

@@ -130,7 +130,12 @@ const PRUNE_PENALTIES: f64 = 2.0;
 /// IEEE terms (where a fast one looks white or a slow one like a walk, the
 /// datasheet term is kept), each group by increasing z. The last term stays.
 fn prune_insignificant(data: &Data, fs: f64, mut best: Candidate) -> CoreResult<Candidate> {
+    // The allowance is cumulative against the selected fit: each removal raises
+    // δ and so makes the next one look cheaper; without this, terms fall in a
+    // cascade.
     let allowance = PRUNE_PENALTIES * data.n_eff().max(2.0).ln();
+    let selected = best.solution.loss;
+    let mut removed = 0.0;
     'outer: loop {
         let fit = summarise(data, fs, &best);
         let active = fit.ieee.iter().filter(|v| **v > 0.0).count() + fit.gm.len();
@@ -164,8 +169,9 @@ fn prune_insignificant(data: &Data, fs: f64, mut best: Candidate) -> CoreResult<
                 times.remove((slot - IEEE_TERMS) / 2);
             }
             if let Ok(next) = search::candidate(data, fs, ieee, times, best.solution.d2) {
-                if next.solution.loss - best.solution.loss < allowance {
+                if next.solution.loss - selected < allowance * (removed + 1.0) {
                     best = next;
+                    removed += 1.0;
                     continue 'outer;
                 }
             }
