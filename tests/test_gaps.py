@@ -8,7 +8,7 @@ from pathlib import Path
 import imunoise
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 from imunoise.readers.grid import Gaps, TimeGrid
 from imunoise.readers.log import ImuLog
@@ -67,6 +67,9 @@ def test_grid_finds_exactly_the_dropped_samples(
     for start in rng.integers(1, n - 1, n_runs):
         drop[start : min(start + int(rng.integers(1, 20)), n - 1)] = True
     keep = np.flatnonzero(~drop)
+    # The documented scope: the record keeps most of its samples (a handful of
+    # jittered stamps cannot fix the step to a fifth of itself).
+    assume(keep.size >= max(40, n // 2))
     grid = TimeGrid.from_timestamps(t[keep])
     assert grid.n == n
     assert grid.duplicate_time == 0 and grid.time_reversed == 0
