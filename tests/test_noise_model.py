@@ -88,8 +88,12 @@ def test_coefficients_do_not_depend_on_the_tau_grid(seed):
         if np.all(vals == 0):
             continue
         assert vals.max() - vals.min() <= 2 * stds.max(), (term, vals, stds)
+    # The datasheet B of the model: a borderline ramp term in or out moves it by
+    # up to ~2.6 of its uncertainties (seed 4), never more than 3.
     beq = np.array([float(m.equivalent("B")[0]) for m in fits.values()])
-    assert np.all(beq == 0) or beq.max() / beq.min() - 1 < 0.05, beq
+    beq_std = np.array([float(m.equivalent_std("B")[0]) for m in fits.values()])
+    assert np.all(beq > 0), beq
+    assert beq.max() - beq.min() <= 3 * beq_std.max(), (beq, beq_std)
 
 
 def test_real_vn100_log_is_followed_on_every_grid():
