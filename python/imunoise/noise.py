@@ -107,17 +107,20 @@ _CLOSE = 0.05
 """A model within this relative distance of the measured deviation follows it."""
 
 
-def _basis(taus: np.ndarray) -> np.ndarray:
-    """IEEE model variance per unit squared coefficient, shape (len(taus), 5)."""
-    t = np.asarray(taus, dtype=float)
-    return np.stack(
-        [3.0 / t**2, 1.0 / t, np.full_like(t, FLICKER**2), t / 3.0, t**2 / 2.0], axis=-1
-    )
+def _terms(taus, fs: float, coef, markov=()) -> np.ndarray:
+    """Allan variance of each model term at ``taus``: (len(taus), 5 + len(markov)),
+    from the one implementation of the model (Rust); ``coef`` holds Q…R,
+    ``markov`` (sigma, tau_c) pairs."""
+    from imunoise import _core
+
+    t = np.ascontiguousarray(np.atleast_1d(np.asarray(taus, dtype=float)))
+    return _core.noise_terms(t, float(fs), [float(c) ** 2 for c in coef],
+                             [(s * s, tc) for s, tc in markov])
 
 
 def model_variance(taus, Q=0.0, N=0.0, B=0.0, K=0.0, R=0.0) -> np.ndarray:
     """Allan variance of the five-term IEEE model at ``taus`` (scalar coefficients)."""
-    return _basis(taus) @ np.array([Q * Q, N * N, B * B, K * K, R * R], dtype=float)
+    return _terms(taus, 1.0, (Q, N, B, K, R)).sum(axis=1)
 
 
 @dataclass(frozen=True)
@@ -254,18 +257,13 @@ class NoiseModel:
         Returns the total curve σ(τ) and each term's own curve, e.g.
         ``terms["N"] = N/√τ``, ``terms["GM1"]`` for the first Gauss–Markov term.
         """
-        from imunoise import _core
-
         t = self.taus if taus is None else np.asarray(taus, dtype=float)
         if t.ndim != 1 or t.size == 0 or not np.all(np.isfinite(t)) or np.any(t <= 0):
             raise ValueError(f"taus must be a non-empty 1-D array of finite values > 0; got {t!r}")
-        t = np.ascontiguousarray(t)
         names = [*TERMS, *(f"GM{k + 1}" for k in range(GM_MAX))]
         parts = np.zeros((t.size, len(names), self.channels))
         for c in range(self.channels):
-            ieee = [float(self.value(k)[c]) ** 2 for k in TERMS]
-            gm = [(s * s, tc) for s, tc in self.gauss_markov(c)]
-            var = _core.noise_terms(t, self.fs, ieee, gm)
+            var = _terms(t, self.fs, [self.value(k)[c] for k in TERMS], self.gauss_markov(c))
             parts[:, : var.shape[1], c] = var
         total = np.sqrt(parts.sum(axis=1))
         used = names[: len(TERMS) + max(len(self.gauss_markov(c)) for c in
@@ -725,7 +723,9 @@ def fit(result, method: str = "wls", terms: str | Sequence[str] = "auto", tau_ra
             fits = list(pool.map(fit_channel, range(channels)))
         for c, out in enumerate(fits):
             coef[c], std[c], sup[c], gm[c], gm_std[c], stats[c], cov[c] = out
-            rng[c] = _support_range(taus[usable[c]], coef[c], sup[c])
+            markov = [(a, b) for a, b in gm[c] if np.isfinite(a)]
+            rng[c] = _support_range(_terms(taus[usable[c]], result.fs, coef[c], markov),
+                                    taus[usable[c]], sup[c])
     else:
         for c in range(channels):
             ok = usable[c]
@@ -916,9 +916,11 @@ def _fit_wls(t, v, e, fs, mask, gm_count, select):
             (delta, chi2, n_eff), cov)
 
 
-def _support_range(t, coef, sup, min_share=0.25):
-    basis = _basis(t) * coef**2
-    total = basis.sum(axis=1)
+def _support_range(parts, t, sup, min_share=0.25):
+    """Per IEEE term, the fitted taus where it is at least ``min_share`` of the
+    whole model (Gauss–Markov terms included)."""
+    total = parts.sum(axis=1)
+    basis = parts[:, :5]
     out = np.full((5, 2), np.nan)
     with np.errstate(divide="ignore", invalid="ignore"):
         share = basis / total[:, None]

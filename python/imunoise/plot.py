@@ -11,12 +11,13 @@ its maximum, so 10⁷ points draw in milliseconds and no spike disappears.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping, Sequence
 from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
+
+from imunoise.noise import FLICKER
 
 __all__ = [
     "AXIS_COLORS",
@@ -39,9 +40,6 @@ TERM_STYLES = {
     "K": ("rate random walk K", (0, (5, 1, 1, 1))),
     "R": ("rate ramp R", (0, (1, 2))),
 }
-#: 2 ln2 / π, the bias-instability flat-floor factor of σ² (IEEE Std 952).
-_B_FACTOR = 2.0 * math.log(2.0) / math.pi
-
 _RC = {
     "figure.dpi": 100,
     "savefig.dpi": 110,
@@ -223,17 +221,12 @@ def histograms(
 
 
 def _curves(coeffs: Mapping[str, float], taus: np.ndarray) -> dict[str, np.ndarray]:
-    """Deviation of each noise term and the total at ``taus`` (IEEE Std 952 model)."""
-    t = np.asarray(taus, dtype=np.float64)
-    var = {
-        "Q": 3.0 * coeffs.get("Q", 0.0) ** 2 / t**2,
-        "N": coeffs.get("N", 0.0) ** 2 / t,
-        "B": _B_FACTOR * coeffs.get("B", 0.0) ** 2 * np.ones_like(t),
-        "K": coeffs.get("K", 0.0) ** 2 * t / 3.0,
-        "R": coeffs.get("R", 0.0) ** 2 * t**2 / 2.0,
-    }
-    out = {name: np.sqrt(v) for name, v in var.items()}
-    out["total"] = np.sqrt(sum(var.values()))
+    """Deviation of each IEEE noise term and the total at ``taus``."""
+    from imunoise.noise import TERMS, _terms
+
+    var = _terms(taus, 1.0, [coeffs.get(k, 0.0) for k in TERMS])  # fs: no GM terms here
+    out = {name: np.sqrt(var[:, i]) for i, name in enumerate(TERMS)}
+    out["total"] = np.sqrt(var.sum(axis=1))
     return out
 
 
@@ -339,7 +332,7 @@ def allan(
                             linestyle="none", label="K at τ=3 s")
                 if marks.get("B", 0.0) > 0:
                     imin = int(np.argmin(curves["total"]))
-                    ax.plot([grid[imin]], [marks["B"] * math.sqrt(_B_FACTOR)], marker="D",
+                    ax.plot([grid[imin]], [marks["B"] * FLICKER], marker="D",
                             color="darkgreen", ms=5, linestyle="none",
                             label="B·0.664 floor")
             ax.set_xscale("log")
