@@ -45,6 +45,7 @@ from pathlib import Path
 import numpy as np
 
 from imunoise import units as _units
+from imunoise.noise import gm_white_density
 
 __all__ = [
     "ekf_dict",
@@ -228,8 +229,7 @@ def _ekf_axes(model, sensor: str, input_unit, min_samples: float) -> dict:
         for sigma, tau_c in model.gauss_markov(c):
             if tau_c * model.fs < min_samples:
                 # Too fast to be a filter state at the IMU rate: white noise.
-                phi = math.exp(-1.0 / (model.fs * tau_c))
-                white2 += sigma**2 * (1 + phi) / ((1 - phi) * model.fs)
+                white2 += gm_white_density(sigma, tau_c, model.fs)
                 continue
             states.append({
                 "sigma": sigma * scale,

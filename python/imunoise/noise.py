@@ -99,6 +99,14 @@ _PARAMS = 5 + 2 * GM_MAX
 """Parameter slots of the covariance: five IEEE variances, (σ², ln τc) per GM term."""
 
 
+def gm_white_density(sigma: float, tau_c: float, fs: float) -> float:
+    """N² (rate²·s) that a sampled Gauss–Markov term of standard deviation ``sigma``
+    and correlation time ``tau_c`` contributes at τ ≫ τc: σ²(1+φ)/((1−φ)·fs),
+    φ = exp(−1/(fs·τc)), the −½ asymptote of its Allan variance."""
+    phi = math.exp(-1.0 / (fs * tau_c))
+    return sigma**2 * (1 + phi) / ((1 - phi) * fs)
+
+
 def _is_log_time(slot: int) -> bool:
     return slot >= 5 and (slot - 5) % 2 == 1
 
@@ -288,14 +296,15 @@ class NoiseModel:
         at the longest tau with a slope below −¼: no flat part). Other terms,
         and ``method="slopes"``: the coefficient. Shape (channels,).
         """
-        return self._equivalents(term)[0]
+        return self._equivalents(term, with_std=False)[0]
 
     def equivalent_std(self, term: str) -> np.ndarray:
         """Standard uncertainty of :meth:`equivalent`, propagated from the fit's
         covariance (linearised: a numerical gradient), shape (channels,)."""
         return self._equivalents(term)[1]
 
-    def _equivalents(self, term: str) -> tuple[np.ndarray, np.ndarray]:
+    def _equivalents(self, term: str, with_std: bool = True) -> tuple[np.ndarray, np.ndarray]:
+        """Values and (``with_std``: the gradients are the costly part) their stds."""
         _check_term(term)
         if self.method != "wls" or term not in ("N", "B", "K"):
             return self.value(term).astype(float), self.std(term).astype(float)
@@ -306,7 +315,7 @@ class NoiseModel:
             p = self._parameters(c)
             f0 = self._equivalent_of(term, p)
             values[c] = f0
-            if not f0 > 0:
+            if not (with_std and f0 > 0):
                 continue
             active = np.flatnonzero(np.diag(cov[c]) > 0)
             grad = np.zeros(_PARAMS)
@@ -345,8 +354,7 @@ class NoiseModel:
         total = p[1] if term == "N" else p[3]
         for q2, tau_c in gm:
             if term == "N" and tau_c <= 1.0:
-                phi = math.exp(-1.0 / (self.fs * tau_c))
-                total += q2 * (1 + phi) / ((1 - phi) * self.fs)
+                total += q2 * gm_white_density(1.0, tau_c, self.fs)
             elif term == "K" and tau_c > 1.0:
                 total += 2.0 * q2 / tau_c
         return math.sqrt(max(total, 0.0))
