@@ -23,7 +23,8 @@ import warnings
 import allantools
 import imunoise
 import numpy as np
-from imunoise import _core, allan
+from imunoise import allan
+from imunoise._core import allan as _core_allan
 
 
 def quiet(fn, *args, **kwargs):
@@ -67,7 +68,7 @@ def main() -> None:
             warnings.simplefilter("ignore")  # the cost warning, expected at 10^5
             t_br, br = timed(imunoise.theobr, y, 1.0)
             t_h = float("nan") if args.no_theoh else timed(imunoise.theoh, y, 1.0)[0]
-        direct, fast = _core.theobr_work(size + 1, [int(m) for m in br.m])
+        direct, fast = _core_allan.theobr_work(size + 1, [int(m) for m in br.m])
         predicted = (
             direct / allan._THEO1_DIRECT_PER_SECOND + fast / allan._THEO1_FAST_PER_SECOND
         )

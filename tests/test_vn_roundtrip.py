@@ -3,11 +3,11 @@
 import imunoise
 import numpy as np
 import pytest
-from imunoise import _core
+from imunoise._core import vn as _core_vn
 from imunoise.readers.vn import read_vn_tables
 from imunoise.readers.vn_write import binary_columns
 
-FIELDS = _core.vn_message_fields()
+FIELDS = _core_vn.vn_message_fields()
 NANOS = ("time_startup", "time_gps", "time_syncin", "time_pps", "gps_tow")
 
 
@@ -72,7 +72,7 @@ def test_log_roundtrip_ascii_and_binary():
 
 
 def test_binary_every_field():
-    groups = _core.vn_binary_fields()
+    groups = _core_vn.vn_binary_fields()
     rng = np.random.default_rng(1)
     for group, (_, fields) in groups.items():
         selection = {group: sorted(fields)}

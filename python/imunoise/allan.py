@@ -64,7 +64,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import stats as _stats
 
-from imunoise import _core
+from imunoise._core import allan as _core_allan
 from imunoise.taus import averaging_factors, keep_estimable
 
 #: One-sigma confidence, erf(1/√2).
@@ -496,7 +496,7 @@ def theobr(x, fs, taus="octave", *, confidence: float = ONE_SIGMA, gaps: str = "
     if m.size == 0:
         raise ValueError(f"none of the taus is in range for theobr; got {taus!r}")
     _warn_theobr_cost("theobr", n, m, data.shape[1])
-    var, terms, alpha, identified, edf, _ = _core.analyse(data, "theobr", m.astype(np.uint64))
+    var, terms, alpha, identified, edf, _ = _core_allan.analyse(data, "theobr", m.astype(np.uint64))
     return _assemble(
         "theobr", True, 0.75 * m / fs, m, var, terms, alpha, identified, edf, fs,
         confidence, one_d, missing, gaps,
@@ -576,7 +576,7 @@ def theoh(x, fs, taus="octave", *, confidence: float = ONE_SIGMA, gaps: str = "s
     _warn_theobr_cost("theoh", n, m_theo, data.shape[1])
     m = np.concatenate([m_avar, m_theo]).astype(np.int64)
     statistics = ["oadev"] * m_avar.size + ["theobr"] * m_theo.size
-    var, terms, alpha, identified, edf, _ = _core.analyse_plan(
+    var, terms, alpha, identified, edf, _ = _core_allan.analyse_plan(
         data, statistics, m.astype(np.uint64)
     )
     tau = np.concatenate([m_avar / fs, 0.75 * m_theo / fs])
@@ -615,14 +615,14 @@ def _deviation(
     if kind == "theo1" and not user_given:
         m = m[m % 2 == 0]  # Theo1 is defined for even m only
     m = m.astype(np.uint64)
-    terms = _core.estimator_terms(statistic, n + 1, m)
+    terms = _core_allan.estimator_terms(statistic, n + 1, m)
     m = keep_estimable(m.astype(np.int64), terms.astype(np.int64), fs, user_given, kind)
     if m.size == 0:
         raise ValueError(
             f"x has {n} samples, too few for any tau of {kind} "
             f"(the shortest tau needs at least {_minimum_samples(statistic)})"
         )
-    var, terms, alpha, identified, edf, core_missing = _core.analyse(
+    var, terms, alpha, identified, edf, core_missing = _core_allan.analyse(
         data, statistic, m.astype(np.uint64)
     )
     if missing is None:
@@ -747,7 +747,7 @@ def _keep_theobr(m, n: int, fs: float, user_given: bool, kind: str, lower: float
     """Even m in ThêoBR's range (10 ≤ m ≤ N − 1) with 0.75·m > ``lower`` (in
     samples), unique and sorted; warns when explicit taus are dropped."""
     m = np.asarray(m, dtype=np.int64)
-    terms = _core.estimator_terms("theobr", n + 1, m.astype(np.uint64)).astype(np.int64)
+    terms = _core_allan.estimator_terms("theobr", n + 1, m.astype(np.uint64)).astype(np.int64)
     keep = (terms > 1) & (0.75 * m > lower)
     dropped = int(np.count_nonzero(~keep))
     if dropped and user_given:
@@ -765,7 +765,7 @@ def _warn_theobr_cost(kind: str, n: int, m: np.ndarray, channels: int) -> None:
     that is long."""
     if m.size == 0:
         return
-    direct, fast = _core.theobr_work(n + 1, [int(v) for v in m])
+    direct, fast = _core_allan.theobr_work(n + 1, [int(v) for v in m])
     seconds = channels * (direct / _THEO1_DIRECT_PER_SECOND + fast / _THEO1_FAST_PER_SECOND)
     if seconds > 60:
         warnings.warn(
@@ -778,7 +778,7 @@ def _warn_theobr_cost(kind: str, n: int, m: np.ndarray, channels: int) -> None:
 
 def _minimum_samples(statistic: str) -> int:
     for n in range(1, 16):
-        if _core.estimator_terms(statistic, n + 1, np.array([1], dtype=np.uint64))[0] > 1:
+        if _core_allan.estimator_terms(statistic, n + 1, np.array([1], dtype=np.uint64))[0] > 1:
             return n
     return 16
 

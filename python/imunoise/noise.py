@@ -119,10 +119,10 @@ def _terms(taus, fs: float, coef, markov=()) -> np.ndarray:
     """Allan variance of each model term at ``taus``: (len(taus), 5 + len(markov)),
     from the one implementation of the model (Rust); ``coef`` holds Q…R,
     ``markov`` (sigma, tau_c) pairs."""
-    from imunoise import _core
+    from imunoise._core import fit as _core_fit
 
     t = np.ascontiguousarray(np.atleast_1d(np.asarray(taus, dtype=float)))
-    return _core.noise_terms(t, float(fs), [float(c) ** 2 for c in coef],
+    return _core_fit.noise_terms(t, float(fs), [float(c) ** 2 for c in coef],
                              [(s * s, tc) for s, tc in markov])
 
 
@@ -340,10 +340,10 @@ class NoiseModel:
     def _equivalent_of(self, term: str, p: np.ndarray) -> float:
         gm = [(p[5 + 2 * k], math.exp(p[6 + 2 * k])) for k in range(GM_MAX) if p[5 + 2 * k] > 0]
         if term == "B":
-            from imunoise import _core
+            from imunoise._core import fit as _core_fit
 
             grid = np.geomspace(self.taus[0], self.taus[-1], 200)
-            dev = np.sqrt(_core.noise_terms(grid, self.fs, list(p[:5]), gm).sum(axis=1))
+            dev = np.sqrt(_core_fit.noise_terms(grid, self.fs, list(p[:5]), gm).sum(axis=1))
             i = int(np.argmin(dev))
             # A minimum at the longest tau is a floor only where the curve has
             # flattened (log-log slope above −¼ there); else it is still falling.
@@ -898,10 +898,10 @@ def _readonly(a):
 
 
 def _fit_wls(t, v, e, fs, mask, gm_count, select):
-    from imunoise import _core
+    from imunoise._core import fit as _core_fit
 
     try:
-        sq, gm, cov, delta, chi2, n_eff, _params, _bic = _core.fit_noise(
+        sq, gm, cov, delta, chi2, n_eff, _params, _bic = _core_fit.fit_noise(
             np.ascontiguousarray(t), np.ascontiguousarray(v), np.ascontiguousarray(e), fs,
             [bool(m) for m in mask], gm_count, select,
         )

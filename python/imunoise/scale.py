@@ -51,7 +51,7 @@ from pathlib import Path
 
 import numpy as np
 
-from imunoise import _core
+from imunoise._core import vn as _core_vn
 from imunoise.readers.grid import Gaps, TimeGrid
 from imunoise.readers.log import (
     CHANNELS,
@@ -544,7 +544,7 @@ def _stream_vn(path: Path, writer: _Writer, chunk_bytes: int, progress) -> tuple
             fin = len(block) < chunk_bytes
             data = carry + block if carry else block
             del block
-            raw = _core.parse_vn_chunk(data, False, fin)
+            raw = _core_vn.parse_vn_chunk(data, False, fin)
             used = int(raw["bytes_consumed"])
             tally.add(raw, offset, lines)
             for name, cols in raw["tables"].items():

@@ -30,6 +30,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from imunoise import _schema
+
 __all__ = [
     "G",
     "DEG",
@@ -44,7 +46,7 @@ __all__ = [
     "unit_info",
 ]
 
-G = 9.80665
+G = _schema.G
 """Standard gravity, m/s²."""
 
 DEG = math.pi / 180.0

@@ -9,6 +9,7 @@ from types import MappingProxyType
 
 import numpy as np
 
+from imunoise import _schema
 from imunoise.readers.grid import Gaps, TimeGrid
 
 #: Sample rate assumed when neither timestamps nor ``fs=`` tell it (the VN-100's
@@ -95,36 +96,9 @@ class ParseIssues:
         return "no issues" if not parts else ", ".join(parts)
 
 
-#: Channel name -> (columns, unit). Every channel is float64 (n, columns).
-CHANNELS: Mapping[str, tuple[int, str]] = MappingProxyType(
-    {
-        "gyro": (3, "rad/s"),
-        "accel": (3, "m/s^2"),
-        "mag": (3, "Gauss"),
-        "ypr": (3, "deg"),
-        "quaternion": (4, "1"),
-        "temperature": (1, "degC"),
-        "pressure": (1, "kPa"),
-        "delta_theta": (3, "deg"),
-        "delta_velocity": (3, "m/s"),
-    }
-)
-
-
-#: Column suffixes of the multi-column channels. The quaternion is stored as the
-#: readers decode it (VN-100 and ROS order): vector part first, scalar ``w`` last.
-_AXES: Mapping[int, tuple[str, ...]] = MappingProxyType(
-    {3: ("x", "y", "z"), 4: ("x", "y", "z", "w")}
-)
-
-
-def column_names(channel: str) -> list[str]:
-    """Flat column names of a channel, as every writer (``imunoise convert`` to
-    CSV/NPZ/Parquet, :mod:`imunoise.scale`) names them: ``gyro_x`` ...,
-    ``quaternion_x, quaternion_y, quaternion_z, quaternion_w``; one-column channels
-    (and ``"time"``, ``"valid"``) keep their name."""
-    cols = CHANNELS[channel][0] if channel in CHANNELS else 1
-    return [channel] if cols == 1 else [f"{channel}_{a}" for a in _AXES[cols]]
+# The channel table and column naming live in the one schema module.
+CHANNELS = _schema.CHANNELS
+column_names = _schema.column_names
 
 
 @dataclass(frozen=True)

@@ -43,7 +43,7 @@ from types import MappingProxyType
 
 import numpy as np
 
-from imunoise import _core
+from imunoise._core import vn as _core_vn
 from imunoise.readers.grid import TimeGrid
 from imunoise.readers.log import ISSUE_KINDS, ImuLog, ParseIssues, log_on_grid
 
@@ -144,7 +144,7 @@ def read_vn_tables(
     -------
     VnTables
     """
-    raw = _core.parse_vn(_source_arg(source), strict, progress)
+    raw = _core_vn.parse_vn(_source_arg(source), strict, progress)
     binary = raw["binary_records"] > raw["ascii_records"]
     pick = 0 if binary else 1
     first = {k: tuple(loc[pick] for loc in raw["first"].get(k, ())) for k in ISSUE_KINDS}

@@ -12,7 +12,7 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 
-from imunoise import _core
+from imunoise._core import vn as _core_vn
 from imunoise.readers.log import ImuLog
 
 # column base name -> (channel, column index or None for 1-D channels)
@@ -127,7 +127,7 @@ def write_vn_ascii(
     -------
     bytes
     """
-    fields = _core.vn_message_fields()
+    fields = _core_vn.vn_message_fields()
     if message not in fields:
         raise ValueError(f"message must be one of {sorted(fields)}; got {message!r}")
     columns, missing = [], []
@@ -141,7 +141,7 @@ def write_vn_ascii(
     opt = [
         None if a is None else np.ascontiguousarray(a, dtype=np.float64) for a in (count, status)
     ]
-    out = _core.write_vn_ascii(
+    out = _core_vn.write_vn_ascii(
         message, columns, list(decimals) if decimals is not None else None, opt[0], opt[1], crc,
         line_ending.encode(),
     )
@@ -149,7 +149,7 @@ def write_vn_ascii(
 
 
 def _selection(fields) -> list[tuple[int, int]]:
-    table = _core.vn_binary_fields()
+    table = _core_vn.vn_binary_fields()
     if isinstance(fields, Mapping):
         out = []
         for group, names in fields.items():
@@ -170,7 +170,7 @@ def _selection(fields) -> list[tuple[int, int]]:
 
 def binary_columns(fields) -> list[str]:
     """Column names (group-qualified, payload order) of packets for ``fields``."""
-    return list(_core.vn_binary_columns(_selection(fields))[0])
+    return list(_core_vn.vn_binary_columns(_selection(fields))[0])
 
 
 def write_vn_binary(
@@ -202,7 +202,7 @@ def write_vn_binary(
     if fields is None:
         fields = _default_fields(data)
     selection = _selection(fields)
-    names, _ = _core.vn_binary_columns(selection)
+    names, _ = _core_vn.vn_binary_columns(selection)
     n = _length(data)
     columns, missing = {}, []
     for name in names:
@@ -221,4 +221,4 @@ def write_vn_binary(
         columns[name] = col
     if missing:
         raise ValueError(f"data lacks {missing} needed for fields {fields!r}")
-    return _finish(_core.write_vn_binary(selection, columns), path)
+    return _finish(_core_vn.write_vn_binary(selection, columns), path)
