@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 from imunoise import scale
 from imunoise.cli import main
+from imunoise.scale.convert import _Steps
 from imunoise.simulate_log import still_log
 
 FS = 40.0
@@ -233,7 +234,7 @@ def test_cli_batch_writes_table(fleet, tmp_path, capsys):
 def test_streamed_step_median_equals_numpy(n):
     rng = np.random.default_rng(n)
     t = np.cumsum(rng.choice([0.0, 0.00125, 0.00125, 0.0012501, -0.5, 0.0025], size=n))
-    steps = scale._Steps()
+    steps = _Steps()
     for piece in np.array_split(t, 4):
         steps.add(piece)
     d = np.diff(t)

@@ -1,5 +1,5 @@
 """Damaged streams: every good record recovered, every bad one counted, every byte
-accounted for; strict mode raises ValueError only."""
+accounted for; strict mode raises ParseError (a ValueError) only."""
 
 import imunoise
 import numpy as np
@@ -7,6 +7,7 @@ import pytest
 from conftest import DATA
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from imunoise.errors import ParseError
 from imunoise.readers.vn import read_vn_tables
 from vn_oracle import good_sentences
 
@@ -40,8 +41,10 @@ def test_bad_checksums_counted_and_others_kept():
     assert t.issues.first["bad_checksum"] == tuple(int(i) + 1 for i in bad[:5])
     expected = np.array(good_sentences(data))
     np.testing.assert_array_equal(t.tables["VNYMR"]["gyro_z"], expected[:, 11])
-    with pytest.raises(ValueError, match=f"line {bad[0] + 1} .*bad_checksum"):
+    with pytest.raises(ParseError) as raised:
         read_vn_tables(data, strict=True)
+    assert (raised.value.kind, raised.value.line) == ("bad_checksum", bad[0] + 1)
+    assert raised.value.source is None
 
 
 def test_truncated_lines_and_inserted_noise():
@@ -80,8 +83,9 @@ def test_binary_damage():
     # A cut last packet is reported, not lost silently.
     t = read_vn_tables(WAVES[: starts[98] + 60])
     assert t.binary_records == 98 and t.issues.counts["truncated_record"] == 1
-    with pytest.raises(ValueError, match=f"byte offset {starts[98]}"):
+    with pytest.raises(ParseError) as raised:
         read_vn_tables(WAVES[: starts[98] + 60], strict=True)
+    assert (raised.value.kind, raised.value.offset) == ("truncated_record", starts[98])
 
 
 def test_file_and_bytes_agree_with_progress(tmp_path):

@@ -158,7 +158,7 @@ def test_parallel_binary_matches_written_values(tmp_path):
 def test_channels_are_views_of_one_table():
     data = imunoise.write_vn_ascii(_still(500, 40.0, 4), "VNYMR")
     log = imunoise.read(data, fs=40.0)
-    t = _core_vn.parse_vn(data, False, None)["tables"]["VNYMR"]
+    t = _core_vn.parse_vn(data, False, None).tables["VNYMR"]
     # Rows of the 12-column VNYMR matrix, not a stacked copy.
     assert log.gyro.strides == (12 * 8, 8) and log.accel.strides == (12 * 8, 8)
     np.testing.assert_array_equal(log.gyro[:, 1], t["gyro_y"])

@@ -4,6 +4,7 @@ import imunoise
 import numpy as np
 import pytest
 from conftest import DATA, shared_file
+from imunoise.errors import ParseError
 from imunoise.readers.vn import read_vn_tables
 from vn_oracle import good_sentences
 
@@ -26,8 +27,10 @@ def test_rugged_ascii_counts_and_values():
     first_line = raw.split(b"\n", 1)[0]
     assert log.issues.counts["bytes_skipped"] == len(first_line) + 1
     assert log.issues.location == "line"
-    with pytest.raises(ValueError, match=r"line 3904 .*truncated_record"):
+    with pytest.raises(ParseError) as raised:
         imunoise.read(path, strict=True, fs=40)
+    assert (raised.value.kind, raised.value.line) == ("truncated_record", 3904)
+    assert raised.value.source == str(path)
 
 
 def test_rugged_fs_default_warns():

@@ -4,6 +4,7 @@
 import imunoise
 import numpy as np
 import pytest
+from imunoise.errors import ParseError
 from imunoise.readers.vn import read_vn_tables
 
 A = {
@@ -74,8 +75,9 @@ def test_must_reject(line):
     t = read_vn_tables(line + b"\r\n")
     assert t.ascii_records == 0
     assert t.issues.total == 1
-    with pytest.raises(ValueError, match="line 1"):
+    with pytest.raises(ParseError) as raised:
         read_vn_tables(line + b"\r\n", strict=True)
+    assert (raised.value.line, raised.value.offset) == (1, 0)
 
 
 def test_crc16_sentences():

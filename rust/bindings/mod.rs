@@ -4,8 +4,9 @@
 //! name (`_core.allan`, `_core.vn`, `_core.fit`), so the Python side mirrors this
 //! folder.
 
-use pyo3::exceptions::{PyOSError, PyValueError};
+use pyo3::exceptions::{PyFileNotFoundError, PyOSError, PyPermissionError, PyValueError};
 use pyo3::prelude::*;
+use pyo3::types::PyDict;
 
 use crate::error::CoreError;
 
@@ -15,10 +16,40 @@ mod vn;
 
 impl From<CoreError> for PyErr {
     fn from(err: CoreError) -> PyErr {
-        match err {
-            CoreError::Io(msg) => PyOSError::new_err(msg),
-            other => PyValueError::new_err(other.to_string()),
-        }
+        core_error_to_py(err, None)
+    }
+}
+
+/// `err` as a Python exception; `source` (the file parsed, if any) goes into
+/// `ParseError.source`. Parse failures become `imunoise.errors.ParseError`
+/// with `kind`, `line`, `offset` and `reason` as attributes; I/O failures the
+/// `OSError` subclass of their kind.
+pub(crate) fn core_error_to_py(err: CoreError, source: Option<String>) -> PyErr {
+    match err {
+        CoreError::Parse {
+            kind,
+            line,
+            offset,
+            reason,
+        } => Python::attach(|py| {
+            let raised = || -> PyResult<PyErr> {
+                let class = py.import("imunoise.errors")?.getattr("ParseError")?;
+                let kwargs = PyDict::new(py);
+                kwargs.set_item("kind", kind)?;
+                kwargs.set_item("line", line)?;
+                kwargs.set_item("offset", offset)?;
+                kwargs.set_item("source", source)?;
+                let instance = class.call((reason,), Some(&kwargs))?;
+                Ok(PyErr::from_value(instance))
+            };
+            raised().unwrap_or_else(|e| e)
+        }),
+        CoreError::Io { kind, message } => match kind {
+            std::io::ErrorKind::NotFound => PyFileNotFoundError::new_err(message),
+            std::io::ErrorKind::PermissionDenied => PyPermissionError::new_err(message),
+            _ => PyOSError::new_err(message),
+        },
+        other => PyValueError::new_err(other.to_string()),
     }
 }
 

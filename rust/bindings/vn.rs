@@ -1,6 +1,7 @@
 //! Bindings for VectorNav parsing and writing: the parse runs with the GIL
 //! released; the progress callback reacquires it only to be called.
 
+use std::collections::BTreeMap;
 use std::path::PathBuf;
 
 use numpy::{IntoPyArray, PyReadonlyArray1};
@@ -8,17 +9,22 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict, PyList, PySlice};
 
+use crate::bindings::core_error_to_py;
 use crate::error::CoreError;
-use crate::vn::ascii::MESSAGES;
-use crate::vn::binary::Layout;
+use crate::vn::binary::{self, Layout};
+use crate::vn::messages::MESSAGES;
 use crate::vn::write::{self, AsciiCheck};
-use crate::vn::{stream, IssueKind, VnData};
+use crate::vn::{stream, IssueKind, Table, VnData, FIRST_KEEP};
 
-fn to_dict<'py>(py: Python<'py>, data: VnData) -> PyResult<Bound<'py, PyDict>> {
+/// Tables as `{name: {column: float64 array}}` and the damaged-record rows as
+/// `{name: uint64 array}` (types with damaged records only).
+fn tables_to_py<'py>(
+    py: Python<'py>,
+    tables: BTreeMap<String, Table>,
+) -> PyResult<(Bound<'py, PyDict>, Bound<'py, PyDict>)> {
     let out = PyDict::new(py);
-    let tables = PyDict::new(py);
     let missing = PyDict::new(py);
-    for (name, table) in data.tables {
+    for (name, table) in tables {
         if !table.missing.is_empty() {
             missing.set_item(&name, table.missing.into_pyarray(py))?;
         }
@@ -36,15 +42,51 @@ fn to_dict<'py>(py: Python<'py>, data: VnData) -> PyResult<Bound<'py, PyDict>> {
         for (col_name, col) in table.extra {
             cols.set_item(col_name, col.into_pyarray(py))?;
         }
-        tables.set_item(name, cols)?;
+        out.set_item(name, cols)?;
     }
-    out.set_item("tables", tables)?;
-    out.set_item("missing", missing)?;
+    Ok((out, missing))
+}
+
+/// What a parse produced (`parse_vn`, `VnStream.finish`).
+#[pyclass(module = "imunoise._core.vn", frozen, get_all)]
+pub struct VnResult {
+    /// `{message: {column: float64 array}}`.
+    tables: Py<PyDict>,
+    /// `{message: uint64 array}`: the good rows before each damaged record.
+    missing: Py<PyDict>,
+    /// `{message: records}`, command responses included.
+    messages: Py<PyDict>,
+    /// `{kind: count}` for every name of `ISSUE_KINDS`.
+    issues: Py<PyDict>,
+    /// `{kind: [(byte_offset, line), ...]}`, at most `FIRST_KEEP` per kind.
+    first: Py<PyDict>,
+    bytes_total: u64,
+    bytes_parsed: u64,
+    bytes_in_bad_records: u64,
+    bytes_skipped: u64,
+    ascii_records: u64,
+    binary_records: u64,
+}
+
+#[pymethods]
+impl VnResult {
+    /// `"vn-binary"` if binary packets outnumber sentences, else `"vn-ascii"`.
+    #[getter]
+    fn format(&self) -> &'static str {
+        if self.binary_records > self.ascii_records {
+            "vn-binary"
+        } else {
+            "vn-ascii"
+        }
+    }
+}
+
+fn to_result(py: Python<'_>, data: VnData) -> PyResult<VnResult> {
+    let (tables, missing) = tables_to_py(py, data.tables)?;
     let messages = PyDict::new(py);
     for (name, n) in data.messages {
         messages.set_item(name, n)?;
     }
-    out.set_item("messages", messages)?;
     let counts = PyDict::new(py);
     let first = PyDict::new(py);
     for kind in IssueKind::ALL {
@@ -55,24 +97,81 @@ fn to_dict<'py>(py: Python<'py>, data: VnData) -> PyResult<Bound<'py, PyDict>> {
             .collect();
         first.set_item(kind.name(), locs)?;
     }
-    out.set_item("issues", counts)?;
-    out.set_item("first", first)?;
-    out.set_item("bytes_total", data.bytes_total)?;
-    out.set_item("bytes_parsed", data.bytes_parsed)?;
-    out.set_item("bytes_in_bad_records", data.bytes_in_bad_records)?;
-    out.set_item("bytes_skipped", data.bytes_skipped)?;
-    out.set_item("ascii_records", data.ascii_records)?;
-    out.set_item("binary_records", data.binary_records)?;
-    Ok(out)
+    Ok(VnResult {
+        tables: tables.unbind(),
+        missing: missing.unbind(),
+        messages: messages.unbind(),
+        issues: counts.unbind(),
+        first: first.unbind(),
+        bytes_total: data.bytes_total,
+        bytes_parsed: data.bytes_parsed,
+        bytes_in_bad_records: data.bytes_in_bad_records,
+        bytes_skipped: data.bytes_skipped,
+        ascii_records: data.ascii_records,
+        binary_records: data.binary_records,
+    })
 }
 
-/// parse_vn(source, strict=False, progress=None) -> dict
+/// The rows of one piece of a stream (`VnStream.feed`).
+#[pyclass(module = "imunoise._core.vn", frozen, get_all)]
+pub struct VnRows {
+    /// `{message: {column: float64 array}}`: the records completed by the piece.
+    tables: Py<PyDict>,
+    /// `{message: uint64 array}`: good rows of this piece before each damaged record.
+    missing: Py<PyDict>,
+}
+
+/// VnStream(strict=False): one VN parse fed piece by piece (a file larger than
+/// memory). `feed(data)` returns the rows of the records the bytes so far
+/// complete; `finish()` the summary of the whole stream (issues, byte
+/// accounting, message counts; its tables hold the last rows only).
+#[pyclass(module = "imunoise._core.vn")]
+pub struct VnStream {
+    pieces: Option<stream::Pieces>,
+}
+
+impl VnStream {
+    fn pieces(&mut self) -> PyResult<&mut stream::Pieces> {
+        self.pieces.as_mut().ok_or_else(|| {
+            PyValueError::new_err("VnStream is finished; feed must come before finish")
+        })
+    }
+}
+
+#[pymethods]
+impl VnStream {
+    #[new]
+    #[pyo3(signature = (strict=false))]
+    fn new(strict: bool) -> VnStream {
+        VnStream {
+            pieces: Some(stream::Pieces::new(strict)),
+        }
+    }
+
+    fn feed<'py>(&mut self, py: Python<'py>, data: &Bound<'py, PyBytes>) -> PyResult<VnRows> {
+        let slice: &[u8] = data.as_bytes();
+        let pieces = self.pieces()?;
+        let tables = py.detach(|| pieces.feed(slice))?;
+        let (tables, missing) = tables_to_py(py, tables)?;
+        Ok(VnRows {
+            tables: tables.unbind(),
+            missing: missing.unbind(),
+        })
+    }
+
+    fn finish(&mut self, py: Python<'_>) -> PyResult<VnResult> {
+        let pieces = self.pieces.take().ok_or_else(|| {
+            PyValueError::new_err("VnStream is finished; finish must be called once")
+        })?;
+        let data = py.detach(|| pieces.finish())?;
+        to_result(py, data)
+    }
+}
+
+/// parse_vn(source, strict=False, progress=None) -> VnResult
 ///
-/// `source` is `bytes` (parsed in memory) or a path (read in chunks). Returns
-/// tables of float64 columns per message type, message counts, issue counts and
-/// first locations, byte accounting, and `missing`: per message type, the good
-/// rows before each damaged record of that type (uint64). `progress(done, total)` is called after
-/// every chunk of a file.
+/// `source` is `bytes` (parsed in memory) or a path (read in chunks).
+/// `progress(done, total)` is called after every chunk of a file.
 #[pyfunction]
 #[pyo3(signature = (source, strict=false, progress=None))]
 fn parse_vn<'py>(
@@ -80,7 +179,7 @@ fn parse_vn<'py>(
     source: &Bound<'py, PyAny>,
     strict: bool,
     progress: Option<Py<PyAny>>,
-) -> PyResult<Bound<'py, PyDict>> {
+) -> PyResult<VnResult> {
     let data = if let Ok(bytes) = source.cast::<PyBytes>() {
         let slice: &[u8] = bytes.as_bytes();
         py.detach(|| stream::parse_bytes(slice, strict))?
@@ -113,30 +212,9 @@ fn parse_vn<'py>(
         if let Some(e) = cb_err {
             return Err(e);
         }
-        result?
+        result.map_err(|e| core_error_to_py(e, Some(path.display().to_string())))?
     };
-    to_dict(py, data)
-}
-
-/// parse_vn_chunk(data, strict=False, fin=False) -> dict
-///
-/// Like `parse_vn` on `bytes`, for one piece of a longer stream: only complete
-/// records are decoded (all of `data` when `fin`); `"bytes_consumed"` says how
-/// far, so the caller can carry the rest into the next piece. Locations are
-/// relative to `data`.
-#[pyfunction]
-#[pyo3(signature = (data, strict=false, fin=false))]
-fn parse_vn_chunk<'py>(
-    py: Python<'py>,
-    data: &Bound<'py, PyBytes>,
-    strict: bool,
-    fin: bool,
-) -> PyResult<Bound<'py, PyDict>> {
-    let slice: &[u8] = data.as_bytes();
-    let (used, parsed) = py.detach(|| stream::parse_prefix(slice, strict, fin))?;
-    let out = to_dict(py, parsed)?;
-    out.set_item("bytes_consumed", used)?;
-    Ok(out)
+    to_result(py, data)
 }
 
 /// vn_message_fields() -> dict[str, list[str]]: field names of every ASCII message.
@@ -150,9 +228,9 @@ fn vn_message_fields(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
 }
 
 /// write_vn_ascii(message, columns, decimals=None, count=None, status=None,
-/// crc=False, eol=b"\r\n") -> bytes
+/// crc=False, line_ending=b"\r\n") -> bytes
 #[pyfunction]
-#[pyo3(signature = (message, columns, decimals=None, count=None, status=None, crc=false, eol=b"\r\n".to_vec()))]
+#[pyo3(signature = (message, columns, decimals=None, count=None, status=None, crc=false, line_ending=b"\r\n".to_vec()))]
 #[allow(clippy::too_many_arguments)]
 fn write_vn_ascii<'py>(
     py: Python<'py>,
@@ -162,7 +240,7 @@ fn write_vn_ascii<'py>(
     count: Option<PyReadonlyArray1<'py, f64>>,
     status: Option<PyReadonlyArray1<'py, f64>>,
     crc: bool,
-    eol: Vec<u8>,
+    line_ending: Vec<u8>,
 ) -> PyResult<Bound<'py, PyBytes>> {
     let cols: Vec<&[f64]> = columns
         .iter()
@@ -183,14 +261,15 @@ fn write_vn_ascii<'py>(
             count,
             status,
             check,
-            &eol,
+            &line_ending,
         )
     })?;
     Ok(PyBytes::new(py, &out))
 }
 
-/// vn_binary_columns(selection) -> list[str]: column names (payload order) of the
-/// packets for `selection`, a list of (group index, field mask).
+/// vn_binary_columns(selection) -> (list[str], str): column names (payload order)
+/// and table name of the packets for `selection`, a list of (group index, field
+/// mask).
 #[pyfunction]
 fn vn_binary_columns(selection: Vec<(usize, u32)>) -> PyResult<(Vec<String>, String)> {
     let layout: Layout = write::binary_layout(&selection)?;
@@ -229,24 +308,27 @@ fn write_vn_binary<'py>(
 #[pyfunction]
 fn vn_binary_fields(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     let out = PyDict::new(py);
-    for g in [0usize, 1, 2, 4] {
+    for g in binary::DECODABLE_GROUPS {
         let fields = PyDict::new(py);
-        for k in 0..31 {
-            if let Some(spec) = crate::vn::binary::field_spec(g, k) {
-                if spec.name != "reserved" {
-                    fields.set_item(spec.name, k)?;
-                }
-            }
+        for (k, spec) in binary::named_fields(g) {
+            fields.set_item(spec.name, k)?;
         }
-        out.set_item(crate::vn::binary::group_name(g), (g, fields))?;
+        out.set_item(binary::group_name(g), (g, fields))?;
     }
     Ok(out)
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    // The parser's issue kinds in order (the index of each count) and how many
+    // first locations it keeps per kind: one source for the Python readers.
+    let kinds: Vec<&str> = IssueKind::ALL.iter().map(|k| k.name()).collect();
+    m.add("ISSUE_KINDS", pyo3::types::PyTuple::new(m.py(), kinds)?)?;
+    m.add("FIRST_KEEP", FIRST_KEEP)?;
     m.add_function(wrap_pyfunction!(vn_binary_fields, m)?)?;
     m.add_function(wrap_pyfunction!(parse_vn, m)?)?;
-    m.add_function(wrap_pyfunction!(parse_vn_chunk, m)?)?;
+    m.add_class::<VnResult>()?;
+    m.add_class::<VnRows>()?;
+    m.add_class::<VnStream>()?;
     m.add_function(wrap_pyfunction!(vn_message_fields, m)?)?;
     m.add_function(wrap_pyfunction!(write_vn_ascii, m)?)?;
     m.add_function(wrap_pyfunction!(vn_binary_columns, m)?)?;

@@ -302,6 +302,18 @@ pub fn group_name(group: usize) -> &'static str {
     }
 }
 
+/// The groups whose fields the writer offers by name (Common, Time, IMU,
+/// Attitude: an IMU's own outputs). GNSS and INS packets are still decoded
+/// when read.
+pub const DECODABLE_GROUPS: [usize; 4] = [0, 1, 2, 4];
+
+/// The named fields of `group` as (field number, spec), reserved slots left out.
+pub fn named_fields(group: usize) -> impl Iterator<Item = (usize, &'static FieldSpec)> {
+    (0..16 * MAX_WORDS)
+        .filter_map(move |k| field_spec(group, k).map(|spec| (k, spec)))
+        .filter(|(_, spec)| spec.name != "reserved")
+}
+
 /// Field spec for SDK group index `group` and SDK field number `field`
 /// (word `w`, bit `b` → `16·w + b`).
 pub fn field_spec(group: usize, field: usize) -> Option<&'static FieldSpec> {

@@ -5,9 +5,9 @@
 use std::io::Write as _;
 
 use crate::error::{CoreError, CoreResult};
-use crate::vn::ascii::{spec_by_id, MESSAGES};
 use crate::vn::binary::{self, field_spec, HeaderScan, Kind, Layout};
 use crate::vn::checksum::{crc16, xor8};
+use crate::vn::messages::{spec_by_id, MESSAGES};
 
 /// Which check an ASCII writer appends.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

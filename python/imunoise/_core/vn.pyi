@@ -2,32 +2,75 @@
 
 import os
 from collections.abc import Callable
-from typing import Any
 
 import numpy as np
 import numpy.typing as npt
+
+#: The parser's issue kinds, in order.
+ISSUE_KINDS: tuple[str, ...]
+#: First locations kept per issue kind.
+FIRST_KEEP: int
+
+class VnResult:
+    """What a parse produced (``parse_vn``, ``VnStream.finish``)."""
+
+    @property
+    def tables(self) -> dict[str, dict[str, npt.NDArray[np.float64]]]:
+        """{message: {column: float64 array}}."""
+    @property
+    def missing(self) -> dict[str, npt.NDArray[np.uint64]]:
+        """{message: good rows before each damaged record of that type}."""
+    @property
+    def messages(self) -> dict[str, int]:
+        """{message: records}, command responses included."""
+    @property
+    def issues(self) -> dict[str, int]:
+        """{kind: count} for every name of ISSUE_KINDS."""
+    @property
+    def first(self) -> dict[str, list[tuple[int, int]]]:
+        """{kind: [(byte_offset, line), ...]}, at most FIRST_KEEP per kind."""
+    @property
+    def bytes_total(self) -> int: ...
+    @property
+    def bytes_parsed(self) -> int: ...
+    @property
+    def bytes_in_bad_records(self) -> int: ...
+    @property
+    def bytes_skipped(self) -> int: ...
+    @property
+    def ascii_records(self) -> int: ...
+    @property
+    def binary_records(self) -> int: ...
+    @property
+    def format(self) -> str:
+        """"vn-binary" if binary packets outnumber sentences, else "vn-ascii"."""
+
+class VnRows:
+    """The rows of one piece of a stream (``VnStream.feed``)."""
+
+    @property
+    def tables(self) -> dict[str, dict[str, npt.NDArray[np.float64]]]: ...
+    @property
+    def missing(self) -> dict[str, npt.NDArray[np.uint64]]: ...
+
+class VnStream:
+    """One VN parse fed piece by piece: ``feed`` returns the rows the bytes so far
+    complete; ``finish`` the summary of the whole stream (its tables hold the last
+    rows only). Counts, first locations and lines run on across pieces."""
+
+    def __init__(self, strict: bool = False) -> None: ...
+    def feed(self, data: bytes) -> VnRows: ...
+    def finish(self) -> VnResult: ...
 
 def parse_vn(
     source: bytes | str | os.PathLike[str],
     strict: bool = False,
     progress: Callable[[int, int], object] | None = None,
-) -> dict[str, Any]:
+) -> VnResult:
     """Decode a VN byte stream (bytes, or a path read in chunks) with the GIL released.
 
-    Keys: ``tables`` {message: {column: float64 array}}, ``messages`` {message: count},
-    ``issues`` {kind: count}, ``first`` {kind: [(byte_offset, line), ...]},
-    ``bytes_total``, ``bytes_parsed``, ``bytes_in_bad_records``, ``bytes_skipped``,
-    ``ascii_records``, ``binary_records``, ``missing`` {message: uint64 array of the
-    good rows before each damaged record of that type}. ``progress(done, total)``
-    after every chunk.
-    """
-
-def parse_vn_chunk(data: bytes, strict: bool = False, fin: bool = False) -> dict[str, Any]:
-    """Decode the complete records at the start of ``data`` (all of it when ``fin``).
-
-    Same keys as :func:`parse_vn` plus ``bytes_consumed``: the bytes decoded; the rest
-    (a record cut by the end of ``data``) starts the next piece. Locations are relative
-    to ``data``.
+    ``progress(done, total)`` after every chunk. Strict mode raises
+    :class:`imunoise.errors.ParseError` for the first damaged record.
     """
 
 def vn_message_fields() -> dict[str, list[str]]:
@@ -46,7 +89,7 @@ def write_vn_ascii(
     count: npt.NDArray[np.float64] | None = None,
     status: npt.NDArray[np.float64] | None = None,
     crc: bool = False,
-    eol: bytes = b"\r\n",
+    line_ending: bytes = b"\r\n",
 ) -> bytes:
     """Sentences of ``message`` from columns in field order (XOR-8 or CRC-16)."""
 

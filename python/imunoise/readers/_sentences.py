@@ -16,10 +16,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from imunoise._core import vn as _core_vn
 from imunoise.readers.log import CHANNELS, ISSUE_KINDS, ImuLog, ParseIssues
 
-#: How many locations per issue kind a reader keeps in ``ParseIssues.first``.
-MAX_FIRST = 10
+#: How many locations per issue kind a reader keeps in ``ParseIssues.first``: the
+#: VN parser's number, so ``first`` means the same for every reader.
+MAX_FIRST = _core_vn.FIRST_KEEP
 
 
 def parse_sentences(data: bytes, *, strict: bool, source: str) -> ImuLog:

@@ -10,6 +10,7 @@ from types import MappingProxyType
 import numpy as np
 
 from imunoise import _schema
+from imunoise._core import vn as _core_vn
 from imunoise.readers.grid import Gaps, TimeGrid
 
 #: Sample rate assumed when neither timestamps nor ``fs=`` tell it (the VN-100's
@@ -17,16 +18,21 @@ from imunoise.readers.grid import Gaps, TimeGrid
 DEFAULT_FS = 40.0
 
 #: Kinds of problem a reader counts. Every skipped byte or record lands in one.
-ISSUE_KINDS = (
-    "bad_checksum",  # 8-bit checksum or CRC-16 mismatch
-    "malformed_field",  # a field that does not parse as its type, or a wrong field count
-    "unknown_message",  # a well-formed record of a type we do not decode
-    "truncated_record",  # a record cut short (end of file, or next record started)
-    "bytes_skipped",  # bytes that belong to no record (noise between records)
-    "device_error",  # $VNERR replies, recorded not decoded
-    "duplicate_time",  # a sample whose grid slot was taken (same or too-close timestamp): dropped
-    "time_reversed",  # a timestamp smaller than the one before: kept, placed by its time
-)
+#: The parser's own kinds come from Rust, in its order:
+#:
+#: - ``bad_checksum``: 8-bit checksum or CRC-16 mismatch
+#: - ``malformed_field``: a field that does not parse as its type, or a wrong field count
+#: - ``unknown_message``: a well-formed record of a type we do not decode
+#: - ``truncated_record``: a record cut short (end of file, or next record started)
+#: - ``bytes_skipped``: bytes that belong to no record (noise between records)
+#: - ``device_error``: ``$VNERR`` replies, recorded not decoded
+#:
+#: then the time grid's (:mod:`imunoise.readers.grid`):
+#:
+#: - ``duplicate_time``: a sample whose grid slot was taken (same or too-close
+#:   timestamp): dropped
+#: - ``time_reversed``: a timestamp smaller than the one before: kept, placed by its time
+ISSUE_KINDS = (*_core_vn.ISSUE_KINDS, "duplicate_time", "time_reversed")
 
 #: Kinds that count something other than a skipped record.
 _NOT_RECORDS = ("bytes_skipped", "time_reversed")

@@ -91,6 +91,8 @@ class VnTables:
         Per message type, for every damaged record of that type (bad checksum or
         CRC, malformed field, truncated record, whose type could still be read):
         the number of good records of the type before it (int64, increasing).
+    format : str
+        ``"vn-binary"`` if binary packets outnumber sentences, else ``"vn-ascii"``.
     """
 
     tables: Mapping[str, Mapping[str, np.ndarray]]
@@ -103,11 +105,7 @@ class VnTables:
     ascii_records: int
     binary_records: int
     missing: Mapping[str, np.ndarray] = field(default_factory=dict)
-
-    @property
-    def format(self) -> str:
-        """``"vn-binary"`` if binary packets outnumber sentences, else ``"vn-ascii"``."""
-        return "vn-binary" if self.binary_records > self.ascii_records else "vn-ascii"
+    format: str = "vn-ascii"
 
 
 def _source_arg(source) -> bytes | str:
@@ -134,9 +132,9 @@ def read_vn_tables(
     source : str, os.PathLike or bytes
         A file (read in chunks, never whole into memory) or the bytes of a stream.
     strict : bool
-        Raise ``ValueError`` naming the line (and byte offset) of the first damaged
-        record (bad checksum or CRC, malformed field, truncated record) instead of
-        skipping and counting it.
+        Raise :class:`~imunoise.errors.ParseError` (a ``ValueError``) with the
+        kind, line and byte offset of the first damaged record (bad checksum or
+        CRC, malformed field, truncated record) instead of skipping and counting it.
     progress : callable, optional
         ``progress(bytes_done, bytes_total)``, called every chunk (8 MB) of a file.
 
@@ -145,28 +143,34 @@ def read_vn_tables(
     VnTables
     """
     raw = _core_vn.parse_vn(_source_arg(source), strict, progress)
-    binary = raw["binary_records"] > raw["ascii_records"]
+    return tables_of(raw)
+
+
+def tables_of(raw: _core_vn.VnResult) -> VnTables:
+    """:class:`VnTables` of a Rust parse result (read-only mappings, locations as
+    lines for ASCII streams and byte offsets for binary ones)."""
+    binary = raw.format == "vn-binary"
     pick = 0 if binary else 1
-    first = {k: tuple(loc[pick] for loc in raw["first"].get(k, ())) for k in ISSUE_KINDS}
-    issues = ParseIssues(
-        counts=dict(raw["issues"]), first=first, location="byte" if binary else "line"
-    )
+    first = {k: tuple(loc[pick] for loc in raw.first.get(k, ())) for k in ISSUE_KINDS}
+    location = "byte" if binary else "line"
+    issues = ParseIssues(counts=dict(raw.issues), first=first, location=location)
     tables = MappingProxyType(
-        {name: MappingProxyType(dict(cols)) for name, cols in raw["tables"].items()}
+        {name: MappingProxyType(dict(cols)) for name, cols in raw.tables.items()}
     )
     return VnTables(
         tables=tables,
-        messages=MappingProxyType(dict(raw["messages"])),
+        messages=MappingProxyType(dict(raw.messages)),
         issues=issues,
-        bytes_total=int(raw["bytes_total"]),
-        bytes_parsed=int(raw["bytes_parsed"]),
-        bytes_in_bad_records=int(raw["bytes_in_bad_records"]),
-        bytes_skipped=int(raw["bytes_skipped"]),
-        ascii_records=int(raw["ascii_records"]),
-        binary_records=int(raw["binary_records"]),
+        bytes_total=raw.bytes_total,
+        bytes_parsed=raw.bytes_parsed,
+        bytes_in_bad_records=raw.bytes_in_bad_records,
+        bytes_skipped=raw.bytes_skipped,
+        ascii_records=raw.ascii_records,
+        binary_records=raw.binary_records,
         missing=MappingProxyType(
-            {k: np.asarray(v, dtype=np.int64) for k, v in raw.get("missing", {}).items()}
+            {k: np.asarray(v, dtype=np.int64) for k, v in raw.missing.items()}
         ),
+        format=raw.format,
     )
 
 
@@ -222,16 +226,28 @@ def table_channels(cols: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
     return out
 
 
-def _primary(tables: Mapping[str, Mapping[str, np.ndarray]]) -> tuple[str, dict[str, np.ndarray]]:
+def richest_table(shapes: Mapping[str, tuple[int, int]]) -> str | None:
+    """The table the channels come from, given ``(channels filled, rows)`` per
+    table: the most channels, then the most rows (``None`` if none fills one)."""
     best: tuple[int, int] = (-1, -1)
-    chosen: tuple[str, dict[str, np.ndarray]] = ("", {})
-    for name, cols in tables.items():
-        channels = table_channels(cols)
-        n = len(next(iter(cols.values()))) if cols else 0
-        filled = sum(1 for k in channels if k != "time")
+    chosen = None
+    for name, (filled, n) in shapes.items():
         if filled and (filled, n) > best:
-            best, chosen = (filled, n), (name, channels)
+            best, chosen = (filled, n), name
     return chosen
+
+
+def _primary(tables: Mapping[str, Mapping[str, np.ndarray]]) -> tuple[str, dict[str, np.ndarray]]:
+    channels = {name: table_channels(cols) for name, cols in tables.items()}
+    shapes = {
+        name: (
+            sum(1 for k in channels[name] if k != "time"),
+            len(next(iter(cols.values()))) if cols else 0,
+        )
+        for name, cols in tables.items()
+    }
+    name = richest_table(shapes)
+    return ("", {}) if name is None else (name, channels[name])
 
 
 def _grid(tables: VnTables, name: str, time: np.ndarray | None, n: int) -> TimeGrid | None:

@@ -1,11 +1,10 @@
-"""Scale: logs larger than memory, and fleets of logs.
+"""Logs larger than memory: stream a log into a columnar file, memory-map it back.
 
-Out of core
------------
 :func:`convert` streams a log into a columnar file without holding it in memory:
-the file is read in pieces of ``chunk_bytes``, each piece cut after its last
-complete record (the Rust parser reports how many bytes it consumed; the cut
-record starts the next piece), and each piece's rows are appended to the output.
+the file is read in pieces of ``chunk_bytes`` and fed to one streaming parser
+(:class:`imunoise._core.vn.VnStream`), which hands back the rows of the records
+each piece completes (a record cut by the end of a piece waits for the next), and
+those rows are appended to the output.
 Memory stays about three pieces (the bytes, their decoded columns, the rows being
 written) whatever the size of the log. :func:`load` opens the result as an
 :class:`~imunoise.readers.log.ImuLog` whose channels are memory-mapped ``.npy``
@@ -29,22 +28,13 @@ Output layouts (chosen by ``out``):
 
 VN-100 logs (ASCII, binary, or both) are streamed; CSV and ROS bags are read
 whole by :func:`imunoise.read` and then written the same way.
-
-Fleets
-------
-:func:`batch` analyses many logs with dask.distributed: one task per log (read,
-Allan deviation, noise fit, datasheet comparison), one result row per log, sensor
-and axis. A log that fails becomes one row with its error message.
 """
 
 from __future__ import annotations
 
-import glob
 import json
 import os
 import shutil
-import sys
-import warnings
 from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -52,28 +42,16 @@ from pathlib import Path
 import numpy as np
 
 from imunoise._core import vn as _core_vn
+from imunoise._schema import CHANNELS, column_names
 from imunoise.readers.grid import Gaps, TimeGrid
-from imunoise.readers.log import (
-    CHANNELS,
-    ISSUE_KINDS,
-    ImuLog,
-    ParseIssues,
-    column_names,
-    fs_from_median_step,
-)
+from imunoise.readers.log import ImuLog, ParseIssues, fs_from_median_step
+from imunoise.readers.vn import richest_table, table_channels, tables_of
 
-__all__ = ["Conversion", "batch", "convert", "load", "BATCH_SENSORS"]
+__all__ = ["CHUNK_BYTES", "Conversion", "convert", "load"]
 
 #: Default bytes read per piece by :func:`convert`.
 CHUNK_BYTES = 64 << 20
-#: First locations kept per issue kind (as the Rust reader keeps).
-_FIRST_KEEP = 5
 _META_VERSION = 1
-
-
-# ---------------------------------------------------------------------------
-# Conversion
-# ---------------------------------------------------------------------------
 
 
 @dataclass(frozen=True)
@@ -480,98 +458,51 @@ class _GridStream:
         return TimeGrid(slot=np.arange(n, dtype=np.int64) + shift, n=n + len(inner))
 
 
-class _Tally:
-    """Issues, message counts and record counts summed over pieces."""
-
-    def __init__(self):
-        self.counts = dict.fromkeys(ISSUE_KINDS, 0)
-        self.first: dict[str, list[tuple[int, int]]] = {k: [] for k in ISSUE_KINDS}
-        self.messages: dict[str, int] = {}
-        self.ascii = 0
-        self.binary = 0
-        self.rows: dict[str, int] = {}
-
-    def add(self, raw: dict, offset: int, lines: int) -> None:
-        for k in ISSUE_KINDS:
-            self.counts[k] += int(raw["issues"].get(k, 0))
-            keep = self.first[k]
-            for off, line in raw["first"].get(k, ()):
-                if len(keep) < _FIRST_KEEP:
-                    keep.append((int(off) + offset, int(line) + lines))
-        for name, n in raw["messages"].items():
-            self.messages[name] = self.messages.get(name, 0) + int(n)
-        self.ascii += int(raw["ascii_records"])
-        self.binary += int(raw["binary_records"])
-
-    @property
-    def format(self) -> str:
-        return "vn-binary" if self.binary > self.ascii else "vn-ascii"
-
-    def issues(self) -> ParseIssues:
-        binary = self.format == "vn-binary"
-        first = {k: tuple(loc[0 if binary else 1] for loc in v) for k, v in self.first.items()}
-        return ParseIssues(counts=self.counts, first=first, location="byte" if binary else "line")
-
-
-def _table_channels(cols: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
-    from imunoise.readers.vn import table_channels
-
-    return table_channels(cols)
-
-
-def _primary(rows: Mapping[str, tuple[int, int]]) -> str | None:
-    """The VN reader's choice of table: most channels filled, then most rows."""
-    best, chosen = (-1, -1), None
-    for name, (filled, n) in rows.items():
-        if filled and (filled, n) > best:
-            best, chosen = (filled, n), name
-    return chosen
-
-
 def _stream_vn(path: Path, writer: _Writer, chunk_bytes: int, progress) -> tuple:
-    """Parse ``path`` piece by piece into ``writer``; returns (tally, steps per table, rows)."""
-    tally = _Tally()
+    """Parse ``path`` piece by piece into ``writer`` with one streaming parser (issues,
+    locations and binary configurations run on across pieces as in one read).
+
+    Returns the parse summary (:class:`~imunoise.readers.vn.VnTables` without rows),
+    the timestamp steps and the ``(channels filled, rows)`` of every table, and the
+    grids the rows were placed on.
+    """
+    stream = _core_vn.VnStream()
     grids: dict[str, _GridStream] = {}
     steps: dict[str, _Steps] = {}
     shape: dict[str, tuple[int, int]] = {}
+
+    def write(rows) -> None:
+        for name, cols in rows.tables.items():
+            chans = table_channels(cols)
+            if not chans:
+                continue
+            grid = grids.setdefault(name, _GridStream())
+            n = len(next(iter(chans.values())))
+            if n == 0:
+                grid.place(chans, rows.missing.get(name))  # damaged records only
+                continue
+            filled = sum(1 for k in chans if k != "time")
+            prev = shape.get(name, (filled, 0))
+            shape[name] = (filled, prev[1] + n)
+            if "time" in chans:
+                steps.setdefault(name, _Steps()).add(chans["time"])
+            writer.append(name, grid.place(chans, rows.missing.get(name)))
+
     total = path.stat().st_size
-    offset, lines, done = 0, 0, 0
-    carry = b""
+    done = 0
     with open(path, "rb") as f:
         while True:
             block = f.read(chunk_bytes)
             done += len(block)
-            fin = len(block) < chunk_bytes
-            data = carry + block if carry else block
-            del block
-            raw = _core_vn.parse_vn_chunk(data, False, fin)
-            used = int(raw["bytes_consumed"])
-            tally.add(raw, offset, lines)
-            for name, cols in raw["tables"].items():
-                chans = _table_channels(cols)
-                if not chans:
-                    continue
-                grid = grids.setdefault(name, _GridStream())
-                n = len(next(iter(chans.values())))
-                if n == 0:
-                    grid.place(chans, raw["missing"].get(name))  # damaged records only
-                    continue
-                filled = sum(1 for k in chans if k != "time")
-                prev = shape.get(name, (filled, 0))
-                shape[name] = (filled, prev[1] + n)
-                if "time" in chans:
-                    steps.setdefault(name, _Steps()).add(chans["time"])
-                writer.append(name, grid.place(chans, raw["missing"].get(name)))
-            del raw
-            lines += data.count(b"\n", 0, used)
-            offset += used
-            carry = data[used:]
-            del data
+            write(stream.feed(block))
             if progress is not None:
                 progress(done, max(total, done))
-            if fin:
+            if len(block) < chunk_bytes:
                 break
-    return tally, steps, shape, grids
+            del block
+    summary = stream.finish()
+    write(summary)
+    return tables_of(summary), steps, shape, grids
 
 
 def _meta(*, fs, source, fmt, issues: ParseIssues, messages, samples, channels, table,
@@ -657,16 +588,17 @@ def convert(
     writer = _Writer(out, layout)
     try:
         if format in ("vn-ascii", "vn-binary") and path.is_file():
-            tally, steps, shape, grids = _stream_vn(path, writer, int(chunk_bytes), progress)
-            primary = _primary(shape)
+            parsed, steps, shape, grids = _stream_vn(path, writer, int(chunk_bytes), progress)
+            primary = richest_table(shape)
             step_histogram = steps.get(primary) if primary else None
             rate = fs_from_median_step(
                 step_histogram.median() if step_histogram is not None else None, fs, str(path)
             )
             grid = grids[primary] if primary else _GridStream()
-            tally.counts["duplicate_time"] += grid.duplicate_time
-            tally.counts["time_reversed"] += grid.time_reversed
-            issues, messages, fmt = tally.issues(), tally.messages, tally.format
+            counts = {**parsed.issues.counts, "duplicate_time": grid.duplicate_time,
+                      "time_reversed": grid.time_reversed}
+            issues = replace(parsed.issues, counts=counts)
+            messages, fmt = parsed.messages, parsed.format
             gaps = Gaps(index=[g[0] for g in grid.gaps], samples=[g[1] for g in grid.gaps],
                         fs=rate)
         else:
@@ -774,239 +706,3 @@ def load(out) -> ImuLog:
     gaps = None if gaps is None else Gaps(gaps["index"], gaps["samples"], fs)
     return ImuLog(fs=fs, source=meta["source"], format=meta["format"],
                   issues=issues, messages=meta["messages"], gaps=gaps, **arrays)
-
-
-# ---------------------------------------------------------------------------
-# Fleets
-# ---------------------------------------------------------------------------
-
-#: Sensors analysed by :func:`batch`.
-BATCH_SENSORS = ("gyro", "accel")
-_TERM_ORDER = ("N", "B", "K", "Q", "R")
-_VERDICT_RANK = {"fail": 3, "marginal": 2, "pass": 1, "unresolved": 0}
-#: Averaging times of the batch analysis: log-spaced points per decade (as the report).
-BATCH_TAUS = 10
-
-
-def _expand(paths) -> list[str]:
-    if isinstance(paths, (str, os.PathLike)):
-        paths = [paths]
-    out: list[str] = []
-    for p in paths:
-        if not isinstance(p, (str, os.PathLike)):
-            raise TypeError(f"paths must be paths or glob patterns; got {type(p).__name__}")
-        text = os.fspath(p)
-        matches = sorted(glob.glob(text)) if glob.has_magic(text) else [text]
-        if not matches:
-            raise ValueError(f"paths: the pattern {text!r} matches no file")
-        out += matches
-    if not out:
-        raise ValueError("paths must name at least one log; got none")
-    return out
-
-
-def _base_row(path: str) -> dict:
-    row: dict = {"path": path, "sensor": None, "axis": None, "format": None,
-                 "samples": 0, "fs": np.nan, "duration_s": np.nan}
-    for kind in ISSUE_KINDS:
-        row[f"issues_{kind}"] = 0
-    for t in _TERM_ORDER:
-        row[t] = np.nan
-        row[f"{t}_std"] = np.nan
-        row[f"{t}_supported"] = False
-    row["verdict"] = None
-    row["error"] = None
-    return row
-
-
-def analyse_log(path: str, spec=None, fs: float | None = None) -> list[dict]:
-    """The batch rows of one log: one per sensor and axis, or one error row.
-
-    Reads the log (:func:`imunoise.read`), computes the overlapping Allan
-    deviation on :data:`BATCH_TAUS` taus per decade, fits the noise model
-    (:func:`imunoise.fit`) and compares it with ``spec`` (a name, a TOML file or
-    a :class:`~imunoise.datasheet.Spec`; ``None`` skips the comparison). Never
-    raises for a bad log: the exception becomes the ``error`` of one row.
-    """
-    import imunoise
-
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            log = imunoise.read(path, fs=fs)
-        if len(log) < 2:
-            raise ValueError(f"no usable records ({log.issues})")
-        sensors = [s for s in BATCH_SENSORS if getattr(log, s) is not None]
-        if not sensors:
-            raise ValueError(f"no gyro or accel channel (has {', '.join(log.channels)})")
-        models = {s: imunoise.fit(imunoise.adev(getattr(log, s), log.fs, taus=BATCH_TAUS))
-                  for s in sensors}
-        verdicts: dict[tuple[str, str], dict[str, str]] = {}
-        if spec is not None:
-            for r in imunoise.compare(models, spec).rows:
-                verdicts.setdefault((r["sensor"], r["axis"]), {})[r["term"]] = r["verdict"]
-        rows = []
-        for s in sensors:
-            m = models[s]
-            for j, axis in enumerate(("X", "Y", "Z")[: m.channels]):
-                row = _base_row(path)
-                row.update(sensor=s, axis=axis, format=log.format, samples=len(log),
-                           fs=log.fs, duration_s=log.duration)
-                for kind, n in log.issues.counts.items():
-                    row[f"issues_{kind}"] = int(n)
-                for t in _TERM_ORDER:
-                    row[t] = float(np.atleast_1d(m.value(t))[j])
-                    row[f"{t}_std"] = float(np.atleast_1d(m.std(t))[j])
-                    row[f"{t}_supported"] = bool(np.atleast_1d(m.supported[t])[j])
-                v = verdicts.get((s, axis), {})
-                if v:
-                    row["verdict"] = max(v.values(), key=_VERDICT_RANK.__getitem__)
-                for t in _TERM_ORDER:
-                    row[f"verdict_{t}"] = v.get(t)
-                rows.append(row)
-        return rows
-    except Exception as exc:  # noqa: BLE001 - a bad log is a row, not a failed batch
-        row = _base_row(path)
-        for t in _TERM_ORDER:
-            row[f"verdict_{t}"] = None
-        row["error"] = f"{type(exc).__name__}: {exc}"
-        return [row]
-
-
-def _frame(rows: list[dict]):
-    import pandas as pd
-
-    df = pd.DataFrame(rows)
-    cols = list(_base_row("").keys())
-    cols.remove("error")
-    cols += [f"verdict_{t}" for t in _TERM_ORDER] + ["error"]
-    df = df.reindex(columns=cols)
-    df["samples"] = df["samples"].astype("int64")
-    for kind in ISSUE_KINDS:
-        df[f"issues_{kind}"] = df[f"issues_{kind}"].astype("int64")
-    for t in _TERM_ORDER:
-        df[f"{t}_supported"] = df[f"{t}_supported"].astype(bool)
-    return df
-
-
-def _bar(enabled: bool | None, total: int):
-    if enabled is None:
-        enabled = sys.stderr.isatty()
-    if not enabled:
-        return None
-    from tqdm import tqdm
-
-    return tqdm(total=total, file=sys.stderr, unit="log", desc="imunoise batch")
-
-
-def batch(
-    paths,
-    client=None,
-    spec="vn100",
-    *,
-    fs: float | None = None,
-    progress: bool | None = None,
-):
-    """Characterise many logs in parallel with dask.distributed.
-
-    Parameters
-    ----------
-    paths : str, path or sequence of them
-        Logs or glob patterns (``"logs/*.bin"``), expanded in sorted order.
-    client : None, False, str or distributed.Client
-        ``None``: start a local cluster on this machine (2 worker processes, one
-        thread each) for this call; a ``Client``: use it unchanged; a string: the
-        address of a running scheduler (``"tcp://host:8786"``); ``False``: no Dask,
-        analyse the logs one after another in this process (the reference path:
-        the results are identical).
-    spec : str, path, Spec or None
-        Datasheet to compare with (``"vn100"``, a TOML file); ``None`` or
-        ``"none"`` skips the verdict.
-    fs : float, optional
-        Sample rate of logs without timestamps.
-    progress : bool, optional
-        Show a progress bar on stderr; default: when stderr is a terminal.
-
-    Returns
-    -------
-    pandas.DataFrame
-        One row per log, sensor (gyro, accel) and axis (X, Y, Z), in the order of
-        ``paths``: ``path, sensor, axis, format, samples, fs, duration_s``, the
-        parse issue counts ``issues_<kind>``, the fitted coefficients ``N, B, K,
-        Q, R`` in the log's units (rad/s or m/s² per √s ... as
-        :class:`~imunoise.noise.NoiseModel`), their standard uncertainties
-        ``<term>_std`` and ``<term>_supported``, the datasheet ``verdict`` (worst
-        over the specified terms: fail, marginal, pass, unresolved) and per term
-        ``verdict_<term>``, and ``error``. A log that cannot be analysed has one
-        row with ``sensor`` empty and the exception in ``error``.
-
-    Notes
-    -----
-    The workers must be able to import imunoise and to read the paths (on a
-    remote cluster: the same files at the same paths).
-    """
-    from imunoise.datasheet import load_spec
-
-    files = _expand(paths)
-    if isinstance(spec, str) and spec.lower() == "none":
-        spec = None
-    if spec is not None:
-        spec = load_spec(spec)  # fail early, and ship the parsed spec to the workers
-    bar = _bar(progress, len(files))
-    try:
-        if client is False:
-            results = []
-            for p in files:
-                results.append(analyse_log(p, spec, fs))
-                if bar is not None:
-                    bar.update(1)
-        else:
-            results = _run_dask(files, client, spec, fs, bar)
-    finally:
-        if bar is not None:
-            bar.close()
-    return _frame([row for rows in results for row in rows])
-
-
-def _run_dask(files, client, spec, fs, bar) -> list[list[dict]]:
-    try:
-        from distributed import Client, LocalCluster, as_completed
-    except ImportError:
-        raise ImportError(
-            "imunoise.batch needs dask.distributed (pip install 'imunoise[scale]'); "
-            "pass client=False to run without it"
-        ) from None
-    own_cluster = own_client = None
-    if client is None:
-        own_cluster = LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                                   dashboard_address=None)
-        client = own_client = Client(own_cluster)
-    elif isinstance(client, str):
-        client = own_client = Client(client)
-    elif not isinstance(client, Client):
-        raise TypeError(
-            "client must be None, False, a scheduler address or a distributed.Client; "
-            f"got {type(client).__name__}"
-        )
-    try:
-        futures = [client.submit(analyse_log, p, spec, fs, pure=False) for p in files]
-        index = {f.key: i for i, f in enumerate(futures)}
-        results: list[list[dict] | None] = [None] * len(files)
-        for fut in as_completed(futures):
-            i = index[fut.key]
-            try:
-                results[i] = fut.result()
-            except Exception as exc:  # noqa: BLE001 - a lost worker must not lose the batch
-                row = _base_row(files[i])
-                for t in _TERM_ORDER:
-                    row[f"verdict_{t}"] = None
-                row["error"] = f"{type(exc).__name__}: {exc}"
-                results[i] = [row]
-            if bar is not None:
-                bar.update(1)
-        return results  # type: ignore[return-value]
-    finally:
-        if own_client is not None:
-            own_client.close()
-        if own_cluster is not None:
-            own_cluster.close()

@@ -1,0 +1,252 @@
+"""Fleets of logs: one noise analysis per log, in parallel.
+
+:func:`batch` analyses many logs with dask.distributed: one task per log (read,
+Allan deviation, noise fit, datasheet comparison), one result row per log, sensor
+and axis. A log that fails becomes one row with its error message.
+"""
+
+from __future__ import annotations
+
+import glob
+import os
+import sys
+import warnings
+
+import numpy as np
+
+from imunoise import _schema
+from imunoise.allan import adev
+from imunoise.datasheet import compare, load_spec
+from imunoise.noise import fit
+from imunoise.readers.log import ISSUE_KINDS
+from imunoise.readers.read import read
+
+__all__ = ["BATCH_SENSORS", "BATCH_TAUS", "analyse_log", "batch"]
+
+
+#: Sensors analysed by :func:`batch`.
+BATCH_SENSORS = _schema.ALLAN_SENSORS
+_TERM_ORDER = ("N", "B", "K", "Q", "R")
+_VERDICT_RANK = {"fail": 3, "marginal": 2, "pass": 1, "unresolved": 0}
+#: Averaging times of the batch analysis: log-spaced points per decade (as the report).
+BATCH_TAUS = 10
+
+
+def _expand(paths) -> list[str]:
+    if isinstance(paths, (str, os.PathLike)):
+        paths = [paths]
+    out: list[str] = []
+    for p in paths:
+        if not isinstance(p, (str, os.PathLike)):
+            raise TypeError(f"paths must be paths or glob patterns; got {type(p).__name__}")
+        text = os.fspath(p)
+        matches = sorted(glob.glob(text)) if glob.has_magic(text) else [text]
+        if not matches:
+            raise ValueError(f"paths: the pattern {text!r} matches no file")
+        out += matches
+    if not out:
+        raise ValueError("paths must name at least one log; got none")
+    return out
+
+
+def _base_row(path: str) -> dict:
+    row: dict = {"path": path, "sensor": None, "axis": None, "format": None,
+                 "samples": 0, "fs": np.nan, "duration_s": np.nan}
+    for kind in ISSUE_KINDS:
+        row[f"issues_{kind}"] = 0
+    for t in _TERM_ORDER:
+        row[t] = np.nan
+        row[f"{t}_std"] = np.nan
+        row[f"{t}_supported"] = False
+    row["verdict"] = None
+    row["error"] = None
+    return row
+
+
+def analyse_log(path: str, spec=None, fs: float | None = None) -> list[dict]:
+    """The batch rows of one log: one per sensor and axis, or one error row.
+
+    Reads the log (:func:`imunoise.read`), computes the overlapping Allan
+    deviation on :data:`BATCH_TAUS` taus per decade, fits the noise model
+    (:func:`imunoise.fit`) and compares it with ``spec`` (a name, a TOML file or
+    a :class:`~imunoise.datasheet.Spec`; ``None`` skips the comparison). Never
+    raises for a bad log: the exception becomes the ``error`` of one row.
+    """
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            log = read(path, fs=fs)
+        if len(log) < 2:
+            raise ValueError(f"no usable records ({log.issues})")
+        sensors = [s for s in BATCH_SENSORS if getattr(log, s) is not None]
+        if not sensors:
+            raise ValueError(f"no gyro or accel channel (has {', '.join(log.channels)})")
+        models = {s: fit(adev(getattr(log, s), log.fs, taus=BATCH_TAUS))
+                  for s in sensors}
+        verdicts: dict[tuple[str, str], dict[str, str]] = {}
+        if spec is not None:
+            for r in compare(models, spec).rows:
+                verdicts.setdefault((r["sensor"], r["axis"]), {})[r["term"]] = r["verdict"]
+        rows = []
+        for s in sensors:
+            m = models[s]
+            for j, axis in enumerate(_schema.axis_names(m.channels)):
+                row = _base_row(path)
+                row.update(sensor=s, axis=axis, format=log.format, samples=len(log),
+                           fs=log.fs, duration_s=log.duration)
+                for kind, n in log.issues.counts.items():
+                    row[f"issues_{kind}"] = int(n)
+                for t in _TERM_ORDER:
+                    row[t] = float(np.atleast_1d(m.value(t))[j])
+                    row[f"{t}_std"] = float(np.atleast_1d(m.std(t))[j])
+                    row[f"{t}_supported"] = bool(np.atleast_1d(m.supported[t])[j])
+                v = verdicts.get((s, axis), {})
+                if v:
+                    row["verdict"] = max(v.values(), key=_VERDICT_RANK.__getitem__)
+                for t in _TERM_ORDER:
+                    row[f"verdict_{t}"] = v.get(t)
+                rows.append(row)
+        return rows
+    except Exception as exc:  # noqa: BLE001 - a bad log is a row, not a failed batch
+        row = _base_row(path)
+        for t in _TERM_ORDER:
+            row[f"verdict_{t}"] = None
+        row["error"] = f"{type(exc).__name__}: {exc}"
+        return [row]
+
+
+def _frame(rows: list[dict]):
+    import pandas as pd
+
+    df = pd.DataFrame(rows)
+    cols = list(_base_row("").keys())
+    cols.remove("error")
+    cols += [f"verdict_{t}" for t in _TERM_ORDER] + ["error"]
+    df = df.reindex(columns=cols)
+    df["samples"] = df["samples"].astype("int64")
+    for kind in ISSUE_KINDS:
+        df[f"issues_{kind}"] = df[f"issues_{kind}"].astype("int64")
+    for t in _TERM_ORDER:
+        df[f"{t}_supported"] = df[f"{t}_supported"].astype(bool)
+    return df
+
+
+def _bar(enabled: bool | None, total: int):
+    if enabled is None:
+        enabled = sys.stderr.isatty()
+    if not enabled:
+        return None
+    from tqdm import tqdm
+
+    return tqdm(total=total, file=sys.stderr, unit="log", desc="imunoise batch")
+
+
+def batch(
+    paths,
+    client=None,
+    spec="vn100",
+    *,
+    fs: float | None = None,
+    progress: bool | None = None,
+):
+    """Characterise many logs in parallel with dask.distributed.
+
+    Parameters
+    ----------
+    paths : str, path or sequence of them
+        Logs or glob patterns (``"logs/*.bin"``), expanded in sorted order.
+    client : None, False, str or distributed.Client
+        ``None``: start a local cluster on this machine (2 worker processes, one
+        thread each) for this call; a ``Client``: use it unchanged; a string: the
+        address of a running scheduler (``"tcp://host:8786"``); ``False``: no Dask,
+        analyse the logs one after another in this process (the reference path:
+        the results are identical).
+    spec : str, path, Spec or None
+        Datasheet to compare with (``"vn100"``, a TOML file); ``None`` or
+        ``"none"`` skips the verdict.
+    fs : float, optional
+        Sample rate of logs without timestamps.
+    progress : bool, optional
+        Show a progress bar on stderr; default: when stderr is a terminal.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per log, sensor (gyro, accel) and axis (X, Y, Z), in the order of
+        ``paths``: ``path, sensor, axis, format, samples, fs, duration_s``, the
+        parse issue counts ``issues_<kind>``, the fitted coefficients ``N, B, K,
+        Q, R`` in the log's units (rad/s or m/s² per √s ... as
+        :class:`~imunoise.noise.NoiseModel`), their standard uncertainties
+        ``<term>_std`` and ``<term>_supported``, the datasheet ``verdict`` (worst
+        over the specified terms: fail, marginal, pass, unresolved) and per term
+        ``verdict_<term>``, and ``error``. A log that cannot be analysed has one
+        row with ``sensor`` empty and the exception in ``error``.
+
+    Notes
+    -----
+    The workers must be able to import imunoise and to read the paths (on a
+    remote cluster: the same files at the same paths).
+    """
+    files = _expand(paths)
+    if isinstance(spec, str) and spec.lower() == "none":
+        spec = None
+    if spec is not None:
+        spec = load_spec(spec)  # fail early, and ship the parsed spec to the workers
+    bar = _bar(progress, len(files))
+    try:
+        if client is False:
+            results = []
+            for p in files:
+                results.append(analyse_log(p, spec, fs))
+                if bar is not None:
+                    bar.update(1)
+        else:
+            results = _run_dask(files, client, spec, fs, bar)
+    finally:
+        if bar is not None:
+            bar.close()
+    return _frame([row for rows in results for row in rows])
+
+
+def _run_dask(files, client, spec, fs, bar) -> list[list[dict]]:
+    try:
+        from distributed import Client, LocalCluster, as_completed
+    except ImportError:
+        raise ImportError(
+            "imunoise.batch needs dask.distributed (pip install 'imunoise[scale]'); "
+            "pass client=False to run without it"
+        ) from None
+    own_cluster = own_client = None
+    if client is None:
+        own_cluster = LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                   dashboard_address=None)
+        client = own_client = Client(own_cluster)
+    elif isinstance(client, str):
+        client = own_client = Client(client)
+    elif not isinstance(client, Client):
+        raise TypeError(
+            "client must be None, False, a scheduler address or a distributed.Client; "
+            f"got {type(client).__name__}"
+        )
+    try:
+        futures = [client.submit(analyse_log, p, spec, fs, pure=False) for p in files]
+        index = {f.key: i for i, f in enumerate(futures)}
+        results: list[list[dict] | None] = [None] * len(files)
+        for fut in as_completed(futures):
+            i = index[fut.key]
+            try:
+                results[i] = fut.result()
+            except Exception as exc:  # noqa: BLE001 - a lost worker must not lose the batch
+                row = _base_row(files[i])
+                for t in _TERM_ORDER:
+                    row[f"verdict_{t}"] = None
+                row["error"] = f"{type(exc).__name__}: {exc}"
+                results[i] = [row]
+            if bar is not None:
+                bar.update(1)
+        return results  # type: ignore[return-value]
+    finally:
+        if own_client is not None:
+            own_client.close()
+        if own_cluster is not None:
+            own_cluster.close()

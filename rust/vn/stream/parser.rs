@@ -1,0 +1,507 @@
+//! The sequential parser: frames records at `$` and `0xFA`, decodes them into
+//! tables, counts issues with their first locations and keeps the byte
+//! accounting of [`crate::vn::stream`]. Blocks may end inside a record: unless
+//! told the input ends, [`Parser::feed`] leaves it for the next block.
+//!
+//! Cost: O(bytes); locations count newlines only up to the issue (lazily), so a
+//! clean stream never counts lines except once per block.
+
+use std::collections::BTreeMap;
+
+use crate::error::{CoreError, CoreResult};
+use crate::vn::ascii::{self, Decoded};
+use crate::vn::binary::{self, HeaderScan, Layout};
+use crate::vn::messages::{spec_by_id, MsgSpec};
+use crate::vn::stream::parallel::PARALLEL_MIN;
+use crate::vn::stream::scan::{count_newlines, eat_eol, scan_ascii, Ascii, Outcome};
+use crate::vn::{IssueKind, Location, Table, VnData, FIRST_KEEP};
+
+/// Layouts remembered per reader (distinct binary configurations).
+pub(super) const MAX_LAYOUTS: usize = 16;
+/// CRC failures remembered before their configuration is confirmed.
+const MAX_PENDING: usize = 64;
+
+/// A strict-mode failure: the first damaged record.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Failure {
+    pub kind: IssueKind,
+    pub location: Location,
+    pub reason: String,
+}
+
+impl Failure {
+    /// The error a strict parse returns; its text reads
+    /// `line L (byte offset O): kind: reason`.
+    pub fn into_error(self) -> CoreError {
+        CoreError::Parse {
+            kind: self.kind.name(),
+            line: Some(self.location.line),
+            offset: Some(self.location.offset),
+            reason: self.reason,
+        }
+    }
+}
+
+/// Count one record of `key` without allocating once the key exists.
+fn bump(map: &mut BTreeMap<String, u64>, key: &str) {
+    match map.get_mut(key) {
+        Some(n) => *n += 1,
+        None => {
+            map.insert(key.to_string(), 1);
+        }
+    }
+}
+
+/// Sequential parser state. Offsets passed in are relative to the current block;
+/// `base` is the absolute offset of the block start.
+pub struct Parser {
+    pub(super) strict: bool,
+    pub(super) size_hint: u64,
+    pub data: VnData,
+    /// Absolute offset of the current block's first byte.
+    pub(super) base: u64,
+    /// Newlines counted before absolute offset `line_pos` (for locations).
+    pub(super) lines: u64,
+    pub(super) line_pos: u64,
+    /// End (absolute) of the current run of skipped bytes, to record each run once.
+    pub(super) skip_end: u64,
+    /// Binary configurations seen: layout, table name, decoded rows (moved to
+    /// `data.tables` by `finish`).
+    pub(super) layouts: Vec<(Layout, String, Table)>,
+    /// Indices into `layouts` of configurations that framed a good packet.
+    pub(super) good_layouts: Vec<usize>,
+    /// CRC failures of configurations not (yet) seen in a good packet: counted as
+    /// `bad_checksum` once the configuration frames a good packet.
+    pub(super) pending: Vec<(usize, Location)>,
+    /// First damaged record in strict mode: kind, location, reason.
+    pub fail: Option<Failure>,
+    /// Message type of the last sentence taken by the fast path.
+    pub(super) last_spec: Option<&'static MsgSpec>,
+    /// Whether common sentences take [`ascii::fast_sentence`] (off only to check
+    /// that the result is the same without it).
+    pub(super) fast: bool,
+    /// Blocks at least this long are parsed on all cores.
+    pub(super) parallel_min: usize,
+    /// Pieces parsed on other cores and merged (for tests).
+    pub(super) merged_pieces: u64,
+    /// Locations kept for runs of skipped bytes (one more in a piece of a
+    /// parallel parse, see [`Parser::feed_block`]).
+    pub(super) skip_keep: usize,
+}
+
+impl Parser {
+    pub fn new(strict: bool) -> Parser {
+        Parser::with_size_hint(strict, 0)
+    }
+
+    /// A parser for a stream of about `size_hint` bytes: tables reserve their
+    /// rows once (untouched capacity costs address space, not memory).
+    pub fn with_size_hint(strict: bool, size_hint: u64) -> Parser {
+        Parser {
+            size_hint,
+            strict,
+            data: VnData::default(),
+            base: 0,
+            lines: 0,
+            line_pos: 0,
+            skip_end: u64::MAX,
+            layouts: Vec::new(),
+            good_layouts: Vec::new(),
+            pending: Vec::new(),
+            fail: None,
+            last_spec: None,
+            fast: true,
+            parallel_min: PARALLEL_MIN,
+            merged_pieces: 0,
+            skip_keep: FIRST_KEEP,
+        }
+    }
+
+    /// The same parser without the ASCII fast path: every sentence goes through
+    /// the general scanner and decoder. For equivalence tests and fuzzing.
+    pub fn without_fast_path(mut self) -> Parser {
+        self.fast = false;
+        self
+    }
+
+    /// The same parser, splitting blocks of at least `bytes` bytes across cores
+    /// (default 1 MiB). Small values exercise the parallel paths on small inputs
+    /// (equivalence tests, fuzzing); the result never depends on it.
+    pub fn with_parallel_min(mut self, bytes: usize) -> Parser {
+        self.parallel_min = bytes;
+        self
+    }
+
+    /// Rows to reserve for a table whose records are `len` bytes long.
+    fn rows_hint(&self, len: usize) -> usize {
+        let left = self.size_hint.saturating_sub(self.base);
+        (left / len.max(1) as u64).min(1 << 32) as usize
+    }
+
+    fn location(&mut self, buf: &[u8], i: usize) -> Location {
+        let abs = self.base + i as u64;
+        if abs >= self.line_pos {
+            let from = (self.line_pos.saturating_sub(self.base)) as usize;
+            let from = from.min(i);
+            self.lines += count_newlines(&buf[from..i]);
+            self.line_pos = abs;
+        }
+        Location {
+            offset: abs,
+            line: self.lines + 1,
+        }
+    }
+
+    fn issue(&mut self, buf: &[u8], i: usize, kind: IssueKind, reason: &str) {
+        let fails = self.strict && kind.fails_strict() && self.fail.is_none();
+        let wants = self.data.issues.wants_location(kind);
+        if fails || wants {
+            let loc = self.location(buf, i);
+            if wants {
+                self.data.issues.first[kind as usize].push(loc);
+            }
+            if fails {
+                self.fail = Some(Failure {
+                    kind,
+                    location: loc,
+                    reason: reason.to_string(),
+                });
+            }
+        }
+        self.data.issues.counts[kind as usize] += 1;
+    }
+
+    fn skip(&mut self, buf: &[u8], i: usize, n: usize) {
+        let abs = self.base + i as u64;
+        if abs != self.skip_end {
+            let kind = IssueKind::BytesSkipped;
+            if self.data.issues.first[kind as usize].len() < self.skip_keep {
+                let loc = self.location(buf, i);
+                self.data.issues.first[kind as usize].push(loc);
+            }
+        }
+        self.skip_end = abs + n as u64;
+        self.data.issues.counts[IssueKind::BytesSkipped as usize] += n as u64;
+        self.data.bytes_skipped += n as u64;
+    }
+
+    fn push_ascii(&mut self, decoded: Decoded, buf: &[u8], i: usize, len: usize) {
+        match decoded {
+            Decoded::Data {
+                spec,
+                values,
+                count,
+                status,
+            } => {
+                if !self.data.tables.contains_key(spec.id) {
+                    let mut table = Table::new(spec.fields.iter().map(|s| s.to_string()).collect());
+                    table.reserve(self.rows_hint(len));
+                    self.data.tables.insert(spec.id.to_string(), table);
+                }
+                let Some(table) = self.data.tables.get_mut(spec.id) else {
+                    return;
+                };
+                table.push_row(&values[..spec.fields.len()]);
+                if let Some(c) = count {
+                    table.set_extra("serial_count", c);
+                }
+                if let Some(s) = status {
+                    table.set_extra("status", s);
+                }
+                self.data.bytes_parsed += len as u64;
+                self.data.ascii_records += 1;
+            }
+            Decoded::Command(id) => {
+                bump(&mut self.data.messages, id);
+                self.data.bytes_parsed += len as u64;
+                self.data.ascii_records += 1;
+            }
+            Decoded::DeviceError(code) => {
+                let table = self
+                    .data
+                    .tables
+                    .entry("VNERR".to_string())
+                    .or_insert_with(|| Table::new(vec!["code".to_string()]));
+                table.push_row(&[code as f64]);
+                self.issue(buf, i, IssueKind::DeviceError, "device error report");
+                self.data.bytes_in_bad_records += len as u64;
+            }
+            Decoded::Unknown => {
+                self.issue(
+                    buf,
+                    i,
+                    IssueKind::UnknownMessage,
+                    "message type not decoded",
+                );
+                self.data.bytes_in_bad_records += len as u64;
+            }
+            Decoded::Malformed(reason) => {
+                self.issue(buf, i, IssueKind::MalformedField, &reason);
+                self.note_ascii_missing(buf, i);
+                self.data.bytes_in_bad_records += len as u64;
+            }
+        }
+    }
+
+    /// A damaged sentence at `buf[i] == b'$'`: when its message type can still be
+    /// read (`$VNxxx` then `,` or `*`), one sample of that stream is missing here.
+    fn note_ascii_missing(&mut self, buf: &[u8], i: usize) {
+        let Some(head) = buf.get(i + 1..i + 7) else {
+            return;
+        };
+        if head[5] != b',' && head[5] != b'*' {
+            return;
+        }
+        let Some(spec) = spec_by_id(&head[..5]) else {
+            return;
+        };
+        self.data
+            .tables
+            .entry(spec.id.to_string())
+            .or_insert_with(|| Table::new(spec.fields.iter().map(|s| s.to_string()).collect()))
+            .note_missing();
+    }
+
+    fn layout_index(&mut self, buf: &[u8], i: usize) -> Result<usize, bool> {
+        // Fast path: a known header.
+        for (k, (l, _, _)) in self.layouts.iter().enumerate() {
+            let h = &l.header;
+            if buf.get(i + 1..i + 1 + h.len()) == Some(h.as_slice()) {
+                return Ok(k);
+            }
+        }
+        match binary::parse_header(&buf[i..]) {
+            HeaderScan::Incomplete => Err(true),
+            HeaderScan::Invalid => Err(false),
+            HeaderScan::Ok(layout) => {
+                if self.layouts.len() >= MAX_LAYOUTS {
+                    // Forget configurations that never framed a good packet.
+                    let keep: Vec<usize> = self.good_layouts.clone();
+                    if keep.len() >= MAX_LAYOUTS {
+                        return Err(false);
+                    }
+                    let mut kept = Vec::new();
+                    for (k, entry) in self.layouts.drain(..).enumerate() {
+                        if keep.contains(&k) {
+                            kept.push(entry);
+                        }
+                    }
+                    self.layouts = kept;
+                    self.pending.clear();
+                    self.good_layouts = (0..self.layouts.len()).collect();
+                }
+                let name = layout.table_name();
+                self.layouts.push((layout, name, Table::default()));
+                Ok(self.layouts.len() - 1)
+            }
+        }
+    }
+
+    /// Parse `buf` (absolute offset `self.base`). Returns the number of bytes
+    /// consumed; unless `fin`, a record cut by the end of `buf` is left for the
+    /// next call (at most [`binary::MAX_PACKET`] bytes).
+    pub fn feed(&mut self, buf: &[u8], fin: bool) -> usize {
+        let n = buf.len();
+        let mut i = 0usize;
+        while i < n {
+            if self.fail.is_some() {
+                return n;
+            }
+            match buf[i] {
+                b'$' if self.fast && self.fast_ascii(buf, &mut i) => {}
+                b'$' => match scan_ascii(buf, i, fin) {
+                    Ascii::Need => break,
+                    Ascii::Noise => {
+                        self.skip(buf, i, 1);
+                        i += 1;
+                    }
+                    Ascii::Record { end, outcome } => {
+                        let len = end - i;
+                        match outcome {
+                            Outcome::Good { body } => {
+                                let d = ascii::decode(&buf[body.0..body.1]);
+                                self.push_ascii(d, buf, i, len);
+                            }
+                            Outcome::Issue(kind, reason) => {
+                                self.issue(buf, i, kind, &reason);
+                                self.note_ascii_missing(buf, i);
+                                self.data.bytes_in_bad_records += len as u64;
+                            }
+                        }
+                        i = end;
+                    }
+                },
+                0xFA => match self.binary_at(buf, i, fin) {
+                    None => break,
+                    Some(next) => i = next,
+                },
+                _ => {
+                    let j = buf[i..]
+                        .iter()
+                        .position(|&c| c == b'$' || c == 0xFA)
+                        .map_or(n, |p| i + p);
+                    self.skip(buf, i, j - i);
+                    i = j;
+                }
+            }
+        }
+        // Keep the line count current up to the consumed end: the next block
+        // no longer sees these bytes.
+        let from = (self.line_pos.saturating_sub(self.base) as usize).min(i);
+        self.lines += count_newlines(&buf[from..i]);
+        self.base += i as u64;
+        self.line_pos = self.base;
+        self.data.bytes_total += i as u64;
+        i
+    }
+
+    /// The common sentence ([`ascii::fast_sentence`]) at `buf[*i] == b'$'`:
+    /// decoded and `*i` moved past it, or `false` with nothing changed.
+    #[inline]
+    fn fast_ascii(&mut self, buf: &[u8], i: &mut usize) -> bool {
+        let Some((spec, values, star)) = ascii::fast_sentence(&buf[*i..], self.last_spec) else {
+            return false;
+        };
+        self.last_spec = Some(spec);
+        let end = eat_eol(buf, *i + star + 3);
+        let len = end - *i;
+        let table = match self.data.tables.get_mut(spec.id) {
+            Some(t) => t,
+            None => {
+                let mut table = Table::new(spec.fields.iter().map(|s| s.to_string()).collect());
+                table.reserve(self.rows_hint(len));
+                self.data.tables.entry(spec.id.to_string()).or_insert(table)
+            }
+        };
+        table.push_row(&values[..spec.fields.len()]);
+        self.data.bytes_parsed += len as u64;
+        self.data.ascii_records += 1;
+        *i = end;
+        true
+    }
+
+    /// Try a binary packet at `buf[i] == 0xFA`; `None` means "need more input".
+    fn binary_at(&mut self, buf: &[u8], i: usize, fin: bool) -> Option<usize> {
+        let n = buf.len();
+        let k = match self.layout_index(buf, i) {
+            Ok(k) => k,
+            Err(true) if !fin => return None,
+            Err(_) => {
+                self.skip(buf, i, 1);
+                return Some(i + 1);
+            }
+        };
+        let hl = 1 + self.layouts[k].0.header.len();
+        let size = match binary::payload_size(&self.layouts[k].0, &buf[i + hl..]) {
+            Ok(s) => s,
+            Err(true) if !fin => return None,
+            Err(_) => {
+                self.skip(buf, i, 1);
+                return Some(i + 1);
+            }
+        };
+        let end = i + hl + size + 2;
+        if end > n {
+            if !fin {
+                return None;
+            }
+            if self.good_layouts.contains(&k) {
+                self.issue(
+                    buf,
+                    i,
+                    IssueKind::TruncatedRecord,
+                    "input ends inside a binary packet",
+                );
+                self.layouts[k].2.note_missing();
+                self.data.bytes_in_bad_records += (n - i) as u64;
+                return Some(n);
+            }
+            self.skip(buf, i, 1);
+            return Some(i + 1);
+        }
+        if !binary::crc_ok(&buf[i..end]) {
+            if self.good_layouts.contains(&k) {
+                let reason = "binary packet CRC mismatch";
+                // The record is counted; its bytes are re-scanned (resync one byte).
+                self.issue(buf, i, IssueKind::BadChecksum, reason);
+                self.layouts[k].2.note_missing();
+            } else if self.pending.len() < MAX_PENDING {
+                let loc = self.location(buf, i);
+                self.pending.push((k, loc));
+            }
+            self.skip(buf, i, 1);
+            return Some(i + 1);
+        }
+        if !self.good_layouts.contains(&k) {
+            self.good_layouts.push(k);
+            let kind = IssueKind::BadChecksum;
+            for (_, loc) in self.pending.iter().filter(|(p, _)| *p == k) {
+                if self.data.issues.wants_location(kind) {
+                    self.data.issues.first[kind as usize].push(*loc);
+                }
+                self.data.issues.counts[kind as usize] += 1;
+                if self.strict && self.fail.is_none() {
+                    self.fail = Some(Failure {
+                        kind,
+                        location: *loc,
+                        reason: "binary packet CRC mismatch".to_string(),
+                    });
+                }
+            }
+            self.pending.retain(|(p, _)| *p != k);
+        }
+        let (layout, _, table) = &mut self.layouts[k];
+        if table.names.is_empty() {
+            *table = Table::new(layout.column_names());
+            let rows = (self.size_hint.saturating_sub(self.base + i as u64) / (end - i) as u64)
+                .min(1 << 32) as usize;
+            table.reserve(rows);
+        }
+        binary::decode_into(layout, &buf[i + hl..i + hl + size], table);
+        self.data.bytes_parsed += (end - i) as u64;
+        self.data.binary_records += 1;
+        Some(end)
+    }
+
+    /// Move out the rows decoded so far, by table name (ASCII message types and
+    /// binary configurations), padded as [`Parser::finish`] pads them; parsing
+    /// goes on with empty tables of the same columns (see [`super::Pieces`]).
+    pub fn take_tables(&mut self) -> BTreeMap<String, Table> {
+        let mut out = BTreeMap::new();
+        for (name, table) in self.data.tables.iter_mut() {
+            let fresh = Table::new(table.names.clone());
+            out.insert(name.clone(), std::mem::replace(table, fresh));
+        }
+        for (_, name, table) in self.layouts.iter_mut() {
+            if !table.names.is_empty() {
+                let fresh = Table::new(table.names.clone());
+                out.insert(name.clone(), std::mem::replace(table, fresh));
+            }
+        }
+        out.retain(|_, table| table.len > 0 || !table.missing.is_empty());
+        for table in out.values_mut() {
+            table.finish();
+        }
+        out
+    }
+
+    /// Finish: pad tables and turn a strict-mode failure into an error.
+    pub fn finish(mut self) -> CoreResult<VnData> {
+        if let Some(failure) = self.fail.take() {
+            return Err(failure.into_error());
+        }
+        for (_, name, table) in self.layouts.drain(..) {
+            if table.len > 0 {
+                self.data.tables.insert(name, table);
+            }
+        }
+        for (name, t) in self.data.tables.iter_mut() {
+            t.finish();
+            t.shrink();
+            if name != "VNERR" {
+                self.data.messages.insert(name.clone(), t.len as u64);
+            }
+        }
+        Ok(self.data)
+    }
+}
