@@ -13,8 +13,8 @@ from imunoise.simulate_log import still_log
 def _damaged() -> bytes:
     log = still_log(0.02, 40.0, seed=5)
     ascii_part = bytearray(imunoise.write_vn_ascii(log, "VNYMR"))
-    star = ascii_part.index(b"*", 5000)
-    ascii_part[star + 1] = ord("0") if ascii_part[star + 1] != ord("0") else ord("1")  # bad checksum
+    star = ascii_part.index(b"*", 5000)  # one bad checksum: another first hex digit
+    ascii_part[star + 1] = ord("0") if ascii_part[star + 1] != ord("0") else ord("1")
     binary_part = imunoise.write_vn_binary(log)
     return bytes(ascii_part[:40_000]) + b"noise" + binary_part + bytes(ascii_part[40_000:-30])
 

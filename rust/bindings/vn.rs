@@ -231,6 +231,9 @@ fn vn_message_fields(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
 /// crc=False, line_ending=b"\r\n") -> bytes
 #[pyfunction]
 #[pyo3(signature = (message, columns, decimals=None, count=None, status=None, crc=false, line_ending=b"\r\n".to_vec()))]
+#[pyo3(
+    text_signature = "(message, columns, decimals=None, count=None, status=None, crc=False, line_ending=b'\\r\\n')"
+)]
 #[allow(clippy::too_many_arguments)]
 fn write_vn_ascii<'py>(
     py: Python<'py>,

@@ -2,15 +2,31 @@
 
 import os
 from collections.abc import Callable
+from typing import final
 
 import numpy as np
 import numpy.typing as npt
+
+__all__ = [
+    "FIRST_KEEP",
+    "ISSUE_KINDS",
+    "VnResult",
+    "VnRows",
+    "VnStream",
+    "parse_vn",
+    "vn_binary_columns",
+    "vn_binary_fields",
+    "vn_message_fields",
+    "write_vn_ascii",
+    "write_vn_binary",
+]
 
 #: The parser's issue kinds, in order.
 ISSUE_KINDS: tuple[str, ...]
 #: First locations kept per issue kind.
 FIRST_KEEP: int
 
+@final
 class VnResult:
     """What a parse produced (``parse_vn``, ``VnStream.finish``)."""
 
@@ -45,6 +61,7 @@ class VnResult:
     def format(self) -> str:
         """"vn-binary" if binary packets outnumber sentences, else "vn-ascii"."""
 
+@final
 class VnRows:
     """The rows of one piece of a stream (``VnStream.feed``)."""
 
@@ -53,12 +70,13 @@ class VnRows:
     @property
     def missing(self) -> dict[str, npt.NDArray[np.uint64]]: ...
 
+@final
 class VnStream:
     """One VN parse fed piece by piece: ``feed`` returns the rows the bytes so far
     complete; ``finish`` the summary of the whole stream (its tables hold the last
     rows only). Counts, first locations and lines run on across pieces."""
 
-    def __init__(self, strict: bool = False) -> None: ...
+    def __new__(cls, strict: bool = False) -> VnStream: ...
     def feed(self, data: bytes) -> VnRows: ...
     def finish(self) -> VnResult: ...
 
