@@ -19,7 +19,9 @@ finite = st.floats(-1e6, 1e6, allow_nan=False, allow_infinity=False)
     offset=st.floats(-1e3, 1e3),
 )
 def test_scale_and_offset_invariance(y, scale, offset):
-    if np.ptp(y) == 0:
+    # Below ~1e-100 the squared differences (scaled by up to 1e-3) reach the
+    # subnormal range, where float64 keeps fewer digits than the tolerance.
+    if np.ptp(y) < 1e-100:
         return
     for func in FUNCS:
         base = func(y, 10.0)

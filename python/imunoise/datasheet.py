@@ -191,7 +191,8 @@ def compare(models, spec="vn100", *, sensor: str = "gyro", input_units: dict | N
     -------
     Comparison
     """
-    from imunoise.noise import NoiseModel, _axis_names
+    from imunoise._schema import axis_names as _axis_names
+    from imunoise.noise import NoiseModel
 
     if isinstance(models, NoiseModel):
         if sensor not in _units.SENSORS:
