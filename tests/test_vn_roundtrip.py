@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 from imunoise._core import vn as _core_vn
 from imunoise.readers.vn import read_vn_tables
-from imunoise.readers.vn_write import binary_columns
+from imunoise.writers.vn import binary_columns
 
 FIELDS = _core_vn.vn_message_fields()
 NANOS = ("time_startup", "time_gps", "time_syncin", "time_pps", "gps_tow")
