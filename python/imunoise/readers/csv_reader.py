@@ -22,8 +22,12 @@ import numpy as np
 
 from imunoise.readers._sentences import IssueTally, sentence_rows
 from imunoise.readers.log import CHANNELS, ImuLog, log_on_grid
+from imunoise.readers.probe import Confidence, Probe
 
-__all__ = ["UNITS", "read_csv"]
+__all__ = ["SUFFIXES", "UNITS", "read_csv", "sniff"]
+
+#: Extensions read as delimited text whatever the content.
+SUFFIXES = (".csv", ".tsv")
 
 _G = 9.80665
 
@@ -96,6 +100,18 @@ _RAW_NAMES = ("raw", "sentence", "raw_imu_string", "vnymr")
 _SENTENCE = re.compile(r"\$VN[A-Z]{3}[,*]")
 
 _CHUNK_BYTES = 1 << 22
+
+
+def sniff(probe: Probe) -> Confidence:
+    """A ``.csv``/``.tsv`` file, or a first line with a delimiter (a weak guess)."""
+    if probe.is_dir:
+        return Confidence.NO
+    if probe.suffix in SUFFIXES:
+        return Confidence.NAME
+    first_line = probe.head.split(b"\n", 1)[0]
+    if any(d in first_line for d in (b",", b"\t", b";", b" ")):
+        return Confidence.GUESS
+    return Confidence.NO
 
 
 def _normalise(name: str) -> tuple[str, str | None]:

@@ -26,6 +26,7 @@ Issue locations are 1-based message numbers on the topic (``issues.location ==
 
 from __future__ import annotations
 
+import errno
 import os
 import tempfile
 import warnings
@@ -36,15 +37,30 @@ import numpy as np
 
 from imunoise.readers._sentences import IssueTally, sentence_rows
 from imunoise.readers.log import ImuLog, log_on_grid
+from imunoise.readers.probe import Confidence, Probe
 
-__all__ = ["read_rosbag"]
+__all__ = ["SIGNATURES", "read_rosbag", "sniff"]
 
 IMU = "sensor_msgs/msg/Imu"
 MAG = "sensor_msgs/msg/MagneticField"
 TESLA_TO_GAUSS = 1e4
 _BATCH = 20_000  # messages per call of the VN parser
 
-_MAGIC = {b"#ROSBAG": ".bag", b"\x89MCAP": ".mcap", b"SQLite format 3": ".db3"}
+#: First bytes of each bag file format -> the extension rosbags reads it by.
+SIGNATURES = {b"#ROSBAG V2.0": ".bag", b"\x89MCAP": ".mcap", b"SQLite format 3\x00": ".db3"}
+
+
+def sniff(probe: Probe) -> Confidence:
+    """A bag by magic number or extension, or a ROS 2 bag directory."""
+    if probe.is_dir:
+        path = probe.path
+        is_bag = (
+            (path / "metadata.yaml").exists() or any(path.glob("*.db3")) or any(path.glob("*.mcap"))
+        )
+        return Confidence.SIGNATURE if is_bag else Confidence.NO
+    if probe.suffix in SIGNATURES.values() or probe.head.startswith(tuple(SIGNATURES)):
+        return Confidence.SIGNATURE
+    return Confidence.NO
 
 
 def _typestore(typestore, msg_defs: Mapping[str, str] | None):
@@ -142,7 +158,7 @@ def read_rosbag(
 
     if isinstance(source, bytes | bytearray | memoryview):
         data = bytes(source)
-        suffix = next((s for m, s in _MAGIC.items() if data.startswith(m)), None)
+        suffix = next((s for m, s in SIGNATURES.items() if data.startswith(m)), None)
         if suffix is None:
             raise ValueError("source: bytes are not a ROS 1 bag, an MCAP file or a sqlite3 bag")
         with tempfile.TemporaryDirectory() as tmp:
@@ -162,7 +178,7 @@ def read_rosbag(
         raise TypeError(f"source must be a path or bytes; got {type(source).__name__}")
     path = Path(source)
     if not path.exists():
-        raise FileNotFoundError(f"source: no such bag {str(path)!r}")
+        raise FileNotFoundError(errno.ENOENT, "no such bag", str(path))
     name = str(path)
     total = (
         sum(p.stat().st_size for p in path.iterdir() if p.is_file())
