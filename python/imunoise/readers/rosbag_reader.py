@@ -356,7 +356,7 @@ def _read_vn_topic(reader, conns, kind, field, tally, strict, name, tick) -> _To
     kept_ns: list[np.ndarray] = []
     messages: dict[str, int] = {}
 
-    def flush():
+    def flush() -> None:
         # sentences are decoded in batches so that no Python object per message
         # outlives its batch
         rows = sentence_rows(items, locs, tally, strict=strict, source=name, where="message")
