@@ -12,6 +12,7 @@ import pytest
 import vn_helpers
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from imunoise.errors import ParseError
 from imunoise.readers import csv_reader
 from imunoise.readers.csv_reader import read_csv
 from vn_helpers import ymr, ymr_fields
@@ -190,7 +191,7 @@ def test_bad_arguments():
 # -- bad rows ---------------------------------------------------------------------------
 
 
-def test_malformed_rows_counted_with_line_numbers():
+def test_malformed_rows_counted_with_line_numbers(tmp_path):
     text = (
         "# exported by a logger\n"
         "t;gx;gy;gz\n"  # line 2
@@ -208,10 +209,24 @@ def test_malformed_rows_counted_with_line_numbers():
     assert log.issues.counts["malformed_field"] == 4
     assert log.issues.first["malformed_field"] == (4, 6, 8, 9)
     np.testing.assert_array_equal(log.gyro, [[1, 2, 3], [4, 5, 6], [1, 1, 1]])
-    with pytest.raises(ValueError, match=r"line 4: 3 fields, expected 4"):
+    with pytest.raises(ParseError) as info:
         read_csv(text.encode(), strict=True)
-    with pytest.raises(ValueError, match=r"line 5: column 3 is not a number: 'x'"):
+    error = info.value
+    assert (error.kind, error.line, error.offset, error.source) == (
+        "malformed_field",
+        4,
+        None,
+        None,  # bytes in memory
+    )
+    assert error.reason == "3 fields, expected 4"
+    with pytest.raises(ParseError) as info:
         read_csv(text.replace("0.01;1;2\n", "").encode(), strict=True)
+    assert (info.value.line, info.value.reason) == (5, "column 3 is not a number: 'x'")
+    path = tmp_path / "log.csv"
+    path.write_text(text)
+    with pytest.raises(ParseError) as info:
+        read_csv(path, strict=True)
+    assert (info.value.line, info.value.source) == (4, str(path))
 
 
 @pytest.mark.parametrize("chunk", [1 << 22, 997])
@@ -260,8 +275,8 @@ def test_random_rows_are_all_accounted_for(rows, crlf):
     assert not np.isinf(log.gyro).any()
     try:
         strict = read_csv(text.encode(), fs=10.0, strict=True)
-    except ValueError as exc:
-        assert "line" in str(exc) and log.issues.total > 0
+    except ParseError as exc:
+        assert exc.line == log.issues.first["malformed_field"][0]
     else:
         assert len(strict) == len(log) and log.issues.total == 0
 

@@ -285,7 +285,7 @@ def test_vn_ascii_damaged_sentences_are_missing_samples_in_place():
 
 
 def test_vn_ascii_serial_counter_places_samples():
-    from imunoise.readers.vn_write import write_vn_ascii
+    from imunoise.writers.vn import write_vn_ascii
 
     n = 50
     count = np.arange(n, dtype=float) * 2 + 1000  # a SyncOut counter, step 2
@@ -299,7 +299,7 @@ def test_vn_ascii_serial_counter_places_samples():
 
 
 def test_vn_binary_time_startup_gaps():
-    from imunoise.readers.vn_write import write_vn_binary
+    from imunoise.writers.vn import write_vn_binary
 
     n = 200
     rng = np.random.default_rng(4)
@@ -319,7 +319,7 @@ def test_vn_binary_time_startup_gaps():
 
 
 def test_vn_binary_bad_crc_without_time_is_a_missing_sample():
-    from imunoise.readers.vn_write import write_vn_binary
+    from imunoise.writers.vn import write_vn_binary
 
     n = 20
     packets = [

@@ -77,8 +77,8 @@ def test_arbitrary_variances_never_crash(var, method):
 @pytest.mark.parametrize(
     ("kwargs", "exc", "word"),
     [
-        ({"n": 0}, ValueError, "n must"),
-        ({"n": 1.5}, TypeError, "n must"),
+        ({"n_samples": 0}, ValueError, "n_samples must"),
+        ({"n_samples": 1.5}, TypeError, "n_samples must"),
         ({"fs": 0.0}, ValueError, "fs must"),
         ({"fs": np.nan}, ValueError, "fs must"),
         ({"N": -1.0}, ValueError, "N must"),
@@ -88,6 +88,6 @@ def test_arbitrary_variances_never_crash(var, method):
     ],
 )
 def test_simulate_errors(kwargs, exc, word):
-    args = {"n": 10, "fs": 1.0} | kwargs
+    args = {"n_samples": 10, "fs": 1.0} | kwargs
     with pytest.raises(exc, match=word):
         imunoise.simulate(**args)

@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import vn_helpers
+from imunoise.errors import ParseError
 from imunoise.readers import rosbag_reader
 from imunoise.readers.rosbag_reader import read_rosbag
 from rosbags.highlevel import AnyReader
@@ -269,3 +270,25 @@ def test_custom_vn_message_bad_sentences(tmp_path, batch, monkeypatch):
     np.testing.assert_allclose(log.time, np.array(ns) * 1e-9, atol=5e-7, rtol=0)
     with pytest.raises(ValueError, match=r"message 5\b"):
         read_rosbag(tmp_path / "vn", strict=True)
+
+
+def test_strict_error_names_the_message(tmp_path):
+    store = get_typestore(Stores.ROS2_HUMBLE)
+    ns = [10**18 + k * 10**7 for k in range(6)]
+    gyro = [[k, 0.0, 0.0] for k in range(6)]
+    gyro[2][1] = np.nan  # message 3 is damaged
+    items = [
+        (t, _imu(store, t, w, [0, 0, 9.8], [0, 0, 0, 1])) for t, w in zip(ns, gyro, strict=True)
+    ]
+    _write(tmp_path / "bag", store, {"/imu": ("sensor_msgs/msg/Imu", items)}, StoragePlugin.MCAP)
+    log = read_rosbag(tmp_path / "bag")
+    assert log.issues.first["malformed_field"] == (3,) and list(log.gaps.index) == [2]
+    with pytest.raises(ParseError) as info:
+        read_rosbag(tmp_path / "bag", strict=True)
+    error = info.value
+    assert (error.kind, error.line, error.reason) == ("malformed_field", 3, "non-finite value")
+    assert error.source == str(tmp_path / "bag")
+    (mcap,) = (tmp_path / "bag").glob("*.mcap")
+    with pytest.raises(ParseError) as info:
+        read_rosbag(mcap.read_bytes(), strict=True)
+    assert (info.value.line, info.value.source) == (3, None)  # bytes in memory

@@ -60,3 +60,29 @@ def test_long_flicker_is_chunked_consistently():
     steps = np.diff(y)
     seams = steps[(1 << 10) - 1 :: 1 << 10]
     assert np.std(seams) == pytest.approx(np.std(steps), rel=0.3)
+
+
+def test_old_call_forms_warn_and_give_the_same_samples():
+    new = imunoise.simulate(200, 10.0, 0.0, 1.0, channels=2, seed=3)
+    with pytest.warns(DeprecationWarning, match=r"simulate\(n=...\) is deprecated"):
+        np.testing.assert_array_equal(
+            imunoise.simulate(n=200, fs=10.0, N=1.0, channels=2, seed=3), new
+        )
+    with pytest.warns(DeprecationWarning, match="channels, seed to simulate"):
+        np.testing.assert_array_equal(
+            imunoise.simulate(200, 10.0, 0.0, 1.0, 0.0, 0.0, 0.0, 2, 3), new
+        )
+    with pytest.raises(TypeError, match="both 'n_samples' and its old name 'n'"):
+        imunoise.simulate(n_samples=10, fs=1.0, n=10)
+    with pytest.raises(TypeError, match="at most 9 positional"):
+        imunoise.simulate(10, 1.0, 0, 0, 0, 0, 0, 1, None, ())
+
+
+def test_sample_rate_checks():
+    for fs in (0.0, -5, float("nan"), float("inf")):
+        with pytest.raises(ValueError, match=r"fs must be positive and finite \(Hz\)"):
+            imunoise.simulate(10, fs)
+    for fs in ("100", None, True):
+        with pytest.raises(TypeError, match="fs must be a real number of Hz"):
+            imunoise.simulate(10, fs)
+    assert imunoise.simulate(3, np.float32(2.0)).shape == (3,)

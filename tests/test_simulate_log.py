@@ -36,3 +36,6 @@ def test_still_log_is_reproducible_and_validates():
         still_log(1e-6, 40.0)
     with pytest.raises(ValueError, match="format must be one of vn-ascii, vn-binary; got 'csv'"):
         simulate_log("x.csv", 0.01, format="csv")
+    with pytest.warns(DeprecationWarning, match="format to simulate_log"):
+        with pytest.raises(ValueError, match="format must be one of"):
+            simulate_log("x.csv", 0.01, 40.0, "csv")

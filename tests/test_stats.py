@@ -50,6 +50,16 @@ def test_describe_array_and_table():
         imunoise.describe([1.0, np.inf, 2.0])
     with pytest.raises(TypeError, match="dtype"):
         imunoise.describe(np.array(["a", "b"]))
+    with pytest.warns(DeprecationWarning, match=r"describe\(log_or_array=...\)"):
+        old = imunoise.describe(log_or_array=x, fs=2.0)
+    np.testing.assert_array_equal(old.drift_per_hour, d.drift_per_hour)
+
+
+def test_distribution_bins_by_position_is_deprecated():
+    x = np.random.default_rng(1).normal(size=500)
+    with pytest.warns(DeprecationWarning, match="bins= by keyword"):
+        old = imunoise.distribution(x, 15)
+    np.testing.assert_array_equal(old.edges, imunoise.distribution(x, bins=15).edges)
 
 
 def test_distribution_matches_scipy():

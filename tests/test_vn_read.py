@@ -1,11 +1,11 @@
 """imunoise.read: format detection and dispatch to the CSV and ROS bag readers."""
 
-import sys
-import types
+from dataclasses import replace
 
 import imunoise
 import pytest
 from conftest import DATA
+from imunoise.readers import registry
 from imunoise.readers.read import detect_format
 from imunoise.readers.vn import parse_vn_sentences
 
@@ -28,22 +28,21 @@ def test_detect(tmp_path):
         detect_format(b"\x00\x01\x02")
 
 
-@pytest.mark.parametrize(
-    ("fmt", "module", "func"),
-    [("csv", "csv_reader", "read_csv"), ("rosbag", "rosbag_reader", "read_rosbag")],
-)
-def test_dispatch(monkeypatch, fmt, module, func):
+@pytest.mark.parametrize("fmt", ["csv", "rosbag"])
+def test_dispatch(monkeypatch, fmt):
     calls = []
-    fake = types.ModuleType(f"imunoise.readers.{module}")
 
     def reader(source, *, strict, fs, progress):
         calls.append((source, strict, fs, progress))
         return "log"
 
-    setattr(fake, func, reader)
-    monkeypatch.setitem(sys.modules, f"imunoise.readers.{module}", fake)
-    assert imunoise.read(b"a,b\n1,2\n", fmt, strict=True, fs=5.0) == "log"
+    entries = [replace(f, read=reader) if f.name == fmt else f for f in registry.FORMATS]
+    monkeypatch.setattr(registry, "FORMATS", tuple(entries))
+    assert imunoise.read(b"a,b\n1,2\n", format=fmt, strict=True, fs=5.0) == "log"
     assert calls == [(b"a,b\n1,2\n", True, 5.0, None)]
+    with pytest.warns(DeprecationWarning, match="format= by keyword"):
+        assert imunoise.read(b"a,b\n1,2\n", fmt) == "log"
+    assert calls[-1] == (b"a,b\n1,2\n", False, None, None)
 
 
 def test_parse_vn_sentences_embedded():

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 from imunoise._core import vn as _core_vn
 from imunoise.readers.vn import read_vn_tables
-from imunoise.readers.vn_write import binary_columns
+from imunoise.writers.vn import binary_columns
 
 FIELDS = _core_vn.vn_message_fields()
 NANOS = ("time_startup", "time_gps", "time_syncin", "time_pps", "gps_tow")
@@ -111,3 +111,14 @@ def test_writer_errors_name_the_problem():
         imunoise.write_vn_ascii({"ypr": np.full((2, 3), np.nan)}, "VNYPR")
     with pytest.raises(ValueError, match="unknown field"):
         imunoise.write_vn_binary({}, {"common": ["Nope"]})
+
+
+def test_old_writer_module_still_imports_with_a_warning(monkeypatch):
+    import importlib
+    import sys
+
+    monkeypatch.delitem(sys.modules, "imunoise.readers.vn_write", raising=False)
+    with pytest.warns(DeprecationWarning, match="imunoise.writers.vn"):
+        old = importlib.import_module("imunoise.readers.vn_write")
+    assert old.write_vn_ascii is imunoise.write_vn_ascii
+    assert old.write_vn_binary is imunoise.write_vn_binary

@@ -26,11 +26,11 @@ from imunoise.errors import ParseError
 from imunoise.noise import NoiseModel, fit
 from imunoise.readers import Gaps, ImuLog, ParseIssues
 from imunoise.readers.read import read
-from imunoise.readers.vn_write import write_vn_ascii, write_vn_binary
 from imunoise.scale import batch
 from imunoise.simulate import simulate
 from imunoise.simulate_log import simulate_log
 from imunoise.stats import describe, distribution
+from imunoise.writers.vn import write_vn_ascii, write_vn_binary
 
 __all__ = [
     "__version__",
