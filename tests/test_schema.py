@@ -2,13 +2,11 @@
 API helpers that keep old call forms working warn and forward exactly."""
 
 import math
-import warnings
 
 import imunoise
 import numpy as np
 import pytest
 from imunoise import _schema, noise, units
-from imunoise._api import positional_options, renamed_keyword
 from imunoise._core import fit as core_fit
 from imunoise.readers import log as readers_log
 
@@ -39,34 +37,10 @@ def test_axis_names():
 
 def test_fit_options_by_position_still_work_with_a_warning():
     r = imunoise.adev(np.random.default_rng(1).normal(size=20_000), 100.0)
-    with pytest.warns(DeprecationWarning, match="method=..."):
+    with pytest.warns(DeprecationWarning, match="pass method= by keyword"):
         old = imunoise.fit(r, "slopes")
     new = imunoise.fit(r, method="slopes")
     assert np.array_equal(old.N, new.N)
-
-
-def test_positional_options_rejects_too_many_and_clashes():
-    @positional_options(1, "b")
-    def f(a, *, b=0):
-        return a, b
-
-    assert f(1, b=2) == (1, 2)
-    with pytest.raises(TypeError, match="takes 1 positional"):
-        f(1, 2, 3)
-    with pytest.raises(TypeError, match="multiple values"), warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        f(1, 2, b=3)
-
-
-def test_renamed_keyword_forwards_with_a_warning():
-    @renamed_keyword("eol", "line_ending")
-    def g(*, line_ending="\n"):
-        return line_ending
-
-    with pytest.warns(DeprecationWarning, match="line_ending=..."):
-        assert g(eol="\r\n") == "\r\n"
-    with pytest.raises(TypeError, match="both"):
-        g(eol="a", line_ending="b")
 
 
 def test_parse_error_carries_its_location():

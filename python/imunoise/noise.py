@@ -69,8 +69,8 @@ import numpy as np
 
 from imunoise import _schema
 from imunoise import units as _units
-from imunoise._api import positional_options
 from imunoise._core import fit as _core_fit
+from imunoise._deprecation import old_call_forms
 
 __all__ = ["TERMS", "FLICKER", "NoiseModel", "Prediction", "fit", "model_variance"]
 
@@ -359,7 +359,7 @@ class NoiseModel:
         return math.sqrt(max(total, 0.0))
 
     # -- units and tables ---------------------------------------------------
-    @positional_options(2, "units", "input_unit")
+    @old_call_forms(keyword_only=("units", "input_unit"))
     def in_units(self, sensor: str = "gyro", *, units: dict[str, str] | None = None,
                  input_unit: str | None = None) -> dict[str, dict]:
         """Datasheet values in datasheet units: N, B, K are the model's
@@ -404,7 +404,7 @@ class NoiseModel:
             }
         return out
 
-    @positional_options(2, "units", "input_unit", "axes", "terms")
+    @old_call_forms(keyword_only=("units", "input_unit", "axes", "terms"))
     def table(self, sensor: str = "gyro", *, units: dict[str, str] | None = None,
               input_unit: str | None = None, axes: Sequence[str] | None = None,
               terms: Sequence[str] = ("N", "B", "K", "Q", "R")) -> list[dict]:
@@ -442,7 +442,7 @@ class NoiseModel:
         return format_table(rows, _schema.axis_names(self.channels, kwargs.get("axes")))
 
     # -- exports ------------------------------------------------------------
-    @positional_options(1, "accel", "path")
+    @old_call_forms(keyword_only=("accel", "path"))
     def to_kalibr(self, *, accel: NoiseModel | None = None, path=None, **kwargs) -> str:
         """Kalibr ``imu.yaml`` text with this model as the gyroscope.
 
@@ -622,7 +622,7 @@ def _parse_terms(terms) -> tuple[np.ndarray, int, bool]:
     return np.array([t in names for t in TERMS]), gm, False
 
 
-@positional_options(1, "method", "terms", "tau_range")
+@old_call_forms(keyword_only=("method", "terms", "tau_range"))
 def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
         tau_range: tuple[float, float] | None = None, uncertainty: str = "independent",
         replicates: int = 30, seed=None) -> NoiseModel:
