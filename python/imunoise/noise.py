@@ -632,7 +632,8 @@ def _parse_terms(terms) -> tuple[np.ndarray, int, bool]:
 
 
 def fit(result, method: str = "wls", terms: str | Sequence[str] = "auto", tau_range=None, *,
-        uncertainty: str = "independent", replicates: int = 30, seed=None) -> NoiseModel:
+        uncertainty: str = "independent", replicates: int = 30, seed=None,
+        warn_coverage: bool = True) -> NoiseModel:
     """Fit the noise model to an Allan deviation.
 
     Parameters
@@ -664,6 +665,9 @@ def fit(result, method: str = "wls", terms: str | Sequence[str] = "auto", tau_ra
         ``"bootstrap"`` only: number of simulated records (≥ 5; default 30).
     seed : int, numpy.random.Generator or None
         ``"bootstrap"`` only: seed of the simulations, for reproducible results.
+    warn_coverage : bool
+        Warn when the model follows the curve poorly (below); False for callers
+        that say it in their own words (the report, ``imunoise fit``).
 
     Returns
     -------
@@ -781,7 +785,7 @@ def fit(result, method: str = "wls", terms: str | Sequence[str] = "auto", tau_ra
     )
     cover = _coverage(model, taus, dev_all, edf_raw)
     object.__setattr__(model, "coverage", shaped(cover))
-    for c in np.flatnonzero(cover < 0.8) if method == "wls" else ():
+    for c in np.flatnonzero(cover < 0.8) if method == "wls" and warn_coverage else ():
         warnings.warn(
             f"the noise model follows the Allan deviation of channel {c} at only "
             f"{cover[c]:.0%} of the taus (inside the 95 % interval or within 5 %); its "
