@@ -23,7 +23,7 @@ Modules: :mod:`.build` (:func:`build`, the context and the list of sections),
 """
 
 from imunoise.report.build import SECTIONS, TAUS_PER_DECADE, Report, build
-from imunoise.report.formatting import format_number, gap_note, terms_used
+from imunoise.report.formatting import gap_note, terms_used
 from imunoise.report.inputs import read_log
 from imunoise.report.model_text import comparison_rows, datasheet_rows, model_sentences
 
@@ -34,7 +34,6 @@ __all__ = [
     "build",
     "comparison_rows",
     "datasheet_rows",
-    "format_number",
     "gap_note",
     "model_sentences",
     "read_log",
