@@ -69,13 +69,13 @@ def _build_parser() -> argparse.ArgumentParser:
     r.add_argument("long_log", metavar="LONG_LOG", nargs="?")
     r.add_argument("-o", "--output", default="imunoise-report", metavar="DIR",
                    help="output directory (default: %(default)s)")
-    _options(r, spec=True, fs=True, progress=True)
+    _shared_options(r, spec=True, fs=True, progress=True)
 
     a = sub.add_parser("adev", help="print an Allan-family deviation table",
                        description="Print tau, deviation, confidence interval and number of "
                        "terms per axis.")
     a.add_argument("log", metavar="LOG")
-    _options(a, fs=True)
+    _shared_options(a, fs=True)
     a.add_argument("--sensor", choices=SAMPLE_SENSORS, default="gyro")
     a.add_argument("--kind", choices=KINDS, default="adev")
     a.add_argument("--taus", default="octave",
@@ -85,7 +85,7 @@ def _build_parser() -> argparse.ArgumentParser:
                        description="Fit Q, N, B, K, R per axis to the Allan deviation and print "
                        "them in datasheet units with uncertainties.")
     f.add_argument("log", metavar="LOG")
-    _options(f, fs=True)
+    _shared_options(f, fs=True)
     f.add_argument("--sensor", choices=ALLAN_SENSORS, default=None,
                    help="one sensor (default: gyro and accel)")
     f.add_argument("--bootstrap", type=int, default=0, metavar="REPLICATES",
@@ -96,7 +96,7 @@ def _build_parser() -> argparse.ArgumentParser:
                        description="Per channel mean, std, variance, min, max, drift per hour; "
                        "per axis normal fit and normality statistics.")
     s.add_argument("log", metavar="LOG")
-    _options(s, fs=True)
+    _shared_options(s, fs=True)
 
     c = sub.add_parser("convert", help="convert a log to .npy, Parquet, CSV or NPZ",
                        description="Write the log's channels to OUTPUT; the format follows the "
@@ -108,7 +108,7 @@ def _build_parser() -> argparse.ArgumentParser:
     c.add_argument("-o", "--output", required=True, metavar="OUTPUT")
     c.add_argument("--chunk-mb", type=_positive_float, default=64.0, metavar="MB",
                    help="bytes read per piece when streaming (default: %(default)s MB)")
-    _options(c, fs=True, progress=True)
+    _shared_options(c, fs=True, progress=True)
 
     b = sub.add_parser("batch", help="characterise many logs in parallel (Dask)",
                        description="Allan deviation, noise fit and datasheet verdict of every "
@@ -122,7 +122,7 @@ def _build_parser() -> argparse.ArgumentParser:
                    help="address of a running Dask scheduler (default: a local cluster)")
     b.add_argument("--serial", action="store_true",
                    help="no Dask: analyse the logs one after another in this process")
-    _options(b, spec=True, fs=True, progress=True)
+    _shared_options(b, spec=True, fs=True, progress=True)
 
     m = sub.add_parser("simulate", help="write the log of a simulated still VN-100",
                        description="Write the log of a still VN-100 (gravity on -Z, a constant "
@@ -141,11 +141,11 @@ def _build_parser() -> argparse.ArgumentParser:
     d.add_argument("--hours", type=_positive_float, default=5.0,
                    help="length of the simulated long log (default: %(default)s)")
     d.add_argument("--seed", type=int, default=1)
-    _options(d, progress=True)
+    _shared_options(d, progress=True)
     return p
 
 
-def _options(p, *, spec: bool = False, fs: bool = False, progress: bool = False) -> None:
+def _shared_options(p, *, spec: bool = False, fs: bool = False, progress: bool = False) -> None:
     """Add the options several commands share, each worded once."""
     if spec:
         p.add_argument("--spec", default="vn100",
