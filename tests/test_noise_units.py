@@ -100,7 +100,7 @@ def test_in_units_and_table(gyro_model):
         assert row_n[ax] == pytest.approx(n / DEG * 60, rel=0.05)
         assert row_n[ax + "_supported"]
     text = model.table_text("gyro")
-    assert "°/√h" in text and "X" in text and "unresolved" in text  # R is unresolved
+    assert "°/√h" in text and "X" in text and "not resolved" in text  # R is not resolved
     with pytest.raises(ValueError, match="axes"):
         model.table("gyro", axes=["X", "Y"])
 

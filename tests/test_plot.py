@@ -54,15 +54,22 @@ def test_histograms_and_allan_render(tmp_path):
     assert (tmp_path / "adev.png").is_file() and (tmp_path / "adev.svg").is_file()
 
 
-def test_model_curves_follow_ieee952():
-    taus = np.array([0.5, 1.0, 3.0, 10.0])
+def test_coefficient_curves_follow_ieee952():
+    rng = np.random.default_rng(3)
+    r = imunoise.adev(rng.normal(0, 1e-3, (20000, 1)), 40.0)
     c = {"Q": 1e-4, "N": 2e-3, "B": 5e-4, "K": 1e-5, "R": 1e-7}
-    curves = plot._curves(c, taus)
-    np.testing.assert_allclose(curves["N"][1], c["N"])  # N read off at tau = 1 s
-    np.testing.assert_allclose(curves["K"][2], c["K"])  # K read off at tau = 3 s
-    np.testing.assert_allclose(curves["B"], c["B"] * np.sqrt(2 * np.log(2) / np.pi))
-    total2 = sum(curves[t] ** 2 for t in "QNBKR")
-    np.testing.assert_allclose(curves["total"] ** 2, total2)
+    fig = plot.allan(r, coefficients=[c])
+    lines = {ln.get_label(): ln.get_xydata() for ln in fig.get_axes()[0].get_lines()}
+    tau, n = lines["white noise N"].T
+    np.testing.assert_allclose(n * np.sqrt(tau), c["N"])  # N read off at tau = 1 s
+    tau, k = lines["rate random walk K"].T
+    np.testing.assert_allclose(k / np.sqrt(tau / 3), c["K"])  # K read off at tau = 3 s
+    np.testing.assert_allclose(lines["bias instability B"][:, 1],
+                               c["B"] * np.sqrt(2 * np.log(2) / np.pi))
+    labels = ("quantization Q", "white noise N", "bias instability B", "rate random walk K",
+              "rate ramp R")
+    total2 = sum(lines[label][:, 1] ** 2 for label in labels)
+    np.testing.assert_allclose(lines["model"][:, 1] ** 2, total2)
 
 
 def test_missing_samples_leave_a_hole_and_are_shaded():

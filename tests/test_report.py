@@ -212,12 +212,7 @@ def test_figures_listed(built):
     assert len(rep.figures) == 22
 
 
-def test_progress_bar_only_when_asked(capsys):
-    bar = report._Progress(True, total=2)
-    bar.step("one")
-    bar.close()
-    assert "one" in capsys.readouterr().err
-    quiet = report._Progress(None, total=2)  # stderr is not a terminal under pytest
-    quiet.step("two")
-    quiet.close()
-    assert capsys.readouterr().err == ""
+def test_sections_are_numbered_from_the_list(built):
+    rep, _, _ = built
+    headings = re.findall(r"^## (\d+)\. (.*)$", rep.markdown.read_text(), re.M)
+    assert headings == [(str(i), s.title) for i, s in enumerate(report.SECTIONS, start=1)]

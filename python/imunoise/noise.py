@@ -500,11 +500,12 @@ class NoiseModel:
 def format_table(rows: list[dict], axes: Sequence[str]) -> str:
     """Render :meth:`NoiseModel.table` rows as fixed-width text.
 
-    Unsupported terms print as ``—``; values carry ``± std``.
+    Terms the data do not resolve print as ``not resolved`` (the report's and
+    ``imunoise fit``'s wording too); values carry ``± std``.
     """
     def cell(row, ax):
         if not row[ax + "_supported"]:
-            return "— (unresolved)"
+            return "not resolved"
         v, s = row[ax], row[ax + "_std"]
         return f"{v:.4g} ± {s:.2g}" if np.isfinite(s) else f"{v:.4g}"
 
@@ -625,7 +626,7 @@ def _parse_terms(terms) -> tuple[np.ndarray, int, bool]:
 @old_call_forms(keyword_only=("method", "terms", "tau_range"))
 def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
         tau_range: tuple[float, float] | None = None, uncertainty: str = "independent",
-        replicates: int = 30, seed=None) -> NoiseModel:
+        replicates: int = 30, seed=None, warn_coverage: bool = True) -> NoiseModel:
     """Fit the noise model to an Allan deviation.
 
     Parameters
@@ -657,6 +658,9 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
         ``"bootstrap"`` only: number of simulated records (≥ 5; default 30).
     seed : int, numpy.random.Generator or None
         ``"bootstrap"`` only: seed of the simulations, for reproducible results.
+    warn_coverage : bool
+        Warn when the model follows the curve poorly (below); False for callers
+        that say it in their own words (the report, ``imunoise fit``).
 
     Returns
     -------
@@ -774,7 +778,7 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
     )
     cover = _coverage(model, taus, dev_all, edf_raw)
     object.__setattr__(model, "coverage", shaped(cover))
-    for c in np.flatnonzero(cover < 0.8) if method == "wls" else ():
+    for c in np.flatnonzero(cover < 0.8) if method == "wls" and warn_coverage else ():
         warnings.warn(
             f"the noise model follows the Allan deviation of channel {c} at only "
             f"{cover[c]:.0%} of the taus (inside the 95 % interval or within 5 %); its "
