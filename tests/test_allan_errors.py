@@ -115,7 +115,9 @@ def test_no_input_escapes_as_anything_but_value_or_type_error(x, fs, func, taus)
         r = func(x, fs, taus=taus)
     except (ValueError, TypeError):
         return
-    assert np.all(np.isfinite(r.dev) | (r.dev == 0))
+    # NaN marks a channel whose gaps leave fewer than 2 terms at that tau.
+    no_terms = np.broadcast_to(np.asarray(r.n) < 2, r.dev.shape)
+    assert np.all(np.isfinite(r.dev) | (r.dev == 0) | no_terms)
     assert r.dev.shape[0] == len(r.taus)
 
 
