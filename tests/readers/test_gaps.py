@@ -8,6 +8,7 @@ from pathlib import Path
 import imunoise
 import numpy as np
 import pytest
+from helpers.vn_sentences import ymr
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 from imunoise.readers.grid import Gaps, TimeGrid
@@ -16,9 +17,8 @@ from rosbags.rosbag1 import Writer as Writer1
 from rosbags.rosbag2 import StoragePlugin
 from rosbags.typesys import Stores, get_typestore
 from test_rosbag_reader import _imu, _write
-from vn_helpers import ymr
 
-DATA = Path(__file__).parent / "data"
+DATA = Path(__file__).parents[1] / "data"
 ROS1_REAL = Path("/work/shared/data/vn100-ros/ros1_stationary.bag")
 
 

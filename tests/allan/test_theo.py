@@ -10,7 +10,7 @@ import allantools as at
 import imunoise
 import numpy as np
 import pytest
-from conftest import noise
+from helpers.signals import noise
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra import numpy as hnp

@@ -5,7 +5,7 @@ from __future__ import annotations
 import imunoise
 import numpy as np
 import pytest
-from _allan_helper import StandInResult
+from helpers.noise_fit import StandInResult
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra import numpy as hnp

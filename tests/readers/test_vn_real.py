@@ -3,9 +3,9 @@
 import imunoise
 import numpy as np
 import pytest
-from conftest import DATA, shared_file
+from helpers.data import DATA, shared_file
+from helpers.vn_oracle import good_sentences
 from imunoise.readers.vn import read_vn_tables
-from vn_oracle import good_sentences
 
 
 def test_rugged_ascii_counts_and_values():

@@ -4,11 +4,11 @@ accounted for; strict mode raises ValueError only."""
 import imunoise
 import numpy as np
 import pytest
-from conftest import DATA
+from helpers.data import DATA
+from helpers.vn_oracle import good_sentences
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from imunoise.readers.vn import read_vn_tables
-from vn_oracle import good_sentences
 
 RUGGED = (DATA / "rugged_0513test.txt").read_bytes()
 # The complete lines of the real log (drop the truncated first and last lines).

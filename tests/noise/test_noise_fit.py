@@ -10,7 +10,7 @@ from __future__ import annotations
 import imunoise
 import numpy as np
 import pytest
-from _allan_helper import StandInResult, allan
+from helpers.noise_fit import StandInResult, allan
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from imunoise.noise import FLICKER, model_variance

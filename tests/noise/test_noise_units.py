@@ -9,7 +9,7 @@ import re
 import imunoise
 import numpy as np
 import pytest
-from _allan_helper import allan
+from helpers.noise_fit import allan
 from hypothesis import given
 from hypothesis import strategies as st
 from imunoise import export, units

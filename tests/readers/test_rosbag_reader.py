@@ -7,16 +7,16 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-import vn_helpers
+from helpers import vn_sentences as vn_helpers
+from helpers.vn_sentences import ymr, ymr_fields
 from imunoise.errors import ParseError
 from imunoise.readers import rosbag_reader
 from imunoise.readers.rosbag_reader import read_rosbag
 from rosbags.highlevel import AnyReader
 from rosbags.rosbag2 import StoragePlugin, Writer
 from rosbags.typesys import Stores, get_types_from_msg, get_typestore
-from vn_helpers import ymr, ymr_fields
 
-DATA = Path(__file__).parent / "data"
+DATA = Path(__file__).parents[1] / "data"
 MCAP = DATA / "vn100-ros" / "11sec_motion_0.mcap"
 SHARED = Path("/work/shared/data/vn100-ros")
 ROS1 = SHARED / "ros1_stationary.bag"

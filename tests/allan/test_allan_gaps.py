@@ -7,7 +7,7 @@ import allantools
 import imunoise
 import numpy as np
 import pytest
-from conftest import noise
+from helpers.signals import noise
 from hypothesis import given, settings
 from hypothesis import strategies as st
 

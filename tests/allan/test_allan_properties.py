@@ -3,7 +3,7 @@
 import imunoise
 import numpy as np
 import pytest
-from conftest import noise
+from helpers.signals import noise
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra import numpy as hnp

@@ -9,15 +9,15 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-import vn_helpers
+from helpers import vn_sentences as vn_helpers
+from helpers.vn_sentences import ymr, ymr_fields
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from imunoise.errors import ParseError
 from imunoise.readers import csv_reader
 from imunoise.readers.csv_reader import read_csv
-from vn_helpers import ymr, ymr_fields
 
-DATA = Path(__file__).parent / "data"
+DATA = Path(__file__).parents[1] / "data"
 VN_CSV = DATA / "vn100-csv" / "stationary_data_5min_0.csv"
 SHARED = Path("/work/shared/data")
 IG500N = SHARED / "other-imu" / "ig500n_static.txt"

@@ -8,7 +8,7 @@ import imunoise
 import numpy as np
 import pytest
 from allantools import ci as at_ci
-from conftest import noise
+from helpers.signals import noise
 
 # imunoise call -> allantools function with the same definition
 PAIRS = {

@@ -11,7 +11,7 @@ import imunoise
 import numpy as np
 import pytest
 from allantools import ci as at_ci
-from conftest import noise
+from helpers.signals import noise
 
 OURS = {
     "mtotdev": imunoise.mtotdev,

@@ -4,7 +4,7 @@ from dataclasses import replace
 
 import imunoise
 import pytest
-from conftest import DATA
+from helpers.data import DATA
 from imunoise.readers import registry
 from imunoise.readers.read import detect_format
 from imunoise.readers.vn import parse_vn_sentences

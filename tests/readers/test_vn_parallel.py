@@ -13,11 +13,11 @@ from __future__ import annotations
 import imunoise
 import numpy as np
 import pytest
+from helpers.vn_oracle import good_sentences, xor8
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from imunoise._core import vn as _core_vn
 from imunoise.readers.vn import read_vn_tables
-from vn_oracle import good_sentences, xor8
 
 _DIGITS = st.text("0123456789", min_size=0, max_size=24)
 
