@@ -45,7 +45,7 @@ def _fail(message: str):
 
 def _version() -> str:
     try:
-        from imunoise import __version__
+        from imunoise._core import __version__
 
         return __version__
     except ImportError:  # pragma: no cover
