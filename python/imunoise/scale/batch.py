@@ -9,12 +9,12 @@ from __future__ import annotations
 
 import glob
 import os
-import sys
 import warnings
 
 import numpy as np
 
 from imunoise import _schema
+from imunoise._progress import Progress
 from imunoise.allan import adev
 from imunoise.datasheet import compare, load_spec
 from imunoise.noise import fit
@@ -131,16 +131,6 @@ def _frame(rows: list[dict]):
     return df
 
 
-def _bar(enabled: bool | None, total: int):
-    if enabled is None:
-        enabled = sys.stderr.isatty()
-    if not enabled:
-        return None
-    from tqdm import tqdm
-
-    return tqdm(total=total, file=sys.stderr, unit="log", desc="imunoise batch")
-
-
 def batch(
     paths,
     client=None,
@@ -192,23 +182,18 @@ def batch(
         spec = None
     if spec is not None:
         spec = load_spec(spec)  # fail early, and ship the parsed spec to the workers
-    bar = _bar(progress, len(files))
-    try:
+    with Progress(progress, len(files), unit="log", desc="imunoise batch", leave=True) as bar:
         if client is False:
             results = []
             for p in files:
                 results.append(analyse_log(p, spec, fs))
-                if bar is not None:
-                    bar.update(1)
+                bar.step()
         else:
             results = _run_dask(files, client, spec, fs, bar)
-    finally:
-        if bar is not None:
-            bar.close()
     return _frame([row for rows in results for row in rows])
 
 
-def _run_dask(files, client, spec, fs, bar) -> list[list[dict]]:
+def _run_dask(files, client, spec, fs, bar: Progress) -> list[list[dict]]:
     try:
         from distributed import Client, LocalCluster, as_completed
     except ImportError:
@@ -242,8 +227,7 @@ def _run_dask(files, client, spec, fs, bar) -> list[list[dict]]:
                     row[f"verdict_{t}"] = None
                 row["error"] = f"{type(exc).__name__}: {exc}"
                 results[i] = [row]
-            if bar is not None:
-                bar.update(1)
+            bar.step()
         return results  # type: ignore[return-value]
     finally:
         if own_client is not None:

@@ -43,6 +43,7 @@ import numpy as np
 
 from imunoise._core import vn as _core_vn
 from imunoise._schema import CHANNELS, column_names
+from imunoise.readers import registry
 from imunoise.readers.grid import Gaps, TimeGrid
 from imunoise.readers.log import ImuLog, ParseIssues, fs_from_median_step
 from imunoise.readers.vn import richest_table, table_channels, tables_of
@@ -587,7 +588,7 @@ def convert(
     out.parent.mkdir(parents=True, exist_ok=True)
     writer = _Writer(out, layout)
     try:
-        if format in ("vn-ascii", "vn-binary") and path.is_file():
+        if registry.get(format).streamable and path.is_file():
             parsed, steps, shape, grids = _stream_vn(path, writer, int(chunk_bytes), progress)
             primary = richest_table(shape)
             step_histogram = steps.get(primary) if primary else None
