@@ -436,6 +436,49 @@ proptest! {
     }
 
     #[test]
+    fn pieces_equal_whole(
+        kinds in proptest::collection::vec(0u8..6, 1..200),
+        piece in 1usize..300,
+        flip in any::<u16>(),
+    ) {
+        // Damaged streams too: counts, first locations and rows do not depend on
+        // where the pieces end.
+        let b2 = binary_b2();
+        let mut s = Vec::new();
+        for k in kinds {
+            match k {
+                0 => s.extend_from_slice(&B1),
+                1 => s.extend_from_slice(&b2),
+                2 | 3 => s.extend_from_slice(A1),
+                4 => s.extend_from_slice(&A1[..40]),
+                _ => s.extend_from_slice(b"$VNRRG,05,115200*5C\n"),
+            }
+        }
+        let at = flip as usize % s.len();
+        s[at] ^= 0x20;
+        let whole = parse_bytes(&s, false).unwrap();
+        let mut stream = Pieces::new(false);
+        let mut rows: BTreeMap<String, Vec<f64>> = BTreeMap::new();
+        let mut add = |tables: BTreeMap<String, crate::vn::Table>| {
+            for (name, t) in tables {
+                rows.entry(name).or_default().extend_from_slice(&t.values);
+            }
+        };
+        for part in s.chunks(piece) {
+            add(stream.feed(part).unwrap());
+        }
+        let mut summary = stream.finish().unwrap();
+        add(std::mem::take(&mut summary.tables));
+        for (name, t) in &whole.tables {
+            let got = rows.get(name).map_or(&[][..], |v| v.as_slice());
+            prop_assert_eq!(format!("{got:?}"), format!("{:?}", t.values), "{}", name);
+        }
+        let mut want = whole.clone();
+        want.tables.clear();
+        prop_assert_eq!(format!("{summary:?}"), format!("{want:?}"));
+    }
+
+    #[test]
     fn random_bytes_are_accounted(data in proptest::collection::vec(any::<u8>(), 0..3000)) {
         let d = parse_bytes(&data, false).unwrap();
         prop_assert!(accounted(&d, data.len()));
