@@ -1,0 +1,90 @@
+"""The dependency rules of docs/architecture.md, checked on the source: no module
+imports the package facade or another module's private names, and module-level
+imports between the package's modules form no cycle."""
+
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+import pytest
+
+PACKAGE = Path(__file__).resolve().parents[1] / "python" / "imunoise"
+
+
+def _module_name(path: Path) -> str:
+    parts = path.relative_to(PACKAGE.parent).with_suffix("").parts
+    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+
+
+MODULES = {_module_name(p): p for p in PACKAGE.rglob("*.py")}
+
+
+def _imports(path: Path, *, top_level_only: bool):
+    """(imported module, names) pairs of a file; names empty for ``import x``."""
+    tree = ast.parse(path.read_text(), filename=str(path))
+    nodes = tree.body if top_level_only else list(ast.walk(tree))
+    package = _module_name(path) if path.name == "__init__.py" else _module_name(path).rpartition(
+        ".")[0]
+    for node in nodes:
+        if isinstance(node, ast.Import):
+            for alias in node.names:
+                yield alias.name, ()
+        elif isinstance(node, ast.ImportFrom):
+            base = node.module or ""
+            if node.level:
+                anchor = package.split(".")
+                anchor = anchor[: len(anchor) - node.level + 1]
+                base = ".".join([*anchor, base] if base else anchor)
+            yield base, tuple(a.name for a in node.names)
+
+
+def _resolve(module: str, names: tuple[str, ...]) -> list[str]:
+    """Package modules an import statement loads (``from a import b`` may load a.b)."""
+    submodules = [f"{module}.{n}" for n in names if f"{module}.{n}" in MODULES]
+    only_submodules = names and len(submodules) == len(names)
+    return submodules + ([module] if module in MODULES and not only_submodules else [])
+
+
+@pytest.mark.parametrize("name", sorted(n for n in MODULES if n != "imunoise"))
+def test_no_module_imports_the_facade_or_private_names(name):
+    for module, names in _imports(MODULES[name], top_level_only=False):
+        if module == "imunoise":
+            facade = [n for n in names if f"imunoise.{n}" not in MODULES]
+            assert not facade, f"{name} imports {facade} from the package facade"
+            assert names, f"{name} does `import imunoise` (the facade)"
+        if module.startswith("imunoise") and module in MODULES:
+            private = [n for n in names if n.startswith("_") and f"{module}.{n}" not in MODULES
+                       and n != "__version__"]
+            assert not private, f"{name} imports private {private} from {module}"
+
+
+def test_no_import_cycle_between_modules():
+    graph = {
+        name: {
+            target
+            for module, names in _imports(path, top_level_only=True)
+            for target in _resolve(module, names)
+            if target != name and target != "imunoise"
+        }
+        for name, path in MODULES.items()
+        if name != "imunoise"
+    }
+    state: dict[str, int] = {}
+    stack: list[str] = []
+
+    def visit(node: str) -> None:
+        state[node] = 1
+        stack.append(node)
+        for nxt in sorted(graph.get(node, ())):
+            if state.get(nxt) == 1:
+                cycle = stack[stack.index(nxt):] + [nxt]
+                pytest.fail("import cycle: " + " -> ".join(cycle))
+            if nxt not in state:
+                visit(nxt)
+        stack.pop()
+        state[node] = 2
+
+    for node in sorted(graph):
+        if node not in state:
+            visit(node)
