@@ -65,16 +65,22 @@ def test_long_numbers_do_not_wrap():
     assert t.tables["VNYPR"]["roll"][0] == float("-0.12345678901234567890")
 
 
+#: Channel -> (mean, standard deviation) of a still VN-100 (per axis for 3-axis channels).
+_STILL = {
+    "ypr": ([100.0, -7.3, 0.7], 0.01),
+    "mag": ([-0.005, -0.245, 0.54], 0.001),
+    "accel": ([0.0, 0.0, -9.81], 0.01),
+    "gyro": (0.0, 0.0005),
+    "temperature": (25.0, 0.1),
+    "pressure": (101.3, 0.01),
+}
+
+
 def _still(n: int, fs: float, seed: int) -> imunoise.ImuLog:
     rng = np.random.default_rng(seed)
+    shape = {"temperature": n, "pressure": n}
     return imunoise.ImuLog.from_arrays(
-        fs,
-        ypr=rng.normal([100.0, -7.3, 0.7], 0.01, (n, 3)),
-        mag=rng.normal([-0.005, -0.245, 0.54], 0.001, (n, 3)),
-        accel=rng.normal([0.0, 0.0, -9.81], 0.01, (n, 3)),
-        gyro=rng.normal(0.0, 0.0005, (n, 3)),
-        temperature=rng.normal(25.0, 0.1, n),
-        pressure=rng.normal(101.3, 0.01, n),
+        fs, **{k: rng.normal(mean, sd, shape.get(k, (n, 3))) for k, (mean, sd) in _STILL.items()}
     )
 
 
