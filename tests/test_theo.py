@@ -296,8 +296,8 @@ def test_long_records_warn_before_a_slow_run(monkeypatch):
     def refuse(*_args, **_kwargs):
         raise RuntimeError("kernel reached")
 
-    monkeypatch.setattr(allan_module._core, "analyse", refuse)
-    monkeypatch.setattr(allan_module._core, "analyse_plan", refuse)
+    monkeypatch.setattr(allan_module._core_allan, "analyse", refuse)
+    monkeypatch.setattr(allan_module._core_allan, "analyse_plan", refuse)
     x = np.zeros(1_000_000)
     for fn in (imunoise.theobr, imunoise.theoh):
         with pytest.warns(UserWarning, match=r"N/30 averaging factors.*minutes.*average blocks"):

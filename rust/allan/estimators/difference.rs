@@ -1,143 +1,57 @@
-//! The Allan-family variances over the cumulative phase `c` (n + 1 points, in
-//! units of one sample period). Each function returns the variance at
-//! τ = m·τ0 together with the number of terms in its sum, counted as Stable32
-//! and allantools count them. References: NIST SP 1065 (Riley 2008), eqs. 6–25.
+//! The difference estimators over the cumulative phase `c` (n + 1 points, in
+//! units of one sample period): the Allan, modified Allan and Hadamard variances,
+//! which can leave out the terms a missing sample touches, and the total variance
+//! TOTVAR, the overlapping Allan variance of the phase reflected about both ends.
+//! Terms are counted as Stable32 and allantools count them. References: NIST
+//! SP 1065 (Riley 2008), eqs. 6–25.
+//!
+//! Cost. One pass over the phase per tau, O(n): the overlapping sums stream fixed
+//! combinations of three or four shifted slices (`sum_of_squared_combinations`),
+//! the modified variance slides a window sum. `fast::blocked` does all taus of the
+//! overlapping Allan and Hadamard variances in one sweep instead.
+//!
+//! Digits. Squares are summed in plain blocks of 256 (relative error below 256·ε,
+//! the terms being non-negative) and the blocks with compensation; the modified
+//! variance's window sum is compensated so that millions of updates do not drift.
 
 use std::ops::Range;
 
-use super::blocked::Difference;
-use super::sum::{sum_of_squared_combinations, sum_of_squares, Neumaier};
-use super::theo;
-use super::total;
+use super::Estimate;
+use crate::allan::sum::{sum_of_squared_combinations, sum_of_squares, Neumaier};
 
-/// A variance estimate and the number of terms it averages.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Estimate {
-    pub var: f64,
-    pub terms: usize,
-}
-
-impl Estimate {
-    const EMPTY: Estimate = Estimate {
-        var: f64::NAN,
-        terms: 0,
-    };
-}
-
-/// Which statistic to compute.
+/// A variance made of squared differences of the phase, one term per start
+/// index; the only estimators that can skip gaps.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum Statistic {
+pub enum DifferenceVariance {
     /// Allan variance; `overlapping` selects stride 1 instead of stride m.
     Allan { overlapping: bool },
     /// Modified Allan variance (always overlapping).
     Modified,
     /// Hadamard variance; `overlapping` selects stride 1 instead of stride m.
     Hadamard { overlapping: bool },
-    /// Total variance (SP 1065 eq. 25, reflection at both ends).
-    Total,
-    /// Modified total variance (SP 1065 eq. 27); m ≤ N/3.
-    ModifiedTotal,
-    /// Hadamard total variance (overlapping Hadamard at m = 1); m ≤ n/3.
-    HadamardTotal,
-    /// Theo1 (SP 1065 eq. 30), even m only; effective τ = 0.75·m·τ0.
-    Theo1,
-    /// ThêoBR (SP 1065 §5.2.15): Theo1 times the data's AVAR/Theo1 bias ratio
-    /// (`theo::bias_ratio`); even 10 ≤ m < N and N ≥ 90 phase points.
-    TheoBR,
 }
 
-impl Statistic {
-    /// Number of terms the estimator averages for `n_phase` phase points at
-    /// averaging factor `m` (0 when the tau does not fit).
+impl DifferenceVariance {
+    /// Number of terms for `n_phase` phase points at averaging factor `m` (0 when
+    /// the tau does not fit).
     pub fn terms(self, n_phase: usize, m: usize) -> usize {
         if m == 0 {
             return 0;
         }
         match self {
-            Statistic::Allan { overlapping } => {
+            DifferenceVariance::Allan { overlapping } => {
                 strided_count(n_phase, 2 * m, stride(overlapping, m))
             }
-            Statistic::Hadamard { overlapping } => {
+            DifferenceVariance::Hadamard { overlapping } => {
                 strided_count(n_phase, 3 * m, stride(overlapping, m))
             }
-            Statistic::Modified => (n_phase + 1).saturating_sub(3 * m),
-            Statistic::Total => {
-                if m < n_phase && n_phase >= 3 {
-                    n_phase - 2
-                } else {
-                    0
-                }
-            }
-            // allantools' limits: m ≤ len(phase)/3 and m ≤ len(rate)/3.
-            Statistic::ModifiedTotal => {
-                if 3 * m <= n_phase {
-                    n_phase + 1 - 3 * m
-                } else {
-                    0
-                }
-            }
-            Statistic::HadamardTotal => {
-                let n = n_phase.saturating_sub(1);
-                if 3 * m > n {
-                    0
-                } else if m == 1 {
-                    Statistic::Hadamard { overlapping: true }.terms(n_phase, 1)
-                } else {
-                    n + 1 - 3 * m
-                }
-            }
-            // Terms counted as allantools counts them: (N − m) outer × m/2 inner.
-            Statistic::Theo1 => {
-                if m.is_multiple_of(2) && m < n_phase {
-                    (n_phase - m) * (m / 2)
-                } else {
-                    0
-                }
-            }
-            // Theo1's terms, over SP 1065's range 10 ≤ m ≤ N − 1, where the bias
-            // ratio exists.
-            Statistic::TheoBR => {
-                if m >= 10 && theo::ratio_count(n_phase).is_some() {
-                    Statistic::Theo1.terms(n_phase, m)
-                } else {
-                    0
-                }
-            }
+            DifferenceVariance::Modified => (n_phase + 1).saturating_sub(3 * m),
         }
     }
 
-    /// Averaging factor at which the noise type is identified: m itself, except
-    /// for Theo1 whose estimate belongs to τ = 0.75·m·τ0.
-    pub fn noise_id_factor(self, m: usize) -> usize {
-        match self {
-            Statistic::Theo1 | Statistic::TheoBR => ((3 * m) / 4).max(1),
-            _ => m,
-        }
-    }
-
-    /// For the overlapping Allan and Hadamard variances: the order of the
-    /// difference whose squares `blocked::sums_of_squares` sums for all taus at once.
-    pub fn blocked_difference(self) -> Option<Difference> {
-        match self {
-            Statistic::Allan { overlapping: true } => Some(Difference::Second),
-            Statistic::Hadamard { overlapping: true } => Some(Difference::Third),
-            _ => None,
-        }
-    }
-
-    /// The variance from a sum of squared differences (see `blocked_difference`).
+    /// The variance from a sum of `terms` squared terms at averaging factor m.
     pub fn variance_from_sum(self, sum: f64, m: usize, terms: usize) -> f64 {
         sum / (self.normaliser(m) * terms as f64)
-    }
-
-    /// Whether terms can be left out where samples are missing: the difference
-    /// estimators can; the total family, whose terms reflect or detrend the
-    /// record around each point, cannot.
-    pub fn skips_gaps(self) -> bool {
-        matches!(
-            self,
-            Statistic::Allan { .. } | Statistic::Modified | Statistic::Hadamard { .. }
-        )
     }
 
     /// The divisor of a sum of squared terms per term: 2m² (Allan), 6m²
@@ -145,21 +59,20 @@ impl Statistic {
     fn normaliser(self, m: usize) -> f64 {
         let mf = m as f64;
         match self {
-            Statistic::Hadamard { .. } => 6.0 * mf * mf,
-            Statistic::Modified => 2.0 * mf.powi(4),
-            _ => 2.0 * mf * mf,
+            DifferenceVariance::Hadamard { .. } => 6.0 * mf * mf,
+            DifferenceVariance::Modified => 2.0 * mf.powi(4),
+            DifferenceVariance::Allan { .. } => 2.0 * mf * mf,
         }
     }
 
-    /// The sum of the `terms` squared terms of a difference estimator
-    /// ([`Statistic::skips_gaps`]); `terms` = `self.terms(c.len(), m)` > 0.
+    /// The sum of the `terms` squared terms; `terms` = `self.terms(c.len(), m)` > 0.
     fn sum_of_terms(self, c: &[f64], m: usize, terms: usize) -> f64 {
         match self {
-            Statistic::Allan { overlapping: true } => sum_of_squared_combinations(
+            DifferenceVariance::Allan { overlapping: true } => sum_of_squared_combinations(
                 [&c[2 * m..2 * m + terms], &c[m..m + terms], &c[..terms]],
                 [1.0, -2.0, 1.0],
             ),
-            Statistic::Hadamard { overlapping: true } => sum_of_squared_combinations(
+            DifferenceVariance::Hadamard { overlapping: true } => sum_of_squared_combinations(
                 [
                     &c[3 * m..3 * m + terms],
                     &c[2 * m..2 * m + terms],
@@ -168,32 +81,33 @@ impl Statistic {
                 ],
                 [1.0, -3.0, 3.0, -1.0],
             ),
-            Statistic::Allan { overlapping } => {
+            DifferenceVariance::Allan { overlapping } => {
                 let s = stride(overlapping, m);
                 sum_of_squares(terms, |j| {
                     let k = j * s;
                     c[k + 2 * m] - 2.0 * c[k + m] + c[k]
                 })
             }
-            Statistic::Hadamard { overlapping } => {
+            DifferenceVariance::Hadamard { overlapping } => {
                 let s = stride(overlapping, m);
                 sum_of_squares(terms, |j| {
                     let k = j * s;
                     c[k + 3 * m] - 3.0 * c[k + 2 * m] + 3.0 * c[k + m] - c[k]
                 })
             }
-            _ => modified_sum(c, m, terms),
+            DifferenceVariance::Modified => modified_sum(c, m, terms),
         }
     }
 
     /// The phase points of one gap-free run of samples (`segment`, see
-    /// [`super::phase::Gaps`]) on which this estimator's terms are exactly the
-    /// record's terms that lie inside the run: c[a..=b], for the non-overlapping
-    /// estimators from the first multiple of m on (their terms start at 0, m, 2m, …).
+    /// [`crate::allan::phase::Gaps`]) on which this estimator's terms are exactly
+    /// the record's terms that lie inside the run: c[a..=b], for the
+    /// non-overlapping estimators from the first multiple of m on (their terms
+    /// start at 0, m, 2m, …).
     pub fn segment_phase<'a>(self, c: &'a [f64], segment: &Range<usize>, m: usize) -> &'a [f64] {
         let start = match self {
-            Statistic::Allan { overlapping: false }
-            | Statistic::Hadamard { overlapping: false } => {
+            DifferenceVariance::Allan { overlapping: false }
+            | DifferenceVariance::Hadamard { overlapping: false } => {
                 segment.start.next_multiple_of(m.max(1))
             }
             _ => segment.start,
@@ -206,17 +120,8 @@ impl Statistic {
     }
 
     /// The estimate over the terms that lie inside the gap-free `segments` of a
-    /// record with missing samples ([`Statistic::skips_gaps`] statistics only:
-    /// `None` for the others). No term: NaN.
-    pub fn estimate_in_segments(
-        self,
-        c: &[f64],
-        segments: &[Range<usize>],
-        m: usize,
-    ) -> Option<Estimate> {
-        if !self.skips_gaps() {
-            return None;
-        }
+    /// record with missing samples. No term: NaN.
+    pub fn estimate_in_segments(self, c: &[f64], segments: &[Range<usize>], m: usize) -> Estimate {
         let mut sum = Neumaier::new();
         let mut terms = 0;
         for segment in segments {
@@ -227,10 +132,10 @@ impl Statistic {
                 terms += t;
             }
         }
-        Some(Estimate {
+        Estimate {
             var: sum.value() / (self.normaliser(m) * terms as f64),
             terms,
-        })
+        }
     }
 
     /// The variance at averaging factor `m` over the cumulative phase `c` of a
@@ -240,27 +145,33 @@ impl Statistic {
         if terms == 0 {
             return Estimate::EMPTY;
         }
-        let mf = m as f64;
-        let var = match self {
-            Statistic::Allan { .. } | Statistic::Hadamard { .. } | Statistic::Modified => {
-                self.sum_of_terms(c, m, terms) / (self.normaliser(m) * terms as f64)
-            }
-            Statistic::Total => total_sum(c, m) / (2.0 * mf * mf * terms as f64),
-            Statistic::ModifiedTotal => total::mtot_var(c, m),
-            Statistic::HadamardTotal if m == 1 => {
-                Statistic::Hadamard { overlapping: true }.estimate(c, 1).var
-            }
-            Statistic::HadamardTotal => total::htot_var(c, m),
-            Statistic::Theo1 => total::theo1_var(c, m),
-            // One tau alone pays for the whole bias ratio; `analyse` computes the
-            // ratio once per channel instead.
-            Statistic::TheoBR => match theo::bias_ratio(c) {
-                Some(ratio) => ratio * total::theo1_var(c, m),
-                None => return Estimate::EMPTY,
-            },
-        };
-        Estimate { var, terms }
+        Estimate {
+            var: self.variance_from_sum(self.sum_of_terms(c, m, terms), m, terms),
+            terms,
+        }
     }
+}
+
+/// The overlapping Allan variance at averaging factor m (NaN when it does not fit).
+pub fn oavar(c: &[f64], m: usize) -> f64 {
+    DifferenceVariance::Allan { overlapping: true }
+        .estimate(c, m)
+        .var
+}
+
+/// Terms of TOTVAR: the N − 2 inner phase points, for 1 ≤ m < N.
+pub fn total_terms(n_phase: usize, m: usize) -> usize {
+    if m >= 1 && m < n_phase && n_phase >= 3 {
+        n_phase - 2
+    } else {
+        0
+    }
+}
+
+/// Total variance at averaging factor m; `total_terms(c.len(), m)` > 0.
+pub fn totvar(c: &[f64], m: usize) -> f64 {
+    let mf = m as f64;
+    total_sum(c, m) / (2.0 * mf * mf * total_terms(c.len(), m) as f64)
 }
 
 fn stride(overlapping: bool, m: usize) -> usize {
@@ -353,6 +264,7 @@ fn total_sum(c: &[f64], m: usize) -> f64 {
 mod tests {
     use super::*;
     use crate::allan::phase::cumulative_phase;
+    use crate::allan::Statistic;
 
     /// NIST SP 1065 NBS14 10-point frequency data.
     const NBS14: [f64; 9] = [
