@@ -135,7 +135,11 @@ struct Job<'a> {
 }
 
 impl<'a> Job<'a> {
-    fn new(phases: &'a [Phase], plan: &'a [(Statistic, usize)], n_phase: usize) -> CoreResult<Self> {
+    fn new(
+        phases: &'a [Phase],
+        plan: &'a [(Statistic, usize)],
+        n_phase: usize,
+    ) -> CoreResult<Self> {
         let full_terms: Vec<usize> = plan.iter().map(|&(s, m)| s.terms(n_phase, m)).collect();
         if let Some(pos) = full_terms.iter().position(|&t| t == 0) {
             return Err(CoreError::InvalidArgument(format!(
@@ -256,7 +260,10 @@ impl<'a> Job<'a> {
 
     /// Variances and noise types as arrays; a variance that overflowed where there
     /// are terms is an error.
-    fn gather(&self, estimates: Vec<(f64, Option<i32>)>) -> CoreResult<(Vec<f64>, Vec<i32>, Vec<bool>)> {
+    fn gather(
+        &self,
+        estimates: Vec<(f64, Option<i32>)>,
+    ) -> CoreResult<(Vec<f64>, Vec<i32>, Vec<bool>)> {
         let mut var = Vec::with_capacity(self.pairs.len());
         let mut alpha = vec![0; self.pairs.len()];
         let mut alpha_identified = vec![false; self.pairs.len()];

@@ -66,12 +66,17 @@ pub fn kernel_case(
     max_len: usize,
 ) -> impl proptest::strategy::Strategy<Value = (f64, Vec<f64>, Vec<f64>)> {
     use proptest::strategy::Strategy;
-    (3usize..max_len, 0.0f64..1.0, 0u64..1000, 0usize..3, -1e4f64..1e4).prop_map(
-        |(n, pick, seed, order, offset)| {
+    (
+        3usize..max_len,
+        0.0f64..1.0,
+        0u64..1000,
+        0usize..3,
+        -1e4f64..1e4,
+    )
+        .prop_map(|(n, pick, seed, order, offset)| {
             let (shifted, back) = offset_pair(&integrated_noise(n, seed, order), offset);
             (pick, shifted, back)
-        },
-    )
+        })
 }
 
 /// Theo1 variance by its definition (SP 1065 eq. 30) on phase values x, as

@@ -264,16 +264,18 @@ fn total_sum(c: &[f64], m: usize) -> f64 {
 mod tests {
     use super::*;
     use crate::allan::phase::cumulative_phase;
-    use crate::allan::Statistic;
 
     /// NIST SP 1065 NBS14 10-point frequency data.
     const NBS14: [f64; 9] = [
         892.0, 809.0, 823.0, 798.0, 671.0, 644.0, 883.0, 903.0, 677.0,
     ];
 
-    fn dev(stat: Statistic, m: usize) -> f64 {
-        let c = cumulative_phase(NBS14.iter().copied()).unwrap();
-        stat.estimate(&c, m).var.sqrt()
+    fn nbs14_phase() -> Vec<f64> {
+        cumulative_phase(NBS14.iter().copied()).unwrap()
+    }
+
+    fn dev(estimator: DifferenceVariance, m: usize) -> f64 {
+        estimator.estimate(&nbs14_phase(), m).var.sqrt()
     }
 
     fn close(a: f64, b: f64) {
@@ -282,23 +284,26 @@ mod tests {
 
     #[test]
     fn nbs14_ten_point_reference_values() {
-        close(dev(Statistic::Allan { overlapping: false }, 2), 115.8082);
-        close(dev(Statistic::Allan { overlapping: true }, 1), 91.22945);
-        close(dev(Statistic::Allan { overlapping: true }, 2), 85.95287);
-        close(dev(Statistic::Modified, 2), 74.78849);
-        close(dev(Statistic::Hadamard { overlapping: false }, 1), 70.80608);
-        close(dev(Statistic::Hadamard { overlapping: false }, 2), 116.7980);
-        close(dev(Statistic::Hadamard { overlapping: true }, 2), 85.61487);
-        close(dev(Statistic::Total, 2), 93.90379);
+        use DifferenceVariance::{Allan, Hadamard, Modified};
+        close(dev(Allan { overlapping: false }, 2), 115.8082);
+        close(dev(Allan { overlapping: true }, 1), 91.22945);
+        close(dev(Allan { overlapping: true }, 2), 85.95287);
+        close(dev(Modified, 2), 74.78849);
+        close(dev(Hadamard { overlapping: false }, 1), 70.80608);
+        close(dev(Hadamard { overlapping: false }, 2), 116.7980);
+        close(dev(Hadamard { overlapping: true }, 2), 85.61487);
+        close(totvar(&nbs14_phase(), 2).sqrt(), 93.90379);
+        close(oavar(&nbs14_phase(), 2).sqrt(), 85.95287);
     }
 
     #[test]
     fn taus_that_do_not_fit_have_no_terms() {
-        let c = cumulative_phase(NBS14.iter().copied()).unwrap();
-        let e = Statistic::Allan { overlapping: true }.estimate(&c, 5);
+        let e = DifferenceVariance::Allan { overlapping: true }.estimate(&nbs14_phase(), 5);
         assert_eq!(e.terms, 0);
         assert!(e.var.is_nan());
-        assert_eq!(Statistic::Modified.terms(10, 4), 0);
-        assert_eq!(Statistic::Modified.terms(10, 3), 2);
+        assert_eq!(DifferenceVariance::Modified.terms(10, 4), 0);
+        assert_eq!(DifferenceVariance::Modified.terms(10, 3), 2);
+        assert_eq!(total_terms(10, 10), 0);
+        assert_eq!(total_terms(10, 9), 8);
     }
 }

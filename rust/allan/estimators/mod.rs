@@ -56,4 +56,3 @@ where
         .collect();
     parts.into_iter().sum::<Neumaier>().value()
 }
-

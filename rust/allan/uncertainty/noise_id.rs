@@ -154,7 +154,13 @@ fn solve3(mut a: [[f64; 3]; 3], mut b: [f64; 3]) -> Option<[f64; 3]> {
 /// FM (α = 0). The last identifiable taus rest on 30–60 points each, so one of
 /// them is misidentified now and then; the median keeps a single outlier from
 /// deciding the noise type (and so the EDF) of every longer tau.
-pub fn fill_from_nearest(alpha: &mut [i32], known: &[bool], c: usize, channels: usize, taus: usize) {
+pub fn fill_from_nearest(
+    alpha: &mut [i32],
+    known: &[bool],
+    c: usize,
+    channels: usize,
+    taus: usize,
+) {
     let idx = |t: usize| t * channels + c;
     let identified: Vec<usize> = (0..taus).filter(|&t| known[idx(t)]).collect();
     for t in 0..taus {
