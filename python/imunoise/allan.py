@@ -583,7 +583,8 @@ def theoh(x: npt.ArrayLike, fs: float, *, taus: TauSpec = "octave",
     _warn_theobr_cost("theoh", n, m_theo, data.shape[1])
     m = np.concatenate([m_avar, m_theo]).astype(np.int64)
     kind = _REGISTRY["theoh"]
-    statistics = [kind.short_taus] * m_avar.size + [kind.statistic] * m_theo.size
+    below_k = kind.short_taus or kind.statistic
+    statistics = [below_k] * m_avar.size + [kind.statistic] * m_theo.size
     core = _core_allan.analyse_plan(data, statistics, m.astype(np.uint64))
     tau = np.concatenate([m_avar / fs, 0.75 * m_theo / fs])
     return _assemble(
