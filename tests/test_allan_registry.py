@@ -16,6 +16,11 @@ def test_the_registry_uses_exactly_the_core_statistics():
     assert len(core_allan.STATISTICS) == len(set(core_allan.STATISTICS))
 
 
+def test_gap_skipping_is_the_difference_family():
+    assert core_allan.GAP_SKIPPING == ("adev", "oadev", "mdev", "hdev", "ohdev")
+    assert allan._SKIPS_GAPS == set(core_allan.GAP_SKIPPING)
+
+
 def test_every_kind_is_a_public_function_whose_result_names_it():
     assert allan.KINDS == tuple(allan._REGISTRY)
     for name in allan.KINDS:

@@ -189,7 +189,7 @@ KINDS: tuple[str, ...] = tuple(_REGISTRY)
 __all__ = ["AllanResult", *KINDS, "KINDS", "GAPS", "ONE_SIGMA", "chi2_interval"]
 
 #: Statistics (core names) that can leave out the terms touching a missing sample.
-_SKIPS_GAPS = frozenset({"adev", "oadev", "mdev", "hdev", "ohdev"})
+_SKIPS_GAPS = frozenset(_core_allan.GAP_SKIPPING)
 
 
 @dataclass(frozen=True)

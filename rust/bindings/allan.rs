@@ -1,7 +1,8 @@
 //! Bindings for the Allan family: one call computes variances, terms, noise
 //! identification and EDF for every tau and channel with the GIL released, and
-//! returns them as one frozen [`Analysis`]. Statistic names come from the Rust
-//! table (`allan::Statistic`), exported as `STATISTICS`.
+//! returns them as one frozen [`AnalysisArrays`] (`Analysis` in Python). Statistic
+//! names come from the Rust table (`allan::Statistic`), exported as `STATISTICS`,
+//! and those that can skip missing samples as `GAP_SKIPPING`.
 
 use numpy::ndarray::Array2;
 use numpy::{Element, IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
@@ -151,8 +152,18 @@ fn estimator_terms<'py>(
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    let names: Vec<&str> = Statistic::ALL.iter().map(|s| s.name()).collect();
-    m.add("STATISTICS", PyTuple::new(m.py(), names)?)?;
+    let names = |keep: fn(&Statistic) -> bool| -> Vec<&'static str> {
+        Statistic::ALL
+            .iter()
+            .filter(|s| keep(s))
+            .map(|s| s.name())
+            .collect()
+    };
+    m.add("STATISTICS", PyTuple::new(m.py(), names(|_| true))?)?;
+    m.add(
+        "GAP_SKIPPING",
+        PyTuple::new(m.py(), names(|s| s.skips_gaps()))?,
+    )?;
     m.add("THEOBR_MIN_SAMPLES", theobr::MIN_SAMPLES)?;
     m.add_class::<AnalysisArrays>()?;
     m.add_function(wrap_pyfunction!(analyse, m)?)?;

@@ -7,6 +7,7 @@ import numpy.typing as npt
 
 __all__ = [
     "STATISTICS",
+    "GAP_SKIPPING",
     "THEOBR_MIN_SAMPLES",
     "Analysis",
     "analyse",
@@ -18,6 +19,8 @@ __all__ = [
 #: Statistic names the functions below accept, from the Rust table
 #: (rust/allan/statistic.rs).
 STATISTICS: tuple[str, ...]
+#: The statistics that can leave out the terms touching a missing sample (NaN).
+GAP_SKIPPING: tuple[str, ...]
 #: Fewest samples ThêoBR (and ThêoH) accept: its bias ratio needs 90 phase points.
 THEOBR_MIN_SAMPLES: int
 
