@@ -22,14 +22,15 @@ from imunoise.allan import (
     ttotdev,
 )
 from imunoise.datasheet import compare
+from imunoise.errors import ParseError
 from imunoise.noise import NoiseModel, fit
 from imunoise.readers import Gaps, ImuLog, ParseIssues
 from imunoise.readers.read import read
-from imunoise.readers.vn_write import write_vn_ascii, write_vn_binary
 from imunoise.scale import batch
 from imunoise.simulate import simulate
 from imunoise.simulate_log import simulate_log
 from imunoise.stats import describe, distribution
+from imunoise.writers.vn import write_vn_ascii, write_vn_binary
 
 __all__ = [
     "__version__",
@@ -37,6 +38,7 @@ __all__ = [
     "Gaps",
     "ImuLog",
     "NoiseModel",
+    "ParseError",
     "ParseIssues",
     "adev",
     "batch",
@@ -49,7 +51,10 @@ __all__ = [
     "htotdev",
     "mdev",
     "mtotdev",
+    "plot",
     "read",
+    "report",
+    "scale",
     "simulate",
     "simulate_log",
     "tdev",
@@ -62,3 +67,19 @@ __all__ = [
     "write_vn_ascii",
     "write_vn_binary",
 ]
+
+# Modules that pull in matplotlib (plot, report) or optional dependencies (scale)
+# load on first use, so that ``import imunoise`` stays light.
+_LAZY_MODULES = ("plot", "report", "scale")
+
+
+def __getattr__(name: str):
+    if name in _LAZY_MODULES:
+        import importlib
+
+        return importlib.import_module(f"imunoise.{name}")
+    raise AttributeError(f"module 'imunoise' has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_LAZY_MODULES))

@@ -13,12 +13,20 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["main"]
+from imunoise._schema import (
+    ALLAN_SENSORS,
+    CHANNELS,
+    SAMPLE_SENSORS,
+    axis_names,
+    column_names,
+    sensor_label,
+)
 
-SENSORS = ("gyro", "accel", "mag")
+__all__ = ["bundled_log", "main"]
+
 KINDS = ("adev", "mdev", "hdev", "tdev", "totdev", "mtotdev", "ttotdev", "htotdev", "theo1",
          "theobr", "theoh")
-_AXES = ("X", "Y", "Z")
+
 
 class _Parser(argparse.ArgumentParser):
     """argparse with one-line errors and exit status 2."""
@@ -37,7 +45,7 @@ def _fail(message: str):
 
 def _version() -> str:
     try:
-        from imunoise import __version__
+        from imunoise._core import __version__
 
         return __version__
     except ImportError:  # pragma: no cover
@@ -61,18 +69,14 @@ def _build_parser() -> argparse.ArgumentParser:
     r.add_argument("long_log", metavar="LONG_LOG", nargs="?")
     r.add_argument("-o", "--output", default="imunoise-report", metavar="DIR",
                    help="output directory (default: %(default)s)")
-    r.add_argument("--spec", default="vn100",
-                   help="datasheet to compare with: a name or a TOML file (default: "
-                   "%(default)s); 'none' to skip")
-    _fs_arg(r)
-    _progress_args(r)
+    _shared_options(r, spec=True, fs=True, progress=True)
 
     a = sub.add_parser("adev", help="print an Allan-family deviation table",
                        description="Print tau, deviation, confidence interval and number of "
                        "terms per axis.")
     a.add_argument("log", metavar="LOG")
-    _fs_arg(a)
-    a.add_argument("--sensor", choices=SENSORS, default="gyro")
+    _shared_options(a, fs=True)
+    a.add_argument("--sensor", choices=SAMPLE_SENSORS, default="gyro")
     a.add_argument("--kind", choices=KINDS, default="adev")
     a.add_argument("--taus", default="octave",
                    help="octave, decade, all, or points per decade (default: %(default)s)")
@@ -81,8 +85,8 @@ def _build_parser() -> argparse.ArgumentParser:
                        description="Fit Q, N, B, K, R per axis to the Allan deviation and print "
                        "them in datasheet units with uncertainties.")
     f.add_argument("log", metavar="LOG")
-    _fs_arg(f)
-    f.add_argument("--sensor", choices=("gyro", "accel"), default=None,
+    _shared_options(f, fs=True)
+    f.add_argument("--sensor", choices=ALLAN_SENSORS, default=None,
                    help="one sensor (default: gyro and accel)")
     f.add_argument("--bootstrap", type=int, default=0, metavar="REPLICATES",
                    help="uncertainties by parametric bootstrap with this many simulated "
@@ -92,7 +96,7 @@ def _build_parser() -> argparse.ArgumentParser:
                        description="Per channel mean, std, variance, min, max, drift per hour; "
                        "per axis normal fit and normality statistics.")
     s.add_argument("log", metavar="LOG")
-    _fs_arg(s)
+    _shared_options(s, fs=True)
 
     c = sub.add_parser("convert", help="convert a log to .npy, Parquet, CSV or NPZ",
                        description="Write the log's channels to OUTPUT; the format follows the "
@@ -101,11 +105,10 @@ def _build_parser() -> argparse.ArgumentParser:
                        "pyarrow), .csv or .npz. VN logs to a directory, .npy or .parquet are "
                        "streamed with bounded memory, whatever their size.")
     c.add_argument("log", metavar="LOG")
-    _fs_arg(c)
     c.add_argument("-o", "--output", required=True, metavar="OUTPUT")
     c.add_argument("--chunk-mb", type=_positive_float, default=64.0, metavar="MB",
                    help="bytes read per piece when streaming (default: %(default)s MB)")
-    _progress_args(c)
+    _shared_options(c, fs=True, progress=True)
 
     b = sub.add_parser("batch", help="characterise many logs in parallel (Dask)",
                        description="Allan deviation, noise fit and datasheet verdict of every "
@@ -119,11 +122,7 @@ def _build_parser() -> argparse.ArgumentParser:
                    help="address of a running Dask scheduler (default: a local cluster)")
     b.add_argument("--serial", action="store_true",
                    help="no Dask: analyse the logs one after another in this process")
-    b.add_argument("--spec", default="vn100",
-                   help="datasheet to compare with: a name or a TOML file (default: "
-                   "%(default)s); 'none' to skip")
-    _fs_arg(b)
-    _progress_args(b)
+    _shared_options(b, spec=True, fs=True, progress=True)
 
     m = sub.add_parser("simulate", help="write the log of a simulated still VN-100",
                        description="Write the log of a still VN-100 (gravity on -Z, a constant "
@@ -142,17 +141,22 @@ def _build_parser() -> argparse.ArgumentParser:
     d.add_argument("--hours", type=_positive_float, default=5.0,
                    help="length of the simulated long log (default: %(default)s)")
     d.add_argument("--seed", type=int, default=1)
-    _progress_args(d)
+    _shared_options(d, progress=True)
     return p
 
 
-def _fs_arg(p) -> None:
-    p.add_argument("--fs", type=_positive_float, default=None, metavar="HZ",
-                   help="sample rate of logs without timestamps (VN ASCII: the rate the "
-                   "sensor was set to; default 40 Hz with a warning)")
-
-
-def _progress_args(p) -> None:
+def _shared_options(p, *, spec: bool = False, fs: bool = False, progress: bool = False) -> None:
+    """Add the options several commands share, each worded once."""
+    if spec:
+        p.add_argument("--spec", default="vn100",
+                       help="datasheet to compare with: a name or a TOML file (default: "
+                       "%(default)s); 'none' to skip")
+    if fs:
+        p.add_argument("--fs", type=_positive_float, default=None, metavar="HZ",
+                       help="sample rate of logs without timestamps (VN ASCII: the rate the "
+                       "sensor was set to; default 40 Hz with a warning)")
+    if not progress:
+        return
     g = p.add_mutually_exclusive_group()
     g.add_argument("--progress", dest="progress", action="store_true", default=None,
                    help="always show progress bars on stderr")
@@ -174,9 +178,9 @@ def _positive_float(text: str) -> float:
 
 
 def _read(args):
-    from imunoise.report import _load, _Progress
+    from imunoise.report import read_log
 
-    log = _load(args.log, "input", _Progress(False, 0), args.fs)
+    log = read_log(args.log, "input", fs=args.fs)
     _note_gaps(log.source, log)
     return log
 
@@ -206,20 +210,17 @@ def _cmd_report(args) -> int:
 
 
 def _cmd_adev(args) -> int:
-    import imunoise
-    from imunoise import report
+    from imunoise import allan, report
 
     log = _read(args)
     y = getattr(log, args.sensor)
     if y is None:
         _fail(f"{args.log}: the log has no {args.sensor} channel (has {', '.join(log.channels)})")
     taus = int(args.taus) if args.taus.isdigit() else args.taus
-    r = getattr(imunoise, args.kind)(y, log.fs, taus=taus)
-    from imunoise.readers.log import CHANNELS
-
+    r = getattr(allan, args.kind)(y, log.fs, taus=taus)
     unit = CHANNELS[args.sensor][1]
     head = ["tau[s]", "n"]
-    for a in _AXES:
+    for a in axis_names(y.shape[1]):
         head += [f"{a}[{unit}]", f"{a}_ci_low", f"{a}_ci_high"]
     rows = []
     for i, tau in enumerate(r.taus):
@@ -234,26 +235,26 @@ def _cmd_adev(args) -> int:
 
 
 def _cmd_fit(args) -> int:
-    from imunoise import fit, report
+    from imunoise import allan, noise, report
 
     log = _read(args)
-    sensors = [args.sensor] if args.sensor else [s for s in ("gyro", "accel")
+    sensors = [args.sensor] if args.sensor else [s for s in ALLAN_SENSORS
                                                   if getattr(log, s) is not None]
     if not sensors or any(getattr(log, s) is None for s in sensors):
         _fail(f"{args.log}: no {' or '.join(sensors or ['gyro/accel'])} channel in the log")
     if args.bootstrap and args.bootstrap < 5:
         _fail(f"--bootstrap must be >= 5 replicates; got {args.bootstrap}")
     for s in sensors:
-        result = report._allan(getattr(log, s), log.fs)
+        result = allan.adev(getattr(log, s), log.fs, taus=report.TAUS_PER_DECADE)
         if args.bootstrap:
-            model = fit(result, uncertainty="bootstrap", replicates=args.bootstrap,
-                                 seed=0)
-        else:
-            model = report._fit(result)
-        head, rows = report._datasheet_rows(model, s)
+            model = noise.fit(result, uncertainty="bootstrap", replicates=args.bootstrap,
+                              seed=0)
+        else:  # the sentences below say how well the model follows the curve
+            model = noise.fit(result, warn_coverage=False)
+        head, rows = report.datasheet_rows(model, s)
         print(f"# {s}")
         _print_table(head, rows)
-        for sentence in report._model_sentences(model, s):
+        for sentence in report.model_sentences(model, s):
             print(sentence.replace("**", ""))
     return 0
 
@@ -268,14 +269,14 @@ def _cmd_stats(args) -> int:
     print()
     head = ["channel", "step", "spacing", "mu", "sigma", "KS_D", "KS_p", "AD_A2", "skew", "ex_kurt"]
     rows = []
-    for sensor in SENSORS:
+    for sensor in SAMPLE_SENSORS:
         y = getattr(log, sensor)
         if y is None:
             continue
         for j in range(y.shape[1]):
             d = stats.distribution(y[:, j])
             rows.append([
-                f"{sensor} {_AXES[j]}",
+                sensor_label(sensor, j, y.shape[1]),
                 f"{d.step:.6g}" if d.step else "-",
                 f"{d.level_spacing:.6g}" if d.level_spacing else "-",
             ] + [
@@ -291,8 +292,6 @@ def _columns(log) -> tuple[list[str], list[np.ndarray]]:
     if log.time is not None:
         names.append("time")
         cols.append(np.asarray(log.time))
-    from imunoise.readers.log import column_names
-
     for ch in log.channels:
         arr = getattr(log, ch)
         names.extend(column_names(ch))
@@ -311,24 +310,12 @@ def _cmd_convert(args) -> int:
               f"got {str(out)!r}")
     if suffix in ("", ".npy", ".parquet"):
         return _convert_streaming(args, out)
-    if suffix == ".parquet":
-        try:
-            import pyarrow  # noqa: F401
-        except ImportError:
-            _fail("Parquet output needs pyarrow (pip install pyarrow)")
     log = _read(args)
     names, cols = _columns(log)
     out.parent.mkdir(parents=True, exist_ok=True)
     if suffix == ".csv":
         np.savetxt(out, np.column_stack(cols), delimiter=",", header=",".join(names),
                    comments="", fmt="%.10g")
-    elif suffix == ".parquet":
-        import pyarrow as pa
-        import pyarrow.parquet as pq
-
-        table = pa.table(dict(zip(names, cols, strict=True)))
-        table = table.replace_schema_metadata({"fs": str(log.fs), "source": log.source})
-        pq.write_table(table, out)
     else:
         np.savez(out, fs=log.fs, **dict(zip(names, cols, strict=True)))
     print(f"wrote {len(log)} samples x {len(names)} columns to {out}")
@@ -337,16 +324,14 @@ def _cmd_convert(args) -> int:
 
 def _convert_streaming(args, out: Path) -> int:
     from imunoise import scale
-    from imunoise.report import _Progress
+    from imunoise._progress import byte_bar, wanted
 
-    bar = _Progress(args.progress, 0)
+    bar = byte_bar(f"converting {Path(args.log).name}") if wanted(args.progress) else None
     try:
         done = scale.convert(args.log, out, fs=args.fs, chunk_bytes=int(args.chunk_mb * 2**20),
-                             progress=bar.reader(f"converting {Path(args.log).name}"))
+                             progress=bar)
     except ImportError as exc:
         _fail(str(exc))
-    finally:
-        bar.close()
     _note_gaps(str(args.log), done)
     print(f"wrote {done.samples} samples ({', '.join(done.channels)}) at {done.fs:.6g} Hz to "
           f"{done.out}; parse issues: {done.issues}")

@@ -27,6 +27,7 @@ from pathlib import Path
 import numpy as np
 
 from imunoise import units as _units
+from imunoise._schema import axis_names
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -191,7 +192,7 @@ def compare(models, spec="vn100", *, sensor: str = "gyro", input_units: dict | N
     -------
     Comparison
     """
-    from imunoise.noise import NoiseModel, _axis_names
+    from imunoise.noise import NoiseModel
 
     if isinstance(models, NoiseModel):
         if sensor not in _units.SENSORS:
@@ -221,7 +222,7 @@ def compare(models, spec="vn100", *, sensor: str = "gyro", input_units: dict | N
         values = _units.convert(eq, item.term, info.name, sensor=item.sensor, input_unit=iu)
         stds = _units.convert(eq_std, item.term, info.name, sensor=item.sensor, input_unit=iu)
         sup = (eq > 0) & np.isfinite(eq)
-        for i, ax in enumerate(_axis_names(model.channels, axes)):
+        for i, ax in enumerate(axis_names(model.channels, axes)):
             measured = float(values[i])
             ok = bool(sup[i])
             ratio = measured / item.value if ok else math.nan

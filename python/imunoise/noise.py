@@ -67,14 +67,17 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from imunoise import _schema
 from imunoise import units as _units
+from imunoise._core import fit as _core_fit
+from imunoise._deprecation import old_call_forms
 
 __all__ = ["TERMS", "FLICKER", "NoiseModel", "Prediction", "fit", "model_variance"]
 
-TERMS = ("Q", "N", "B", "K", "R")
-"""The five coefficients, in the order used everywhere."""
+TERMS: tuple[str, ...] = tuple(_core_fit.IEEE_TERM_NAMES)
+"""The five coefficients, in the order used everywhere (Q, N, B, K, R)."""
 
-FLICKER = math.sqrt(2 * math.log(2) / math.pi)
+FLICKER = math.sqrt(_core_fit.FLICKER_FACTOR)
 """σ_flat / B = √(2 ln2/π) ≈ 0.6643."""
 
 _NAMES = {
@@ -92,10 +95,10 @@ _SENSOR_NAMES = {
 # straight line is read (IEEE 952 Annex C).
 _SLOPE = {"Q": -1.0, "N": -0.5, "B": 0.0, "K": 0.5, "R": 1.0}
 _READ_TAU = {"Q": math.sqrt(3.0), "N": 1.0, "K": 3.0, "R": math.sqrt(2.0)}
-GM_MAX = 3
+GM_MAX: int = _core_fit.MAX_GAUSS_MARKOV
 """Most first-order Gauss–Markov terms a model may have."""
 
-_PARAMS = 5 + 2 * GM_MAX
+_PARAMS: int = _core_fit.PARAMETERS
 """Parameter slots of the covariance: five IEEE variances, (σ², ln τc) per GM term."""
 
 
@@ -119,8 +122,6 @@ def _terms(taus, fs: float, coef, markov=()) -> np.ndarray:
     """Allan variance of each model term at ``taus``: (len(taus), 5 + len(markov)),
     from the one implementation of the model (Rust); ``coef`` holds Q…R,
     ``markov`` (sigma, tau_c) pairs."""
-    from imunoise._core import fit as _core_fit
-
     t = np.ascontiguousarray(np.atleast_1d(np.asarray(taus, dtype=float)))
     return _core_fit.noise_terms(t, float(fs), [float(c) ** 2 for c in coef],
                              [(s * s, tc) for s, tc in markov])
@@ -340,8 +341,6 @@ class NoiseModel:
     def _equivalent_of(self, term: str, p: np.ndarray) -> float:
         gm = [(p[5 + 2 * k], math.exp(p[6 + 2 * k])) for k in range(GM_MAX) if p[5 + 2 * k] > 0]
         if term == "B":
-            from imunoise._core import fit as _core_fit
-
             grid = np.geomspace(self.taus[0], self.taus[-1], 200)
             dev = np.sqrt(_core_fit.noise_terms(grid, self.fs, list(p[:5]), gm).sum(axis=1))
             i = int(np.argmin(dev))
@@ -360,7 +359,8 @@ class NoiseModel:
         return math.sqrt(max(total, 0.0))
 
     # -- units and tables ---------------------------------------------------
-    def in_units(self, sensor: str = "gyro", units: dict[str, str] | None = None,
+    @old_call_forms(keyword_only=("units", "input_unit"))
+    def in_units(self, sensor: str = "gyro", *, units: dict[str, str] | None = None,
                  input_unit: str | None = None) -> dict[str, dict]:
         """Datasheet values in datasheet units: N, B, K are the model's
         :meth:`equivalent` values (what a datasheet quotes from this curve, with
@@ -404,7 +404,8 @@ class NoiseModel:
             }
         return out
 
-    def table(self, sensor: str = "gyro", units: dict[str, str] | None = None,
+    @old_call_forms(keyword_only=("units", "input_unit", "axes", "terms"))
+    def table(self, sensor: str = "gyro", *, units: dict[str, str] | None = None,
               input_unit: str | None = None, axes: Sequence[str] | None = None,
               terms: Sequence[str] = ("N", "B", "K", "Q", "R")) -> list[dict]:
         """Per-axis table in datasheet units: one row per coefficient.
@@ -413,8 +414,8 @@ class NoiseModel:
         per axis name (default X, Y, Z…), the value, ``<axis>_std`` and
         ``<axis>_supported``. Render it with :func:`format_table`.
         """
-        axes = _axis_names(self.channels, axes)
-        conv = self.in_units(sensor, units, input_unit)
+        axes = _schema.axis_names(self.channels, axes)
+        conv = self.in_units(sensor, units=units, input_unit=input_unit)
         rows = []
         for term in terms:
             _check_term(term)
@@ -438,10 +439,11 @@ class NoiseModel:
     def table_text(self, sensor: str = "gyro", **kwargs) -> str:
         """Text rendering of :meth:`table`."""
         rows = self.table(sensor, **kwargs)
-        return format_table(rows, _axis_names(self.channels, kwargs.get("axes")))
+        return format_table(rows, _schema.axis_names(self.channels, kwargs.get("axes")))
 
     # -- exports ------------------------------------------------------------
-    def to_kalibr(self, accel: NoiseModel | None = None, path=None, **kwargs) -> str:
+    @old_call_forms(keyword_only=("accel", "path"))
+    def to_kalibr(self, *, accel: NoiseModel | None = None, path=None, **kwargs) -> str:
         """Kalibr ``imu.yaml`` text with this model as the gyroscope.
 
         See :func:`imunoise.export.kalibr_yaml` for the options; with ``path``
@@ -495,25 +497,15 @@ class NoiseModel:
         return d
 
 
-def _axis_names(channels: int, axes: Sequence[str] | None) -> list[str]:
-    if axes is None:
-        axes = ["X", "Y", "Z"] if channels == 3 else [f"ch{i}" for i in range(channels)]
-        if channels == 1:
-            axes = ["value"]
-    axes = list(axes)
-    if len(axes) != channels:
-        raise ValueError(f"axes must name {channels} channels; got {axes!r}")
-    return axes
-
-
 def format_table(rows: list[dict], axes: Sequence[str]) -> str:
     """Render :meth:`NoiseModel.table` rows as fixed-width text.
 
-    Unsupported terms print as ``—``; values carry ``± std``.
+    Terms the data do not resolve print as ``not resolved`` (the report's and
+    ``imunoise fit``'s wording too); values carry ``± std``.
     """
     def cell(row, ax):
         if not row[ax + "_supported"]:
-            return "— (unresolved)"
+            return "not resolved"
         v, s = row[ax], row[ax + "_std"]
         return f"{v:.4g} ± {s:.2g}" if np.isfinite(s) else f"{v:.4g}"
 
@@ -631,8 +623,10 @@ def _parse_terms(terms) -> tuple[np.ndarray, int, bool]:
     return np.array([t in names for t in TERMS]), gm, False
 
 
-def fit(result, method: str = "wls", terms: str | Sequence[str] = "auto", tau_range=None, *,
-        uncertainty: str = "independent", replicates: int = 30, seed=None) -> NoiseModel:
+@old_call_forms(keyword_only=("method", "terms", "tau_range"))
+def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
+        tau_range: tuple[float, float] | None = None, uncertainty: str = "independent",
+        replicates: int = 30, seed=None, warn_coverage: bool = True) -> NoiseModel:
     """Fit the noise model to an Allan deviation.
 
     Parameters
@@ -664,6 +658,9 @@ def fit(result, method: str = "wls", terms: str | Sequence[str] = "auto", tau_ra
         ``"bootstrap"`` only: number of simulated records (≥ 5; default 30).
     seed : int, numpy.random.Generator or None
         ``"bootstrap"`` only: seed of the simulations, for reproducible results.
+    warn_coverage : bool
+        Warn when the model follows the curve poorly (below); False for callers
+        that say it in their own words (the report, ``imunoise fit``).
 
     Returns
     -------
@@ -781,7 +778,7 @@ def fit(result, method: str = "wls", terms: str | Sequence[str] = "auto", tau_ra
     )
     cover = _coverage(model, taus, dev_all, edf_raw)
     object.__setattr__(model, "coverage", shaped(cover))
-    for c in np.flatnonzero(cover < 0.8) if method == "wls" else ():
+    for c in np.flatnonzero(cover < 0.8) if method == "wls" and warn_coverage else ():
         warnings.warn(
             f"the noise model follows the Allan deviation of channel {c} at only "
             f"{cover[c]:.0%} of the taus (inside the 95 % interval or within 5 %); its "
@@ -898,15 +895,15 @@ def _readonly(a):
 
 
 def _fit_wls(t, v, e, fs, mask, gm_count, select):
-    from imunoise._core import fit as _core_fit
-
     try:
-        sq, gm, cov, delta, chi2, n_eff, _params, _bic = _core_fit.fit_noise(
+        r = _core_fit.fit_noise(
             np.ascontiguousarray(t), np.ascontiguousarray(v), np.ascontiguousarray(e), fs,
             [bool(m) for m in mask], gm_count, select,
         )
     except ValueError as exc:
         raise ValueError(f"cannot fit the noise model to result: {exc}") from None
+    sq, gm, cov = r.ieee, r.gm, r.cov
+    delta, chi2, n_eff = r.discrepancy, r.chi2, r.n_eff
     supported = sq > 0
     coef = np.sqrt(np.maximum(sq, 0.0))
     var_sq = np.diag(cov)[:5]

@@ -11,13 +11,18 @@ its maximum, so 10⁷ points draw in milliseconds and no spike disappears.
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from imunoise.noise import FLICKER
+from imunoise._schema import axis_names
+from imunoise.noise import FLICKER, TERMS, NoiseModel, model_variance
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
 __all__ = [
     "AXIS_COLORS",
@@ -32,7 +37,6 @@ __all__ = [
 AXIS_COLORS = ("#1f77b4", "#ff7f0e", "#2ca02c", "#9467bd")
 #: Shading of missing samples (gaps) on time plots.
 GAP_COLOR = "#d62728"
-AXIS_NAMES = ("X", "Y", "Z", "W")
 TERM_STYLES = {
     "Q": ("quantization Q", ":"),
     "N": ("white noise N", "--"),
@@ -68,7 +72,7 @@ def _plt():
 
 
 @contextmanager
-def style():
+def style() -> Iterator[None]:
     """Context manager applying the imunoise figure style."""
     import matplotlib
 
@@ -135,7 +139,7 @@ def time_series(
     names: Sequence[str] | None = None,
     columns: int = 1600,
     gaps: Sequence[tuple[float, float]] = (),
-):
+) -> Figure:
     """Time series of a sensor's axes, one panel per axis, min/max decimated.
 
     Parameters
@@ -147,22 +151,22 @@ def time_series(
     title, unit : str
         Figure title and y-axis unit.
     names : sequence of str, optional
-        Axis names; default X, Y, Z.
+        Axis names; default X, Y, Z (``value`` for one column).
     columns : int
         Buckets per panel (≈ pixel width of the saved figure).
     gaps : sequence of (start, duration)
         Missing samples, in seconds from the first sample, shaded on every panel.
     """
-    Figure = _plt()
+    new_figure = _plt()
     y = np.asarray(y, dtype=np.float64).reshape(len(y), -1)
     k = y.shape[1]
-    names = list(names) if names is not None else list(AXIS_NAMES[:k])
+    names = list(names) if names is not None else axis_names(k)
     duration = len(y) / fs
     scale, tunit = (1.0, "s") if duration < 600 else (60.0, "min")
     if duration >= 3 * 3600:
         scale, tunit = 3600.0, "h"
     with style():
-        fig = Figure(figsize=(9, 1.7 * k + 0.6))
+        fig = new_figure(figsize=(9, 1.7 * k + 0.6))
         axes = fig.subplots(k, 1, sharex=True, squeeze=False)[:, 0]
         for j, ax in enumerate(axes):
             _draw_series(ax, 0.0, fs * scale, y[:, j], AXIS_COLORS[j % 4], columns)
@@ -186,7 +190,7 @@ def histograms(
     title: str = "",
     unit: str = "",
     names: Sequence[str] | None = None,
-):
+) -> Figure:
     """Histograms (as densities) with the fitted normal pdf, one panel per axis.
 
     Parameters
@@ -194,11 +198,11 @@ def histograms(
     dists : sequence of :class:`imunoise.stats.Distribution`
         One per axis.
     """
-    Figure = _plt()
+    new_figure = _plt()
     k = len(dists)
-    names = list(names) if names is not None else list(AXIS_NAMES[:k])
+    names = list(names) if names is not None else axis_names(k)
     with style():
-        fig = Figure(figsize=(3.2 * k, 2.8))
+        fig = new_figure(figsize=(3.2 * k, 2.8))
         axes = fig.subplots(1, k, squeeze=False)[0]
         for j, (ax, d) in enumerate(zip(axes, dists, strict=True)):
             color = AXIS_COLORS[j % 4]
@@ -220,17 +224,15 @@ def histograms(
     return fig
 
 
-def _curves(coeffs: Mapping[str, float], taus: np.ndarray) -> dict[str, np.ndarray]:
-    """Deviation of each IEEE noise term and the total at ``taus``."""
-    from imunoise.noise import TERMS, _terms
-
-    var = _terms(taus, 1.0, [coeffs.get(k, 0.0) for k in TERMS])  # fs: no GM terms here
-    out = {name: np.sqrt(var[:, i]) for i, name in enumerate(TERMS)}
-    out["total"] = np.sqrt(var.sum(axis=1))
+def _coefficient_curves(coeffs: Mapping[str, float], grid: np.ndarray) -> dict[str, np.ndarray]:
+    """Deviation of each IEEE term of hand-given coefficients and their total at
+    ``grid``, by :func:`imunoise.noise.model_variance` (the model's one formula)."""
+    out = {t: np.sqrt(model_variance(grid, **{t: coeffs.get(t, 0.0)})) for t in TERMS}
+    out["total"] = np.sqrt(model_variance(grid, **{t: coeffs.get(t, 0.0) for t in TERMS}))
     return out
 
 
-def _model_curves(model, grid: np.ndarray, channel: int) -> dict[str, np.ndarray]:
+def _model_curves(model: NoiseModel, grid: np.ndarray, channel: int) -> dict[str, np.ndarray]:
     """Deviation of each term of a fitted model and its total at ``grid``."""
     pred = model.predict(grid)
     out = {name: np.reshape(v, (grid.size, -1))[:, channel] for name, v in pred.terms.items()}
@@ -238,21 +240,21 @@ def _model_curves(model, grid: np.ndarray, channel: int) -> dict[str, np.ndarray
     return out
 
 
-def _readoff_points(model, channel: int) -> dict[str, float]:
+def _readoff_points(model: NoiseModel, channel: int) -> dict[str, float]:
     """The model's datasheet equivalents N (τ = 1 s), K (τ = 3 s), B for the marks."""
     return {t: float(np.atleast_1d(model.equivalent(t))[channel]) for t in ("N", "K", "B")}
 
 
 def allan(
     result,
-    model=None,
+    model: NoiseModel | None = None,
     *,
     coefficients: Sequence[Mapping[str, float]] | None = None,
     title: str = "",
     unit: str = "",
     names: Sequence[str] | None = None,
     residuals: bool = True,
-):
+) -> Figure:
     r"""Allan deviation of a sensor's axes on log-log axes, one panel per axis.
 
     Parameters
@@ -272,7 +274,7 @@ def allan(
     residuals : bool
         Draw the data/model panel when a model is given (default True).
     """
-    Figure = _plt()
+    new_figure = _plt()
     from matplotlib.ticker import NullFormatter
 
     taus = np.asarray(result.taus, dtype=np.float64)
@@ -280,12 +282,12 @@ def allan(
     lo = np.asarray(result.ci_low, dtype=np.float64).reshape(dev.shape)
     hi = np.asarray(result.ci_high, dtype=np.float64).reshape(dev.shape)
     k = dev.shape[1]
-    names = list(names) if names is not None else list(AXIS_NAMES[:k])
+    names = list(names) if names is not None else axis_names(k)
     kind = getattr(result, "kind", "adev").upper()
     grid = np.geomspace(taus[0], taus[-1], 200)
     show_res = model is not None and residuals
     with style():
-        fig = Figure(figsize=(3.6 * k, 3.9 + (1.3 if show_res else 0.0)))
+        fig = new_figure(figsize=(3.6 * k, 3.9 + (1.3 if show_res else 0.0)))
         if show_res:
             gs = fig.add_gridspec(2, k, height_ratios=(3, 1), hspace=0.08)
             axes = [fig.add_subplot(gs[0, j]) for j in range(k)]
@@ -311,7 +313,7 @@ def allan(
                 curves = _model_curves(model, grid, j)
                 marks = _readoff_points(model, j)
             elif coefficients is not None:
-                curves = _curves(coefficients[j], grid)
+                curves = _coefficient_curves(coefficients[j], grid)
                 c = coefficients[j]
                 marks = {t: c.get(t, 0.0) for t in ("N", "K", "B")}
             if model is not None or coefficients is not None:
@@ -393,7 +395,7 @@ def allan(
     return fig
 
 
-def save(fig, path, formats: Sequence[str] = ("png", "svg")) -> list[Path]:
+def save(fig: Figure, path, *, formats: Sequence[str] = ("png", "svg")) -> list[Path]:
     """Save ``fig`` as ``path.<fmt>`` for each format; returns the paths written."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)

@@ -46,6 +46,9 @@ from collections.abc import Sequence
 import numpy as np
 from scipy import fft as _fft
 
+from imunoise._deprecation import old_call_forms
+from imunoise._validate import sample_rate
+
 __all__ = ["simulate", "flicker"]
 
 _CHUNK = 1 << 22
@@ -79,12 +82,15 @@ def _kw_filter(length: int, alpha: float = 1.0) -> np.ndarray:
     return h
 
 
-def flicker(n: int, scale: float, rng: np.random.Generator, taps: int = _FLICKER_TAPS,
-            out: np.ndarray | None = None) -> np.ndarray:
+@old_call_forms(keyword_only=("taps", "out"), renamed={"n": "n_samples"})
+def flicker(n_samples: int, scale: float, rng: np.random.Generator, *,
+            taps: int = _FLICKER_TAPS, out: np.ndarray | None = None) -> np.ndarray:
     """Kasdin–Walter flicker (1/f) noise: white noise of std ``scale`` filtered.
 
-    Adds into ``out`` when given (shape (n,)), otherwise returns a new array.
+    Adds into ``out`` when given (shape (n_samples,)), otherwise returns a new array.
+    The filter is truncated to ``taps`` taps (see the module docstring).
     """
+    n = n_samples
     if out is None:
         out = np.zeros(n)
     if scale == 0.0 or n == 0:
@@ -107,15 +113,16 @@ def flicker(n: int, scale: float, rng: np.random.Generator, taps: int = _FLICKER
     return out
 
 
-def simulate(n: int, fs: float, Q: float = 0.0, N: float = 0.0, B: float = 0.0,
-             K: float = 0.0, R: float = 0.0, channels: int = 1, seed=None, *,
+@old_call_forms(keyword_only=("channels", "seed"), renamed={"n": "n_samples"})
+def simulate(n_samples: int, fs: float, Q: float = 0.0, N: float = 0.0, B: float = 0.0,
+             K: float = 0.0, R: float = 0.0, *, channels: int = 1, seed=None,
              gm: Sequence[tuple[float, float]] = ()) -> np.ndarray:
     """Rate noise with the given IEEE 952 coefficients.
 
     Parameters
     ----------
-    n : int
-        Number of samples (≥ 1).
+    n_samples : int
+        Number of samples (≥ 1). (The old name ``n=`` still works, deprecated.)
     fs : float
         Sample rate, Hz.
     Q, N, B, K, R : float
@@ -134,7 +141,8 @@ def simulate(n: int, fs: float, Q: float = 0.0, N: float = 0.0, B: float = 0.0,
     Returns
     -------
     ndarray
-        float64, shape (n,) when ``channels == 1`` else (n, channels).
+        float64, shape (n_samples,) when ``channels == 1`` else
+        (n_samples, channels).
 
     Examples
     --------
@@ -143,14 +151,9 @@ def simulate(n: int, fs: float, Q: float = 0.0, N: float = 0.0, B: float = 0.0,
     >>> y.shape
     (100000,)
     """
-    n = _check_int("n", n, 1)
+    n = _check_int("n_samples", n_samples, 1)
     channels = _check_int("channels", channels, 1)
-    try:
-        fs = float(fs)
-    except (TypeError, ValueError):
-        raise TypeError(f"fs must be a real number; got {fs!r}") from None
-    if not (math.isfinite(fs) and fs > 0):
-        raise ValueError(f"fs must be finite and > 0; got {fs!r}")
+    fs = sample_rate(fs)
     Q, N, B, K, R = (_check_coef(k, v) for k, v in zip("QNBKR", (Q, N, B, K, R), strict=True))
     markov = _check_gm(gm)
     rng = np.random.default_rng(seed)

@@ -13,10 +13,14 @@ from pathlib import Path
 
 import numpy as np
 
+from imunoise import _schema
+from imunoise._deprecation import old_call_forms
+from imunoise._validate import positive_finite, sample_rate
 from imunoise.datasheet import load_spec
 from imunoise.readers.log import ImuLog
 from imunoise.simulate import simulate
 from imunoise.units import convert_back
+from imunoise.writers.vn import write_vn_ascii, write_vn_binary
 
 __all__ = ["DEFAULT_K", "noise_of_spec", "simulate_log", "still_log"]
 
@@ -25,7 +29,7 @@ __all__ = ["DEFAULT_K", "noise_of_spec", "simulate_log", "still_log"]
 DEFAULT_K = {"gyro": 2e-6, "accel": 3e-5}
 
 #: What a still, level VN-100 reads besides noise (Earth rate ignored).
-_STILL_MEAN = {"gyro": (0.0, 0.0, 0.0), "accel": (0.0, 0.0, -9.80665)}
+_STILL_MEAN = {"gyro": (0.0, 0.0, 0.0), "accel": (0.0, 0.0, -_schema.G)}
 _STILL_YPR = (-77.7, -1.3, 0.15)  # deg
 _STILL_MAG = (0.045, 0.247, -0.338)  # Gauss
 _FORMATS = ("vn-ascii", "vn-binary")
@@ -56,12 +60,8 @@ def noise_of_spec(spec="vn100") -> dict[str, dict[str, float]]:
 def still_log(hours: float, fs: float = 40.0, *, spec="vn100", seed=None) -> ImuLog:
     """An :class:`ImuLog` of a still sensor with the noise of ``spec``: gyro and
     accelerometer simulated, attitude and magnetic field constant."""
-    hours = float(hours)
-    fs = float(fs)
-    if not (np.isfinite(hours) and hours > 0):
-        raise ValueError(f"hours must be positive and finite; got {hours!r}")
-    if not (np.isfinite(fs) and fs > 0):
-        raise ValueError(f"fs must be positive and finite (Hz); got {fs!r}")
+    hours = positive_finite(hours, "hours")
+    fs = sample_rate(fs)
     n = int(round(hours * 3600.0 * fs))
     if n < 2:
         raise ValueError(f"hours={hours:g} at fs={fs:g} Hz gives {n} samples; at least 2 needed")
@@ -79,8 +79,9 @@ def still_log(hours: float, fs: float = 40.0, *, spec="vn100", seed=None) -> Imu
     return ImuLog.from_arrays(fs, source=f"<simulated {label}, {hours:g} h>", **channels)
 
 
-def simulate_log(path, hours: float, fs: float = 40.0, format: str = "vn-ascii",
-                 spec="vn100", seed=None) -> Path:
+@old_call_forms(keyword_only=("format", "spec", "seed"))
+def simulate_log(path: str | os.PathLike, hours: float, fs: float = 40.0, *,
+                 format: str = "vn-ascii", spec="vn100", seed=None) -> Path:
     """Write the log of a still VN-100 with datasheet-level noise.
 
     Parameters
@@ -104,8 +105,6 @@ def simulate_log(path, hours: float, fs: float = 40.0, format: str = "vn-ascii",
     pathlib.Path
         The file written; ``imunoise.read`` reads it back.
     """
-    from imunoise.readers.vn_write import write_vn_ascii, write_vn_binary
-
     if format not in _FORMATS:
         raise ValueError(f"format must be one of {', '.join(_FORMATS)}; got {format!r}")
     log = still_log(hours, fs, spec=spec, seed=seed)

@@ -44,6 +44,11 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import stats as _sstats
 
+from imunoise import _schema
+from imunoise._deprecation import old_call_forms
+from imunoise._validate import sample_rate
+from imunoise.readers.log import ImuLog
+
 __all__ = [
     "Description",
     "Distribution",
@@ -53,9 +58,9 @@ __all__ = [
     "SENSOR_CHANNELS",
 ]
 
-#: ImuLog channels :func:`describe` reports, in this order.
-SENSOR_CHANNELS = ("gyro", "accel", "mag", "temperature", "pressure")
-_AXES = ("X", "Y", "Z", "W")
+#: ImuLog channels :func:`describe` reports, in this order (kept here as a public
+#: name; the schema module owns the list).
+SENSOR_CHANNELS = _schema.STATISTICS_CHANNELS
 
 #: Largest number of bins :func:`distribution` builds.
 MAX_BINS = 10_000
@@ -157,12 +162,13 @@ def _fmt(v: float) -> str:
     return "—" if not np.isfinite(v) else f"{v:.6g}"
 
 
-def describe(log_or_array, fs: float | None = None) -> Description:
+@old_call_forms(renamed={"log_or_array": "x"})
+def describe(x, fs: float | None = None) -> Description:
     r"""Per-channel mean, standard deviation, variance, extremes and linear drift.
 
     Parameters
     ----------
-    log_or_array : ImuLog or array_like, shape (n,) or (n, k)
+    x : ImuLog or array_like, shape (n,) or (n, k)
         An :class:`imunoise.ImuLog` (its gyro, accel, mag, temperature and
         pressure channels are described, axes named X/Y/Z), or rate samples.
     fs : float, optional
@@ -182,10 +188,8 @@ def describe(log_or_array, fs: float | None = None) -> Description:
     statistics use its valid samples (and their times), ``missing`` counts the
     others; a channel with fewer than two valid samples gets NaN.
     """
-    from imunoise.readers.log import CHANNELS, ImuLog
-
-    if isinstance(log_or_array, ImuLog):
-        log = log_or_array
+    if isinstance(x, ImuLog):
+        log = x
         fs = log.fs if fs is None else fs
         blocks, names, sensors, units = [], [], [], []
         for sensor in SENSOR_CHANNELS:
@@ -194,35 +198,33 @@ def describe(log_or_array, fs: float | None = None) -> Description:
                 continue
             arr = arr.reshape(len(arr), -1)
             blocks.append(arr)
-            unit = CHANNELS[sensor][1]
+            unit = _schema.CHANNELS[sensor][1]
             for j in range(arr.shape[1]):
-                names.append(sensor if arr.shape[1] == 1 else f"{sensor} {_AXES[j]}")
+                names.append(_schema.sensor_label(sensor, j, arr.shape[1]))
                 sensors.append(sensor)
                 units.append(unit)
         if not blocks:
             raise ValueError(
-                f"log_or_array has none of the channels {SENSOR_CHANNELS}; "
+                f"x has none of the channels {SENSOR_CHANNELS}; "
                 f"got channels {log.channels}"
             )
         x = np.hstack(blocks) if len(blocks) > 1 else blocks[0]
     else:
-        x = _as_samples(log_or_array, "log_or_array")
+        x = _as_samples(x, "x")
         x = x.reshape(len(x), -1)
         k = x.shape[1]
         names = [f"ch{j}" for j in range(k)] if k > 1 else ["x"]
         sensors = ["-"] * k
         units = [""] * k
     if fs is not None:
-        fs = float(fs)
-        if not (np.isfinite(fs) and fs > 0):
-            raise ValueError(f"fs must be a positive finite number of Hz; got {fs!r}")
+        fs = sample_rate(fs)
     n = x.shape[0]
     if n < 2:
-        raise ValueError(f"log_or_array needs at least 2 samples; got {n}")
+        raise ValueError(f"x needs at least 2 samples; got {n}")
     nan = np.isnan(x)
     missing = nan.sum(axis=0)
     if np.isinf(x).any():
-        raise ValueError("log_or_array must be finite or NaN (a missing sample); it contains inf")
+        raise ValueError("x must be finite or NaN (a missing sample); it contains inf")
     t = None if fs is None else np.arange(n, dtype=np.float64) / fs
     if missing.any():
         columns = [
@@ -393,7 +395,8 @@ class Distribution:
         return self.counts / (self.counts.sum() * widths)
 
 
-def distribution(x, bins="auto", *, qq_points: int = 1001) -> Distribution:
+@old_call_forms(keyword_only=("bins",))
+def distribution(x, *, bins="auto", qq_points: int = 1001) -> Distribution:
     r"""Histogram with quantization-aware bins, normal fit and normality tests.
 
     Parameters

@@ -79,7 +79,9 @@ def _unique_in_range(m, n_phase: int) -> np.ndarray:
     return m[(m >= 1) & (m < n_phase)]
 
 
-def keep_estimable(m: np.ndarray, terms: np.ndarray, fs: float, user_given: bool, kind: str):
+def keep_estimable(
+    m: np.ndarray, terms: np.ndarray, fs: float, user_given: bool, kind: str
+) -> np.ndarray:
     """Drops taus whose estimator has fewer than two terms (or m < 1), warning once
     when the caller asked for them explicitly, and merges duplicates."""
     keep = (m >= 1) & (terms > 1)

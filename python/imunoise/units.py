@@ -52,7 +52,8 @@ G = _schema.G
 DEG = math.pi / 180.0
 """One degree in radians."""
 
-SENSORS = ("gyro", "accel")
+SENSORS = _schema.ALLAN_SENSORS
+"""Sensors whose noise coefficients have datasheet units."""
 
 INPUT_UNITS: dict[str, dict[str, float]] = {
     # factor that turns one input unit into the SI rate unit (rad/s or m/s²)
@@ -188,7 +189,7 @@ def unit_info(term: str, unit: str | None, sensor: str) -> Unit:
 
 
 def convert(value, term: str, unit: str | None = None, *, sensor: str = "gyro",
-            input_unit: str | None = None):
+            input_unit: str | None = None) -> float | np.ndarray:
     """Convert a coefficient from input units to a datasheet unit.
 
     Parameters
@@ -211,7 +212,7 @@ def convert(value, term: str, unit: str | None = None, *, sensor: str = "gyro",
 
 
 def convert_back(value, term: str, unit: str | None = None, *, sensor: str = "gyro",
-                 input_unit: str | None = None):
+                 input_unit: str | None = None) -> float | np.ndarray:
     """Inverse of :func:`convert`: a datasheet value back to input units."""
     info = unit_info(term, unit, sensor)
     scale = input_scale(sensor, input_unit) * info.factor

@@ -1,25 +1,36 @@
 //! Bindings for the noise-model fit: one channel per call (the problem has one
 //! row per tau, so it is small next to the Allan computation), and the model's
-//! per-term curves for plots and predictions.
+//! per-term curves for plots and predictions. The model's constants (term names,
+//! most Gauss–Markov terms, parameter slots, flicker factor) are exported here so
+//! Python never writes them again.
 
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
-use crate::fit::{self, Options, IEEE_TERMS, PARAMETERS};
+use crate::fit::{self, Options, FLICKER_FACTOR, IEEE_TERMS, IEEE_TERM_NAMES, MAX_GM, PARAMETERS};
 
-/// (ieee, gm, cov, discrepancy, chi2, n_eff, parameters, bic)
-type FitTuple<'py> = (
-    Bound<'py, PyArray1<f64>>,
-    Bound<'py, PyArray2<f64>>,
-    Bound<'py, PyArray2<f64>>,
-    f64,
-    f64,
-    f64,
-    usize,
-    f64,
-);
+/// The fit of one channel, as `_core.fit.NoiseFit`.
+#[pyclass(name = "NoiseFit", module = "imunoise._core.fit", frozen, get_all)]
+struct PyNoiseFit {
+    /// (Q², N², B², K², R²).
+    ieee: Py<PyArray1<f64>>,
+    /// (k, 2) rows of (q², τc), one per Gauss–Markov term.
+    gm: Py<PyArray2<f64>>,
+    /// PARAMETERS × PARAMETERS covariance of (Q²…R², then q², ln τc per slot).
+    cov: Py<PyArray2<f64>>,
+    /// δ, the relative model discrepancy.
+    discrepancy: f64,
+    /// Octave-weighted residual sum with the sampling variance alone.
+    chi2: f64,
+    /// Octaves of evidence.
+    n_eff: f64,
+    /// Free parameters of the chosen structure.
+    parameters: usize,
+    /// Its Bayesian information criterion.
+    bic: f64,
+}
 
 fn ieee_flags(terms: &[bool]) -> PyResult<[bool; IEEE_TERMS]> {
     if terms.len() != IEEE_TERMS {
@@ -39,10 +50,7 @@ fn to_matrix(rows: Vec<Vec<f64>>, cols: usize) -> PyResult<Array2<f64>> {
         .map_err(|e| PyValueError::new_err(e.to_string()))
 }
 
-/// fit_noise(taus, var, edf, fs, terms, gm, select) -> (ieee, gm, cov, discrepancy, chi2, n_eff, parameters, bic)
-///
-/// `ieee` holds (Q², N², B², K², R²); `gm` is (k, 2) rows of (q², τc); `cov`
-/// the PARAMETERS × PARAMETERS covariance of (Q²…R², then q², ln τc per term).
+/// fit_noise(taus, var, edf, fs, terms, gm, select) -> NoiseFit
 #[pyfunction]
 #[allow(clippy::too_many_arguments)] // mirrors the Python keyword arguments
 #[pyo3(signature = (taus, var, edf, fs, terms, gm=3, select=true))]
@@ -55,7 +63,7 @@ fn fit_noise<'py>(
     terms: Vec<bool>,
     gm: usize,
     select: bool,
-) -> PyResult<FitTuple<'py>> {
+) -> PyResult<PyNoiseFit> {
     let opts = Options {
         ieee: ieee_flags(&terms)?,
         gm,
@@ -66,16 +74,16 @@ fn fit_noise<'py>(
     let edf = edf.as_array().to_vec();
     let r = py.detach(|| fit::fit_noise(&taus, &var, &edf, fs, &opts))?;
     let gm_rows: Vec<Vec<f64>> = r.gm.iter().map(|&(q2, tc)| vec![q2, tc]).collect();
-    Ok((
-        r.ieee.to_vec().into_pyarray(py),
-        to_matrix(gm_rows, 2)?.into_pyarray(py),
-        to_matrix(r.cov, PARAMETERS)?.into_pyarray(py),
-        r.discrepancy,
-        r.chi2,
-        r.n_eff,
-        r.parameters,
-        r.bic,
-    ))
+    Ok(PyNoiseFit {
+        ieee: r.ieee.to_vec().into_pyarray(py).unbind(),
+        gm: to_matrix(gm_rows, 2)?.into_pyarray(py).unbind(),
+        cov: to_matrix(r.cov, PARAMETERS)?.into_pyarray(py).unbind(),
+        discrepancy: r.discrepancy,
+        chi2: r.chi2,
+        n_eff: r.n_eff,
+        parameters: r.parameters,
+        bic: r.bic,
+    })
 }
 
 /// noise_terms(taus, fs, ieee, gm) -> (len(taus), 5 + k) Allan variance of each term
@@ -107,6 +115,11 @@ fn noise_terms<'py>(
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("IEEE_TERM_NAMES", IEEE_TERM_NAMES.to_vec())?;
+    m.add("MAX_GAUSS_MARKOV", MAX_GM)?;
+    m.add("PARAMETERS", PARAMETERS)?;
+    m.add("FLICKER_FACTOR", FLICKER_FACTOR)?;
+    m.add_class::<PyNoiseFit>()?;
     m.add_function(wrap_pyfunction!(fit_noise, m)?)?;
     m.add_function(wrap_pyfunction!(noise_terms, m)?)?;
     Ok(())

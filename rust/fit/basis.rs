@@ -20,6 +20,9 @@
 /// Number of IEEE 952 terms: Q, N, B, K, R.
 pub const IEEE_TERMS: usize = 5;
 
+/// The IEEE 952 coefficients in the order of every array of the fit.
+pub const IEEE_TERM_NAMES: [&str; IEEE_TERMS] = ["Q", "N", "B", "K", "R"];
+
 /// (2 ln 2)/π: the Allan variance of flicker rate noise per unit B².
 pub const FLICKER_FACTOR: f64 = 2.0 * std::f64::consts::LN_2 / std::f64::consts::PI;
 

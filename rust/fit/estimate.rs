@@ -191,16 +191,28 @@ pub fn ml_discrepancy(data: &Data, model: &[f64]) -> f64 {
     (lo * hi).sqrt()
 }
 
+/// One least-squares problem: the data, the design (one column per term) and
+/// which columns may be non-zero.
+#[derive(Clone, Copy)]
+pub struct Problem<'a> {
+    pub data: &'a Data,
+    pub basis: &'a Mat<f64>,
+    pub allowed: &'a [bool],
+}
+
 /// Minimise the loss over θ ≥ 0 (θⱼ = 0 where `!allowed[j]`) for fixed δ².
 /// Returns θ and the model values.
 pub fn solve_theta(
-    data: &Data,
-    basis: &Mat<f64>,
-    allowed: &[bool],
+    problem: Problem<'_>,
     d2: f64,
     start: Option<&[f64]>,
     max_steps: usize,
 ) -> CoreResult<(Vec<f64>, Vec<f64>)> {
+    let Problem {
+        data,
+        basis,
+        allowed,
+    } = problem;
     let (n, k) = (basis.nrows(), basis.ncols());
     let mut theta = vec![0.0; k];
     let mut model: Vec<f64> = data.y.iter().map(|y| y.exp()).collect();
@@ -284,14 +296,13 @@ pub struct Solution {
 
 /// Alternate θ and δ² to the joint minimum of the loss.
 pub fn solve_joint(
-    data: &Data,
-    basis: &Mat<f64>,
-    allowed: &[bool],
+    problem: Problem<'_>,
     d2_start: f64,
     start: Option<&[f64]>,
 ) -> CoreResult<Solution> {
+    let data = problem.data;
     let mut d2 = d2_start;
-    let (mut theta, mut model) = solve_theta(data, basis, allowed, d2, start, 50)?;
+    let (mut theta, mut model) = solve_theta(problem, d2, start, 50)?;
     for _ in 0..30 {
         let next = ml_discrepancy(data, &model);
         let settled = (next - d2).abs() <= 1e-6 * next.max(1e-12);
@@ -299,7 +310,7 @@ pub fn solve_joint(
         if settled {
             break;
         }
-        (theta, model) = solve_theta(data, basis, allowed, d2, Some(&theta), 50)?;
+        (theta, model) = solve_theta(problem, d2, Some(&theta), 50)?;
     }
     let loss = loss(data, &model, d2);
     Ok(Solution {

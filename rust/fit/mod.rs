@@ -4,9 +4,9 @@
 //! σ²(τ) = 3Q²/τ² + N²/τ + (2 ln2/π)·B² + K²τ/3 + R²τ²/2 + Σₖ qₖ²·g(τ; τcₖ)
 //! ```
 //!
-//! the IEEE Std 952 / 1293 terms plus up to two first-order Gauss–Markov bias
-//! terms of variance qₖ² and correlation time τcₖ (up to three: a MEMS sensor's
-//! own filter, a bump of correlated bias, and slow wander) (`basis`). The estimator
+//! the IEEE Std 952 / 1293 terms plus up to [`MAX_GM`] = 3 first-order
+//! Gauss–Markov bias terms of variance qₖ² and correlation time τcₖ (three: a
+//! MEMS sensor's own filter, a bump of correlated bias, and slow wander) (`basis`). The estimator
 //! (`estimate`) is a weighted least-squares fit of ln σ̂² with weights from the
 //! EDF, the share of an octave each tau stands for, and a model-discrepancy
 //! variance fitted by maximum likelihood; the structure (`search`) is chosen by
@@ -26,7 +26,7 @@ pub mod nnls;
 pub mod search;
 pub mod special;
 
-pub use basis::{FLICKER_FACTOR, IEEE_TERMS};
+pub use basis::{FLICKER_FACTOR, IEEE_TERMS, IEEE_TERM_NAMES};
 
 use crate::error::{CoreError, CoreResult};
 use estimate::Data;

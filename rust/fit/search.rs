@@ -67,7 +67,16 @@ impl Searcher<'_> {
     fn loss(&self, times: &[f64]) -> f64 {
         let basis = design(self.data, self.fs, times);
         let allowed = allowed_with_gm(&self.ieee, times.len());
-        match estimate::solve_theta(self.data, &basis, &allowed, self.d2, None, 8) {
+        match estimate::solve_theta(
+            estimate::Problem {
+                data: self.data,
+                basis: &basis,
+                allowed: &allowed,
+            },
+            self.d2,
+            None,
+            8,
+        ) {
             Ok((_, model)) => estimate::loss(self.data, &model, self.d2),
             Err(_) => f64::INFINITY,
         }
@@ -204,7 +213,15 @@ pub fn candidate(
 ) -> CoreResult<Candidate> {
     let basis = design(data, fs, &gm_tau);
     let allowed = allowed_with_gm(&ieee, gm_tau.len());
-    let solution = estimate::solve_joint(data, &basis, &allowed, d2, None)?;
+    let solution = estimate::solve_joint(
+        estimate::Problem {
+            data,
+            basis: &basis,
+            allowed: &allowed,
+        },
+        d2,
+        None,
+    )?;
     let bic = solution.loss + parameters(&solution.theta) as f64 * data.n_eff().max(2.0).ln();
     Ok(Candidate {
         gm_tau,

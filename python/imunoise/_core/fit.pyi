@@ -1,7 +1,47 @@
 # rust/bindings/fit.rs: the noise-model fit.
 
+from typing import final
+
 import numpy as np
 import numpy.typing as npt
+
+IEEE_TERM_NAMES: list[str]
+"""The IEEE 952 coefficients in array order: Q, N, B, K, R."""
+MAX_GAUSS_MARKOV: int
+"""Most first-order Gauss–Markov terms a model may have."""
+PARAMETERS: int
+"""Slots of the covariance: Q²…R², then (q², ln τc) per Gauss–Markov term."""
+FLICKER_FACTOR: float
+"""(2 ln 2)/π: the Allan variance of flicker rate noise per unit B²."""
+
+@final
+class NoiseFit:
+    """The fit of one channel."""
+
+    @property
+    def ieee(self) -> npt.NDArray[np.float64]:
+        """(Q², N², B², K², R²)."""
+    @property
+    def gm(self) -> npt.NDArray[np.float64]:
+        """(k, 2) rows of (q², τc), one per Gauss–Markov term."""
+    @property
+    def cov(self) -> npt.NDArray[np.float64]:
+        """(PARAMETERS, PARAMETERS) covariance of (Q²…R², then q², ln τc per slot)."""
+    @property
+    def discrepancy(self) -> float:
+        """δ, the relative model discrepancy."""
+    @property
+    def chi2(self) -> float:
+        """Octave-weighted residual sum with the sampling variance alone."""
+    @property
+    def n_eff(self) -> float:
+        """Octaves of evidence."""
+    @property
+    def parameters(self) -> int:
+        """Free parameters of the chosen structure."""
+    @property
+    def bic(self) -> float:
+        """Its Bayesian information criterion."""
 
 def fit_noise(
     taus: npt.NDArray[np.float64],
@@ -11,16 +51,7 @@ def fit_noise(
     terms: list[bool],
     gm: int = 3,
     select: bool = True,
-) -> tuple[
-    npt.NDArray[np.float64],  # (Q², N², B², K², R²)
-    npt.NDArray[np.float64],  # (k, 2): (q², τc) per Gauss–Markov term
-    npt.NDArray[np.float64],  # (11, 11) covariance of (Q²…R², then q², ln τc per GM term)
-    float,  # discrepancy δ
-    float,  # chi2 (sampling variance only, octave-weighted)
-    float,  # n_eff (octaves of evidence)
-    int,  # free parameters
-    float,  # BIC
-]:
+) -> NoiseFit:
     """Log-space, octave-weighted fit of the noise model (IEEE terms and up to
     ``gm`` Gauss–Markov terms) to one channel; structure chosen by BIC when
     ``select``."""

@@ -46,7 +46,7 @@ def write_vn_ascii(
     count: npt.NDArray[np.float64] | None = None,
     status: npt.NDArray[np.float64] | None = None,
     crc: bool = False,
-    eol: bytes = b"\r\n",
+    eol: bytes = ...,
 ) -> bytes:
     """Sentences of ``message`` from columns in field order (XOR-8 or CRC-16)."""
 

@@ -20,12 +20,16 @@ from collections.abc import Callable, Mapping, Sequence
 
 import numpy as np
 
+from imunoise._schema import CHANNELS, COLUMN_SUFFIXES, G
+from imunoise.errors import ParseError
 from imunoise.readers._sentences import IssueTally, sentence_rows
-from imunoise.readers.log import CHANNELS, ImuLog, log_on_grid
+from imunoise.readers.log import ImuLog, log_on_grid
+from imunoise.readers.probe import Confidence, Probe
 
-__all__ = ["UNITS", "read_csv"]
+__all__ = ["SUFFIXES", "UNITS", "read_csv", "sniff"]
 
-_G = 9.80665
+#: Extensions read as delimited text whatever the content.
+SUFFIXES = (".csv", ".tsv")
 
 #: Unit name -> (channel family, factor to SI, offset) with SI = value * factor + offset.
 UNITS: Mapping[str, tuple[str, float, float]] = {
@@ -34,8 +38,8 @@ UNITS: Mapping[str, tuple[str, float, float]] = {
     "deg/h": ("angular_rate", math.pi / 180 / 3600, 0.0),
     "mrad/s": ("angular_rate", 1e-3, 0.0),
     **{u: ("acceleration", 1.0, 0.0) for u in ("m/s^2", "m/s2", "m/s²", "mps2")},
-    "g": ("acceleration", _G, 0.0),
-    "mg": ("acceleration", _G * 1e-3, 0.0),
+    "g": ("acceleration", G, 0.0),
+    "mg": ("acceleration", G * 1e-3, 0.0),
     "gauss": ("magnetic", 1.0, 0.0),
     "mgauss": ("magnetic", 1e-3, 0.0),
     **{u: ("magnetic", 1e4, 0.0) for u in ("t", "tesla")},
@@ -73,7 +77,6 @@ _FAMILY = {
 
 # Header-name patterns, matched against the normalised name (lower case, separators
 # replaced by "_", unit suffix removed, a leading "field_" dropped).
-_AXES = "xyz"
 _VECTOR_PREFIXES = {
     "gyro": ("gyro", "gyr", "gyroscope", "g", "w", "omega", "angular_velocity", "ang_vel"),
     "accel": ("acc", "accel", "accelerometer", "acceleration", "a", "linear_acceleration"),
@@ -96,6 +99,18 @@ _RAW_NAMES = ("raw", "sentence", "raw_imu_string", "vnymr")
 _SENTENCE = re.compile(r"\$VN[A-Z]{3}[,*]")
 
 _CHUNK_BYTES = 1 << 22
+
+
+def sniff(probe: Probe) -> Confidence:
+    """A ``.csv``/``.tsv`` file, or a first line with a delimiter (a weak guess)."""
+    if probe.is_dir:
+        return Confidence.NO
+    if probe.suffix in SUFFIXES:
+        return Confidence.NAME
+    first_line = probe.head.split(b"\n", 1)[0]
+    if any(d in first_line for d in (b",", b"\t", b";", b" ")):
+        return Confidence.GUESS
+    return Confidence.NO
 
 
 def _normalise(name: str) -> tuple[str, str | None]:
@@ -125,10 +140,14 @@ def _unit_factor(channel: str, unit: str) -> tuple[float, float]:
     return factor, offset
 
 
+_BYTES = "<bytes>"  # the name of a log given as bytes
+
+
 def _open(source) -> tuple[io.BufferedIOBase, int, str]:
+    """The open file, its size and its name; ``FileNotFoundError`` if missing."""
     if isinstance(source, bytes | bytearray | memoryview):
         data = bytes(source)
-        return io.BytesIO(data), len(data), "<bytes>"
+        return io.BytesIO(data), len(data), _BYTES
     if isinstance(source, str | os.PathLike):
         path = os.fspath(source)
         return open(path, "rb"), os.path.getsize(path), path
@@ -186,6 +205,11 @@ def _is_number(text: str) -> bool:
     return True
 
 
+def _prefixed(index: dict[str, int], prefix: str, suffixes: Sequence[str]) -> list[int]:
+    """Columns named ``<prefix>_<suffix>`` or ``<prefix><suffix>``; -1 where absent."""
+    return [index.get(f"{prefix}_{c}", index.get(f"{prefix}{c}", -1)) for c in suffixes]
+
+
 def _auto_columns(names: list[str], raw_col: int | None) -> dict[str, list[int]]:
     """Channel -> column indices from common header names."""
     norm = [_normalise(n)[0] for n in names]
@@ -194,14 +218,14 @@ def _auto_columns(names: list[str], raw_col: int | None) -> dict[str, list[int]]
     if raw_col is None:
         for channel, prefixes in _VECTOR_PREFIXES.items():
             for prefix in prefixes:
-                cols = [index.get(f"{prefix}_{ax}", index.get(f"{prefix}{ax}", -1)) for ax in _AXES]
+                cols = _prefixed(index, prefix, COLUMN_SUFFIXES[3])
                 if min(cols) >= 0:
                     found[channel] = cols
                     break
         if all(n in index for n in ("yaw", "pitch", "roll")):
             found["ypr"] = [index["yaw"], index["pitch"], index["roll"]]
         for prefix in ("q", "quat", "quaternion", "orientation"):
-            cols = [index.get(f"{prefix}_{c}", index.get(f"{prefix}{c}", -1)) for c in "xyzw"]
+            cols = _prefixed(index, prefix, COLUMN_SUFFIXES[4])
             if min(cols) >= 0:
                 found["quaternion"] = cols
                 break
@@ -255,8 +279,9 @@ def read_csv(
     source : str, os.PathLike or bytes
         The file, or its contents.
     strict : bool
-        Raise ``ValueError`` naming the line and the reason at the first data line
-        that does not parse, instead of counting it as ``malformed_field``.
+        Raise :class:`~imunoise.errors.ParseError` (``kind="malformed_field"``,
+        ``.line`` the 1-based line) at the first data line that does not parse,
+        instead of counting it as ``malformed_field``.
     fs : float, optional
         Sample rate in Hz, used when the file has no time column.
     progress : callable, optional
@@ -354,10 +379,7 @@ class _Reader:
         Returns True when ``line`` was a header (and so is not data).
         """
         if self.delimiter is None:
-            for d in (",", "\t", ";"):
-                if d in line:
-                    self.delimiter = d
-                    break
+            self.delimiter = next((d for d in (",", "\t", ";") if d in line), None)
         fields = _split(line, self.delimiter)
         header = any(
             not _is_number(f) and "$VN" not in f and re.match(r"\s*[A-Za-z_%\"]", f) is not None
@@ -368,50 +390,10 @@ class _Reader:
         sample = line if not header else next_line
         sample_fields = _split(sample, self.delimiter) if sample is not None else []
 
-        cols = self.user_columns
-        explicit = any(ch in CHANNELS for ch in cols)
+        explicit = any(ch in CHANNELS for ch in self.user_columns)
         auto = _auto_columns(names, None) if names is not None and not explicit else {}
-        raw_col = None
-        if "raw" in cols:
-            raw_col = _resolve(cols["raw"], names, self.ncols, "columns['raw']")
-        elif not explicit:
-            taken = {i for idx in auto.values() for i in idx}
-            for i, f in enumerate(sample_fields[: self.ncols]):
-                if i not in taken and _SENTENCE.search(f):
-                    raw_col = i
-                    break
-            if raw_col is None and names is not None:
-                norm = [_normalise(n)[0] for n in names]
-                for opt in _RAW_NAMES:
-                    i = norm.index(opt) if opt in norm else -1
-                    if (
-                        i >= 0
-                        and i not in taken
-                        and not (i < len(sample_fields) and _is_number(sample_fields[i]))
-                    ):
-                        raw_col = i
-                        break
-        numeric: dict[str, list[int]] = {}
-        header_units: dict[str, str] = {}
-        if names is not None and not explicit:
-            numeric = auto if raw_col is None else _auto_columns(names, raw_col)
-        elif names is not None and "time" not in cols:
-            time_auto = _auto_columns(names, raw_col).get("time")
-            if time_auto is not None:
-                numeric["time"] = time_auto
-        for ch, spec in cols.items():
-            if ch == "raw":
-                continue
-            specs = [spec] if isinstance(spec, int | str | np.integer) else list(spec)
-            want = 1 if ch == "time" else CHANNELS[ch][0]
-            if len(specs) != want:
-                raise ValueError(f"columns[{ch!r}] needs {want} column(s); got {spec!r}")
-            numeric[ch] = [_resolve(s, names, self.ncols, f"columns[{ch!r}]") for s in specs]
-        if names is not None:
-            for ch, idx in numeric.items():
-                unit = _normalise(names[idx[0]])[1]
-                if unit is not None and ch not in self.user_units:
-                    header_units[ch] = unit
+        raw_col = self._raw_column(names, sample_fields, explicit, auto)
+        numeric = self._numeric_columns(names, raw_col, explicit, auto)
         if not numeric and raw_col is None:
             raise ValueError(
                 f"{self.name}: no IMU columns recognised in "
@@ -425,12 +407,74 @@ class _Reader:
         self.pos = {i: k for k, i in enumerate(self.used)}
         # NaN is a missing sample in a channel column, but a time must be a number
         self.time_pos = self.pos[numeric["time"][0]] if "time" in numeric else None
-        self.conv = {}
-        for ch in numeric:
-            unit = self.user_units.get(ch, header_units.get(ch))
-            self.conv[ch] = None if unit is None else _unit_factor(ch, unit)
+        self.conv = self._conversions(names, numeric)
         self.layout_done = True
         return header
+
+    def _raw_column(
+        self, names: list[str] | None, sample_fields: list[str], explicit: bool, auto
+    ) -> int | None:
+        """The column of VN sentences: as given, else (with no channel given) the
+        first free column holding a sentence, else one with a raw-sentence name."""
+        if "raw" in self.user_columns:
+            return _resolve(self.user_columns["raw"], names, self.ncols, "columns['raw']")
+        if explicit:
+            return None
+        taken = {i for idx in auto.values() for i in idx}
+        for i, f in enumerate(sample_fields[: self.ncols]):
+            if i not in taken and _SENTENCE.search(f):
+                return i
+        if names is None:
+            return None
+        norm = [_normalise(n)[0] for n in names]
+        for opt in _RAW_NAMES:
+            i = norm.index(opt) if opt in norm else -1
+            if (
+                i >= 0
+                and i not in taken
+                and not (i < len(sample_fields) and _is_number(sample_fields[i]))
+            ):
+                return i
+        return None
+
+    def _numeric_columns(
+        self, names: list[str] | None, raw_col: int | None, explicit: bool, auto
+    ) -> dict[str, list[int]]:
+        """Channel (and ``time``) -> column indices: from the header unless channels
+        were given, a time column from the header if none was, then the given ones."""
+        numeric: dict[str, list[int]] = {}
+        if names is not None and not explicit:
+            numeric = auto if raw_col is None else _auto_columns(names, raw_col)
+        elif names is not None and "time" not in self.user_columns:
+            time_auto = _auto_columns(names, raw_col).get("time")
+            if time_auto is not None:
+                numeric["time"] = time_auto
+        for ch, spec in self.user_columns.items():
+            if ch == "raw":
+                continue
+            specs = [spec] if isinstance(spec, int | str | np.integer) else list(spec)
+            want = 1 if ch == "time" else CHANNELS[ch][0]
+            if len(specs) != want:
+                raise ValueError(f"columns[{ch!r}] needs {want} column(s); got {spec!r}")
+            numeric[ch] = [_resolve(s, names, self.ncols, f"columns[{ch!r}]") for s in specs]
+        return numeric
+
+    def _conversions(
+        self, names: list[str] | None, numeric: dict[str, list[int]]
+    ) -> dict[str, tuple[float, float] | None]:
+        """Channel -> (factor, offset) to the SI unit, from ``units=`` or else the
+        unit in the header of its first column; ``None`` for values already in it."""
+        header_units: dict[str, str] = {}
+        if names is not None:
+            for ch, idx in numeric.items():
+                unit = _normalise(names[idx[0]])[1]
+                if unit is not None and ch not in self.user_units:
+                    header_units[ch] = unit
+        conv = {}
+        for ch in numeric:
+            unit = self.user_units.get(ch, header_units.get(ch))
+            conv[ch] = None if unit is None else _unit_factor(ch, unit)
+        return conv
 
     # -- rows -----------------------------------------------------------------------
     def _bad(self, line_no: int, reason: str) -> None:
@@ -439,7 +483,8 @@ class _Reader:
                 sentence_rows(
                     self.raw_items, self.raw_lines, self.tally, strict=True, source=self.name
                 )
-            raise ValueError(f"{self.name}: line {line_no}: {reason}")
+            source = None if self.name == _BYTES else self.name
+            raise ParseError(reason, kind="malformed_field", line=line_no, source=source)
         self.tally.add("malformed_field", line_no)
 
     def feed(self, first_line: int, lines: list[str]) -> None:

@@ -10,6 +10,7 @@ from types import MappingProxyType
 import numpy as np
 
 from imunoise import _schema
+from imunoise._validate import sample_rate
 from imunoise.readers.grid import Gaps, TimeGrid
 
 #: Sample rate assumed when neither timestamps nor ``fs=`` tell it (the VN-100's
@@ -155,8 +156,7 @@ class ImuLog:
     gaps: Gaps | None = None
 
     def __post_init__(self) -> None:
-        if not (np.isfinite(self.fs) and self.fs > 0):
-            raise ValueError(f"fs must be a positive finite number of Hz; got {self.fs!r}")
+        sample_rate(self.fs)
         lengths = {}
         for name, (cols, _unit) in CHANNELS.items():
             value = getattr(self, name)
@@ -240,7 +240,8 @@ class ImuLog:
         time=None,
         source: str = "<arrays>",
     ) -> ImuLog:
-        """Wrap arrays already in memory (SI units as in :data:`CHANNELS`).
+        """Wrap arrays already in memory, in the units of :data:`CHANNELS` (rad/s, m/s²,
+        Gauss, deg, degC, kPa).
 
         The arrays are taken to be on a uniform grid at ``fs``: a row with NaN in
         any channel is a missing sample, and runs of them are the log's ``gaps``.
@@ -322,10 +323,7 @@ def fs_from_median_step(
     if median_step is not None:
         return float(1.0 / median_step)
     if fs is not None:
-        fs = float(fs)
-        if not (np.isfinite(fs) and fs > 0):
-            raise ValueError(f"fs must be a positive finite number of Hz; got {fs!r}")
-        return fs
+        return sample_rate(fs)
     warnings.warn(
         f"{source}: no timestamps and no fs given; assuming {DEFAULT_FS:g} Hz "
         "(pass fs= to set the sample rate)",

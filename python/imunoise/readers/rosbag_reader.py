@@ -26,25 +26,47 @@ Issue locations are 1-based message numbers on the topic (``issues.location ==
 
 from __future__ import annotations
 
+import errno
 import os
 import tempfile
 import warnings
 from collections.abc import Callable, Mapping
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from imunoise.errors import ParseError
 from imunoise.readers._sentences import IssueTally, sentence_rows
 from imunoise.readers.log import ImuLog, log_on_grid
+from imunoise.readers.probe import Confidence, Probe
 
-__all__ = ["read_rosbag"]
+__all__ = ["SIGNATURES", "read_rosbag", "sniff"]
 
 IMU = "sensor_msgs/msg/Imu"
 MAG = "sensor_msgs/msg/MagneticField"
 TESLA_TO_GAUSS = 1e4
 _BATCH = 20_000  # messages per call of the VN parser
 
-_MAGIC = {b"#ROSBAG": ".bag", b"\x89MCAP": ".mcap", b"SQLite format 3": ".db3"}
+#: What a topic is (see _classify_topics) and, for a VN message, the attribute
+#: path of its sentence field.
+_Kind = tuple[str, tuple[str, ...] | None]
+
+#: First bytes of each bag file format -> the extension rosbags reads it by.
+SIGNATURES = {b"#ROSBAG V2.0": ".bag", b"\x89MCAP": ".mcap", b"SQLite format 3\x00": ".db3"}
+
+
+def sniff(probe: Probe) -> Confidence:
+    """A bag by magic number or extension, or a ROS 2 bag directory."""
+    if probe.is_dir:
+        path = probe.path
+        is_bag = (
+            (path / "metadata.yaml").exists() or any(path.glob("*.db3")) or any(path.glob("*.mcap"))
+        )
+        return Confidence.SIGNATURE if is_bag else Confidence.NO
+    if probe.suffix in SIGNATURES.values() or probe.head.startswith(tuple(SIGNATURES)):
+        return Confidence.SIGNATURE
+    return Confidence.NO
 
 
 def _typestore(typestore, msg_defs: Mapping[str, str] | None):
@@ -114,8 +136,9 @@ def read_rosbag(
         A ``.bag``, ``.mcap`` or ``.db3`` file, or a ROS 2 bag directory (with its
         ``metadata.yaml``); bytes are written to a temporary file first.
     strict : bool
-        Raise ``ValueError`` naming the message number at the first message that
-        does not decode, instead of counting it.
+        Raise :class:`~imunoise.errors.ParseError` at the first message that does
+        not decode (``.line`` is its 1-based number on the topic), instead of
+        counting it.
     fs : float, optional
         Sample rate used when the topic carries no usable timestamps.
     progress : callable, optional
@@ -137,39 +160,41 @@ def read_rosbag(
         lists the topics that were not read as ``"ignored <topic> [<type>]"``.
         Rows are on the grid of the header stamps (the receive time where a
         message has none): dropped messages are NaN rows and ``log.gaps``.
-    """
-    from rosbags.highlevel import AnyReader, AnyReaderError
 
+    Raises
+    ------
+    FileNotFoundError
+        When ``source`` is a path that does not exist.
+    """
     if isinstance(source, bytes | bytearray | memoryview):
         data = bytes(source)
-        suffix = next((s for m, s in _MAGIC.items() if data.startswith(m)), None)
+        suffix = next((s for m, s in SIGNATURES.items() if data.startswith(m)), None)
         if suffix is None:
             raise ValueError("source: bytes are not a ROS 1 bag, an MCAP file or a sqlite3 bag")
         with tempfile.TemporaryDirectory() as tmp:
             path = Path(tmp) / f"bag{suffix}"
             path.write_bytes(data)
-            log = read_rosbag(
-                path,
-                strict=strict,
-                fs=fs,
-                progress=progress,
-                topic=topic,
-                msg_defs=msg_defs,
-                typestore=typestore,
-            )
-        return _with_source(log, "<bytes>")
+            return _read_bag(path, _BYTES, strict, fs, progress, topic, msg_defs, typestore)
     if not isinstance(source, str | os.PathLike):
         raise TypeError(f"source must be a path or bytes; got {type(source).__name__}")
     path = Path(source)
     if not path.exists():
-        raise FileNotFoundError(f"source: no such bag {str(path)!r}")
-    name = str(path)
+        raise FileNotFoundError(errno.ENOENT, "no such bag", str(path))
+    return _read_bag(path, str(path), strict, fs, progress, topic, msg_defs, typestore)
+
+
+_BYTES = "<bytes>"  # the name of a bag given as bytes
+
+
+def _read_bag(path, name, strict, fs, progress, topic, msg_defs, typestore) -> ImuLog:
+    """Open the bag at ``path`` (a file or a ROS 2 bag directory) and read it."""
+    from rosbags.highlevel import AnyReader, AnyReaderError
+
     total = (
         sum(p.stat().st_size for p in path.iterdir() if p.is_file())
         if path.is_dir()
         else path.stat().st_size
     )
-
     default = _typestore(typestore, msg_defs) if (typestore or msg_defs) else None
     try:
         reader = AnyReader([path], default_typestore=default)
@@ -185,24 +210,45 @@ def read_rosbag(
         reader.close()
 
 
-def _with_source(log: ImuLog, source: str) -> ImuLog:
-    from dataclasses import replace
-
-    return replace(log, source=source)
-
-
 def _read(reader, name, total, strict, fs, progress, topic) -> ImuLog:
+    """Read the chosen topic of an open bag: the steps below, in order."""
+    topics, kinds = _classify_topics(reader)
+    chosen = _choose_topic(topics, kinds, topic, reader.typestore.fielddefs, name)
+    count_all = sum(c.msgcount for conns in topics.values() for c in conns) or 1
+    tick = _ticker(progress, total, count_all)
+    tally = IssueTally()
+    kind, field = kinds[chosen]
+    if kind in ("imu", "mag"):
+        # a lone MagneticField topic is merged only when the user did not pick a topic
+        data = _read_sensor_topic(
+            reader, topics, kinds, chosen, topic is None, tally, strict, name, tick
+        )
+    else:
+        data = _read_vn_topic(reader, topics[chosen], kind, field, tally, strict, name, tick)
+    if progress is not None:
+        progress(total, total)
+    return _assemble(data, topics, tally, fs, name)
+
+
+@dataclass
+class _TopicData:
+    """What was read from the chosen topic (and a merged magnetometer topic)."""
+
+    channels: dict[str, np.ndarray]
+    messages: dict[str, int]  # records decoded per message type
+    time_ns: np.ndarray  # int64 stamps, 0 where a message had none
+    topics: tuple[str, ...]  # the topics read
+
+
+def _classify_topics(reader) -> tuple[dict[str, list], dict[str, _Kind]]:
+    """Connections per topic, and what each topic is: ``imu``, ``mag``, ``vn`` (a
+    decodable message with a ``$VN`` string field, whose attribute path is kept),
+    ``vn-bytes`` (an unknown type whose bytes hold ``$VN``) or ``other``."""
     known = reader.typestore.fielddefs
     topics: dict[str, list] = {}
     for conn in reader.connections:
         topics.setdefault(conn.topic, []).append(conn)
-
-    def first_message(conns):
-        for conn, _t, raw in reader.messages(connections=conns):
-            return conn, raw
-        return None, None
-
-    kinds: dict[str, tuple[str, tuple[str, ...] | None]] = {}
+    kinds: dict[str, _Kind] = {}
     for tp, conns in topics.items():
         msgtype = conns[0].msgtype
         if msgtype == IMU:
@@ -210,7 +256,7 @@ def _read(reader, name, total, strict, fs, progress, topic) -> ImuLog:
         elif msgtype == MAG:
             kinds[tp] = ("mag", None)
         else:
-            conn, raw = first_message(conns)
+            raw = next((raw for _c, _t, raw in reader.messages(connections=conns)), None)
             if raw is None:
                 kinds[tp] = ("other", None)
             elif msgtype in known:
@@ -221,13 +267,17 @@ def _read(reader, name, total, strict, fs, progress, topic) -> ImuLog:
                 kinds[tp] = ("vn", field) if field else ("other", None)
             else:
                 kinds[tp] = ("vn-bytes", None) if b"$VN" in raw else ("other", None)
+    return topics, kinds
 
+
+def _choose_topic(topics, kinds, topic, known, name) -> str:
+    """The topic to read: ``topic`` if given, else the one VN topic, else the one
+    Imu topic, else the one MagneticField topic; an error if it cannot be read."""
     if topic is not None:
         if topic not in topics:
             raise ValueError(f"topic: {topic!r} is not in the bag; topics are {sorted(topics)}")
         chosen = topic
     else:
-        chosen = None
         for group in (("vn", "vn-bytes"), ("imu",), ("mag",)):
             cands = sorted(tp for tp, (k, _f) in kinds.items() if k in group)
             if len(cands) > 1:
@@ -235,14 +285,13 @@ def _read(reader, name, total, strict, fs, progress, topic) -> ImuLog:
             if cands:
                 chosen = cands[0]
                 break
-        if chosen is None:
+        else:
             listing = {tp: conns[0].msgtype for tp, conns in topics.items()}
             raise ValueError(
                 f"{name}: no IMU topic (sensor_msgs/msg/Imu, MagneticField or a message "
                 f"with a $VN sentence); topics are {listing}"
             )
-    kind, field = kinds[chosen]
-    if kind == "other":
+    if kinds[chosen][0] == "other":
         msgtype = topics[chosen][0].msgtype
         if msgtype not in known:
             raise ValueError(
@@ -253,103 +302,117 @@ def _read(reader, name, total, strict, fs, progress, topic) -> ImuLog:
             f"{name}: topic {chosen!r} ({msgtype}) is neither sensor_msgs Imu/MagneticField "
             "nor a message with a $VN sentence"
         )
+    return chosen
 
-    count_all = sum(c.msgcount for conns in topics.values() for c in conns) or 1
-    done = [0]
 
-    def tick():
-        done[0] += 1
-        if progress is not None and done[0] % 1000 == 0:
-            progress(int(total * done[0] / count_all), total)
+def _ticker(progress, total: int, count_all: int) -> Callable[[], None]:
+    """A function to call per message read; reports progress every 1000 messages."""
+    done = 0
 
-    tally = IssueTally()
+    def tick() -> None:
+        nonlocal done
+        done += 1
+        if progress is not None and done % 1000 == 0:
+            progress(int(total * done / count_all), total)
+
+    return tick
+
+
+def _read_sensor_topic(
+    reader, topics, kinds, chosen, merge_mag, tally, strict, name, tick
+) -> _TopicData:
+    """An Imu topic (with the bag's one MagneticField topic merged in when it has
+    the same stamps and ``merge_mag``) or a MagneticField topic."""
+    kind = kinds[chosen][0]
+    stamps, values = _sensor_arrays(reader, topics[chosen], kind, tally, strict, name, tick)
     channels: dict[str, np.ndarray] = {}
-    messages: dict[str, int] = {}
-    merged_mag = None
-    if kind in ("imu", "mag"):
-        stamps, values = _read_sensor(reader, topics[chosen], kind, tally, strict, name, tick)
-        if kind == "imu":
-            gyro, accel, quat, has_quat = values
-            channels.update(gyro=gyro, accel=accel)
-            if has_quat:
-                channels["quaternion"] = quat
-            mags = [tp for tp, (k, _f) in kinds.items() if k == "mag"]
-            if topic is None and len(mags) == 1:
-                mstamps, (mag,) = _read_sensor(
-                    reader, topics[mags[0]], "mag", IssueTally(), False, name, lambda: None
-                )
-                if len(mstamps) == len(stamps) and np.array_equal(mstamps, stamps):
-                    channels["mag"] = mag
-                    merged_mag = mags[0]
-        else:
-            channels["mag"] = values[0]
-        messages[topics[chosen][0].msgtype] = len(stamps)
-        if merged_mag:
+    messages = {topics[chosen][0].msgtype: len(stamps)}
+    read = [chosen]
+    if kind == "mag":
+        channels["mag"] = values[0]
+        return _TopicData(channels, messages, stamps, tuple(read))
+    gyro, accel, quat, has_quat = values
+    channels.update(gyro=gyro, accel=accel)
+    if has_quat:
+        channels["quaternion"] = quat
+    mags = [tp for tp, (k, _f) in kinds.items() if k == "mag"]
+    if merge_mag and len(mags) == 1:
+        mstamps, (mag,) = _sensor_arrays(
+            reader, topics[mags[0]], "mag", IssueTally(), False, name, lambda: None
+        )
+        if len(mstamps) == len(stamps) and np.array_equal(mstamps, stamps):
+            channels["mag"] = mag
             messages[MAG] = len(stamps)
-        time_ns = stamps
-    else:
-        items, stamps, locs = [], [], []
-        parts: list[dict[str, np.ndarray]] = []
-        kept_ns: list[np.ndarray] = []
+            read.append(mags[0])
+    return _TopicData(channels, messages, stamps, tuple(read))
 
-        def flush():
-            # sentences are decoded in batches so that no Python object per message
-            # outlives its batch
-            rows = sentence_rows(items, locs, tally, strict=strict, source=name, where="message")
-            if rows.channels:
-                parts.append(rows.channels)
-                kept_ns.append(np.asarray(stamps, dtype=np.int64)[rows.kept])
-            for key, count in rows.messages.items():
-                messages[key] = messages.get(key, 0) + count
-            items.clear()
-            stamps.clear()
-            locs.clear()
 
-        msgtype = topics[chosen][0].msgtype
-        for number, (_conn, t, raw) in enumerate(
-            reader.messages(connections=topics[chosen]), start=1
-        ):
-            tick()
-            if kind == "vn-bytes":
-                items.append(_cut_sentence(raw))
-                stamps.append(t)
-            else:
-                try:
-                    msg = reader.deserialize(raw, msgtype)
-                except Exception as exc:
-                    if strict:
-                        flush()  # a bad sentence in an earlier message is reported first
-                        raise ValueError(
-                            f"{name}: message {number}: does not decode: {exc}"
-                        ) from exc
-                    tally.add("malformed_field", number)
-                    continue
-                value = msg
-                for attr in field:
-                    value = getattr(value, attr, "")
-                items.append(value.encode("latin-1", "replace") if isinstance(value, str) else b"")
-                stamps.append(_stamp(msg) or t)
-            locs.append(number)
-            if len(items) >= _BATCH:
-                flush()
-        flush()
+def _read_vn_topic(reader, conns, kind, field, tally, strict, name, tick) -> _TopicData:
+    """A topic whose messages carry one VN sentence each: in the string field at
+    attribute path ``field`` (``kind == "vn"``), or cut out of the raw message
+    bytes (``"vn-bytes"``, an unknown type: then the receive time is the stamp)."""
+    items, stamps, locs = [], [], []
+    parts: list[dict[str, np.ndarray]] = []
+    kept_ns: list[np.ndarray] = []
+    messages: dict[str, int] = {}
+
+    def flush() -> None:
+        # sentences are decoded in batches so that no Python object per message
+        # outlives its batch
+        rows = sentence_rows(items, locs, tally, strict=strict, source=name, where="message")
+        if rows.channels:
+            parts.append(rows.channels)
+            kept_ns.append(np.asarray(stamps, dtype=np.int64)[rows.kept])
+        for key, count in rows.messages.items():
+            messages[key] = messages.get(key, 0) + count
+        items.clear()
+        stamps.clear()
+        locs.clear()
+
+    msgtype = conns[0].msgtype
+    for number, (_conn, t, raw) in enumerate(reader.messages(connections=conns), start=1):
+        tick()
         if kind == "vn-bytes":
-            warnings.warn(
-                f"{name}: topic {chosen!r} has type {msgtype!r} with no definition in the bag; "
-                "VN sentences were cut out of the message bytes and the bag receive time is "
-                "used (pass msg_defs= to use the message header stamps)",
-                stacklevel=3,
-            )
-        for ch in parts[0] if parts else ():
-            channels[ch] = np.concatenate([p[ch] for p in parts])
-        time_ns = np.concatenate(kept_ns) if kept_ns else np.zeros(0, dtype=np.int64)
+            items.append(_cut_sentence(raw))
+            stamps.append(t)
+        else:
+            try:
+                msg = reader.deserialize(raw, msgtype)
+            except Exception as exc:
+                if strict:
+                    flush()  # a bad sentence in an earlier message is reported first
+                    raise _parse_error(f"does not decode: {exc}", number, name) from exc
+                tally.add("malformed_field", number)
+                continue
+            value = msg
+            for attr in field:
+                value = getattr(value, attr, "")
+            items.append(value.encode("latin-1", "replace") if isinstance(value, str) else b"")
+            stamps.append(_stamp(msg) or t)
+        locs.append(number)
+        if len(items) >= _BATCH:
+            flush()
+    flush()
+    if kind == "vn-bytes":
+        warnings.warn(
+            f"{name}: topic {conns[0].topic!r} has type {msgtype!r} with no definition in the "
+            "bag; VN sentences were cut out of the message bytes and the bag receive time is "
+            "used (pass msg_defs= to use the message header stamps)",
+            stacklevel=5,  # at the caller of read_rosbag
+        )
+    channels = {ch: np.concatenate([p[ch] for p in parts]) for ch in (parts[0] if parts else ())}
+    time_ns = np.concatenate(kept_ns) if kept_ns else np.zeros(0, dtype=np.int64)
+    return _TopicData(channels, messages, time_ns, (conns[0].topic,))
 
+
+def _assemble(data: _TopicData, topics, tally, fs, name) -> ImuLog:
+    """The log of what was read, on the grid of its stamps; topics not read are
+    listed in ``messages`` as ignored."""
+    messages = dict(data.messages)
     for tp, conns in topics.items():
-        if tp != chosen and tp != merged_mag:
-            key = f"ignored {tp} [{conns[0].msgtype}]"
-            messages[key] = sum(c.msgcount for c in conns)
-    if progress is not None:
-        progress(total, total)
+        if tp not in data.topics:
+            messages[f"ignored {tp} [{conns[0].msgtype}]"] = sum(c.msgcount for c in conns)
+    time_ns = data.time_ns
     time = None
     if len(time_ns) and np.all(time_ns > 0):
         sec0 = int(time_ns[0]) // 1_000_000_000
@@ -359,13 +422,20 @@ def _read(reader, name, total, strict, fs, progress, topic) -> ImuLog:
         source=name,
         format="rosbag",
         issues=tally.issues("message"),
-        channels=channels,
+        channels=data.channels,
         time=time,
         messages=messages,
     )
 
 
-def _read_sensor(reader, conns, kind, tally, strict, name, tick):
+def _parse_error(reason: str, number: int, name: str) -> ParseError:
+    """The strict-mode error for message ``number`` of the topic."""
+    return ParseError(
+        reason, kind="malformed_field", line=number, source=None if name == _BYTES else name
+    )
+
+
+def _sensor_arrays(reader, conns, kind, tally, strict, name, tick):
     """Stamps (ns) and arrays of an Imu or MagneticField topic."""
     n = sum(c.msgcount for c in conns)
     stamps = np.zeros(n, dtype=np.int64)
@@ -391,13 +461,13 @@ def _read_sensor(reader, conns, kind, tally, strict, name, tick):
             values = np.asarray(row, dtype=np.float64)
         except Exception as exc:
             if strict:
-                raise ValueError(f"{name}: message {number}: does not decode: {exc}") from exc
+                raise _parse_error(f"does not decode: {exc}", number, name) from exc
             tally.add("malformed_field", number)
             continue
         used = values[:6] if kind == "imu" else values
         if not np.isfinite(used).all():
             if strict:
-                raise ValueError(f"{name}: message {number}: non-finite value")
+                raise _parse_error("non-finite value", number, name)
             tally.add("malformed_field", number)
             continue
         if k >= n:  # msgcount was short: grow

@@ -1,0 +1,82 @@
+"""The log formats :func:`imunoise.read` knows: one :class:`Format` entry each.
+
+Adding a format is a reader module (``read_x(source, *, strict, fs, progress)``
+plus a ``sniff(probe)``, see :mod:`imunoise.readers.probe`) and one entry in
+:data:`FORMATS`; detection, dispatch and the list of ``format=`` values follow.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+from imunoise.readers import csv_reader, rosbag_reader
+from imunoise.readers.log import ImuLog
+from imunoise.readers.probe import Confidence, Probe
+from imunoise.readers.vn import read_vn
+
+__all__ = ["FORMATS", "Format", "get", "names"]
+
+
+@dataclass(frozen=True)
+class Format:
+    """One log format.
+
+    Attributes
+    ----------
+    name : str
+        The ``format=`` value and ``ImuLog.format``.
+    sniff : callable
+        ``sniff(probe) -> Confidence``: how sure it is that a source is in this format.
+    read : callable
+        ``read(source, *, strict, fs, progress) -> ImuLog``.
+    streamable : bool
+        The Rust VN stream parser reads it piece by piece, so
+        :func:`imunoise.scale.convert` converts it in bounded memory; other formats
+        are read whole.
+    """
+
+    name: str
+    sniff: Callable[[Probe], Confidence]
+    read: Callable[..., ImuLog]
+    streamable: bool = False
+
+
+def _vn_counts(probe: Probe) -> tuple[int, int]:
+    """``$VN`` sentence starts and ``0xFA`` binary sync bytes in the first bytes."""
+    return probe.head.count(b"$VN"), probe.head.count(b"\xfa")
+
+
+def _sniff_vn_ascii(probe: Probe) -> Confidence:
+    """VN sentences, at least as many as binary sync bytes."""
+    n_ascii, n_sync = _vn_counts(probe)
+    return Confidence.CONTENT if n_ascii and n_sync <= n_ascii else Confidence.NO
+
+
+def _sniff_vn_binary(probe: Probe) -> Confidence:
+    """More binary sync bytes than VN sentences (both framings may be interleaved)."""
+    n_ascii, n_sync = _vn_counts(probe)
+    return Confidence.CONTENT if n_sync > n_ascii else Confidence.NO
+
+
+#: Every format, in the order ties of confidence are broken.
+FORMATS: tuple[Format, ...] = (
+    # one reader for both VN framings: it accepts them interleaved in one stream
+    Format("vn-ascii", _sniff_vn_ascii, read_vn, streamable=True),
+    Format("vn-binary", _sniff_vn_binary, read_vn, streamable=True),
+    Format("csv", csv_reader.sniff, csv_reader.read_csv),
+    Format("rosbag", rosbag_reader.sniff, rosbag_reader.read_rosbag),
+)
+
+
+def names() -> tuple[str, ...]:
+    """The format names, in registry order."""
+    return tuple(fmt.name for fmt in FORMATS)
+
+
+def get(name: str) -> Format:
+    """The entry of format ``name``."""
+    for fmt in FORMATS:
+        if fmt.name == name:
+            return fmt
+    raise ValueError(f"format must be one of {names()}; got {name!r}")

@@ -1,0 +1,219 @@
+"""Building the report: the context the sections share, the list of sections,
+and :func:`build`, which runs them and writes the directory.
+
+Adding a section is one function in :mod:`.sections` and one entry in
+:data:`SECTIONS`; the numbering and the progress bar follow from the list.
+"""
+
+from __future__ import annotations
+
+import datetime as _dt
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from functools import cached_property
+from pathlib import Path
+
+from imunoise import allan as _allan
+from imunoise import export, noise, plot, stats
+from imunoise._core import __version__
+from imunoise._progress import Progress
+from imunoise._schema import ALLAN_SENSORS, SAMPLE_SENSORS, sensor_label
+from imunoise.readers.log import ImuLog
+from imunoise.report import sections
+from imunoise.report.document import Doc
+from imunoise.report.inputs import read_log
+
+__all__ = ["SECTIONS", "TAUS_PER_DECADE", "TITLE", "Context", "Report", "Section", "build"]
+
+#: Tau grid of the Allan analysis: log-spaced points per decade.
+TAUS_PER_DECADE = 10
+TITLE = "IMU noise report"
+
+
+@dataclass
+class Context:
+    """What the sections share: the logs, the options, the analyses (each computed
+    once, on first use, so sections may be reordered) and the figures written."""
+
+    short: ImuLog
+    long: ImuLog
+    one_log: bool
+    spec: str | None
+    out_dir: Path
+    taus_per_decade: int = TAUS_PER_DECADE
+    figures: list[Path] = field(default_factory=list)
+
+    @property
+    def logs(self) -> list[tuple[str, ImuLog]]:
+        """``[("both", log)]`` for one log, else ``[("short", …), ("long", …)]``."""
+        if self.one_log:
+            return [("both", self.short)]
+        return [("short", self.short), ("long", self.long)]
+
+    @cached_property
+    def description(self) -> stats.Description:
+        """Sample statistics of the short log."""
+        return stats.describe(self.short)
+
+    @cached_property
+    def sensor_distributions(self) -> dict[str, dict[str, stats.Distribution]]:
+        """``{"gyro": {"gyro X": Distribution, …}, …}`` of the short log."""
+        out: dict[str, dict[str, stats.Distribution]] = {}
+        for sensor in SAMPLE_SENSORS:
+            y = getattr(self.short, sensor)
+            if y is not None:
+                out[sensor] = {sensor_label(sensor, j, y.shape[1]): stats.distribution(y[:, j])
+                               for j in range(y.shape[1])}
+        return out
+
+    @property
+    def distributions(self) -> dict[str, stats.Distribution]:
+        """``{"gyro X": Distribution, …}`` of the short log."""
+        return {name: d for per_axis in self.sensor_distributions.values()
+                for name, d in per_axis.items()}
+
+    @cached_property
+    def allan(self) -> dict[str, _allan.AllanResult]:
+        """Overlapping Allan deviation per sensor of the long log on the report's grid."""
+        return {sensor: _allan.adev(getattr(self.long, sensor), self.long.fs,
+                                    taus=self.taus_per_decade)
+                for sensor in ALLAN_SENSORS if getattr(self.long, sensor) is not None}
+
+    @cached_property
+    def models(self) -> dict[str, noise.NoiseModel]:
+        """The noise model per sensor; a poor fit is said in the report's words
+        (:func:`~imunoise.report.model_sentences`), not warned about."""
+        return {sensor: noise.fit(r, warn_coverage=False) for sensor, r in self.allan.items()}
+
+    def add_figure(self, doc: Doc, fig, name: str, caption: str) -> None:
+        """Save ``fig`` as ``figures/<name>.png`` and ``.svg`` and show it in ``doc``."""
+        path = self.out_dir / "figures" / name
+        self.figures += plot.save(fig, path)
+        doc.figure(path.with_suffix(".png"), caption)
+
+
+@dataclass(frozen=True)
+class Section:
+    """A numbered section: its heading and the function that writes its body."""
+
+    title: str
+    write: Callable[[Context, Doc], None]
+
+
+#: The report's sections in reading order.
+SECTIONS: tuple[Section, ...] = (
+    Section("Recording summary", sections.recording_summary),
+    Section("Sample statistics", sections.sample_statistics),
+    Section("Distribution fits", sections.distribution_fits),
+    Section("Allan deviation", sections.allan_deviation),
+    Section("Noise coefficients", sections.noise_coefficients),
+    Section("Datasheet comparison", sections.datasheet_comparison),
+)
+
+
+@dataclass(frozen=True)
+class Report:
+    """What :func:`build` wrote and computed.
+
+    Attributes
+    ----------
+    out_dir, html, markdown : Path
+    figures : tuple of Path
+        Every file under ``figures/``.
+    model_files : tuple of Path
+        ``noise.json``, ``imu.yaml`` and ``ekf_bias_model.yaml``.
+    description : imunoise.stats.Description
+        Sample statistics of the short log.
+    distributions : dict
+        ``{"gyro X": Distribution, ...}`` of the short log.
+    allan : dict
+        ``{"gyro": AllanResult, "accel": AllanResult}`` of the long log.
+    models : dict
+        ``{"gyro": NoiseModel, "accel": NoiseModel}`` (empty without gyro and accel).
+    logs : tuple of ImuLog
+        The logs analysed (short, then long when it is another log).
+    """
+
+    out_dir: Path
+    html: Path
+    markdown: Path
+    figures: tuple[Path, ...]
+    model_files: tuple[Path, ...]
+    description: stats.Description
+    distributions: dict
+    allan: dict
+    models: dict
+    logs: tuple = ()
+
+
+def build(
+    short,
+    long=None,
+    out_dir="imunoise-report",
+    *,
+    spec: str | None = "vn100",
+    fs: float | None = None,
+    progress: bool | None = None,
+) -> Report:
+    """Analyse the logs and write the report directory.
+
+    Parameters
+    ----------
+    short : path or ImuLog
+        Short still recording (minutes): sample statistics and distributions.
+    long : path or ImuLog, optional
+        Long still recording (hours): Allan deviation and noise model. Default: ``short``.
+    out_dir : path
+        Directory to write (created; existing report files are replaced).
+    spec : str or None
+        Datasheet to compare against (name or file, see :func:`imunoise.compare`);
+        None skips the comparison.
+    fs : float, optional
+        Sample rate in Hz for logs without timestamps (VN ASCII); passed to the reader.
+    progress : bool or None
+        Progress bars on stderr; None shows them when stderr is a terminal.
+    """
+    out = Path(out_dir)
+    with Progress(progress, total=len(SECTIONS) + 1) as bar:
+        short_log = read_log(short, "short", fs=fs, progress=bar.shown)
+        long_log = short_log if long is None else read_log(long, "long", fs=fs,
+                                                           progress=bar.shown)
+        (out / "figures").mkdir(parents=True, exist_ok=True)
+        ctx = Context(short=short_log, long=long_log, one_log=long is None, spec=spec,
+                      out_dir=out)
+        doc = Doc()
+        doc.h(1, TITLE)
+        stamp = _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
+        doc.p(f"Generated by imunoise {__version__} on {stamp}.")
+        for number, section in enumerate(SECTIONS, start=1):
+            bar.step(section.title)
+            doc.h(2, f"{number}. {section.title}")
+            section.write(ctx, doc)
+        bar.step("writing")
+        model_files = _write_model_files(ctx.models, out, long_log.fs)
+        md_path, html_path = out / "report.md", out / "report.html"
+        md_path.write_text(doc.markdown(out), encoding="utf-8")
+        html_path.write_text(doc.html(TITLE), encoding="utf-8")
+    return Report(
+        out_dir=out,
+        html=html_path,
+        markdown=md_path,
+        figures=tuple(ctx.figures),
+        model_files=tuple(model_files),
+        description=ctx.description,
+        distributions=ctx.distributions,
+        allan=ctx.allan,
+        models=ctx.models,
+        logs=tuple(log for _label, log in ctx.logs),
+    )
+
+
+def _write_model_files(models: dict, out_dir: Path, fs: float) -> list[Path]:
+    """noise.json, Kalibr imu.yaml and the EKF bias model."""
+    json_path, yaml_path = out_dir / "noise.json", out_dir / "imu.yaml"
+    ekf_path = out_dir / "ekf_bias_model.yaml"
+    export.write_json(json_path, **models)
+    export.write_kalibr(yaml_path, gyro=models.get("gyro"), accel=models.get("accel"),
+                        update_rate=fs)
+    export.write_ekf(ekf_path, gyro=models.get("gyro"), accel=models.get("accel"))
+    return [json_path, yaml_path, ekf_path]

@@ -1,0 +1,122 @@
+"""The report as a document: a list of blocks (headings, paragraphs, tables,
+figures) rendered both to Markdown (figures linked) and to one self-contained HTML
+file (plain HTML + CSS, figures embedded as data URIs, no JavaScript)."""
+
+from __future__ import annotations
+
+import base64
+import html as _html
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+__all__ = ["Doc"]
+
+
+@dataclass
+class Doc:
+    """Blocks in reading order; paragraph text may hold `code` spans."""
+
+    blocks: list = field(default_factory=list)
+
+    def h(self, level: int, text: str) -> None:
+        self.blocks.append(("h", level, text))
+
+    def p(self, text: str) -> None:
+        self.blocks.append(("p", text))
+
+    def table(self, header: Sequence[str], rows: Sequence[Sequence[str]], caption="") -> None:
+        self.blocks.append(("table", list(header), [list(r) for r in rows], caption))
+
+    def figure(self, png: Path, caption: str) -> None:
+        self.blocks.append(("figure", png, caption))
+
+    def markdown(self, out_dir: Path) -> str:
+        """Markdown text; figures linked relative to ``out_dir``."""
+        lines = []
+        for b in self.blocks:
+            if b[0] == "h":
+                lines += ["#" * b[1] + " " + b[2], ""]
+            elif b[0] == "p":
+                lines += [b[1], ""]
+            elif b[0] == "table":
+                _, header, rows, caption = b
+                if caption:
+                    lines += [f"*{caption}*", ""]
+                lines.append("| " + " | ".join(header) + " |")
+                lines.append("|" + "|".join("---" for _ in header) + "|")
+                lines += ["| " + " | ".join(r) + " |" for r in rows]
+                lines.append("")
+            elif b[0] == "figure":
+                rel = b[1].relative_to(out_dir).as_posix()
+                lines += [f"![{b[2]}]({rel})", "", f"*{b[2]}*", ""]
+        return "\n".join(lines)
+
+    def html(self, title: str) -> str:
+        """One HTML page with the CSS inline and every figure embedded."""
+        e = _html.escape
+        body = []
+        for b in self.blocks:
+            if b[0] == "h":
+                body.append(f"<h{b[1]}>{e(b[2])}</h{b[1]}>")
+            elif b[0] == "p":
+                body.append(f"<p>{_inline(b[1])}</p>")
+            elif b[0] == "table":
+                _, header, rows, caption = b
+                cap = f"<caption>{e(caption)}</caption>" if caption else ""
+                th = "".join(f"<th>{e(h)}</th>" for h in header)
+                trs = "".join(
+                    "<tr>" + "".join(f"<td>{e(c)}</td>" for c in r) + "</tr>" for r in rows
+                )
+                body.append(
+                    f'<div class="tw"><table>{cap}<thead><tr>{th}</tr></thead>'
+                    f"<tbody>{trs}</tbody></table></div>"
+                )
+            elif b[0] == "figure":
+                data = base64.b64encode(b[1].read_bytes()).decode("ascii")
+                body.append(
+                    f'<figure><img src="data:image/png;base64,{data}" alt="{e(b[2])}">'
+                    f"<figcaption>{e(b[2])}</figcaption></figure>"
+                )
+        return _HTML.format(title=e(title), css=_CSS, body="\n".join(body))
+
+
+def _inline(text: str) -> str:
+    """Escape and turn `code` spans into <code>."""
+    parts = _html.escape(text).split("`")
+    return "".join(f"<code>{p}</code>" if i % 2 else p for i, p in enumerate(parts))
+
+
+_CSS = """
+:root{--fg:#1d2330;--mut:#5b6475;--bd:#d9dee7;--bg:#fff;--hd:#f3f5f9;--ac:#1f5fbf}
+*{box-sizing:border-box}
+body{font:15px/1.55 -apple-system,"Segoe UI",Roboto,Helvetica,Arial,sans-serif;color:var(--fg);
+background:var(--bg);max-width:1100px;margin:2rem auto;padding:0 1.25rem}
+h1{font-size:1.9rem;margin:.2rem 0 .6rem;border-bottom:3px solid var(--ac);padding-bottom:.4rem}
+h2{font-size:1.35rem;margin-top:2.4rem;border-bottom:1px solid var(--bd);padding-bottom:.25rem}
+h3{font-size:1.1rem;margin-top:1.6rem;color:var(--mut)}
+p{margin:.5rem 0 .9rem}
+code{font:13px/1.4 ui-monospace,SFMono-Regular,Menlo,Consolas,monospace;background:var(--hd);
+padding:.05rem .3rem;border-radius:3px}
+.tw{overflow-x:auto;margin:.6rem 0 1.2rem}
+table{border-collapse:collapse;font-size:13px;font-variant-numeric:tabular-nums}
+caption{caption-side:top;text-align:left;color:var(--mut);font-style:italic;padding:.2rem 0}
+th,td{border:1px solid var(--bd);padding:.3rem .6rem;text-align:right;white-space:nowrap}
+th{background:var(--hd);font-weight:600}
+td:first-child,th:first-child{text-align:left}
+tbody tr:nth-child(even){background:#fafbfd}
+figure{margin:1rem 0 1.6rem}
+img{max-width:100%;height:auto;border:1px solid var(--bd);border-radius:4px}
+figcaption{color:var(--mut);font-size:13px;margin-top:.3rem}
+footer{margin-top:3rem;color:var(--mut);font-size:12px;border-top:1px solid var(--bd);
+padding-top:.6rem}
+"""
+
+_HTML = """<!DOCTYPE html>
+<html lang="en"><head><meta charset="utf-8">
+<meta name="viewport" content="width=device-width, initial-scale=1">
+<title>{title}</title><style>{css}</style></head>
+<body>
+{body}
+</body></html>
+"""

@@ -1,0 +1,52 @@
+"""How the report (and ``imunoise``'s command line) writes numbers, durations,
+term counts and missing samples as text."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+__all__ = ["format_duration", "format_number", "gap_note", "missing_text", "terms_used"]
+
+
+def format_number(v: float) -> str:
+    """Six significant digits, or ``—`` for NaN and infinities."""
+    return "—" if not math.isfinite(v) else f"{v:.6g}"
+
+
+def format_duration(seconds: float) -> str:
+    """``"12.5 s"``, ``"3.2 min"`` or ``"5.00 h"``, by length."""
+    if seconds < 120:
+        return f"{seconds:.1f} s"
+    if seconds < 7200:
+        return f"{seconds / 60:.1f} min"
+    return f"{seconds / 3600:.2f} h"
+
+
+def terms_used(result, i: int) -> str:
+    """Terms behind tau ``i`` of an Allan result: one count, or ``lo–hi`` over
+    channels whose gaps differ."""
+    n = np.reshape(result.n, (len(result.taus), -1))[i]
+    lo, hi = int(n.min()), int(n.max())
+    return str(lo) if lo == hi else f"{lo}–{hi}"
+
+
+def missing_text(issues) -> str:
+    """Missing samples of a log's parse issues: ``"30000 (15 %) in 1 gap"`` or ``"0"``."""
+    if not issues.samples_missing:
+        return "0"
+    plural = "s" if issues.gaps != 1 else ""
+    return (f"{issues.samples_missing} ({100 * issues.share_missing:.3g} %) in "
+            f"{issues.gaps} gap{plural}")
+
+
+def gap_note(source: str, issues, gaps) -> str | None:
+    """One line saying that (and how much of) a log is missing, or None without gaps."""
+    if not len(gaps):
+        return None
+    (start, length, _k), = gaps.largest(1).rows()
+    plural = "s" if issues.gaps != 1 else ""
+    return (f"{source}: {issues.samples_missing} samples ({100 * issues.share_missing:.3g} %) "
+            f"missing in {issues.gaps} gap{plural} (largest {format_duration(length)} at "
+            f"{format_duration(start - gaps.t0)}); left out of the statistics, not spliced over")

@@ -1,0 +1,54 @@
+"""Reading the logs a report (or a command of ``imunoise``) analyses."""
+
+from __future__ import annotations
+
+import warnings
+from pathlib import Path
+
+from imunoise._progress import byte_bar, wanted
+from imunoise.readers.log import ImuLog
+from imunoise.readers.read import read
+
+__all__ = ["read_log"]
+
+
+def read_log(source, label: str = "input", *, fs: float | None = None,
+             progress: bool | None = False) -> ImuLog:
+    """Read a log with :func:`imunoise.read`, naming it by its role in errors.
+
+    Parameters
+    ----------
+    source : path or ImuLog
+        A log file (any format :func:`imunoise.read` knows); an ``ImuLog`` is
+        returned as it is.
+    label : str
+        The log's role in messages, e.g. ``"short"``: "short log 'x.txt' does
+        not exist".
+    fs : float, optional
+        Sample rate of logs without timestamps, passed to the reader.
+    progress : bool or None
+        A byte progress bar on stderr while reading (None: when stderr is a
+        terminal).
+
+    Raises
+    ------
+    OSError
+        When the file does not exist.
+    ValueError
+        When the log has no usable record (the reader's warnings are dropped:
+        the error says it all).
+    """
+    if isinstance(source, ImuLog):
+        return source
+    path = Path(source)
+    if not path.exists():
+        raise OSError(f"{label} log {str(path)!r} does not exist")
+    callback = byte_bar(f"reading {path.name}") if wanted(progress) else None
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        log = read(path, fs=fs, progress=callback)
+    if len(log) == 0:
+        raise ValueError(f"{label} log {str(path)!r}: no usable records ({log.issues})")
+    for w in caught:
+        warnings.warn(w.message, w.category, stacklevel=2)
+    return log

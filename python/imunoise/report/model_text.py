@@ -1,0 +1,98 @@
+"""A fitted noise model in the report's words and tables: the datasheet table per
+axis, one sentence per axis, and the comparison with a datasheet. ``imunoise fit``
+prints the same table and sentences."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from imunoise import datasheet, units
+from imunoise._schema import axis_names
+from imunoise.noise import NoiseModel
+from imunoise.report.formatting import format_number
+
+__all__ = ["comparison_rows", "datasheet_rows", "model_sentences"]
+
+#: Coverage (share of taus the model follows) below which the report says that
+#: the coefficients only summarise the curve.
+POOR_COVERAGE = 0.8
+
+
+def datasheet_rows(model: NoiseModel, sensor: str) -> tuple[list[str], list[list[str]]]:
+    """Noise coefficients per axis in datasheet units, as text.
+
+    Returns the header (``quantity, term, unit``, then one column per axis) and
+    one row per term of :meth:`NoiseModel.table`; a cell is ``value ± std`` or
+    ``not resolved`` where the data do not resolve the term.
+    """
+    axes = axis_names(model.channels)
+    out = []
+    for r in model.table(sensor, axes=axes):
+        cells = [r["quantity"], r["term"], r["unit"]]
+        for a in axes:
+            if not r[f"{a}_supported"]:
+                cells.append("not resolved")
+            else:
+                cells.append(f"{format_number(r[a])} ± {format_number(r[f'{a}_std'])}")
+        out.append(cells)
+    return ["quantity", "term", "unit", *axes], out
+
+
+def model_sentences(model: NoiseModel, sensor: str) -> list[str]:
+    """One sentence per axis: the terms, how well the model follows the curve
+    (and, below :data:`POOR_COVERAGE`, that its coefficients only summarise it),
+    the Gauss–Markov terms, and whether the model's N and B agree with the
+    datasheet read-offs of the curve. Emphasis is Markdown ``**``."""
+    b_unit = units.unit_info("B", None, sensor)
+    n_unit = units.unit_info("N", None, sensor)
+    out = []
+    for c, axis in enumerate(axis_names(model.channels)):
+        terms = [t for t in ("N", "B", "K", "Q", "R") if np.atleast_1d(model.supported[t])[c]]
+        gm = model.gauss_markov(c)
+        parts = [f"{axis}: {' + '.join(terms + [f'{len(gm)} Gauss–Markov'] * bool(gm))}"]
+        cover = float(np.atleast_1d(model.coverage)[c])
+        delta = float(np.atleast_1d(model.discrepancy)[c])
+        parts.append(f"follows {cover:.0%} of the taus (inside the 95 % interval or within 5 %)"
+                     + (f", residual discrepancy {delta / 2:.1%} in σ" if delta > 0.01 else ""))
+        if cover < POOR_COVERAGE:
+            parts.append("**the model does not describe this curve: read its coefficients "
+                         "as a summary only** (see the data/model panel)")
+        for sigma, tau_c in gm:
+            value = units.convert(sigma, "B", b_unit.name, sensor=sensor)
+            parts.append(f"Gauss–Markov bias σ = {format_number(value)} {b_unit.label}, "
+                         f"τc = {format_number(tau_c)} s")
+        for term, unit in (("N", n_unit), ("B", b_unit)):
+            parts += _readoff_agreement(model, c, term, unit, sensor)
+        out.append("; ".join(parts) + ".")
+    return out
+
+
+def _readoff_agreement(model: NoiseModel, c: int, term: str, unit, sensor: str) -> list[str]:
+    """``"N read-off … vs model … (agree)"`` for one channel, or nothing when the
+    curve has no such read-off or the model no such value."""
+    read = float(np.atleast_1d(model.readoff[term]["value"])[c])
+    std = float(np.atleast_1d(model.readoff[term]["std"])[c])
+    eq = float(np.atleast_1d(model.equivalent(term))[c])
+    if not (np.isfinite(read) and eq > 0):
+        return []
+    conv = units.convert(np.array([read, eq, std]), term, unit.name, sensor=sensor)
+    diff = abs(read - eq) / max(std, 1e-300)
+    verdict = ("agree" if diff <= 2 or abs(read / eq - 1) <= 0.05 else
+               "differ: the curve is not the ideal slope there (filter, bumps)")
+    return [f"{term} read-off {format_number(conv[0])} vs model {format_number(conv[1])} "
+            f"{unit.label} ({verdict})"]
+
+
+def comparison_rows(models: dict[str, NoiseModel], spec) -> tuple[list[str], list[list[str]]]:
+    """Measured vs datasheet (:func:`imunoise.datasheet.compare`) as text rows."""
+    cmp = datasheet.compare(models, spec)
+    header = ["sensor", "quantity", "axis", "unit", "measured", "spec", "ratio", "verdict"]
+    out = []
+    for r in cmp.rows:
+        bound = "<" if r["limit"] == "max" else "typ."
+        out.append([
+            r["sensor"], f"{r['quantity']} ({r['term']})", r["axis"], r["unit"],
+            format_number(r["measured"]), f"{bound} {format_number(r['spec'])}",
+            format_number(r["ratio"]), r["verdict"],
+        ])
+    return header, out
