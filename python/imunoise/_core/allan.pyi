@@ -5,17 +5,6 @@ from typing import final
 import numpy as np
 import numpy.typing as npt
 
-__all__ = [
-    "STATISTICS",
-    "GAP_SKIPPING",
-    "THEOBR_MIN_SAMPLES",
-    "Analysis",
-    "analyse",
-    "estimator_terms",
-    "analyse_plan",
-    "theobr_seconds",
-]
-
 #: Statistic names the functions below accept, from the Rust table
 #: (rust/allan/statistic.rs).
 STATISTICS: tuple[str, ...]
