@@ -3,7 +3,8 @@
     python benches/bench_theo.py [--sizes 10000 100000] [--peer-size 2000]
 
 Part 1: imunoise.theobr and imunoise.theoh (octave taus, white FM, one channel) at
-each size, next to the time the cost warning predicts (its kernel-rate model).
+each size, next to the time the cost warning predicts (the kernel rates in
+rust/allan/estimators/theobr.rs: update them from this column's ratio).
 Part 2 (``--peer-size``, 0 to skip): allantools (2024.06) has no ThêoBR; its oadev
 and theo1 at the bias ratio's averaging factors plus theo1 at the octave taus give
 the same numbers (checked), timed once.
@@ -23,7 +24,6 @@ import warnings
 import allantools
 import imunoise
 import numpy as np
-from imunoise import allan
 from imunoise._core import allan as _core_allan
 
 
@@ -68,10 +68,7 @@ def main() -> None:
             warnings.simplefilter("ignore")  # the cost warning, expected at 10^5
             t_br, br = timed(imunoise.theobr, y, 1.0)
             t_h = float("nan") if args.no_theoh else timed(imunoise.theoh, y, 1.0)[0]
-        direct, fast = _core_allan.theobr_work(size + 1, [int(m) for m in br.m])
-        predicted = (
-            direct / allan._THEO1_DIRECT_PER_SECOND + fast / allan._THEO1_FAST_PER_SECOND
-        )
+        predicted = _core_allan.theobr_seconds(size + 1, [int(m) for m in br.m])
         print(
             f"| {size} | {len(br.taus)} | {t_br:.3g} | {t_h:.3g} | {predicted:.3g} |",
             flush=True,

@@ -26,10 +26,10 @@ import allantools
 import imunoise
 import numpy as np
 
+#: (name, imunoise function, allantools function): both libraries use the same names.
 CASES = [
-    ("mtotdev", imunoise.mtotdev, allantools.mtotdev),
-    ("htotdev", imunoise.htotdev, allantools.htotdev),
-    ("theo1", imunoise.theo1, allantools.theo1),
+    (name, getattr(imunoise, name), getattr(allantools, name))
+    for name in ("mtotdev", "htotdev", "theo1")
 ]
 
 
@@ -77,7 +77,6 @@ def compare_with_allantools(n: int, fs: float) -> None:
             f"| {name} | {len(r.taus)} | {ours:.4f} | {peer:.2f} | {peer / ours:.0f}x "
             f"| {diff:.1e} |"
         )
-
 
 
 def alone_on_a_million(fs: float) -> None:

@@ -3,8 +3,10 @@ r"""The Allan-variance family with confidence intervals.
 All statistics take rate samples :math:`y_0 … y_{n-1}` (gyro rate, acceleration,
 fractional frequency, …) at a uniform sample rate ``fs`` and work on the
 cumulative sum of the mean-removed data, :math:`c_k = \sum_{i<k}(y_i - \bar y)`
-(n + 1 points; the phase is :math:`x = c/f_s`), in Rust, one streaming pass per
-tau, with compensated summation. With :math:`\tau = m/f_s` and N = n + 1:
+(n + 1 points; the phase is :math:`x = c/f_s`), in Rust with compensated
+summation: the overlapping Allan and Hadamard variances sweep all their taus in
+one blocked pass, the others take one O(n) pass per tau (Theo1 and ThêoBR
+O(n log² m) at long taus). With :math:`\tau = m/f_s` and N = n + 1:
 
 - overlapping Allan variance
   :math:`\sigma^2_y(\tau) = \frac{1}{2m^2(N-2m)}\sum_{k=0}^{N-2m-1}(c_{k+2m}-2c_{k+m}+c_k)^2`
@@ -12,7 +14,11 @@ tau, with compensated summation. With :math:`\tau = m/f_s` and N = n + 1:
 - modified Allan variance, SP 1065 eq. 14; time variance
   :math:`\sigma_x^2 = \tau^2\,\mathrm{Mod}\,\sigma_y^2/3`;
 - Hadamard variance (third differences, divisor 6), overlapping by default;
-- total variance, SP 1065 eq. 25 (phase reflected about both ends).
+- total variance, SP 1065 eq. 25 (phase reflected about both ends);
+- the total family beyond it (MTOT, TTOT, HTOT, Theo1, ThêoBR, ThêoH), see each
+  function.
+
+:data:`KINDS` lists them all; each is a function of the same name.
 
 Confidence intervals: the noise type α is identified at each tau by the lag-1
 autocorrelation method (Riley & Greenhall 2004) — where the decimated series is
@@ -20,6 +26,17 @@ too short (< 30 points) α is the median of the three nearest identified taus �
 equivalent degrees of freedom follow Greenhall's algorithm (TOTVAR: SP 1065
 Table 7), and the bounds are the χ² quantiles
 :math:`\sigma^2\,\nu/\chi^2_{\nu}(1-p/2) \le \sigma^2 \le \sigma^2\,\nu/\chi^2_{\nu}(p/2)`.
+
+Bias correction
+---------------
+MTOTDEV, TTOTDEV, HTOTDEV and Theo1 take ``bias_correction=``: divide the
+variance by the published bias factor for the noise type identified at each tau
+(``alpha`` in the result; each function lists its factors). Default False: the
+estimate is then a function of the data alone, reproducible and equal to
+allantools' and Stable32's uncorrected values; the correction depends on the
+noise identification, which is uncertain where the curve changes slope, and a
+misidentified tau would jump. Turn it on to compare with Allan-variance values of
+the same noise (a datasheet, a fitted model).
 
 Gaps
 ----
@@ -59,9 +76,13 @@ from __future__ import annotations
 
 import numbers
 import warnings
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
+from types import MappingProxyType
+from typing import TypeAlias
 
 import numpy as np
+import numpy.typing as npt
 from scipy import stats as _stats
 
 from imunoise._core import allan as _core_allan
@@ -70,27 +91,105 @@ from imunoise.taus import averaging_factors, keep_estimable
 #: One-sigma confidence, erf(1/√2).
 ONE_SIGMA = 0.6826894921370859
 
-__all__ = [
-    "AllanResult",
-    "adev",
-    "mdev",
-    "hdev",
-    "tdev",
-    "totdev",
-    "mtotdev",
-    "ttotdev",
-    "htotdev",
-    "theo1",
-    "theobr",
-    "theoh",
-    "ONE_SIGMA",
-    "GAPS",
-]
-
 #: Values of the ``gaps=`` keyword (see the module notes).
 GAPS = ("skip", "longest", "splice")
+
+#: A tau specification: a grid name, points per decade, or taus in seconds
+#: (see :func:`imunoise.taus.averaging_factors`).
+TauSpec: TypeAlias = "str | int | npt.ArrayLike"
+
+#: SP 1065 (Riley 2008) / Riley, "Confidence intervals and bias corrections for the
+#: Stable32 variance functions" (2000): biased/unbiased variance ratio by α.
+_MTOT_BIAS = {2: 0.94, 1: 0.83, 0: 0.73, -1: 0.70, -2: 0.69}
+_HTOT_BIAS = {0: 0.995, -1: 0.851, -2: 0.771, -3: 0.717, -4: 0.679}
+#: Howe, "TheoH: a hybrid, high-confidence statistic" (Metrologia 2006) and
+#: SP 1065: AVAR/Theo1 = a + b/m^c by α (white FM: 1, unbiased).
+_THEO1_BIAS = {
+    2: (0.09, 0.74, 0.40),
+    1: (0.14, 0.82, 0.30),
+    0: (1.00, 0.00, 1.00),
+    -1: (1.87, -1.05, 0.79),
+    -2: (2.70, -1.53, 0.85),
+}
+
+
+def _mtot_bias(alpha: np.ndarray, m: np.ndarray) -> np.ndarray:
+    """Multiplier of the MTOT variance that removes the published bias; alpha (T, ch)."""
+    table = np.vectorize(lambda a: 1.0 / _MTOT_BIAS[int(np.clip(a, -2, 2))])
+    return table(alpha)
+
+
+def _htot_bias(alpha: np.ndarray, m: np.ndarray) -> np.ndarray:
+    """The same for HTOT: none for phase noise (α > 0), nor at m = 1 (OHDEV)."""
+    f = np.vectorize(lambda a: 1.0 / _HTOT_BIAS[int(a)] if a <= 0 else 1.0)(
+        np.clip(alpha, -4, 2)
+    )
+    return np.where((m == 1)[:, None], 1.0, f)
+
+
+def _theo1_bias(alpha: np.ndarray, m: np.ndarray) -> np.ndarray:
+    """The same for Theo1: AVAR/Theo1 = a + b/m^c."""
+    a, b, c = (
+        np.vectorize(lambda al, k=k: _THEO1_BIAS[int(np.clip(al, -2, 2))][k])(alpha)
+        for k in range(3)
+    )
+    return a + b / (m[:, None].astype(float) ** c)
+
+
+@dataclass(frozen=True)
+class _Kind:
+    """How one public statistic maps onto the core."""
+
+    #: Core statistic (one of ``imunoise._core.allan.STATISTICS``); the overlapping
+    #: one where there is a choice.
+    statistic: str
+    #: Core statistic for ``overlapping=False`` (None: always overlapping).
+    non_overlapping: str | None = None
+    #: ThêoH: the core statistic at the taus up to 10 % of the record.
+    short_taus: str | None = None
+    #: Multiplier of the variance for ``bias_correction=True`` (None: no keyword).
+    bias: Callable[[np.ndarray, np.ndarray], np.ndarray] | None = None
+    #: Variance × τ²/3: a time deviation, in input units × s (TDEV, TTOTDEV).
+    time_scaled: bool = False
+    #: ``taus`` are 0.75·m/fs, the averaging time a Theo1-based value belongs to
+    #: (False: m/fs).
+    effective_tau: bool = False
+    #: Theo1 is defined for even m only: odd m of a named grid are skipped.
+    even_m: bool = False
+
+    @property
+    def statistics(self) -> frozenset[str]:
+        """Every core statistic this kind uses."""
+        names = (self.statistic, self.non_overlapping, self.short_taus)
+        return frozenset(name for name in names if name is not None)
+
+
+#: Public name → how it is computed. The functions of the same names, :data:`KINDS`,
+#: ``__all__`` and the CLI's ``--kind`` choices all come from this table.
+_REGISTRY: Mapping[str, _Kind] = MappingProxyType(
+    {
+        "adev": _Kind("oadev", non_overlapping="adev"),
+        "mdev": _Kind("mdev"),
+        "hdev": _Kind("ohdev", non_overlapping="hdev"),
+        "tdev": _Kind("mdev", time_scaled=True),
+        "totdev": _Kind("totdev"),
+        "mtotdev": _Kind("mtotdev", bias=_mtot_bias),
+        "ttotdev": _Kind("mtotdev", bias=_mtot_bias, time_scaled=True),
+        "htotdev": _Kind("htotdev", bias=_htot_bias),
+        "theo1": _Kind("theo1", bias=_theo1_bias, even_m=True),
+        "theobr": _Kind("theobr", effective_tau=True),
+        "theoh": _Kind("theobr", short_taus="oadev", effective_tau=True),
+    }
+)
+
+#: Public names of the statistics, each a function of this module (and of
+#: ``imunoise``) and a value of :attr:`AllanResult.kind`.
+KINDS: tuple[str, ...] = tuple(_REGISTRY)
+
+__all__ = ["AllanResult", *KINDS, "KINDS", "GAPS", "ONE_SIGMA", "chi2_interval"]
+
 #: Statistics (core names) that can leave out the terms touching a missing sample.
-_SKIPS_GAPS = frozenset({"adev", "oadev", "mdev", "hdev", "ohdev"})
+_SKIPS_GAPS = frozenset(_core_allan.GAP_SKIPPING)
 
 
 @dataclass(frozen=True)
@@ -103,12 +202,12 @@ class AllanResult:
     Attributes
     ----------
     kind : str
-        ``"adev"``, ``"mdev"``, ``"hdev"``, ``"tdev"``, ``"totdev"``, ``"mtotdev"``,
-        ``"ttotdev"``, ``"htotdev"``, ``"theo1"``, ``"theobr"`` or ``"theoh"``.
+        The statistic, one of :data:`KINDS` (the function that made the result).
     overlapping : bool
         Whether the estimator uses every start sample (stride 1) or stride m.
     taus : ndarray, (T,)
-        Averaging times in seconds, ``m / fs``.
+        Averaging times in seconds, ``m / fs`` (``"theobr"``/``"theoh"``: the
+        averaging time each value belongs to, see ``m``).
     m : ndarray of int, (T,)
         Averaging factors (ThêoBR points of ``"theobr"``/``"theoh"``: Theo1's even m,
         at ``taus = 0.75 * m / fs``).
@@ -132,6 +231,10 @@ class AllanResult:
         Sample rate in Hz.
     confidence : float
         Two-sided confidence level of ``ci_low``/``ci_high``.
+    n_samples : int
+        Samples the estimates were computed over: the length of ``x`` (with its
+        missing samples, for ``gaps="skip"``), of its longest gap-free run
+        (``"longest"``), or of the spliced record (``"splice"``).
     missing : int or ndarray of int, (channels,)
         Missing samples (NaN) in ``x`` per channel (int for 1-D input).
     gaps : str
@@ -152,6 +255,7 @@ class AllanResult:
     alpha_identified: np.ndarray
     fs: float
     confidence: float
+    n_samples: int
     missing: int | np.ndarray = 0
     gaps: str = "skip"
 
@@ -182,14 +286,14 @@ class AllanResult:
 
 
 def adev(
-    x,
-    fs,
-    taus="octave",
+    x: npt.ArrayLike,
+    fs: float,
     *,
+    taus: TauSpec = "octave",
     overlapping: bool = True,
     confidence: float = ONE_SIGMA,
     gaps: str = "skip",
-):
+) -> AllanResult:
     """Allan deviation, overlapping by default.
 
     Parameters
@@ -223,73 +327,42 @@ def adev(
     >>> bool(abs(r.dev[0] - 1.0) < 0.01)
     True
     """
-    _check_bool("overlapping", overlapping)
-    return _deviation(
-        "adev", "oadev" if overlapping else "adev", x, fs, taus, confidence, overlapping, gaps
-    )
+    return _deviation("adev", x, fs, taus, confidence, gaps, overlapping=overlapping)
 
 
-def mdev(x, fs, taus="octave", *, confidence: float = ONE_SIGMA, gaps: str = "skip"):
+def mdev(x: npt.ArrayLike, fs: float, *, taus: TauSpec = "octave",
+         confidence: float = ONE_SIGMA, gaps: str = "skip") -> AllanResult:
     """Modified Allan deviation (SP 1065 eq. 14); see :func:`adev` for the parameters."""
-    return _deviation("mdev", "mdev", x, fs, taus, confidence, True, gaps)
+    return _deviation("mdev", x, fs, taus, confidence, gaps)
 
 
-def tdev(x, fs, taus="octave", *, confidence: float = ONE_SIGMA, gaps: str = "skip"):
+def tdev(x: npt.ArrayLike, fs: float, *, taus: TauSpec = "octave",
+         confidence: float = ONE_SIGMA, gaps: str = "skip") -> AllanResult:
     """Time deviation, τ·MDEV/√3 (SP 1065 eq. 16), in input units × seconds;
     see :func:`adev` for the parameters."""
-    return _deviation("tdev", "mdev", x, fs, taus, confidence, True, gaps)
+    return _deviation("tdev", x, fs, taus, confidence, gaps)
 
 
-def hdev(
-    x,
-    fs,
-    taus="octave",
-    *,
-    overlapping: bool = True,
-    confidence: float = ONE_SIGMA,
-    gaps: str = "skip",
-):
+def hdev(x: npt.ArrayLike, fs: float, *, taus: TauSpec = "octave", overlapping: bool = True,
+         confidence: float = ONE_SIGMA, gaps: str = "skip") -> AllanResult:
     """Hadamard deviation (SP 1065 eqs. 17–20), overlapping by default; insensitive
     to a linear drift of the rate. See :func:`adev` for the parameters."""
-    _check_bool("overlapping", overlapping)
-    return _deviation(
-        "hdev", "ohdev" if overlapping else "hdev", x, fs, taus, confidence, overlapping, gaps
-    )
+    return _deviation("hdev", x, fs, taus, confidence, gaps, overlapping=overlapping)
 
 
-def totdev(x, fs, taus="octave", *, confidence: float = ONE_SIGMA, gaps: str = "skip"):
+def totdev(x: npt.ArrayLike, fs: float, *, taus: TauSpec = "octave",
+           confidence: float = ONE_SIGMA, gaps: str = "skip") -> AllanResult:
     """Total deviation (SP 1065 eq. 25): the overlapping Allan deviation of the
     phase extended by reflection at both ends, better confidence at long taus.
     No bias correction is applied (it is small for white and flicker FM).
     Cannot skip gaps: NaN in ``x`` needs ``gaps="longest"`` or ``"splice"``.
     See :func:`adev` for the parameters."""
-    return _deviation("totdev", "totdev", x, fs, taus, confidence, True, gaps)
+    return _deviation("totdev", x, fs, taus, confidence, gaps)
 
 
-#: SP 1065 (Riley 2008) / Riley, "Confidence intervals and bias corrections for the
-#: Stable32 variance functions" (2000): biased/unbiased variance ratio by α.
-_MTOT_BIAS = {2: 0.94, 1: 0.83, 0: 0.73, -1: 0.70, -2: 0.69}
-_HTOT_BIAS = {0: 0.995, -1: 0.851, -2: 0.771, -3: 0.717, -4: 0.679}
-#: Howe, "TheoH: a hybrid, high-confidence statistic" (Metrologia 2006) and
-#: SP 1065: AVAR/Theo1 = a + b/m^c by α (white FM: 1, unbiased).
-_THEO1_BIAS = {
-    2: (0.09, 0.74, 0.40),
-    1: (0.14, 0.82, 0.30),
-    0: (1.00, 0.00, 1.00),
-    -1: (1.87, -1.05, 0.79),
-    -2: (2.70, -1.53, 0.85),
-}
-
-
-def mtotdev(
-    x,
-    fs,
-    taus="octave",
-    *,
-    confidence: float = ONE_SIGMA,
-    bias_correction=False,
-    gaps: str = "skip",
-):
+def mtotdev(x: npt.ArrayLike, fs: float, *, taus: TauSpec = "octave",
+            confidence: float = ONE_SIGMA, bias_correction: bool = False,
+            gaps: str = "skip") -> AllanResult:
     r"""Modified total deviation (SP 1065 eq. 27; Howe & Vernotte 1999).
 
     Each of the N − 3m + 1 phase subsequences of 3m points (N = n + 1) has its
@@ -300,57 +373,26 @@ def mtotdev(
     \sum_i \frac{1}{6m}\sum_j (\bar x_j - 2\bar x_{j+m} + \bar x_{j+2m})^2`.
     Taus up to N/3 (as allantools). EDF: SP 1065 Table 8.
 
-    Parameters
-    ----------
-    x, fs, taus, confidence, gaps
-        As for :func:`adev`; cannot skip gaps (``gaps="longest"`` or ``"splice"``
-        for data with NaN).
-    bias_correction : bool, optional
-        Divide the variance by the published bias factor for the noise type
-        identified at each tau (``alpha`` in the result). Default False: the
-        estimate is then a function of the data alone, reproducible and equal to
-        allantools' and Stable32's uncorrected values; the correction depends on
-        the noise identification, which is uncertain where the curve changes
-        slope, and a misidentified tau would jump. Turn it on to compare with
-        Allan-variance values of the same noise (a datasheet, a fitted model).
-        Factors (SP 1065): white PM 0.94, flicker PM 0.83, white FM 0.73,
-        flicker FM 0.70, random-walk FM 0.69.
-
-    Returns
-    -------
-    AllanResult
+    ``x``, ``fs``, ``taus``, ``confidence`` and ``gaps`` as for :func:`adev`;
+    cannot skip gaps (``gaps="longest"`` or ``"splice"`` for data with NaN).
+    ``bias_correction`` as in the module notes, with the SP 1065 factors white PM
+    0.94, flicker PM 0.83, white FM 0.73, flicker FM 0.70, random-walk FM 0.69.
     """
-    return _deviation(
-        "mtotdev", "mtotdev", x, fs, taus, confidence, True, gaps, bias_correction=bias_correction
-    )
+    return _deviation("mtotdev", x, fs, taus, confidence, gaps, bias_correction=bias_correction)
 
 
-def ttotdev(
-    x,
-    fs,
-    taus="octave",
-    *,
-    confidence: float = ONE_SIGMA,
-    bias_correction=False,
-    gaps: str = "skip",
-):
+def ttotdev(x: npt.ArrayLike, fs: float, *, taus: TauSpec = "octave",
+            confidence: float = ONE_SIGMA, bias_correction: bool = False,
+            gaps: str = "skip") -> AllanResult:
     r"""Time total deviation, τ·MTOTDEV/√3 (SP 1065 eq. 28, with τ² in the variance;
     the τ³ printed there is a typo), in input units × seconds. Parameters, EDF and
     bias correction as for :func:`mtotdev`."""
-    return _deviation(
-        "ttotdev", "mtotdev", x, fs, taus, confidence, True, gaps, bias_correction=bias_correction
-    )
+    return _deviation("ttotdev", x, fs, taus, confidence, gaps, bias_correction=bias_correction)
 
 
-def htotdev(
-    x,
-    fs,
-    taus="octave",
-    *,
-    confidence: float = ONE_SIGMA,
-    bias_correction=False,
-    gaps: str = "skip",
-):
+def htotdev(x: npt.ArrayLike, fs: float, *, taus: TauSpec = "octave",
+            confidence: float = ONE_SIGMA, bias_correction: bool = False,
+            gaps: str = "skip") -> AllanResult:
     r"""Hadamard total deviation (SP 1065 eq. 29; Howe, Beard, Greenhall, Riley 2005).
 
     The MTOT construction applied to the *rate* samples: each of the n − 3m + 1
@@ -361,41 +403,19 @@ def htotdev(
     EDF: SP 1065 gives none for HTOT; the overlapping Hadamard EDF (Greenhall) is
     used, a conservative lower bound.
 
-    Parameters
-    ----------
-    x, fs, taus, confidence, gaps
-        As for :func:`adev`; cannot skip gaps (``gaps="longest"`` or ``"splice"``
-        for data with NaN).
-    bias_correction : bool, optional
-        Divide the variance by the published bias factor for the noise type
-        identified at each tau (``alpha`` in the result). Default False: the
-        estimate is then a function of the data alone, reproducible and equal to
-        allantools' and Stable32's uncorrected values; the correction depends on
-        the noise identification, which is uncertain where the curve changes
-        slope, and a misidentified tau would jump. Turn it on to compare with
-        Allan-variance values of the same noise (a datasheet, a fitted model).
-        Factors (SP 1065): white FM 0.995, flicker FM 0.851, random-walk FM 0.771,
-        flicker-walk FM 0.717, random-run FM 0.679; none is published for phase
-        noise (α > 0), where no correction is applied, nor at m = 1.
-
-    Returns
-    -------
-    AllanResult
+    ``x``, ``fs``, ``taus``, ``confidence`` and ``gaps`` as for :func:`adev`;
+    cannot skip gaps (``gaps="longest"`` or ``"splice"`` for data with NaN).
+    ``bias_correction`` as in the module notes, with the SP 1065 factors white FM
+    0.995, flicker FM 0.851, random-walk FM 0.771, flicker-walk FM 0.717,
+    random-run FM 0.679; none is published for phase noise (α > 0), where no
+    correction is applied, nor at m = 1.
     """
-    return _deviation(
-        "htotdev", "htotdev", x, fs, taus, confidence, True, gaps, bias_correction=bias_correction
-    )
+    return _deviation("htotdev", x, fs, taus, confidence, gaps, bias_correction=bias_correction)
 
 
-def theo1(
-    x,
-    fs,
-    taus="octave",
-    *,
-    confidence: float = ONE_SIGMA,
-    bias_correction=False,
-    gaps: str = "skip",
-):
+def theo1(x: npt.ArrayLike, fs: float, *, taus: TauSpec = "octave",
+          confidence: float = ONE_SIGMA, bias_correction: bool = False,
+          gaps: str = "skip") -> AllanResult:
     r"""Theo1 deviation (SP 1065 eq. 30; Howe & Peppler 2003), even m only.
 
     :math:`\mathrm{Theo1}(m) = \frac{1}{0.75\,(N-m)(m\tau_0)^2}\sum_{i=0}^{N-m-1}
@@ -410,33 +430,18 @@ def theo1(
     does. Noise identification uses the factor 0.75·m; EDF: the SP 1065 Theo1
     formulas (Howe & Tasset) with r = 0.75·m.
 
-    Parameters
-    ----------
-    x, fs, taus, confidence, gaps
-        As for :func:`adev`; cannot skip gaps (``gaps="longest"`` or ``"splice"``
-        for data with NaN).
-    bias_correction : bool, optional
-        Divide the variance by the published bias factor for the noise type
-        identified at each tau (``alpha`` in the result). Default False: the
-        estimate is then a function of the data alone, reproducible and equal to
-        allantools' and Stable32's uncorrected values; the correction depends on
-        the noise identification, which is uncertain where the curve changes
-        slope, and a misidentified tau would jump. Turn it on to compare with
-        Allan-variance values of the same noise (a datasheet, a fitted model).
-        With it, the variance is multiplied by AVAR/Theo1 = a + b/m^c (Howe 2006,
-        SP 1065): white PM 0.09 + 0.74/m^0.40, flicker PM 0.14 + 0.82/m^0.30,
-        white FM 1, flicker FM 1.87 − 1.05/m^0.79, random-walk FM 2.70 − 1.53/m^0.85.
-
-    Returns
-    -------
-    AllanResult
+    ``x``, ``fs``, ``taus``, ``confidence`` and ``gaps`` as for :func:`adev`;
+    cannot skip gaps (``gaps="longest"`` or ``"splice"`` for data with NaN).
+    ``bias_correction`` as in the module notes: the variance is multiplied by
+    AVAR/Theo1 = a + b/m^c (Howe 2006, SP 1065): white PM 0.09 + 0.74/m^0.40,
+    flicker PM 0.14 + 0.82/m^0.30, white FM 1, flicker FM 1.87 − 1.05/m^0.79,
+    random-walk FM 2.70 − 1.53/m^0.85.
     """
-    return _deviation(
-        "theo1", "theo1", x, fs, taus, confidence, True, gaps, bias_correction=bias_correction
-    )
+    return _deviation("theo1", x, fs, taus, confidence, gaps, bias_correction=bias_correction)
 
 
-def theobr(x, fs, taus="octave", *, confidence: float = ONE_SIGMA, gaps: str = "skip"):
+def theobr(x: npt.ArrayLike, fs: float, *, taus: TauSpec = "octave",
+           confidence: float = ONE_SIGMA, gaps: str = "skip") -> AllanResult:
     r"""ThêoBR deviation: Theo1 with its bias relative to the Allan variance removed
     by the data's own AVAR/Theo1 ratio (Howe & Tasset 2004; Howe 2006; SP 1065
     §5.2.15). An estimate of the Allan deviation out to τ ≈ 0.75·T (T the record
@@ -496,14 +501,16 @@ def theobr(x, fs, taus="octave", *, confidence: float = ONE_SIGMA, gaps: str = "
     if m.size == 0:
         raise ValueError(f"none of the taus is in range for theobr; got {taus!r}")
     _warn_theobr_cost("theobr", n, m, data.shape[1])
-    var, terms, alpha, identified, edf, _ = _core_allan.analyse(data, "theobr", m.astype(np.uint64))
+    core = _core_allan.analyse(data, "theobr", m.astype(np.uint64))
     return _assemble(
-        "theobr", True, 0.75 * m / fs, m, var, terms, alpha, identified, edf, fs,
-        confidence, one_d, missing, gaps,
+        "theobr", True, 0.75 * m / fs, m, core.var, core.terms, core.alpha,
+        core.alpha_identified, core.edf, fs=fs, confidence=confidence, one_d=one_d,
+        missing=missing, gaps=gaps, n_samples=n,
     )
 
 
-def theoh(x, fs, taus="octave", *, confidence: float = ONE_SIGMA, gaps: str = "skip"):
+def theoh(x: npt.ArrayLike, fs: float, *, taus: TauSpec = "octave",
+          confidence: float = ONE_SIGMA, gaps: str = "skip") -> AllanResult:
     r"""ThêoH deviation: the overlapping Allan deviation at short taus and ThêoBR
     (:func:`theobr`) at long ones (Howe, "ThêoH: a hybrid, high-confidence
     statistic that improves on the Allan deviation", Metrologia 43, 2006; SP 1065
@@ -575,45 +582,42 @@ def theoh(x, fs, taus="octave", *, confidence: float = ONE_SIGMA, gaps: str = "s
         raise ValueError(f"none of the taus is in range for theoh; got {taus!r}")
     _warn_theobr_cost("theoh", n, m_theo, data.shape[1])
     m = np.concatenate([m_avar, m_theo]).astype(np.int64)
-    statistics = ["oadev"] * m_avar.size + ["theobr"] * m_theo.size
-    var, terms, alpha, identified, edf, _ = _core_allan.analyse_plan(
-        data, statistics, m.astype(np.uint64)
-    )
+    kind = _REGISTRY["theoh"]
+    below_k = kind.short_taus or kind.statistic
+    statistics = [below_k] * m_avar.size + [kind.statistic] * m_theo.size
+    core = _core_allan.analyse_plan(data, statistics, m.astype(np.uint64))
     tau = np.concatenate([m_avar / fs, 0.75 * m_theo / fs])
     return _assemble(
-        "theoh", True, tau, m, var, terms, alpha, identified, edf, fs, confidence, one_d,
-        missing, gaps,
+        "theoh", True, tau, m, core.var, core.terms, core.alpha, core.alpha_identified,
+        core.edf, fs=fs, confidence=confidence, one_d=one_d, missing=missing, gaps=gaps,
+        n_samples=n,
     )
-
-
-def _bias_factor(kind, alpha, m):
-    """Multiplier of the variance that removes the published bias; alpha (T, ch)."""
-    if kind in ("mtotdev", "ttotdev"):
-        table = np.vectorize(lambda a: 1.0 / _MTOT_BIAS[int(np.clip(a, -2, 2))])
-        return table(alpha)
-    if kind == "htotdev":
-        f = np.vectorize(lambda a: 1.0 / _HTOT_BIAS[int(a)] if a <= 0 else 1.0)(
-            np.clip(alpha, -4, 2)
-        )
-        return np.where((m == 1)[:, None], 1.0, f)
-    a, b, c = (
-        np.vectorize(lambda al, k=k: _THEO1_BIAS[int(np.clip(al, -2, 2))][k])(alpha)
-        for k in range(3)
-    )
-    return a + b / (m[:, None].astype(float) ** c)
 
 
 def _deviation(
-    kind, statistic, x, fs, taus, confidence, overlapping, gaps, *, bias_correction=False
+    kind: str,
+    x: npt.ArrayLike,
+    fs: float,
+    taus: TauSpec,
+    confidence: float,
+    gaps: str,
+    *,
+    overlapping: bool = True,
+    bias_correction: bool = False,
 ) -> AllanResult:
+    """A statistic of :data:`KINDS` whose taus are m/fs, as its registry entry says.
+    Called from the public function itself (the warnings' stack levels count on it)."""
+    _check_bool("overlapping", overlapping)
+    spec = _REGISTRY[kind]
+    statistic = spec.non_overlapping if not overlapping and spec.non_overlapping else spec.statistic
     data, one_d, missing = _gapped_samples(x, gaps, kind, statistic in _SKIPS_GAPS)
     fs = _check_fs(fs)
     confidence = _check_confidence(confidence)
     _check_bool("bias_correction", bias_correction)
     n = data.shape[0]
     m, user_given = averaging_factors(taus, fs, n)
-    if kind == "theo1" and not user_given:
-        m = m[m % 2 == 0]  # Theo1 is defined for even m only
+    if spec.even_m and not user_given:
+        m = m[m % 2 == 0]
     m = m.astype(np.uint64)
     terms = _core_allan.estimator_terms(statistic, n + 1, m)
     m = keep_estimable(m.astype(np.int64), terms.astype(np.int64), fs, user_given, kind)
@@ -622,19 +626,20 @@ def _deviation(
             f"x has {n} samples, too few for any tau of {kind} "
             f"(the shortest tau needs at least {_minimum_samples(statistic)})"
         )
-    var, terms, alpha, identified, edf, core_missing = _core_allan.analyse(
-        data, statistic, m.astype(np.uint64)
+    core = _core_allan.analyse(data, statistic, m.astype(np.uint64))
+    var, terms, alpha, identified, edf = (
+        core.var, core.terms, core.alpha, core.alpha_identified, core.edf
     )
     if missing is None:
-        missing = core_missing.astype(np.int64)
+        missing = core.missing.astype(np.int64)
         if missing.any():
             m, var, terms, alpha, identified, edf = _keep_gapped(
                 kind, m, var, terms, alpha, identified, edf, fs, user_given
             )
     tau = m / fs
-    if bias_correction:
-        var = var * _bias_factor(kind, alpha, m)
-    if kind in ("tdev", "ttotdev"):
+    if bias_correction and spec.bias is not None:
+        var = var * spec.bias(alpha, m)
+    if spec.time_scaled:
         with np.errstate(over="ignore", invalid="ignore"):
             scaled = var * (tau**2 / 3.0)[:, None]
         if np.any(np.isfinite(var) & ~np.isfinite(scaled)):
@@ -644,8 +649,8 @@ def _deviation(
             )
         var = scaled
     return _assemble(
-        kind, overlapping, tau, m, var, terms, alpha, identified, edf, fs, confidence, one_d,
-        missing, gaps,
+        kind, overlapping, tau, m, var, terms, alpha, identified, edf, fs=fs,
+        confidence=confidence, one_d=one_d, missing=missing, gaps=gaps, n_samples=n,
     )
 
 
@@ -677,8 +682,22 @@ def _keep_gapped(kind, m, var, terms, alpha, identified, edf, fs, user_given):
 
 
 def _assemble(
-    kind, overlapping, tau, m, var, terms, alpha, identified, edf, fs, confidence, one_d,
-    missing, gaps,
+    kind: str,
+    overlapping: bool,
+    tau: np.ndarray,
+    m: np.ndarray,
+    var: np.ndarray,
+    terms: np.ndarray,
+    alpha: np.ndarray,
+    identified: np.ndarray,
+    edf: np.ndarray,
+    *,
+    fs: float,
+    confidence: float,
+    one_d: bool,
+    missing: np.ndarray,
+    gaps: str,
+    n_samples: int,
 ) -> AllanResult:
     """The result object from the core's (T, channels) arrays."""
     dev = np.sqrt(var)
@@ -700,12 +719,15 @@ def _assemble(
         alpha_identified=squeeze(identified),
         fs=fs,
         confidence=confidence,
+        n_samples=int(n_samples),
         missing=int(missing[0]) if one_d else np.asarray(missing, dtype=np.int64),
         gaps=gaps,
     )
 
 
-def chi2_interval(dev, edf, confidence):
+def chi2_interval(
+    dev: npt.ArrayLike, edf: npt.ArrayLike, confidence: float
+) -> tuple[np.ndarray, np.ndarray]:
     """Two-sided χ² interval on a deviation with ``edf`` degrees of freedom
     (SP 1065 eq. 45): σ·√(ν/χ²(1 − p/2, ν)) ≤ σ ≤ σ·√(ν/χ²(p/2, ν)), p = 1 − confidence."""
     tail = (1.0 - confidence) / 2.0
@@ -715,20 +737,13 @@ def chi2_interval(dev, edf, confidence):
     return low, high
 
 
-#: Theo1 kernel rates, release build, 2 shared cores: direct multiply-adds per second
-#: (m < 256) and N·log2(m)² units per second of the fast expansion (measured).
-_THEO1_DIRECT_PER_SECOND = 1.2e9
-_THEO1_FAST_PER_SECOND = 1.1e9
-#: Fewest samples for which ThêoBR's bias ratio exists (N = n + 1 ≥ 90 phase points).
-_THEO_MIN_SAMPLES = 89
-
-
 def _check_theo_length(kind: str, n: int) -> None:
-    if n < _THEO_MIN_SAMPLES:
+    """ThêoBR's bias ratio exists from ``THEOBR_MIN_SAMPLES`` on (the core's number)."""
+    if n < _core_allan.THEOBR_MIN_SAMPLES:
         raise ValueError(
             f"x has {n} samples, too few for {kind}: its bias ratio averages "
             f"n = floor(0.1·N/3) − 3 + 1 terms over the N = samples + 1 phase points, "
-            f"which needs at least {_THEO_MIN_SAMPLES} samples"
+            f"which needs at least {_core_allan.THEOBR_MIN_SAMPLES} samples"
         )
 
 
@@ -747,7 +762,8 @@ def _keep_theobr(m, n: int, fs: float, user_given: bool, kind: str, lower: float
     """Even m in ThêoBR's range (10 ≤ m ≤ N − 1) with 0.75·m > ``lower`` (in
     samples), unique and sorted; warns when explicit taus are dropped."""
     m = np.asarray(m, dtype=np.int64)
-    terms = _core_allan.estimator_terms("theobr", n + 1, m.astype(np.uint64)).astype(np.int64)
+    statistic = _REGISTRY[kind].statistic
+    terms = _core_allan.estimator_terms(statistic, n + 1, m.astype(np.uint64)).astype(np.int64)
     keep = (terms > 1) & (0.75 * m > lower)
     dropped = int(np.count_nonzero(~keep))
     if dropped and user_given:
@@ -765,8 +781,7 @@ def _warn_theobr_cost(kind: str, n: int, m: np.ndarray, channels: int) -> None:
     that is long."""
     if m.size == 0:
         return
-    direct, fast = _core_allan.theobr_work(n + 1, [int(v) for v in m])
-    seconds = channels * (direct / _THEO1_DIRECT_PER_SECOND + fast / _THEO1_FAST_PER_SECOND)
+    seconds = channels * _core_allan.theobr_seconds(n + 1, [int(v) for v in m])
     if seconds > 60:
         warnings.warn(
             f"{kind}'s bias ratio needs Theo1 at N/30 averaging factors (cost ~N² log²N): "

@@ -44,6 +44,62 @@ impl Gaps {
     }
 }
 
+/// Cumulative phases of several channels, computed in parallel. Each item yields
+/// one channel's samples.
+pub fn column_phases<I>(columns: Vec<I>) -> CoreResult<Vec<Phase>>
+where
+    I: Iterator<Item = f64> + Send,
+{
+    let gathered = columns.into_par_iter().map(gather).collect();
+    transform_in_parallel(gathered)
+}
+
+/// Cumulative phases of the columns of a C-ordered `(n, channels)` array given as
+/// its row-major data: one pass over the rows scatters the samples into the
+/// channels' phase vectors (each column gathered separately would stream the whole
+/// array once per channel), then the channels are transformed in parallel.
+pub fn row_major_phases(data: &[f64], channels: usize) -> CoreResult<Vec<Phase>> {
+    if channels == 0 || !data.len().is_multiple_of(channels) {
+        return Err(CoreError::InvalidArgument(format!(
+            "x has {} values, not a whole number of rows of {channels} channels",
+            data.len()
+        )));
+    }
+    let n = data.len() / channels;
+    let mut phases: Vec<Vec<f64>> = (0..channels)
+        .map(|_| {
+            let mut phase = Vec::with_capacity(n + 1);
+            crate::memory::advise_huge_pages(&phase);
+            phase.resize(n + 1, 0.0);
+            phase
+        })
+        .collect();
+    for (i, row) in data.chunks_exact(channels).enumerate() {
+        for (phase, &value) in phases.iter_mut().zip(row) {
+            phase[i + 1] = value;
+        }
+    }
+    transform_in_parallel(phases)
+}
+
+/// Turns gathered samples (behind a leading slot) into cumulative phases, one
+/// channel per task; errors name the channel when there are several.
+fn transform_in_parallel(gathered: Vec<Vec<f64>>) -> CoreResult<Vec<Phase>> {
+    let several = gathered.len() > 1;
+    gathered
+        .into_par_iter()
+        .enumerate()
+        .map(|(channel, phase)| {
+            into_cumulative_phase(phase).map_err(|e| match e {
+                CoreError::InvalidArgument(msg) if several => {
+                    CoreError::InvalidArgument(format!("{msg} (channel {channel})"))
+                }
+                other => other,
+            })
+        })
+        .collect()
+}
+
 /// Cumulative sum of mean-removed samples of a record without missing samples
 /// (NaN is an error here). `samples` may be strided (a column of a C-ordered 2-D
 /// array); it is gathered once into the output vector, which is then transformed
@@ -99,12 +155,9 @@ pub fn into_cumulative_phase(mut phase: Vec<f64>) -> CoreResult<Phase> {
     };
     phase[0] = 0.0;
     let chunk_sums: Vec<f64> = phase[1..].par_chunks(CHUNK).map(compensated_sum).collect();
-    let mut total = Neumaier::new();
-    for s in chunk_sums {
-        total.add(s);
-    }
+    let total = chunk_sums.into_iter().sum::<Neumaier>().value();
     let valid = n - gaps.as_ref().map_or(0, |g| g.missing);
-    let mean = total.value() / valid as f64;
+    let mean = total / valid as f64;
     if let Some(g) = &gaps {
         // A missing sample becomes the mean: it then adds exactly 0 below.
         let mut at = 0;
@@ -194,11 +247,7 @@ fn compensated_step((sum, comp): (f64, f64), v: f64) -> (f64, f64) {
 /// Mean and least-squares slope of f(t), t < count (slope about t = (count − 1)/2).
 /// The block expansions of the total family re-centre their data on this line.
 pub fn least_squares_line(f: impl Fn(usize) -> f64, count: usize) -> (f64, f64) {
-    let mut sum = Neumaier::new();
-    for t in 0..count {
-        sum.add(f(t));
-    }
-    let mean = sum.value() / count as f64;
+    let mean = (0..count).map(&f).sum::<Neumaier>().value() / count as f64;
     let centre = (count as f64 - 1.0) / 2.0;
     let (mut cov, mut var) = (Neumaier::new(), Neumaier::new());
     for t in 0..count {
@@ -234,6 +283,35 @@ fn compensated_sum(values: &[f64]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn row_major_phases_equal_column_phases() {
+        let data: Vec<f64> = (0..300).map(|k| ((k * 7919) % 101) as f64 - 50.0).collect();
+        let rows = row_major_phases(&data, 3).unwrap();
+        let columns = column_phases(
+            (0..3)
+                .map(|c| data.iter().skip(c).step_by(3).copied())
+                .collect(),
+        )
+        .unwrap();
+        assert_eq!(rows, columns);
+        assert!(row_major_phases(&data, 7).is_err());
+        let mut bad = data.clone();
+        bad[4] = f64::INFINITY; // row 1, channel 1
+        let err = row_major_phases(&bad, 3).unwrap_err().to_string();
+        assert!(
+            err.contains("sample 1") && err.contains("channel 1"),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn non_finite_values_name_the_channel() {
+        let a = [1.0, 2.0];
+        let b = [1.0, f64::INFINITY];
+        let err = column_phases(vec![a.iter().copied(), b.iter().copied()]).unwrap_err();
+        assert!(err.to_string().contains("channel 1"), "{err}");
+    }
 
     #[test]
     fn phase_starts_at_zero_and_ends_near_zero() {

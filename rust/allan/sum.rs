@@ -31,6 +31,37 @@ impl Neumaier {
     }
 }
 
+/// Adds the values in iteration order: `parts.into_iter().sum::<Neumaier>().value()`
+/// is the ordered compensated sum that makes parallel reductions independent of
+/// the thread count.
+impl std::iter::Sum<f64> for Neumaier {
+    fn sum<I: Iterator<Item = f64>>(values: I) -> Self {
+        let mut total = Neumaier::new();
+        for v in values {
+            total.add(v);
+        }
+        total
+    }
+}
+
+impl<'a> std::iter::Sum<&'a f64> for Neumaier {
+    fn sum<I: Iterator<Item = &'a f64>>(values: I) -> Self {
+        values.copied().sum()
+    }
+}
+
+/// Column-wise compensated totals of rows of partial sums (one row per parallel
+/// task, `width` columns), each column added in row order.
+pub fn column_totals(rows: &[Vec<f64>], width: usize) -> Vec<f64> {
+    let mut totals = vec![Neumaier::new(); width];
+    for row in rows {
+        for (total, value) in totals.iter_mut().zip(row) {
+            total.add(*value);
+        }
+    }
+    totals.iter().map(Neumaier::value).collect()
+}
+
 /// Sum of squares of `f(k)` for `k` in `range` (stepping by `step`). Terms are
 /// non-negative, so a plain sum over a block of 256 has relative error below
 /// 256·ε; blocks are then added with compensation. Eight independent lanes let
@@ -139,6 +170,14 @@ mod tests {
             acc.add(v);
         }
         assert_eq!(acc.value(), 2.0);
+    }
+
+    #[test]
+    fn sum_trait_adds_in_order_with_compensation() {
+        let values = [1.0, 1e100, 1.0, -1e100];
+        assert_eq!(values.iter().sum::<Neumaier>().value(), 2.0);
+        let rows = vec![vec![1.0, 1e100], vec![1e100, 1.0], vec![-1e100, -1e100]];
+        assert_eq!(column_totals(&rows, 2), vec![1.0, 1.0]);
     }
 
     #[test]

@@ -25,6 +25,60 @@ pub fn integrate(v: &[f64]) -> Vec<f64> {
         .collect()
 }
 
+/// Noise integrated `order` times: white, random walk, random-walk FM phase, ….
+pub fn integrated_noise(n: usize, seed: u64, order: usize) -> Vec<f64> {
+    (0..order).fold(noise(n, seed), |v, _| integrate(&v))
+}
+
+/// `v + offset`, for a kernel, and the same values with the offset taken off
+/// again (exactly, by Sterbenz), for a reference that ignores offsets.
+pub fn offset_pair(v: &[f64], offset: f64) -> (Vec<f64>, Vec<f64>) {
+    let shifted: Vec<f64> = v.iter().map(|x| x + offset).collect();
+    let back = shifted.iter().map(|x| x - offset).collect();
+    (shifted, back)
+}
+
+/// One MTOT/HTOT subsequence by the definition: the linear trend through the
+/// means of its two halves removed, then extended by uninverted even reflection
+/// to three times its length, [flip(z), z, flip(z)].
+pub fn detrended_reflection(xs: &[f64]) -> Vec<f64> {
+    let l = xs.len();
+    let half = l / 2;
+    let gap = l.div_ceil(2);
+    let first: f64 = xs[..half].iter().sum::<f64>() / half as f64;
+    let last: f64 = xs[gap..].iter().sum::<f64>() / half as f64;
+    let slope = (last - first) / gap as f64;
+    let z: Vec<f64> = xs
+        .iter()
+        .enumerate()
+        .map(|(k, v)| v - slope * k as f64)
+        .collect();
+    let mut star: Vec<f64> = z.iter().rev().copied().collect();
+    star.extend(&z);
+    star.extend(z.iter().rev());
+    star
+}
+
+/// Proptest input for the fast kernels: a factor pick in [0, 1) and a white,
+/// random-walk or random-walk-FM signal of 3 to `max_len` points on an offset, as
+/// (pick, shifted, unshifted) (see [`offset_pair`]).
+pub fn kernel_case(
+    max_len: usize,
+) -> impl proptest::strategy::Strategy<Value = (f64, Vec<f64>, Vec<f64>)> {
+    use proptest::strategy::Strategy;
+    (
+        3usize..max_len,
+        0.0f64..1.0,
+        0u64..1000,
+        0usize..3,
+        -1e4f64..1e4,
+    )
+        .prop_map(|(n, pick, seed, order, offset)| {
+            let (shifted, back) = offset_pair(&integrated_noise(n, seed, order), offset);
+            (pick, shifted, back)
+        })
+}
+
 /// Theo1 variance by its definition (SP 1065 eq. 30) on phase values x, as
 /// allantools computes it: the reference the kernels are checked against.
 pub fn naive_theo1(x: &[f64], m: usize) -> f64 {

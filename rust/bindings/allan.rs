@@ -1,43 +1,40 @@
 //! Bindings for the Allan family: one call computes variances, terms, noise
-//! identification and EDF for every tau and channel with the GIL released.
+//! identification and EDF for every tau and channel with the GIL released, and
+//! returns them as one frozen [`AnalysisArrays`] (`Analysis` in Python). Statistic
+//! names come from the Rust table (`allan::Statistic`), exported as `STATISTICS`,
+//! and those that can skip missing samples as `GAP_SKIPPING`.
 
-use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
+use numpy::ndarray::Array2;
+use numpy::{Element, IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
+use pyo3::types::PyTuple;
 
+use crate::allan::estimators::theobr;
 use crate::allan::{self, Statistic};
 
-fn parse_statistic(name: &str) -> PyResult<Statistic> {
-    Ok(match name {
-        "adev" => Statistic::Allan { overlapping: false },
-        "oadev" => Statistic::Allan { overlapping: true },
-        "mdev" => Statistic::Modified,
-        "hdev" => Statistic::Hadamard { overlapping: false },
-        "ohdev" => Statistic::Hadamard { overlapping: true },
-        "totdev" => Statistic::Total,
-        "mtotdev" => Statistic::ModifiedTotal,
-        "htotdev" => Statistic::HadamardTotal,
-        "theo1" => Statistic::Theo1,
-        "theobr" => Statistic::TheoBR,
-        other => {
-            return Err(PyValueError::new_err(format!(
-                "statistic must be one of adev, oadev, mdev, hdev, ohdev, totdev, mtotdev, \
-                 htotdev, theo1, theobr; got {other:?}"
-            )))
-        }
-    })
+/// The arrays of one analysis; 2-D arrays are (taus, channels).
+#[pyclass(name = "Analysis", module = "imunoise._core.allan", frozen, get_all)]
+struct AnalysisArrays {
+    /// Variance at each tau and channel (NaN where gaps leave no term).
+    var: Py<PyArray2<f64>>,
+    /// Terms each estimate averages (with gaps: the terms used).
+    terms: Py<PyArray2<u64>>,
+    /// Noise type α used for the EDF.
+    alpha: Py<PyArray2<i32>>,
+    /// Whether α was identified at that tau (else taken from the nearest ones).
+    alpha_identified: Py<PyArray2<bool>>,
+    /// Equivalent degrees of freedom.
+    edf: Py<PyArray2<f64>>,
+    /// Missing samples (NaN) per channel, shape (channels,).
+    missing: Py<PyArray1<u64>>,
 }
 
-type AnalysisArrays<'py> = (
-    Bound<'py, PyArray2<f64>>,
-    Bound<'py, PyArray2<u64>>,
-    Bound<'py, PyArray2<i32>>,
-    Bound<'py, PyArray2<bool>>,
-    Bound<'py, PyArray2<f64>>,
-    Bound<'py, PyArray1<u64>>,
-);
+fn parse_statistic(name: &str) -> PyResult<Statistic> {
+    Ok(name.parse::<Statistic>()?)
+}
 
-/// analyse(x, statistic, ms) -> (var, terms, alpha, alpha_identified, edf, missing)
+/// analyse(x, statistic, ms) -> Analysis
 ///
 /// `x` is a float64 array (n, channels) in any memory order, NaN where a sample
 /// is missing; `ms` the averaging factors. 2-D outputs have shape (len(ms),
@@ -48,7 +45,7 @@ fn analyse<'py>(
     x: PyReadonlyArray2<'py, f64>,
     statistic: &str,
     ms: PyReadonlyArray1<'py, u64>,
-) -> PyResult<AnalysisArrays<'py>> {
+) -> PyResult<AnalysisArrays> {
     let statistic = parse_statistic(statistic)?;
     let plan: Vec<(Statistic, usize)> = ms
         .as_array()
@@ -66,7 +63,7 @@ fn analyse_plan<'py>(
     x: PyReadonlyArray2<'py, f64>,
     statistics: Vec<String>,
     ms: PyReadonlyArray1<'py, u64>,
-) -> PyResult<AnalysisArrays<'py>> {
+) -> PyResult<AnalysisArrays> {
     let ms = ms.as_array();
     if statistics.len() != ms.len() {
         return Err(PyValueError::new_err(format!(
@@ -87,7 +84,7 @@ fn run_plan<'py>(
     py: Python<'py>,
     x: PyReadonlyArray2<'py, f64>,
     plan: Vec<(Statistic, usize)>,
-) -> PyResult<AnalysisArrays<'py>> {
+) -> PyResult<AnalysisArrays> {
     let view = x.as_array();
     let result = py.detach(|| {
         // A C-ordered array with several channels is scattered row by row in one
@@ -108,29 +105,33 @@ fn run_plan<'py>(
         allan::analyse_plan(&phases, &plan)
     })?;
     let shape = (plan.len(), result.channels);
-    let reshape_err = |e: numpy::ndarray::ShapeError| PyValueError::new_err(e.to_string());
-    let to2 = |v: Vec<f64>| numpy::ndarray::Array2::from_shape_vec(shape, v).map_err(reshape_err);
-    let var = to2(result.var)?.into_pyarray(py);
-    let edf = to2(result.edf)?.into_pyarray(py);
-    let alpha = numpy::ndarray::Array2::from_shape_vec(shape, result.alpha)
-        .map_err(reshape_err)?
-        .into_pyarray(py);
-    let identified = numpy::ndarray::Array2::from_shape_vec(shape, result.alpha_identified)
-        .map_err(reshape_err)?
-        .into_pyarray(py);
-    let terms: Vec<u64> = result.terms.iter().map(|&t| t as u64).collect();
-    let terms = numpy::ndarray::Array2::from_shape_vec(shape, terms)
-        .map_err(reshape_err)?
-        .into_pyarray(py);
-    let missing: Vec<u64> = result.missing.iter().map(|&t| t as u64).collect();
-    Ok((var, terms, alpha, identified, edf, missing.into_pyarray(py)))
+    let as_u64 = |v: &[usize]| v.iter().map(|&t| t as u64).collect::<Vec<u64>>();
+    Ok(AnalysisArrays {
+        var: table(py, shape, result.var)?,
+        terms: table(py, shape, as_u64(&result.terms))?,
+        alpha: table(py, shape, result.alpha)?,
+        alpha_identified: table(py, shape, result.alpha_identified)?,
+        edf: table(py, shape, result.edf)?,
+        missing: as_u64(&result.missing).into_pyarray(py).unbind(),
+    })
 }
 
-/// theobr_work(n_phase, ms) -> (direct steps, fast units) of ThêoBR's bias ratio and
-/// Theo1 at `ms`, per channel (see `allan::theo::theo1_work`)
+/// A tau-major vector as a (taus, channels) array.
+fn table<T: Element>(
+    py: Python<'_>,
+    shape: (usize, usize),
+    values: Vec<T>,
+) -> PyResult<Py<PyArray2<T>>> {
+    let array =
+        Array2::from_shape_vec(shape, values).map_err(|e| PyValueError::new_err(e.to_string()))?;
+    Ok(array.into_pyarray(py).unbind())
+}
+
+/// theobr_seconds(n_phase, ms) -> rough seconds of ThêoBR's bias ratio plus Theo1 at
+/// `ms` on one channel (see `allan::estimators::theobr::estimated_seconds`)
 #[pyfunction]
-fn theobr_work(n_phase: usize, ms: Vec<usize>) -> (f64, f64) {
-    allan::theo::theobr_work(n_phase, &ms)
+fn theobr_seconds(n_phase: usize, ms: Vec<usize>) -> f64 {
+    theobr::estimated_seconds(n_phase, &ms)
 }
 
 /// estimator_terms(statistic, n_phase, ms) -> terms per averaging factor (0: does not fit)
@@ -151,9 +152,23 @@ fn estimator_terms<'py>(
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    let names = |keep: fn(&Statistic) -> bool| -> Vec<&'static str> {
+        Statistic::ALL
+            .iter()
+            .filter(|s| keep(s))
+            .map(|s| s.name())
+            .collect()
+    };
+    m.add("STATISTICS", PyTuple::new(m.py(), names(|_| true))?)?;
+    m.add(
+        "GAP_SKIPPING",
+        PyTuple::new(m.py(), names(|s| s.skips_gaps()))?,
+    )?;
+    m.add("THEOBR_MIN_SAMPLES", theobr::MIN_SAMPLES)?;
+    m.add_class::<AnalysisArrays>()?;
     m.add_function(wrap_pyfunction!(analyse, m)?)?;
     m.add_function(wrap_pyfunction!(estimator_terms, m)?)?;
     m.add_function(wrap_pyfunction!(analyse_plan, m)?)?;
-    m.add_function(wrap_pyfunction!(theobr_work, m)?)?;
+    m.add_function(wrap_pyfunction!(theobr_seconds, m)?)?;
     Ok(())
 }

@@ -116,7 +116,11 @@ def test_no_input_escapes_as_anything_but_value_or_type_error(x, fs, func, taus)
     except (ValueError, TypeError):
         return
     # NaN marks a channel whose gaps leave fewer than 2 terms at that tau.
-    no_terms = np.broadcast_to(np.asarray(r.n) < 2, r.dev.shape)
+    # r.n is (T,) when every channel used the same terms, also for 2-D input.
+    no_terms = np.asarray(r.n) < 2
+    if no_terms.ndim < r.dev.ndim:
+        no_terms = no_terms[:, None]
+    no_terms = np.broadcast_to(no_terms, r.dev.shape)
     assert np.all(np.isfinite(r.dev) | (r.dev == 0) | no_terms)
     assert r.dev.shape[0] == len(r.taus)
 

@@ -1,45 +1,62 @@
 # rust/bindings/allan.rs: the Allan family.
 
+from typing import final
+
 import numpy as np
 import numpy.typing as npt
+
+#: Statistic names the functions below accept, from the Rust table
+#: (rust/allan/statistic.rs).
+STATISTICS: tuple[str, ...]
+#: The statistics that can leave out the terms touching a missing sample (NaN).
+GAP_SKIPPING: tuple[str, ...]
+#: Fewest samples ThêoBR (and ThêoH) accept: its bias ratio needs 90 phase points.
+THEOBR_MIN_SAMPLES: int
+
+@final
+class Analysis:
+    """The arrays of one analysis; 2-D arrays are (taus, channels)."""
+
+    @property
+    def var(self) -> npt.NDArray[np.float64]:
+        """Variance at each tau and channel (NaN where gaps leave no term)."""
+    @property
+    def terms(self) -> npt.NDArray[np.uint64]:
+        """Terms each estimate averages (with gaps: the terms used)."""
+    @property
+    def alpha(self) -> npt.NDArray[np.int32]:
+        """Noise type α used for the EDF."""
+    @property
+    def alpha_identified(self) -> npt.NDArray[np.bool_]:
+        """Whether α was identified at that tau (else taken from the nearest ones)."""
+    @property
+    def edf(self) -> npt.NDArray[np.float64]:
+        """Equivalent degrees of freedom."""
+    @property
+    def missing(self) -> npt.NDArray[np.uint64]:
+        """Missing samples (NaN) per channel, shape (channels,)."""
 
 def analyse(
     x: npt.NDArray[np.float64],
     statistic: str,
     ms: npt.NDArray[np.uint64],
-) -> tuple[
-    npt.NDArray[np.float64],
-    npt.NDArray[np.uint64],
-    npt.NDArray[np.int32],
-    npt.NDArray[np.bool_],
-    npt.NDArray[np.float64],
-    npt.NDArray[np.uint64],
-]:
-    """(var, terms, alpha, alpha_identified, edf, missing) for x (n, channels) at
-    averaging factors ms; 2-D outputs are (len(ms), channels), ``missing`` (channels,)
-    counts each channel's NaN. NaN marks a missing sample: adev, oadev, mdev, hdev and
-    ohdev leave out the terms touching one (``terms`` counts those used; var and edf
-    are NaN where none is left), the others raise ValueError. statistic: adev, oadev,
-    mdev, hdev, ohdev, totdev, mtotdev, htotdev, theo1, theobr."""
+) -> Analysis:
+    """The analysis of x (n, channels) at averaging factors ms. NaN marks a missing
+    sample: adev, oadev, mdev, hdev and ohdev leave out the terms touching one
+    (``terms`` counts those used; var and edf are NaN where none is left), the others
+    raise ValueError. statistic: one of :data:`STATISTICS`."""
 
 def analyse_plan(
     x: npt.NDArray[np.float64],
     statistics: list[str],
     ms: npt.NDArray[np.uint64],
-) -> tuple[
-    npt.NDArray[np.float64],
-    npt.NDArray[np.uint64],
-    npt.NDArray[np.int32],
-    npt.NDArray[np.bool_],
-    npt.NDArray[np.float64],
-    npt.NDArray[np.uint64],
-]:
+) -> Analysis:
     """As :func:`analyse` with one statistic per tau (``statistics[t]`` at ``ms[t]``,
     ordered by tau); ThêoH is oadev at its short taus, then theobr."""
 
-def theobr_work(n_phase: int, ms: list[int]) -> tuple[float, float]:
-    """(direct steps, fast units) of ThêoBR's bias ratio plus Theo1 at ms, per channel:
-    (N − m)·m/2 per Theo1 below the kernel's direct threshold, N·log2(m)² above."""
+def theobr_seconds(n_phase: int, ms: list[int]) -> float:
+    """Rough seconds ThêoBR's bias ratio plus Theo1 at ms take on one channel, from the
+    kernel's work model and rates measured on the development machine."""
 
 def estimator_terms(
     statistic: str, n_phase: int, ms: npt.NDArray[np.uint64]

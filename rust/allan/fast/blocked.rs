@@ -12,7 +12,7 @@
 
 use rayon::prelude::*;
 
-use super::sum::{sum_of_squared_combinations, Neumaier};
+use crate::allan::sum::{column_totals, sum_of_squared_combinations, Neumaier};
 
 /// Samples per block: three windows of every short tau stay in L1/L2.
 const BLOCK: usize = 2048;
@@ -43,6 +43,12 @@ pub fn sums_of_squares(c: &[f64], ms: &[usize], difference: Difference) -> Vec<f
         .iter()
         .map(|&m| c.len().saturating_sub(span * m))
         .collect();
+    let sweep = Sweep {
+        c,
+        ms,
+        terms: &terms,
+        difference,
+    };
     let longest = terms.iter().copied().max().unwrap_or(0);
     let task_len = BLOCK * BLOCKS_PER_TASK;
     let tasks = longest.div_ceil(task_len);
@@ -50,93 +56,77 @@ pub fn sums_of_squares(c: &[f64], ms: &[usize], difference: Difference) -> Vec<f
         .into_par_iter()
         .map(|task| {
             let start = task * task_len;
-            let end = (start + task_len).min(longest);
-            task_sums(c, ms, &terms, start, end, difference)
+            sweep.task_sums(start, (start + task_len).min(longest))
         })
         .collect();
-    let mut totals = vec![Neumaier::new(); ms.len()];
-    for partial in &partials {
-        for (total, value) in totals.iter_mut().zip(partial) {
-            total.add(*value);
-        }
-    }
-    totals.iter().map(Neumaier::value).collect()
+    column_totals(&partials, ms.len())
 }
 
-/// One task's sums, compiled for AVX2 where the CPU has it: the sweep is bound by
-/// arithmetic once blocked, and AVX2 doubles the lanes of the portable SSE2 build.
-fn task_sums(
-    c: &[f64],
-    ms: &[usize],
-    terms: &[usize],
-    start: usize,
-    end: usize,
+/// One sweep: the phase, its averaging factors and their term counts.
+struct Sweep<'a> {
+    c: &'a [f64],
+    ms: &'a [usize],
+    terms: &'a [usize],
     difference: Difference,
-) -> Vec<f64> {
-    #[cfg(target_arch = "x86_64")]
-    {
-        if std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: the CPU supports AVX2 (checked just above).
-            return unsafe { task_sums_avx2(c, ms, terms, start, end, difference) };
-        }
-    }
-    task_sums_portable(c, ms, terms, start, end, difference)
 }
 
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-unsafe fn task_sums_avx2(
-    c: &[f64],
-    ms: &[usize],
-    terms: &[usize],
-    start: usize,
-    end: usize,
-    difference: Difference,
-) -> Vec<f64> {
-    task_sums_portable(c, ms, terms, start, end, difference)
-}
-
-#[inline(always)]
-fn task_sums_portable(
-    c: &[f64],
-    ms: &[usize],
-    terms: &[usize],
-    start: usize,
-    end: usize,
-    difference: Difference,
-) -> Vec<f64> {
-    let mut acc = vec![Neumaier::new(); ms.len()];
-    let mut k0 = start;
-    while k0 < end {
-        let k1 = (k0 + BLOCK).min(end);
-        for (j, &m) in ms.iter().enumerate() {
-            let stop = k1.min(terms[j]);
-            if stop <= k0 {
-                continue;
+impl Sweep<'_> {
+    /// The sums over start indices start..end, compiled for AVX2 where the CPU has
+    /// it: the sweep is bound by arithmetic once blocked, and AVX2 doubles the
+    /// lanes of the portable SSE2 build.
+    fn task_sums(&self, start: usize, end: usize) -> Vec<f64> {
+        #[cfg(target_arch = "x86_64")]
+        {
+            if std::arch::is_x86_feature_detected!("avx2") {
+                // SAFETY: the CPU supports AVX2 (checked just above).
+                return unsafe { self.task_sums_avx2(start, end) };
             }
-            let len = stop - k0;
-            let window = |lag: usize| &c[k0 + lag..k0 + lag + len];
-            let s = match difference {
-                Difference::Second => sum_of_squared_combinations(
-                    [window(2 * m), window(m), window(0)],
-                    [1.0, -2.0, 1.0],
-                ),
-                Difference::Third => sum_of_squared_combinations(
-                    [window(3 * m), window(2 * m), window(m), window(0)],
-                    [1.0, -3.0, 3.0, -1.0],
-                ),
-            };
-            acc[j].add(s);
         }
-        k0 = k1;
+        self.task_sums_portable(start, end)
     }
-    acc.iter().map(Neumaier::value).collect()
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    unsafe fn task_sums_avx2(&self, start: usize, end: usize) -> Vec<f64> {
+        self.task_sums_portable(start, end)
+    }
+
+    #[inline(always)]
+    fn task_sums_portable(&self, start: usize, end: usize) -> Vec<f64> {
+        let c = self.c;
+        let mut acc = vec![Neumaier::new(); self.ms.len()];
+        let mut k0 = start;
+        while k0 < end {
+            let k1 = (k0 + BLOCK).min(end);
+            for (j, &m) in self.ms.iter().enumerate() {
+                let stop = k1.min(self.terms[j]);
+                if stop <= k0 {
+                    continue;
+                }
+                let len = stop - k0;
+                let window = |lag: usize| &c[k0 + lag..k0 + lag + len];
+                let s = match self.difference {
+                    Difference::Second => sum_of_squared_combinations(
+                        [window(2 * m), window(m), window(0)],
+                        [1.0, -2.0, 1.0],
+                    ),
+                    Difference::Third => sum_of_squared_combinations(
+                        [window(3 * m), window(2 * m), window(m), window(0)],
+                        [1.0, -3.0, 3.0, -1.0],
+                    ),
+                };
+                acc[j].add(s);
+            }
+            k0 = k1;
+        }
+        acc.iter().map(Neumaier::value).collect()
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::allan::variance::Statistic;
+    use crate::allan::Statistic;
 
     #[test]
     fn blocked_sums_match_one_tau_at_a_time() {

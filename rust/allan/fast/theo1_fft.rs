@@ -2,8 +2,8 @@
 //!
 //!   S = Σ_{i<N−m} Σ_{k=1}^{m/2} (1/k)·(c_i + c_{i+m} − c_{i+k} − c_{i+m−k})²
 //!
-//! over the N phase points c (`total.rs` has the definition and the direct
-//! form). With G(i) = c_i + c_{i+m} the square expands into
+//! over the N phase points c (`estimators/theo1.rs` has the definition, the
+//! direct form and the threshold between the two). With G(i) = c_i + c_{i+m} the square expands into
 //!
 //!   H·ΣG² + Σ w_k c_{i+k}² + Σ w_k c_{i+m−k}² − 2Σ G(i)·A(i) − 2Σ G(i)·B(i)
 //!   + 2 Σ_k w_k Σ_i c_{i+k}·c_{i+m−k},
@@ -21,12 +21,9 @@
 
 use rayon::prelude::*;
 
-use super::phase::least_squares_line;
 use super::sliding::sliding_dot;
-use super::sum::Neumaier;
-
-/// Averaging factors below this use the direct sum, which is cheaper there.
-pub const DIRECT_BELOW: usize = 256;
+use crate::allan::phase::least_squares_line;
+use crate::allan::sum::Neumaier;
 
 /// Start points per block, in units of m.
 const BLOCK_IN_M: usize = 4;
@@ -61,11 +58,28 @@ impl StrideTwo<'_> {
         }
         let start = self.y0 + s0 - 2 * k1;
         let r = sliding_dot(&self.f[start..start + (s1 - s0) + span - 1], &v);
-        let mut acc = Neumaier::new();
-        for (xs, rs) in self.x[s0..s1].iter().zip(&r) {
-            acc.add(xs * rs);
-        }
-        acc.value()
+        self.x[s0..s1]
+            .iter()
+            .zip(&r)
+            .map(|(xs, rs)| xs * rs)
+            .sum::<Neumaier>()
+            .value()
+    }
+
+    /// Σ_{a ≤ s < b} X(s)·Σ_{κ ∈ kappas(s)} w(κ)·Y(s − 2κ), term by term.
+    fn direct_triangle(
+        &self,
+        a: usize,
+        b: usize,
+        kappas: impl Fn(usize) -> std::ops::RangeInclusive<usize>,
+    ) -> f64 {
+        (a..b)
+            .map(|s| {
+                let inner: f64 = kappas(s).map(|k| self.w[k - 1] * self.y(s, k)).sum();
+                self.x[s] * inner
+            })
+            .sum::<Neumaier>()
+            .value()
     }
 
     /// Pairs a ≤ κ ≤ s < b.
@@ -74,12 +88,7 @@ impl StrideTwo<'_> {
             return 0.0;
         }
         if b - a <= TRIANGLE_DIRECT {
-            let mut acc = Neumaier::new();
-            for s in a..b {
-                let inner: f64 = (a..=s).map(|k| self.w[k - 1] * self.y(s, k)).sum();
-                acc.add(self.x[s] * inner);
-            }
-            return acc.value();
+            return self.direct_triangle(a, b, |s| a..=s);
         }
         let mid = a + (b - a) / 2;
         self.lower(a, mid) + self.lower(mid, b) + self.rectangle(mid, b, a, mid - 1)
@@ -91,12 +100,7 @@ impl StrideTwo<'_> {
             return 0.0;
         }
         if b - a <= TRIANGLE_DIRECT {
-            let mut acc = Neumaier::new();
-            for s in a..b {
-                let inner: f64 = (s + 1..=b).map(|k| self.w[k - 1] * self.y(s, k)).sum();
-                acc.add(self.x[s] * inner);
-            }
-            return acc.value();
+            return self.direct_triangle(a, b, |s| s + 1..=b);
         }
         let mid = a + (b - a) / 2;
         self.upper(a, mid) + self.upper(mid, b) + self.rectangle(a, mid, mid + 1, b)
@@ -199,11 +203,7 @@ pub fn theo1_sum(c: &[f64], m: usize) -> f64 {
             block_sum(&f, b, m, &w, &harmonic)
         })
         .collect();
-    let mut total = Neumaier::new();
-    for v in parts {
-        total.add(v);
-    }
-    total.value()
+    parts.into_iter().sum::<Neumaier>().value()
 }
 
 /// c minus its least-squares line (about the middle of the span).
@@ -220,7 +220,7 @@ fn local_phase(c: &[f64]) -> Vec<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::allan::test_signals::{integrate, noise};
+    use crate::allan::test_signals::{integrate, kernel_case, noise, offset_pair};
 
     fn direct(c: &[f64], m: usize) -> f64 {
         let h = m / 2;
@@ -243,8 +243,7 @@ mod tests {
         let walk = integrate(&white);
         let walk2 = integrate(&walk);
         for c in [&white, &walk, &walk2] {
-            let shifted: Vec<f64> = c.iter().map(|v| v + 1e6).collect();
-            let c: Vec<f64> = shifted.iter().map(|v| v - 1e6).collect();
+            let (shifted, c) = offset_pair(c, 1e6);
             for m in [2, 4, 10, 64, 98, 200, 400, 600, 800, 1000, 1198] {
                 let (fast, slow) = (theo1_sum(&shifted, m), direct(&c, m));
                 assert!(
@@ -260,20 +259,11 @@ mod tests {
         #![proptest_config(proptest::prelude::ProptestConfig { cases: 200, ..Default::default() })]
         #[test]
         fn any_length_and_factor_matches_the_definition(
-            n in 3usize..700,
-            m_pick in 0.0f64..1.0,
-            seed in 0u64..1000,
-            order in 0usize..3,
-            offset in -1e4f64..1e4,
+            (m_pick, shifted, c) in kernel_case(700)
         ) {
             // Even m from 2 to n − 1.
+            let n = c.len();
             let m = 2 * (1 + (m_pick * ((n - 1) / 2 - 1) as f64) as usize);
-            let mut c = noise(n, seed);
-            for _ in 0..order {
-                c = integrate(&c);
-            }
-            let shifted: Vec<f64> = c.iter().map(|x| x + offset).collect();
-            let c: Vec<f64> = shifted.iter().map(|x| x - offset).collect();
             let (fast, slow) = (theo1_sum(&shifted, m), direct(&c, m));
             proptest::prop_assert!((fast - slow).abs() <= 1e-10 * slow + 1e-300, "n {} m {}: {} vs {}", n, m, fast, slow);
         }

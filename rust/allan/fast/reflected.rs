@@ -6,7 +6,8 @@
 //! are detrended (the slope between the means of the first and last halves is
 //! removed), extended by uninverted even reflection to 9m values x*, and
 //! D_j = S(j) − 2S(j+m) + S(j+2m) with S(a) = Σ x*[a..a+m). MTOT takes v = phase,
-//! HTOT v = rate (`total.rs` has the definitions and the direct O(n·m) form).
+//! HTOT v = rate (`estimators/mtot_htot.rs` has the definitions, the direct
+//! O(n·m) form and the threshold between the two).
 //!
 //! How. With P the prefix sum of v, every D_j(i) is a fixed combination of a few
 //! P values. Split j = k·m + j' (k < 6, j' < m): inside one of those six classes
@@ -26,16 +27,13 @@
 //! larger than D². Every D is unchanged when a linear function is added to v
 //! (a quadratic to P), so each block of subsequences builds P from v minus a
 //! local reference line; the block spans only a few times l values, which keeps
-//! the terms within a small factor of their sum. Averaging factors below
-//! `DIRECT_BELOW` go the direct way, where blocks would be too short for that.
+//! the terms within a small factor of their sum. Short averaging factors go the
+//! direct way (`mtot_htot::REFLECTED_FROM`), where blocks would be too short for that.
 
 use rayon::prelude::*;
 
-use super::phase::least_squares_line;
-use super::sum::{blocked_sum, Neumaier};
-
-/// Averaging factors below this use the direct O(n·m) sum (also cheaper there).
-pub const DIRECT_BELOW: usize = 16;
+use crate::allan::phase::least_squares_line;
+use crate::allan::sum::{blocked_sum, Neumaier};
 
 /// Subsequences per block, in units of m: the block's values span (this + 3)·m,
 /// so the expansion's terms stay within ~ (span / m)^5 of the result even for
@@ -285,44 +283,25 @@ where
                 .par_iter()
                 .map(|class| class_sum(&p, &starts, b, m, class, &power_sums))
                 .collect();
-            let mut sum = Neumaier::new();
-            for v in per_class {
-                sum.add(v);
-            }
-            sum.value()
+            per_class.into_iter().sum::<Neumaier>().value()
         })
         .collect();
-    let mut total = Neumaier::new();
-    for v in parts {
-        total.add(v);
-    }
-    total.value()
+    parts.into_iter().sum::<Neumaier>().value()
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::allan::test_signals::{integrate, noise};
+    use crate::allan::test_signals::{
+        detrended_reflection, integrate, kernel_case, noise, offset_pair,
+    };
 
     /// The definition, transcribed: detrend, reflect, sum D².
     fn direct(v: &[f64], m: usize) -> f64 {
         let l = 3 * m;
-        let half = l / 2;
-        let gap = l.div_ceil(2) as f64;
         let mut total = 0.0;
         for i in 0..=v.len() - l {
-            let xs = &v[i..i + l];
-            let m1: f64 = xs[..half].iter().sum::<f64>() / half as f64;
-            let m2: f64 = xs[l - half..].iter().sum::<f64>() / half as f64;
-            let slope = (m2 - m1) / gap;
-            let z: Vec<f64> = xs
-                .iter()
-                .enumerate()
-                .map(|(k, x)| x - slope * k as f64)
-                .collect();
-            let mut star: Vec<f64> = z.iter().rev().copied().collect();
-            star.extend(&z);
-            star.extend(z.iter().rev());
+            let star = detrended_reflection(&v[i..i + l]);
             for j in 0..6 * m {
                 let s = |a: usize| star[a..a + m].iter().sum::<f64>();
                 let d = s(j) - 2.0 * s(j + m) + s(j + 2 * m);
@@ -358,9 +337,7 @@ mod tests {
         let phase = integrate(&rate);
         let white = noise(1500, 4);
         for (v, offset) in [(&phase, 1e7), (&white, 9.81e3)] {
-            let shifted: Vec<f64> = v.iter().map(|x| x + offset).collect();
-            // The same values without the offset (exact, by Sterbenz).
-            let v: Vec<f64> = shifted.iter().map(|x| x - offset).collect();
+            let (shifted, v) = offset_pair(v, offset);
             for m in [16, 100, 250, 499] {
                 let fast = reflected_sum(|k| shifted[k], v.len(), m);
                 let slow = direct(&v, m);
@@ -376,19 +353,10 @@ mod tests {
         #![proptest_config(proptest::prelude::ProptestConfig { cases: 200, ..Default::default() })]
         #[test]
         fn any_length_and_factor_matches_the_definition(
-            n in 3usize..260,
-            m_pick in 0.0f64..1.0,
-            seed in 0u64..1000,
-            order in 0usize..3,
-            offset in -1e4f64..1e4,
+            (m_pick, shifted, v) in kernel_case(260)
         ) {
+            let n = v.len();
             let m = 1 + (m_pick * (n / 3 - 1) as f64) as usize;
-            let mut v = noise(n, seed);
-            for _ in 0..order {
-                v = integrate(&v);
-            }
-            let shifted: Vec<f64> = v.iter().map(|x| x + offset).collect();
-            let v: Vec<f64> = shifted.iter().map(|x| x - offset).collect();
             let (fast, slow) = (reflected_sum(|k| shifted[k], n, m), direct(&v, m));
             proptest::prop_assert!((fast - slow).abs() <= 1e-10 * slow + 1e-300, "n {} m {}: {} vs {}", n, m, fast, slow);
         }

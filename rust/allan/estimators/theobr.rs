@@ -12,21 +12,36 @@
 //!
 //! Cost. κ needs Theo1 at n + 1 ≈ N/30 averaging factors up to ≈ 0.13·N: with
 //! the direct sum that is Σ_i (N − m_i)·m_i/2 ≈ N³/900 steps; with the kernel's
-//! O(N log² m) expansion above m = 256 it is ≈ N²/30·log²(m), the dominant cost
-//! of ThêoBR for long records all the same. The ratios are independent, so they
+//! O(N log² m) expansion from m = `theo1::FFT_FROM` (256) on it is
+//! ≈ N²/30·log²(m), the dominant cost of ThêoBR for long records all the same. The ratios are independent, so they
 //! are computed in parallel (one task per i, each kernel parallel inside) and
 //! summed in order with compensation, so κ does not depend on the thread count.
+//! [`estimated_seconds`] turns that work into a time, for a warning before long runs.
 
 use rayon::prelude::*;
 
-use super::edf;
-use super::sum::Neumaier;
-use super::theo1;
-use super::total;
-use super::variance::Statistic;
+use super::difference::oavar;
+use super::theo1::{self, theo1_var, theo1_work};
+use crate::allan::sum::Neumaier;
 
 /// Fewest phase points for which the bias ratio is defined (n ≥ 0).
 pub const MIN_PHASE_POINTS: usize = 90;
+
+/// Fewest samples ThêoBR accepts: N = samples + 1 phase points.
+pub const MIN_SAMPLES: usize = MIN_PHASE_POINTS - 1;
+
+/// Smallest averaging factor of ThêoBR: SP 1065's range is 10 ≤ m ≤ N − 1.
+const MIN_FACTOR: usize = 10;
+
+/// Terms of ThêoBR: Theo1's, over SP 1065's range 10 ≤ m ≤ N − 1, where the bias
+/// ratio exists.
+pub fn terms(n_phase: usize, m: usize) -> usize {
+    if m >= MIN_FACTOR && ratio_count(n_phase).is_some() {
+        theo1::terms(n_phase, m)
+    } else {
+        0
+    }
+}
 
 /// n = ⌊0.1·N/3⌋ − 3 for N phase points (the ratio averages n + 1 terms), or
 /// `None` when N is too short (n < 0).
@@ -44,8 +59,8 @@ pub fn ratio_factors(i: usize) -> (usize, usize) {
 /// phase, where AVAR vanishes too; that 0/0 counts as no bias (ratio 1).
 fn ratio(c: &[f64], i: usize) -> f64 {
     let (ma, mt) = ratio_factors(i);
-    let avar = Statistic::Allan { overlapping: true }.estimate(c, ma).var;
-    let theo = total::theo1_var(c, mt);
+    let avar = oavar(c, ma);
+    let theo = theo1_var(c, mt);
     if theo == 0.0 {
         1.0
     } else {
@@ -70,13 +85,7 @@ pub fn bias_ratios(phases: &[&[f64]]) -> Option<Vec<f64>> {
     Some(
         ratios
             .chunks(terms)
-            .map(|chunk| {
-                let mut acc = Neumaier::new();
-                for &r in chunk {
-                    acc.add(r);
-                }
-                acc.value() / terms as f64
-            })
+            .map(|chunk| chunk.iter().sum::<Neumaier>().value() / terms as f64)
             .collect(),
     )
 }
@@ -84,43 +93,6 @@ pub fn bias_ratios(phases: &[&[f64]]) -> Option<Vec<f64>> {
 /// The bias ratio κ of one phase (see [`bias_ratios`]).
 pub fn bias_ratio(c: &[f64]) -> Option<f64> {
     bias_ratios(&[c]).map(|v| v[0])
-}
-
-/// Degrees of freedom of the bias ratio κ by noise type α = 2 … −2: 2/(relative
-/// variance of κ), measured here by simulation (300 records of 1000 samples and
-/// 80 of 4000 per noise type; the smaller of the two, rounded to two digits).
-/// κ rests on AVAR at τ up to 10 % of the record, so its scatter does not shrink
-/// as the record grows (white FM: κ's standard deviation is ≈ 11 % at every
-/// length, from 600 to 6000 samples).
-const RATIO_EDF: [f64; 5] = [1.0e4, 400.0, 150.0, 250.0, 340.0];
-
-/// EDF of ThêoBR at averaging factor m: Theo1's (SP 1065, with r = 0.75·m)
-/// combined with the bias ratio's, 1/ν = 1/ν_Theo1 + 1/ν_κ (relative variances of
-/// a product of independent estimates add). Howe's papers and Stable32 use
-/// Theo1's EDF alone, which ignores that every tau is multiplied by the same
-/// uncertain κ: for white FM its 68 % intervals then hold the true deviation for
-/// only 30–60 % of records at taus where Theo1's EDF is large. α is clamped into
-/// [−2, 2].
-pub fn theobr_edf(alpha: i32, m: usize, n_phase: usize) -> f64 {
-    let theo1 = edf::theo1_edf(alpha, m, n_phase);
-    let ratio = RATIO_EDF[(2 - alpha.clamp(-2, 2)) as usize];
-    (1.0 / (1.0 / theo1 + 1.0 / ratio)).max(1.0)
-}
-
-/// Work of one Theo1 evaluation at (N, m) in the kernel's two regimes:
-/// (direct steps, fast units). Below `theo1::DIRECT_BELOW` the direct sum costs
-/// (N − m)·m/2 multiply-adds; above, the expansion costs ∝ N·log²(m) (FFT
-/// sliding sums, recursive triangles), counted as N·log₂(m)² units. Callers turn
-/// both into seconds with measured rates.
-pub fn theo1_work(n_phase: usize, m: usize) -> (f64, f64) {
-    if m >= n_phase || m < 2 {
-        (0.0, 0.0)
-    } else if m < theo1::DIRECT_BELOW {
-        ((n_phase - m) as f64 * (m / 2) as f64, 0.0)
-    } else {
-        let l = (m as f64).log2();
-        (0.0, n_phase as f64 * l * l)
-    }
 }
 
 /// Work of the bias ratio of one phase of `n_phase` points plus Theo1 at `ms`,
@@ -135,6 +107,21 @@ pub fn theobr_work(n_phase: usize, ms: &[usize]) -> (f64, f64) {
         .chain(ms)
         .map(|&m| theo1_work(n_phase, m))
         .fold((0.0, 0.0), |(a, b), (c, d)| (a + c, b + d))
+}
+
+/// Theo1 kernel rates, measured on the release build on the development machine
+/// (2 shared cores; `benches/bench_theo.py` prints them next to real timings):
+/// direct multiply-adds per second below `theo1::FFT_FROM`, and N·log₂(m)² units
+/// per second of the expansion above. They only decide whether a warning says a
+/// run will be long, so a machine twice as fast or slow changes nothing else.
+const DIRECT_STEPS_PER_SECOND: f64 = 1.2e9;
+const FAST_UNITS_PER_SECOND: f64 = 1.1e9;
+
+/// Seconds ThêoBR at `ms` takes on one phase of `n_phase` points, from
+/// [`theobr_work`] and the measured kernel rates.
+pub fn estimated_seconds(n_phase: usize, ms: &[usize]) -> f64 {
+    let (direct, fast) = theobr_work(n_phase, ms);
+    direct / DIRECT_STEPS_PER_SECOND + fast / FAST_UNITS_PER_SECOND
 }
 
 #[cfg(test)]
@@ -162,6 +149,14 @@ mod tests {
             })
             .collect();
         cumulative_phase(y.into_iter()).unwrap()
+    }
+
+    #[test]
+    fn the_shortest_record_has_one_ratio() {
+        assert_eq!(ratio_count(MIN_SAMPLES + 1), Some(0));
+        assert_eq!(ratio_count(MIN_SAMPLES), None);
+        assert!(terms(MIN_SAMPLES + 1, 10) > 0);
+        assert_eq!(terms(MIN_SAMPLES, 10), 0);
     }
 
     #[test]
@@ -211,20 +206,6 @@ mod tests {
     }
 
     #[test]
-    fn theobr_edf_is_below_theo1_and_bounded_by_the_ratio() {
-        for alpha in [-3, -2, -1, 0, 1, 2, 3] {
-            for m in [10, 100, 1000] {
-                let br = theobr_edf(alpha, m, 10_001);
-                let t1 = edf::theo1_edf(alpha, m, 10_001);
-                let cap = RATIO_EDF[(2 - alpha.clamp(-2, 2)) as usize];
-                assert!(br < t1 && br < cap && br >= 1.0, "{alpha} {m}: {br}");
-            }
-        }
-        // White FM at a short tau: the ratio dominates.
-        assert!((theobr_edf(0, 10, 100_001) - 150.0).abs() < 1.0);
-    }
-
-    #[test]
     fn work_counts_the_theo1_regimes() {
         assert_eq!(theobr_work(50, &[]), (0.0, 0.0));
         // N = 90: one ratio, Theo1 at m = 12: (90 − 12)·6 direct steps.
@@ -240,5 +221,10 @@ mod tests {
         let (_, with_tau) = theobr_work(10_001, &[1024]);
         assert!((with_tau - fast - 10_001.0 * 100.0).abs() < 1e-6 * fast);
         assert_eq!(theo1_work(100, 100), (0.0, 0.0));
+        let seconds = estimated_seconds(10_001, &[1024]);
+        assert_eq!(
+            seconds,
+            direct / DIRECT_STEPS_PER_SECOND + with_tau / FAST_UNITS_PER_SECOND
+        );
     }
 }

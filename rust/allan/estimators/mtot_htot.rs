@@ -1,8 +1,8 @@
-//! The total family beyond TOTVAR: modified total (MTOT), Hadamard total (HTOT)
-//! and Theo1, over the cumulative phase `c` (n + 1 points, in units of one
-//! sample period; phase x = τ0·c, rate samples y_k = c_{k+1} − c_k).
+//! The modified total (MTOT) and Hadamard total (HTOT) variances over the
+//! cumulative phase `c` (n + 1 points, in units of one sample period; phase
+//! x = τ0·c, rate samples y_k = c_{k+1} − c_k).
 //!
-//! Definitions follow NIST SP 1065 (Riley 2008) eqs. 27, 29–30 and Howe's
+//! Definitions follow NIST SP 1065 (Riley 2008) eqs. 27 and 29 and Howe's
 //! papers as implemented by allantools and Stable32:
 //!
 //! - MTOT: for each of the N − 3m + 1 phase subsequences of 3m points, remove
@@ -12,28 +12,49 @@
 //! - HTOT: the same on the *rate* samples (n − 3m + 1 subsequences), with the
 //!   Hadamard normalisation (divisor 6); at m = 1 the overlapping Hadamard
 //!   variance is used, as Stable32 and allantools do.
-//! - Theo1 (m even): σ² = Σ_i Σ_{δ<m/2} [(x_i − x_{i−δ+m/2}) + (x_{i+m} − x_{i+δ+m/2})]²
-//!   / (m/2 − δ) / (0.75 (N − m) m²).
 //!
-//! Cost. Every subsequence is detrended and reflected on its own, so each tau
-//! costs O(n·m): 15m operations per subsequence for MTOT/HTOT, m/2 for Theo1.
-//! An O(n) formulation through global prefix sums of products (c_k·c_{k+l})
-//! exists on paper, but it expands the squares into products of the raw phase,
-//! which cancel catastrophically (for random-walk FM on 10⁶ points the terms are
-//! ~10¹² times larger than their sum), and the reflections make anti-diagonal
-//! sums (Σ_j c_{i+j}·c_{i+m−j}) that no one-dimensional prefix sum provides.
-//! Here every subsequence works on offset-removed local values instead, which
-//! keeps all digits; the subsequences of one tau are spread over threads.
+//! Cost. Every subsequence is detrended and reflected on its own, so the direct
+//! form costs O(n·m) per tau, 15m operations per subsequence; from
+//! [`REFLECTED_FROM`] on, `fast::reflected` expands the same sum in O(n). A
+//! formulation through global prefix sums of products (c_k·c_{k+l}) exists on
+//! paper, but it expands the squares into products of the raw phase, which cancel
+//! catastrophically (for random-walk FM on 10⁶ points the terms are ~10¹² times
+//! larger than their sum), and the reflections make anti-diagonal sums
+//! (Σ_j c_{i+j}·c_{i+m−j}) that no one-dimensional prefix sum provides. Here every
+//! subsequence works on offset-removed local values instead, which keeps all
+//! digits; the subsequences of one tau are spread over threads.
 
-use rayon::prelude::*;
+use super::difference::DifferenceVariance;
+use super::sum_over_subsequences;
+use crate::allan::fast::reflected::reflected_sum;
+use crate::allan::sum::Neumaier;
 
-use super::reflected::{reflected_sum, DIRECT_BELOW};
-use super::sum::Neumaier;
-use super::theo1;
+/// Averaging factors from here on use `fast::reflected`'s O(n) expansion; below
+/// it the direct sum is cheaper and the expansion's blocks would be too short to
+/// keep their digits.
+pub const REFLECTED_FROM: usize = 16;
 
-/// Subsequences per parallel work item: large enough to amortise the scratch
-/// buffer, small enough to balance two to sixteen threads.
-const CHUNK_WORK: usize = 1 << 18;
+/// Terms of MTOT, N − 3m + 1, within allantools' limit m ≤ N/3.
+pub fn mtot_terms(n_phase: usize, m: usize) -> usize {
+    if m >= 1 && 3 * m <= n_phase {
+        n_phase + 1 - 3 * m
+    } else {
+        0
+    }
+}
+
+/// Terms of HTOT, n − 3m + 1 rate subsequences within m ≤ n/3 (allantools'
+/// limit); at m = 1 those of the overlapping Hadamard variance.
+pub fn htot_terms(n_phase: usize, m: usize) -> usize {
+    let n = n_phase.saturating_sub(1);
+    if m == 0 || 3 * m > n {
+        0
+    } else if m == 1 {
+        DifferenceVariance::Hadamard { overlapping: true }.terms(n_phase, 1)
+    } else {
+        n + 1 - 3 * m
+    }
+}
 
 /// Σ over the 6m window positions j of D_j² for one subsequence whose prefix
 /// sums (of the detrended values z, local to the subsequence) are `zp`
@@ -77,34 +98,6 @@ fn reflected_second_differences(zp: &[f64], m: usize, p: &mut [f64]) -> f64 {
     lanes.iter().sum()
 }
 
-/// Sum over `count` subsequences of `inner(i, zp, p)`, in parallel chunks with
-/// per-chunk scratch buffers; chunk results are combined in order with
-/// compensation so the answer does not depend on the thread count.
-fn sum_over_subsequences<F>(count: usize, m: usize, per_item: usize, inner: F) -> f64
-where
-    F: Fn(usize, &mut [f64], &mut [f64]) -> f64 + Sync,
-{
-    let chunk = (CHUNK_WORK / per_item.max(1)).clamp(1, count.max(1));
-    let chunks = count.div_ceil(chunk);
-    let parts: Vec<f64> = (0..chunks)
-        .into_par_iter()
-        .map(|k| {
-            let mut zp = vec![0.0; 3 * m + 1];
-            let mut p = vec![0.0; 9 * m + 1];
-            let mut acc = Neumaier::new();
-            for i in k * chunk..((k + 1) * chunk).min(count) {
-                acc.add(inner(i, &mut zp, &mut p));
-            }
-            acc.value()
-        })
-        .collect();
-    let mut total = Neumaier::new();
-    for v in parts {
-        total.add(v);
-    }
-    total.value()
-}
-
 /// Modified total variance at averaging factor m (needs 3m ≤ N = c.len()).
 pub fn mtot_var(c: &[f64], m: usize) -> f64 {
     let n = c.len();
@@ -132,7 +125,7 @@ pub fn mtot_var(c: &[f64], m: usize) -> f64 {
         }
         reflected_second_differences(zp, m, p)
     };
-    let total = if m < DIRECT_BELOW {
+    let total = if m < REFLECTED_FROM {
         sum_over_subsequences(terms, m, 15 * m, inner)
     } else {
         reflected_sum(|k| c[k], n, m)
@@ -141,8 +134,14 @@ pub fn mtot_var(c: &[f64], m: usize) -> f64 {
     total / (12.0 * mf.powi(5) * terms as f64)
 }
 
-/// Hadamard total variance at averaging factor m ≥ 2 (needs 3m ≤ n = c.len() − 1).
+/// Hadamard total variance at averaging factor m (needs 3m ≤ n = c.len() − 1);
+/// at m = 1 the overlapping Hadamard variance, as Stable32 and allantools.
 pub fn htot_var(c: &[f64], m: usize) -> f64 {
+    if m == 1 {
+        return DifferenceVariance::Hadamard { overlapping: true }
+            .estimate(c, 1)
+            .var;
+    }
     let n = c.len() - 1;
     let l = 3 * m;
     let terms = n + 1 - l;
@@ -161,7 +160,7 @@ pub fn htot_var(c: &[f64], m: usize) -> f64 {
         }
         reflected_second_differences(zp, m, p)
     };
-    let total = if m < DIRECT_BELOW {
+    let total = if m < REFLECTED_FROM {
         sum_over_subsequences(terms, m, 15 * m, inner)
     } else {
         reflected_sum(|k| c[k + 1] - c[k], n, m)
@@ -170,48 +169,11 @@ pub fn htot_var(c: &[f64], m: usize) -> f64 {
     total / (36.0 * mf.powi(3) * terms as f64)
 }
 
-/// Theo1 variance at even averaging factor m (needs m < N = c.len()).
-pub fn theo1_var(c: &[f64], m: usize) -> f64 {
-    let n = c.len();
-    let h = m / 2;
-    let outer = n - m;
-    let weights: Vec<f64> = (1..=h).map(|k| 1.0 / k as f64).collect();
-    // With k = m/2 − δ: term = (c_i + c_{i+m} − c_{i+k} − c_{i+m−k})² / k.
-    let inner = |i: usize, _zp: &mut [f64], _p: &mut [f64]| {
-        let ends = c[i] + c[i + m];
-        let fwd = &c[i + 1..=i + h];
-        let mut lanes = [0.0f64; 4];
-        let mut k = 0;
-        while k + 4 <= h {
-            for (lane, acc) in lanes.iter_mut().enumerate() {
-                let q = k + lane;
-                let a = ends - fwd[q] - c[i + m - 1 - q];
-                *acc += weights[q] * a * a;
-            }
-            k += 4;
-        }
-        while k < h {
-            let a = ends - fwd[k] - c[i + m - 1 - k];
-            lanes[0] += weights[k] * a * a;
-            k += 1;
-        }
-        lanes.iter().sum::<f64>()
-    };
-    let total = if m < theo1::DIRECT_BELOW {
-        // Scratch buffers are unused here: ask for the smallest.
-        sum_over_subsequences(outer, 0, h.max(1), inner)
-    } else {
-        theo1::theo1_sum(c, m)
-    };
-    let mf = m as f64;
-    total / (0.75 * outer as f64 * mf * mf)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::allan::phase::cumulative_phase;
-    use crate::allan::test_signals::naive_theo1;
+    use crate::allan::test_signals::detrended_reflection;
 
     /// Direct transcription of the definitions (as allantools computes them),
     /// on phase values, without any of the tricks above.
@@ -220,20 +182,7 @@ mod tests {
         let l = 3 * m;
         let mut dev = 0.0;
         for i in 0..=n - l {
-            let xs = &x[i..i + l];
-            let h1 = l / 2;
-            let h2 = l.div_ceil(2);
-            let m1: f64 = xs[..h1].iter().sum::<f64>() / h1 as f64;
-            let m2: f64 = xs[h2..].iter().sum::<f64>() / h1 as f64;
-            let slope = (m2 - m1) / h2 as f64;
-            let z: Vec<f64> = xs
-                .iter()
-                .enumerate()
-                .map(|(k, v)| v - slope * k as f64)
-                .collect();
-            let mut star: Vec<f64> = z.iter().rev().copied().collect();
-            star.extend(&z);
-            star.extend(z.iter().rev());
+            let star = detrended_reflection(&x[i..i + l]);
             let mut s = 0.0;
             for j in 0..6 * m {
                 let w = |a: usize| star[a..a + m].iter().sum::<f64>();
@@ -272,15 +221,6 @@ mod tests {
             let expected = naive_mtot(&y, m) * 2.0 * (m * m) as f64 / 6.0;
             let got = htot_var(&c, m);
             assert!((got - expected).abs() <= 1e-12 * expected, "m {m}");
-        }
-    }
-
-    #[test]
-    fn theo1_matches_the_definition() {
-        let c = sample();
-        for m in [2, 4, 10, 100, 300] {
-            let (a, b) = (theo1_var(&c, m), naive_theo1(&c, m));
-            assert!((a - b).abs() <= 1e-12 * b, "m {m}: {a} vs {b}");
         }
     }
 
