@@ -21,11 +21,9 @@ from imunoise._schema import (
     column_names,
     sensor_label,
 )
+from imunoise.allan import KINDS  # the --kind choices: every public Allan-family statistic
 
 __all__ = ["bundled_log", "main"]
-
-KINDS = ("adev", "mdev", "hdev", "tdev", "totdev", "mtotdev", "ttotdev", "htotdev", "theo1",
-         "theobr", "theoh")
 
 
 class _Parser(argparse.ArgumentParser):
