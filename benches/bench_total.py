@@ -65,29 +65,36 @@ def main() -> None:
 
 
 def compare_with_allantools(n: int, fs: float) -> None:
-    y = np.random.default_rng(0).normal(size=n)
-    print(f"\n### {n} samples, octave taus\n")
-    print("| statistic | taus | imunoise (s) | allantools (s) | ratio | max rel. diff |")
-    print("|---|---|---|---|---|---|")
+    timings(n, fs, seed=0, with_peer=True)
+
+
+def alone_on_a_million(fs: float) -> None:
+    timings(1_000_000, fs, seed=1, with_peer=False)
+
+
+def timings(n: int, fs: float, *, seed: int, with_peer: bool) -> None:
+    """One Markdown table of every case at n samples, octave taus; with the
+    allantools time and the largest relative difference when ``with_peer``."""
+    y = np.random.default_rng(seed).normal(size=n)
+    alone = "" if with_peer else ", imunoise alone"
+    print(f"\n### {n} samples{alone}, octave taus\n")
+    if with_peer:
+        print("| statistic | taus | imunoise (s) | allantools (s) | ratio | max rel. diff |")
+        print("|---|---|---|---|---|---|")
+    else:
+        print("| statistic | taus | m | imunoise (s) |")
+        print("|---|---|---|---|")
     for name, ours_fn, peer_fn in CASES:
-        ours, r = timed(lambda f=ours_fn: f(y, fs), 3)
+        ours, r = timed(lambda f=ours_fn: f(y, fs), 3 if with_peer else 1)
+        if not with_peer:
+            print(f"| {name} | {len(r.taus)} | 1 … {int(r.m[-1])} | {ours:.2f} |")
+            continue
         peer, (_t, dev, _e, _n) = timed(lambda f=peer_fn: peer_call(f, y, fs), 1)
         diff = float(np.max(np.abs(r.dev / dev - 1.0)))
         print(
             f"| {name} | {len(r.taus)} | {ours:.4f} | {peer:.2f} | {peer / ours:.0f}x "
             f"| {diff:.1e} |"
         )
-
-
-def alone_on_a_million(fs: float) -> None:
-    n = 1_000_000
-    y = np.random.default_rng(1).normal(size=n)
-    print(f"\n### {n} samples, imunoise alone, octave taus\n")
-    print("| statistic | taus | m | imunoise (s) |")
-    print("|---|---|---|---|")
-    for name, ours_fn, _peer in CASES:
-        ours, r = timed(lambda f=ours_fn: f(y, fs), 1)
-        print(f"| {name} | {len(r.taus)} | 1 … {int(r.m[-1])} | {ours:.2f} |")
 
 
 if __name__ == "__main__":

@@ -491,11 +491,8 @@ def theobr(x: npt.ArrayLike, fs: float, *, taus: TauSpec = "octave",
     AllanResult
         ``kind == "theobr"``.
     """
-    data, one_d, missing = _gapped_samples(x, gaps, "theobr", False, stacklevel=3)
-    fs = _check_fs(fs)
-    confidence = _check_confidence(confidence)
+    data, one_d, missing, fs, confidence = _theo_input(x, fs, confidence, gaps, "theobr")
     n = data.shape[0]
-    _check_theo_length("theobr", n)
     m, user_given = _theo1_factors(taus, fs, n)
     m = _keep_theobr(m, n, fs, user_given, "theobr", lower=0.0)
     if m.size == 0:
@@ -541,22 +538,10 @@ def theoh(x: npt.ArrayLike, fs: float, *, taus: TauSpec = "octave",
     ones, as elsewhere). Needs at least 89 samples; cost: that of :func:`theobr`
     (the bias ratio), which a warning announces when it is long.
 
-    Parameters
-    ----------
-    x, fs, taus, confidence, gaps
-        As for :func:`adev`; cannot skip gaps (``gaps="longest"`` or ``"splice"``
-        for data with NaN).
-
-    Returns
-    -------
-    AllanResult
-        ``kind == "theoh"``.
+    Parameters and result as for :func:`theobr`, with ``kind == "theoh"``.
     """
-    data, one_d, missing = _gapped_samples(x, gaps, "theoh", False, stacklevel=3)
-    fs = _check_fs(fs)
-    confidence = _check_confidence(confidence)
+    data, one_d, missing, fs, confidence = _theo_input(x, fs, confidence, gaps, "theoh")
     n = data.shape[0]
-    _check_theo_length("theoh", n)
     # Validates taus and gives the AVAR candidates (rounded to whole samples).
     m_avar, user_given = averaging_factors(taus, fs, n)
     short = m_avar <= 0.1 * n
@@ -735,6 +720,16 @@ def chi2_interval(
         low = dev * np.sqrt(edf / _stats.chi2.ppf(1.0 - tail, edf))
         high = dev * np.sqrt(edf / _stats.chi2.ppf(tail, edf))
     return low, high
+
+
+def _theo_input(x, fs, confidence, gaps, kind: str):
+    """The checked samples, fs and confidence of a Thêo statistic (no gap skipping;
+    a record long enough for ThêoBR)."""
+    data, one_d, missing = _gapped_samples(x, gaps, kind, False, stacklevel=4)
+    fs = _check_fs(fs)
+    confidence = _check_confidence(confidence)
+    _check_theo_length(kind, data.shape[0])
+    return data, one_d, missing, fs, confidence
 
 
 def _check_theo_length(kind: str, n: int) -> None:
