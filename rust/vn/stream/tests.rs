@@ -334,6 +334,25 @@ fn sentences() -> impl Strategy<Value = Vec<u8>> {
     proptest::collection::vec(one, 1..40).prop_map(|v| v.concat())
 }
 
+/// A stream of ASCII and binary records (and a truncated one, a command reply)
+/// in the order `kinds` picks, with one bit flipped at `flip`.
+fn damaged_stream(kinds: &[u8], flip: u16) -> Vec<u8> {
+    let b2 = binary_b2();
+    let mut s = Vec::new();
+    for k in kinds {
+        match k {
+            0 => s.extend_from_slice(&B1),
+            1 => s.extend_from_slice(&b2),
+            2 | 3 => s.extend_from_slice(A1),
+            4 => s.extend_from_slice(&A1[..40]),
+            _ => s.extend_from_slice(b"$VNRRG,05,115200*5C\n"),
+        }
+    }
+    let at = flip as usize % s.len();
+    s[at] ^= 0x20;
+    s
+}
+
 proptest! {
     #![proptest_config(ProptestConfig { cases: 300, ..ProptestConfig::default() })]
 
@@ -404,19 +423,7 @@ proptest! {
         chunk in 1usize..400,
         flip in any::<u16>(),
     ) {
-        let b2 = binary_b2();
-        let mut s = Vec::new();
-        for k in kinds {
-            match k {
-                0 => s.extend_from_slice(&B1),
-                1 => s.extend_from_slice(&b2),
-                2 | 3 => s.extend_from_slice(A1),
-                4 => s.extend_from_slice(&A1[..40]),
-                _ => s.extend_from_slice(b"$VNRRG,05,115200*5C\n"),
-            }
-        }
-        let at = flip as usize % s.len();
-        s[at] ^= 0x20;
+        let s = damaged_stream(&kinds, flip);
         let want = format!("{:?}", reference(&s, false));
         for min in [0usize, 1 << 20] {
             let p = Parser::with_size_hint(false, s.len() as u64).with_parallel_min(min);
@@ -443,19 +450,7 @@ proptest! {
     ) {
         // Damaged streams too: counts, first locations and rows do not depend on
         // where the pieces end.
-        let b2 = binary_b2();
-        let mut s = Vec::new();
-        for k in kinds {
-            match k {
-                0 => s.extend_from_slice(&B1),
-                1 => s.extend_from_slice(&b2),
-                2 | 3 => s.extend_from_slice(A1),
-                4 => s.extend_from_slice(&A1[..40]),
-                _ => s.extend_from_slice(b"$VNRRG,05,115200*5C\n"),
-            }
-        }
-        let at = flip as usize % s.len();
-        s[at] ^= 0x20;
+        let s = damaged_stream(&kinds, flip);
         let whole = parse_bytes(&s, false).unwrap();
         let mut stream = Pieces::new(false);
         let mut rows: BTreeMap<String, Vec<f64>> = BTreeMap::new();
