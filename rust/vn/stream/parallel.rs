@@ -13,9 +13,6 @@ use crate::vn::binary::{self, HeaderScan};
 use crate::vn::stream::parser::{Failure, Parser, MAX_LAYOUTS};
 use crate::vn::{IssueKind, Location, Table, VnData, FIRST_KEEP};
 
-/// Below this a block is parsed on one thread.
-pub(super) const PARALLEL_MIN: usize = 1 << 20;
-
 /// Tables of several pieces by message name, to append in one parallel copy.
 #[derive(Default)]
 struct TableParts(Vec<(String, Vec<Table>)>);

@@ -12,9 +12,12 @@ use crate::error::{CoreError, CoreResult};
 use crate::vn::ascii::{self, Decoded};
 use crate::vn::binary::{self, HeaderScan, Layout};
 use crate::vn::messages::{spec_by_id, MsgSpec};
-use crate::vn::stream::parallel::PARALLEL_MIN;
 use crate::vn::stream::scan::{count_newlines, eat_eol, scan_ascii, Ascii, Outcome};
 use crate::vn::{IssueKind, Location, Table, VnData, FIRST_KEEP};
+
+/// Below this a block is parsed on one thread (the default of
+/// [`Parser::with_parallel_min`]; the parallel path is in `parallel.rs`).
+pub(super) const PARALLEL_MIN: usize = 1 << 20;
 
 /// Layouts remembered per reader (distinct binary configurations).
 pub(super) const MAX_LAYOUTS: usize = 16;
