@@ -88,3 +88,55 @@ def test_no_import_cycle_between_modules():
     for node in sorted(graph):
         if node not in state:
             visit(node)
+
+
+RUST = Path(__file__).resolve().parents[1] / "rust"
+
+
+def _rust_module(path: Path) -> str:
+    parts = list(path.relative_to(RUST).with_suffix("").parts)
+    if parts[-1] in ("mod", "lib"):
+        parts = parts[:-1]
+    return "::".join(["crate", *parts])
+
+
+def _rust_uses(path: Path, modules: set[str]) -> set[str]:
+    """Modules of the crate a file's non-test code names (`use` paths and
+    `crate::`/`super::` paths), resolved to the longest existing module."""
+    import re
+
+    own = _rust_module(path)
+    source = re.split(r"#\[cfg\(test\)\]", path.read_text())[0]
+    parent = own.split("::") if path.name in ("mod.rs", "lib.rs") else own.split("::")[:-1]
+    found = set()
+    for ref in re.findall(r"\b((?:crate|super|self)(?:::\w+)+)", source):
+        segments = ref.split("::")
+        if segments[0] == "crate":
+            resolved = segments
+        else:
+            base = parent[:]
+            while segments and segments[0] == "super":
+                base, segments = base[:-1], segments[1:]
+            if segments and segments[0] == "self":
+                segments = segments[1:]
+            resolved = base + segments
+        for k in range(len(resolved), 0, -1):
+            candidate = "::".join(resolved[:k])
+            if candidate in modules:
+                if candidate != own:
+                    found.add(candidate)
+                break
+    return found
+
+
+def test_no_use_cycle_between_rust_modules():
+    files = [p for p in RUST.rglob("*.rs") if p.name not in ("tests.rs", "test_signals.rs")]
+    modules = {_rust_module(p) for p in RUST.rglob("*.rs")}
+    uses = {_rust_module(p): _rust_uses(p, modules) for p in files}
+    related = [
+        (a, b)
+        for a, targets in uses.items()
+        for b in targets
+        if a in uses.get(b, ()) and not (a.startswith(b + "::") or b.startswith(a + "::"))
+    ]
+    assert not related, f"Rust modules that use each other: {sorted(set(related))}"
