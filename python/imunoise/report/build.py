@@ -13,8 +13,8 @@ from dataclasses import dataclass, field
 from functools import cached_property
 from pathlib import Path
 
+from imunoise import _schema, export, noise, plot, stats
 from imunoise import allan as _allan
-from imunoise import export, noise, plot, stats
 from imunoise._core import __version__
 from imunoise._progress import Progress
 from imunoise._schema import ALLAN_SENSORS, SAMPLE_SENSORS, sensor_label
@@ -26,7 +26,7 @@ from imunoise.report.inputs import read_log
 __all__ = ["SECTIONS", "TAUS_PER_DECADE", "TITLE", "Context", "Report", "Section", "build"]
 
 #: Tau grid of the Allan analysis: log-spaced points per decade.
-TAUS_PER_DECADE = 10
+TAUS_PER_DECADE = _schema.TAUS_PER_DECADE
 TITLE = "IMU noise report"
 
 

@@ -29,7 +29,7 @@ BATCH_SENSORS = _schema.ALLAN_SENSORS
 _TERM_ORDER = ("N", "B", "K", "Q", "R")
 _VERDICT_RANK = {"fail": 3, "marginal": 2, "pass": 1, "unresolved": 0}
 #: Averaging times of the batch analysis: log-spaced points per decade (as the report).
-BATCH_TAUS = 10
+BATCH_TAUS = _schema.TAUS_PER_DECADE
 
 
 def _expand(paths) -> list[str]:
