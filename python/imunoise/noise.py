@@ -854,8 +854,12 @@ def _readoffs(taus, dev, edf, shaped):
 
 
 def _record_length(result) -> int:
-    """Samples behind an Allan result, from its terms at the shortest tau. With
-    gaps, the gap-free length with as many terms (the most of any channel)."""
+    """Samples behind an Allan result: its ``n_samples`` when gap-free; with gaps,
+    the gap-free length with as many terms at the shortest tau (the most of any
+    channel), which is what a simulated replicate must match."""
+    n_samples = getattr(result, "n_samples", None)
+    if n_samples and not np.any(np.asarray(getattr(result, "missing", 0))):
+        return int(n_samples)
     try:
         m0, n0 = int(np.asarray(result.m)[0]), int(np.max(np.asarray(result.n)[0]))
         overlapping = bool(result.overlapping)
