@@ -41,6 +41,9 @@ COLUMN_SUFFIXES: Mapping[int, tuple[str, ...]] = MappingProxyType(
 ALLAN_SENSORS = ("gyro", "accel")
 #: Sensors whose sample statistics and histograms the report shows.
 SAMPLE_SENSORS = ("gyro", "accel", "mag")
+#: Names of the three columns of the ``ypr`` channel (the VN-100's attitude
+#: filter output, degrees).
+ATTITUDE_NAMES = ("yaw", "pitch", "roll")
 #: Log-spaced averaging times per decade of the report's and the batch analysis's
 #: Allan deviation (``adev(x, fs, taus=TAUS_PER_DECADE)``).
 TAUS_PER_DECADE = 10

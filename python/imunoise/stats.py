@@ -55,6 +55,7 @@ __all__ = [
     "describe",
     "distribution",
     "quantization_step",
+    "unwrap_about_circular_mean",
     "SENSOR_CHANNELS",
 ]
 
@@ -583,3 +584,16 @@ def _edges(x: np.ndarray, bins, step: float | None) -> np.ndarray:
     k = max(k, int(np.ceil(levels / MAX_BINS)))
     nb = int(np.ceil(levels / k))
     return lo + (np.arange(nb + 1) * k - 0.5) * step
+
+
+def unwrap_about_circular_mean(angle_deg: np.ndarray) -> np.ndarray:
+    """Angles (degrees) moved by whole turns into the half-turn around their
+    circular mean, the mean itself in (−180°, 180°]: a heading that jitters across
+    ±180° keeps its true spread instead of splitting into two clusters 360° apart."""
+    a = np.asarray(angle_deg, dtype=float)
+    ok = np.isfinite(a)
+    if not ok.any():
+        return a.copy()
+    r = np.radians(a[ok])
+    centre = float(np.degrees(np.arctan2(np.mean(np.sin(r)), np.mean(np.cos(r)))))
+    return centre + (a - centre + 180.0) % 360.0 - 180.0

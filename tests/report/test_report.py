@@ -215,4 +215,6 @@ def test_figures_listed(built):
 def test_sections_are_numbered_from_the_list(built):
     rep, _, _ = built
     headings = re.findall(r"^## (\d+)\. (.*)$", rep.markdown.read_text(), re.M)
-    assert headings == [(str(i), s.title) for i, s in enumerate(report.SECTIONS, start=1)]
+    # These logs carry no attitude: that section is absent and the numbers close up.
+    present = [s.title for s in report.SECTIONS if not s.title.startswith("Attitude")]
+    assert headings == [(str(i), t) for i, t in enumerate(present, start=1)]

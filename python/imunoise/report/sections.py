@@ -10,6 +10,8 @@ from __future__ import annotations
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+import numpy as np
+
 from imunoise import plot
 from imunoise._schema import CHANNELS, SAMPLE_SENSORS, axis_names
 from imunoise.report.formatting import (
@@ -29,6 +31,7 @@ __all__ = [
     "GAP_SHADE",
     "GAP_WARN_SHARE",
     "allan_deviation",
+    "attitude",
     "datasheet_comparison",
     "distribution_fits",
     "noise_coefficients",
@@ -137,6 +140,50 @@ def distribution_fits(ctx: Context, doc: Doc) -> None:
         rows,
         caption="Distribution fits (short log)",
     )
+
+
+def attitude(ctx: Context, doc: Doc) -> None:
+    """Yaw, pitch and roll of the short log: statistics, time series, histograms
+    with the normal fit, and why a filter's output need not be normal."""
+    angles = ctx.attitude
+    dists = ctx.attitude_distributions
+    doc.p("Yaw, pitch and roll are the output of the sensor's attitude filter, not "
+          "measurements: the filter blends the gyro, accelerometer and magnetometer, so its "
+          "output is smoothed, correlated from sample to sample and follows slow magnetic "
+          "disturbances (yaw most of all). Nothing makes it normal; the normal fit "
+          "describes its spread, and the goodness-of-fit figures say how far from normal it "
+          "is. Yaw is taken about its circular mean (whole turns removed), so a heading "
+          "near ±180° is not split into two clusters 360° apart; its mean is given in "
+          "(−180°, 180°].")
+    rows = []
+    for name, v in angles.items():
+        ok = v[np.isfinite(v)]
+        mean = float(ok.mean())
+        if name == "yaw":  # back into (−180°, 180°]
+            mean = (mean + 180.0) % 360.0 - 180.0
+            mean = 180.0 if mean == -180.0 else mean
+        d = dists[name]
+        rows.append([name, "deg", format_number(mean), format_number(float(ok.std(ddof=1))),
+                     format_number(float(ok.var(ddof=1))), format_number(float(ok.min())),
+                     format_number(float(ok.max())), *(format_number(x) for x in (
+                         d.ks_statistic, d.ks_pvalue, d.ad_statistic, d.skewness,
+                         d.excess_kurtosis))])
+    doc.table(
+        ["angle", "unit", "mean", "std", "variance", "min", "max", "KS D", "KS p", "AD A²",
+         "skewness", "excess kurtosis"],
+        rows,
+        caption="Attitude statistics and normality (short log; std and variance with ddof = 1)",
+    )
+    names = list(angles)
+    stacked = np.column_stack([angles[n] for n in names])
+    fig = plot.time_series(stacked, ctx.short.fs, title="attitude (short log)", unit="deg",
+                           names=names)
+    ctx.add_figure(doc, fig, "timeseries_attitude",
+                   "Yaw (about its circular mean), pitch and roll of the short log [deg]")
+    fig = plot.histograms([dists[n] for n in names], title="attitude distribution (short log)",
+                          unit="deg", names=names)
+    ctx.add_figure(doc, fig, "hist_attitude",
+                   "Histograms of yaw, pitch and roll with the fitted normal density")
 
 
 def allan_deviation(ctx: Context, doc: Doc) -> None:
