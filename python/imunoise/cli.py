@@ -67,13 +67,13 @@ def _build_parser() -> argparse.ArgumentParser:
     r.add_argument("long_log", metavar="LONG_LOG", nargs="?")
     r.add_argument("-o", "--output", default="imunoise-report", metavar="DIR",
                    help="output directory (default: %(default)s)")
-    _shared_options(r, spec=True, fs=True, progress=True)
+    _shared_options(r, spec=True, fs=True, progress=True, layout=True)
 
     a = sub.add_parser("adev", help="print an Allan-family deviation table",
                        description="Print tau, deviation, confidence interval and number of "
                        "terms per axis.")
     a.add_argument("log", metavar="LOG")
-    _shared_options(a, fs=True)
+    _shared_options(a, fs=True, layout=True)
     a.add_argument("--sensor", choices=SAMPLE_SENSORS, default="gyro")
     a.add_argument("--kind", choices=KINDS, default="adev")
     a.add_argument("--taus", default="octave",
@@ -83,7 +83,7 @@ def _build_parser() -> argparse.ArgumentParser:
                        description="Fit Q, N, B, K, R per axis to the Allan deviation and print "
                        "them in datasheet units with uncertainties.")
     f.add_argument("log", metavar="LOG")
-    _shared_options(f, fs=True)
+    _shared_options(f, fs=True, layout=True)
     f.add_argument("--sensor", choices=ALLAN_SENSORS, default=None,
                    help="one sensor (default: gyro and accel)")
     f.add_argument("--bootstrap", type=int, default=0, metavar="REPLICATES",
@@ -94,7 +94,7 @@ def _build_parser() -> argparse.ArgumentParser:
                        description="Per channel mean, std, variance, min, max, drift per hour; "
                        "per axis normal fit and normality statistics.")
     s.add_argument("log", metavar="LOG")
-    _shared_options(s, fs=True)
+    _shared_options(s, fs=True, layout=True)
 
     c = sub.add_parser("convert", help="convert a log to .npy, Parquet, CSV or NPZ",
                        description="Write the log's channels to OUTPUT; the format follows the "
@@ -143,8 +143,24 @@ def _build_parser() -> argparse.ArgumentParser:
     return p
 
 
-def _shared_options(p, *, spec: bool = False, fs: bool = False, progress: bool = False) -> None:
+def _shared_options(p, *, spec: bool = False, fs: bool = False, progress: bool = False,
+                    layout: bool = False) -> None:
     """Add the options several commands share, each worded once."""
+    if layout:
+        g = p.add_argument_group(
+            "text logs whose header does not say what each column is",
+            "e.g. --columns gyro=6,7,8 --columns accel=3,4,5 --units gyro=deg/s; "
+            "columns are 0-based indices or header names")
+        g.add_argument("--columns", action="append", type=_channel_assignment, default=[],
+                       metavar="CHANNEL=COLS",
+                       help="the columns of one channel (gyro, accel, mag, ypr, quaternion, "
+                       "temperature, pressure, time); repeat per channel")
+        g.add_argument("--units", action="append", type=_channel_assignment, default=[],
+                       metavar="CHANNEL=UNIT", help="unit of a channel's values in the file, "
+                       "e.g. gyro=deg/s, accel=g, time=ns; repeat per channel")
+        g.add_argument("--delimiter", default=None, metavar="TEXT",
+                       help="field separator (default: comma, tab, semicolon or whitespace, "
+                       "from the first line)")
     if spec:
         p.add_argument("--spec", default="vn100",
                        help="datasheet to compare with: a name or a TOML file (default: "
@@ -160,6 +176,37 @@ def _shared_options(p, *, spec: bool = False, fs: bool = False, progress: bool =
                    help="always show progress bars on stderr")
     g.add_argument("--no-progress", dest="progress", action="store_false",
                    help="never show progress bars")
+
+
+def _channel_assignment(text: str) -> tuple[str, str]:
+    """``CHANNEL=VALUE`` of --columns/--units, the channel checked."""
+    channel, sep, value = text.partition("=")
+    channel, value = channel.strip(), value.strip()
+    known = (*CHANNELS, "time", "raw")
+    if not sep or not value:
+        raise argparse.ArgumentTypeError(f"expected CHANNEL=VALUE; got {text!r}")
+    if channel not in known:
+        raise argparse.ArgumentTypeError(
+            f"channel must be one of {', '.join(known)}; got {channel!r}")
+    return channel, value
+
+
+def _read_options(args) -> dict:
+    """The reader's layout options from --columns/--units/--delimiter (empty when
+    none is given, so the format is detected as usual)."""
+    options: dict = {}
+    columns = {ch: [int(c) if c.strip().lstrip("-").isdigit() else c.strip()
+                    for c in value.split(",")]
+               for ch, value in getattr(args, "columns", [])}
+    if columns:
+        options["columns"] = {ch: cols[0] if len(cols) == 1 else cols
+                              for ch, cols in columns.items()}
+    units = dict(getattr(args, "units", []))
+    if units:
+        options["units"] = units
+    if getattr(args, "delimiter", None) is not None:
+        options["delimiter"] = args.delimiter
+    return options
 
 
 def _positive_float(text: str) -> float:
@@ -178,7 +225,7 @@ def _positive_float(text: str) -> float:
 def _read(args):
     from imunoise.report import read_log
 
-    log = read_log(args.log, "input", fs=args.fs)
+    log = read_log(args.log, "input", fs=args.fs, **_read_options(args))
     _note_gaps(log.source, log)
     return log
 
@@ -200,7 +247,7 @@ def _cmd_report(args) -> int:
 
     spec = None if args.spec.lower() == "none" else args.spec
     rep = report.build(args.short_log, args.long_log, args.output, spec=spec, fs=args.fs,
-                       progress=args.progress)
+                       progress=args.progress, read_options=_read_options(args))
     for log in rep.logs:
         _note_gaps(log.source, log)
     print(f"report written to {rep.html}")

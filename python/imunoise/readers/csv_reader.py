@@ -395,11 +395,7 @@ class _Reader:
         raw_col = self._raw_column(names, sample_fields, explicit, auto)
         numeric = self._numeric_columns(names, raw_col, explicit, auto)
         if not numeric and raw_col is None:
-            raise ValueError(
-                f"{self.name}: no IMU columns recognised in "
-                f"{names if names is not None else f'{self.ncols} unnamed columns'}; "
-                "pass columns={'gyro': [...], ...}"
-            )
+            raise ValueError(_no_columns_message(self.name, names, sample_fields))
         self.numeric = numeric
         self.raw_col = raw_col
         self.names = names
@@ -650,3 +646,24 @@ class _Reader:
             messages=messages,
             values_may_be_nan=True,
         )
+
+
+def _no_columns_message(name: str, names: list[str] | None, first: list[str]) -> str:
+    """Why no channel was found, with the first data row numbered and a ``columns=``
+    example built from it (3-axis channels on consecutive numeric columns)."""
+    what = names if names is not None else f"{len(first)} unnamed columns"
+    shown = "  ".join(f"[{i}] {f.strip()}" for i, f in enumerate(first[:16]))
+    more = f"  … ({len(first)} fields)" if len(first) > 16 else ""
+    numeric = [i for i, f in enumerate(first) if _is_number(f)]
+    example = ""
+    if len(numeric) >= 3:
+        picks = {ch: numeric[3 * k: 3 * k + 3]
+                 for k, ch in enumerate(("gyro", "accel")) if len(numeric) >= 3 * k + 3}
+        python = ", ".join(f"{ch!r}: {idx}" for ch, idx in picks.items())
+        cli = " ".join(f"--columns {ch}={','.join(map(str, idx))}" for ch, idx in picks.items())
+        example = (f"; say which column holds what (0-based), e.g. columns={{{python}}}, "
+                   f"units={{'gyro': 'deg/s'}} (imunoise CLI: {cli} --units gyro=deg/s)")
+    else:
+        example = "; pass columns={'gyro': [...], ...}"
+    return (f"{name}: no IMU columns recognised in {what}; first data row: {shown}{more}"
+            f"{example}")

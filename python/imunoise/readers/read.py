@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import os
-from collections.abc import Callable
+from collections.abc import Callable, Mapping, Sequence
 
 from imunoise._deprecation import old_call_forms
 from imunoise.readers import registry
@@ -56,6 +56,10 @@ def read(
     strict: bool = False,
     fs: float | None = None,
     progress: Callable[[int, int], object] | None = None,
+    columns: Mapping[str, Sequence[int | str] | int | str] | None = None,
+    units: Mapping[str, str] | None = None,
+    delimiter: str | None = None,
+    time_column: int | str | None = None,
 ) -> ImuLog:
     """Read an IMU log into an :class:`~imunoise.readers.log.ImuLog`.
 
@@ -76,6 +80,13 @@ def read(
         Sample rate in Hz, used when the log has no timestamps.
     progress : callable, optional
         ``progress(bytes_done, bytes_total)`` for a progress bar.
+    columns, units, delimiter, time_column : optional
+        The layout of a delimited text log, for files whose header does not say
+        it (or that have none): channel -> 0-based column indices or header names,
+        e.g. ``columns={"gyro": [6, 7, 8], "accel": [3, 4, 5]}``,
+        ``units={"gyro": "deg/s"}``. See :func:`~imunoise.readers.csv_reader.read_csv`.
+        Given with ``format="auto"`` they select the CSV reader; with another
+        format they are an error.
 
     Returns
     -------
@@ -96,6 +107,17 @@ def read(
         raise ValueError(f"format must be one of {choices}; got {format!r}")
     if not isinstance(source, (bytes, bytearray, memoryview, str, os.PathLike)):
         raise TypeError(f"source must be a path or bytes; got {type(source).__name__}")
+    layout = {k: v for k, v in (("columns", columns), ("units", units),
+                                 ("delimiter", delimiter), ("time_column", time_column))
+              if v is not None}
+    if layout:
+        if format not in ("auto", "csv"):
+            raise ValueError(
+                f"{', '.join(layout)} describe a delimited text log; format must be 'auto' "
+                f"or 'csv' with them; got {format!r}"
+            )
+        return registry.get("csv").read(source, strict=strict, fs=fs, progress=progress,
+                                        **layout)
     if format == "auto":
         format = detect_format(source)
     return registry.get(format).read(source, strict=strict, fs=fs, progress=progress)

@@ -8,7 +8,7 @@ Adding a section is one function in :mod:`.sections` and one entry in
 from __future__ import annotations
 
 import datetime as _dt
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from functools import cached_property
 from pathlib import Path
@@ -185,6 +185,7 @@ def build(
     spec: str | None = "vn100",
     fs: float | None = None,
     progress: bool | None = None,
+    read_options: Mapping[str, object] | None = None,
 ) -> Report:
     """Analyse the logs and write the report directory.
 
@@ -203,12 +204,17 @@ def build(
         Sample rate in Hz for logs without timestamps (VN ASCII); passed to the reader.
     progress : bool or None
         Progress bars on stderr; None shows them when stderr is a terminal.
+    read_options : mapping, optional
+        Layout of text logs whose header does not say it, passed to
+        :func:`imunoise.read`: ``{"columns": {"gyro": [6, 7, 8]}, "units": {"gyro":
+        "deg/s"}}`` (also ``delimiter``, ``time_column``).
     """
     out = Path(out_dir)
     with Progress(progress, total=len(SECTIONS) + 1) as bar:
-        short_log = read_log(short, "short", fs=fs, progress=bar.shown)
+        options = dict(read_options or {})
+        short_log = read_log(short, "short", fs=fs, progress=bar.shown, **options)
         long_log = short_log if long is None else read_log(long, "long", fs=fs,
-                                                           progress=bar.shown)
+                                                           progress=bar.shown, **options)
         (out / "figures").mkdir(parents=True, exist_ok=True)
         ctx = Context(short=short_log, long=long_log, one_log=long is None, spec=spec,
                       out_dir=out)

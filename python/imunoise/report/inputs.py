@@ -13,7 +13,7 @@ __all__ = ["read_log"]
 
 
 def read_log(source, label: str = "input", *, fs: float | None = None,
-             progress: bool | None = False) -> ImuLog:
+             progress: bool | None = False, **read_options) -> ImuLog:
     """Read a log with :func:`imunoise.read`, naming it by its role in errors.
 
     Parameters
@@ -29,6 +29,9 @@ def read_log(source, label: str = "input", *, fs: float | None = None,
     progress : bool or None
         A byte progress bar on stderr while reading (None: when stderr is a
         terminal).
+    **read_options
+        Passed to :func:`imunoise.read`: ``columns``, ``units``, ``delimiter``,
+        ``time_column`` for text logs whose header does not say their layout.
 
     Raises
     ------
@@ -46,7 +49,7 @@ def read_log(source, label: str = "input", *, fs: float | None = None,
     callback = byte_bar(f"reading {path.name}") if wanted(progress) else None
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        log = read(path, fs=fs, progress=callback)
+        log = read(path, fs=fs, progress=callback, **read_options)
     if len(log) == 0:
         raise ValueError(f"{label} log {str(path)!r}: no usable records ({log.issues})")
     for w in caught:
