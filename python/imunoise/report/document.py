@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import base64
 import html as _html
+import re
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -58,7 +59,8 @@ class Doc:
         body = []
         for b in self.blocks:
             if b[0] == "h":
-                body.append(f"<h{b[1]}>{e(b[2])}</h{b[1]}>")
+                anchor = f' id="{_slug(b[2])}"' if b[1] == 2 else ""
+                body.append(f"<h{b[1]}{anchor}>{e(b[2])}</h{b[1]}>")
             elif b[0] == "p":
                 body.append(f"<p>{_inline(b[1])}</p>")
             elif b[0] == "table":
@@ -68,8 +70,11 @@ class Doc:
                 trs = "".join(
                     "<tr>" + "".join(f"<td>{e(c)}</td>" for c in r) + "</tr>" for r in rows
                 )
+                # A short table is kept on one printed page; a long one flows
+                # across pages with its header repeated.
+                keep = " keep" if len(rows) <= _KEEP_TOGETHER_ROWS else ""
                 body.append(
-                    f'<div class="tw"><table>{cap}<thead><tr>{th}</tr></thead>'
+                    f'<div class="tw{keep}"><table>{cap}<thead><tr>{th}</tr></thead>'
                     f"<tbody>{trs}</tbody></table></div>"
                 )
             elif b[0] == "figure":
@@ -79,6 +84,17 @@ class Doc:
                     f"<figcaption>{e(b[2])}</figcaption></figure>"
                 )
         return _HTML.format(title=e(title), css=_CSS, body="\n".join(body))
+
+
+#: Tables with at most this many rows are not split across printed pages.
+_KEEP_TOGETHER_ROWS = 20
+
+
+def _slug(heading: str) -> str:
+    """``"4. Attitude (yaw, pitch, roll)"`` -> ``"attitude-yaw-pitch-roll"``: a
+    section's anchor, so report.html#allan-deviation links to it."""
+    words = re.findall(r"[a-z]+", heading.lower())
+    return "-".join(words) or "section"
 
 
 def _inline(text: str) -> str:
@@ -110,6 +126,16 @@ img{max-width:100%;height:auto;border:1px solid var(--bd);border-radius:4px}
 figcaption{color:var(--mut);font-size:13px;margin-top:.3rem}
 footer{margin-top:3rem;color:var(--mut);font-size:12px;border-top:1px solid var(--bd);
 padding-top:.6rem}
+@media print{
+body{max-width:none;margin:0;padding:0;font-size:11pt}
+h2,h3{break-after:avoid}
+figure,caption,tr,.keep{break-inside:avoid}
+thead{display:table-header-group}
+img{max-height:24cm;width:auto;max-width:100%}
+.tw{overflow:visible}
+table{font-size:8pt}
+th,td{white-space:normal;padding:.15rem .3rem}
+}
 """
 
 _HTML = """<!DOCTYPE html>
