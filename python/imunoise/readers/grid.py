@@ -51,6 +51,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from imunoise import _summary
+
 __all__ = ["MAX_GRID_RATIO", "Gaps", "TimeGrid"]
 
 #: Timestamps that would make a grid this many times longer than the samples
@@ -143,7 +145,7 @@ def _line(slot: np.ndarray, t: np.ndarray, dt0: float) -> tuple[float, float]:
     return float(t.mean() - dt * slot.mean()), dt
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class Gaps:
     """The dropouts of a log, one row per run of consecutive missing samples.
 
@@ -243,6 +245,31 @@ class Gaps:
             return "no gaps"
         rows = [f"{a:.3f} s +{d:.3f} s ({s} samples)" for a, d, s in self.rows()]
         return f"{len(self)} gap(s): " + "; ".join(rows)
+
+    def _facts(self) -> str:
+        """``"2 gaps, 43 samples = 1.08 s missing at 40 Hz; longest 40 samples at 12.3 s"``."""
+        if not len(self):
+            return f"no gaps at {_summary.number(self.fs)} Hz"
+        (start, _length, k), = self.largest(1).rows()
+        at = start - self.t0
+        return (f"{_summary.plural(len(self), 'gap')}, {self.total} samples = "
+                f"{_summary.duration(self.total / self.fs)} missing at "
+                f"{_summary.number(self.fs)} Hz; longest {k} samples at "
+                f"{'' if self.t0 == 0 else 't0 + '}{_summary.number(at)} s")
+
+    def __repr__(self) -> str:
+        return f"Gaps({self._facts()})"
+
+    def _repr_html_(self) -> str:
+        shown = self.largest(_summary.HTML_ROWS)
+        caption = f"Gaps: {self._facts()}"
+        if len(shown) < len(self):
+            caption += f" (the {len(shown)} longest shown)"
+        return _summary.html_table(
+            ["start [s from row 0]", "duration [s]", "samples"],
+            [[_summary.number(a - self.t0), _summary.number(d), k] for a, d, k in shown.rows()],
+            caption=caption,
+        )
 
 
 @dataclass(frozen=True)

@@ -3,16 +3,20 @@
 from __future__ import annotations
 
 import warnings
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from types import MappingProxyType
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from imunoise import _schema
+from imunoise import _schema, _summary
 from imunoise._core import vn as _core_vn
 from imunoise._validate import sample_rate
 from imunoise.readers.grid import Gaps, TimeGrid
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
 #: Sample rate assumed when neither timestamps nor ``fs=`` tell it (the VN-100's
 #: factory default asynchronous output rate).
@@ -35,11 +39,14 @@ DEFAULT_FS = 40.0
 #: - ``time_reversed``: a timestamp smaller than the one before: kept, placed by its time
 ISSUE_KINDS = (*_core_vn.ISSUE_KINDS, "duplicate_time", "time_reversed")
 
+#: Locations of each issue kind a summary (repr) shows.
+FIRST_SHOWN = 3
+
 #: Kinds that count something other than a skipped record.
 _NOT_RECORDS = ("bytes_skipped", "time_reversed")
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class ParseIssues:
     """What a reader skipped, by kind.
 
@@ -102,13 +109,39 @@ class ParseIssues:
             )
         return "no issues" if not parts else ", ".join(parts)
 
+    def _first(self, kind: str) -> str:
+        """``"lines 12, 40, 77, …"``: where the first records of ``kind`` were."""
+        where = self.first[kind]
+        if not where:
+            return ""
+        shown = ", ".join(str(w) for w in where[:FIRST_SHOWN])
+        more = ", …" if self.counts[kind] > FIRST_SHOWN else ""
+        return f"{self.location}{'s' if len(where) > 1 else ''} {shown}{more}"
+
+    def __repr__(self) -> str:
+        parts = [f"{k}={v}" + (f" ({self._first(k)})" if self.first[k] else "")
+                 for k, v in self.counts.items() if v]
+        if self.samples_missing:
+            parts.append(f"{self.samples_missing} of {self.samples} samples missing "
+                         f"({100 * self.share_missing:.3g} %) in "
+                         f"{_summary.plural(self.gaps, 'gap')}")
+        return _summary.lines("ParseIssues(", parts or ["no issues"], sep=", ")
+
+    def _repr_html_(self) -> str:
+        rows = [[k, v, self._first(k)] for k, v in self.counts.items() if v]
+        return _summary.html_table(
+            ["kind", "count", "first locations"],
+            rows or [["no issues", 0, ""]],
+            caption=f"ParseIssues: {self}",
+        )
+
 
 # The channel table and column naming live in the one schema module.
 CHANNELS = _schema.CHANNELS
 column_names = _schema.column_names
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class ImuLog:
     """An IMU recording: uniform-rate channels plus the record of what was skipped.
 
@@ -228,6 +261,54 @@ class ImuLog:
     def duration(self) -> float:
         """Length of the record in seconds: grid rows (missing samples included) / fs."""
         return len(self) / self.fs
+
+    def _facts(self) -> list[str]:
+        """Rate, length, channels, gaps and issues, short."""
+        n = len(self)
+        missing = self.gaps.total
+        parts = [
+            f"{_summary.number(self.fs)} Hz",
+            f"{n} samples = {_summary.duration(self.duration)}",
+            "channels " + (" ".join(self.channels) or "none")
+            + (" + time" if self.time is not None else ""),
+            f"{missing} missing in {_summary.plural(len(self.gaps), 'gap')}"
+            if missing else "no gaps",
+        ]
+        issues = _summary.nonzero(self.issues.counts)
+        parts.append(f"issues: {issues}" if issues else "no issues")
+        return parts
+
+    def _origin(self) -> str:
+        """``"vn-ascii 'capture.txt'"``, ``"vn-binary <bytes>"``, ``"arrays"``."""
+        if self.source == f"<{self.format}>":
+            return self.format
+        if self.source.startswith("<"):
+            return f"{self.format} {self.source}"
+        return f"{self.format} {_summary.source_name(self.source)!r}"
+
+    def __repr__(self) -> str:
+        return _summary.lines(f"ImuLog({self._origin()}", self._facts(), sep=", ")
+
+    def _repr_html_(self) -> str:
+        """The log's facts and one row per channel; its issues and gaps when it has any."""
+        caption = f"ImuLog: {self._origin()}, " + ", ".join(self._facts())
+        rows = [[name, " ".join(column_names(name)), CHANNELS[name][1]]
+                for name in self.channels]
+        if self.messages:
+            caption += "; messages " + _summary.nonzero(self.messages)
+        out = _summary.html_table(["channel", "columns", "unit"], rows, caption=caption)
+        if self.issues.total or self.issues.counts["bytes_skipped"]:
+            out += self.issues._repr_html_()
+        if len(self.gaps):
+            out += self.gaps._repr_html_()
+        return out
+
+    def plot(self, channels: str | Sequence[str] | None = None, **kwargs) -> Figure:
+        """Time series of the log's channels, one panel per axis, gaps shaded: see
+        :func:`imunoise.plot.time_series` (``channels`` default: all the log has)."""
+        from imunoise import plot
+
+        return plot.time_series(self, channels=channels, **kwargs)
 
     @classmethod
     def from_arrays(

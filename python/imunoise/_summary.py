@@ -1,0 +1,108 @@
+"""Short summaries of the result objects: the pieces their ``__repr__`` (one to three
+lines, never an array) and ``_repr_html_`` (a small table for notebooks) share.
+
+Numbers print with four significant digits here; the report's and the tables'
+number formatting lives elsewhere.
+"""
+
+from __future__ import annotations
+
+import html
+import math
+from collections.abc import Iterable, Mapping, Sequence
+from pathlib import PurePath
+
+import numpy as np
+
+#: Characters of a repr line before the next part goes to a new line.
+LINE_WIDTH = 100
+#: Lines of a repr at the most (the first one included).
+MAX_LINES = 3
+#: Rows of a long table (gaps) an HTML summary shows.
+HTML_ROWS = 10
+
+
+def number(value) -> str:
+    """Four significant digits, ``—`` for NaN and infinities, ``None`` as ``—``."""
+    if value is None:
+        return "—"
+    v = float(value)
+    return f"{v:.4g}" if math.isfinite(v) else "—"
+
+
+def duration(seconds: float) -> str:
+    """``"12.5 s"``, ``"5.51 min"`` or ``"3.2 h"``: three significant digits, by length."""
+    if not math.isfinite(seconds):
+        return "—"
+    if seconds < 120:
+        return f"{seconds:.3g} s"
+    if seconds < 7200:
+        return f"{seconds / 60:.3g} min"
+    return f"{seconds / 3600:.3g} h"
+
+
+def tau_span(taus) -> str:
+    """``"27 taus 0.025–165 s"`` (``"1 tau 0.5 s"``, ``"no taus"``)."""
+    t = np.asarray(taus, dtype=float).reshape(-1)
+    if not t.size:
+        return "no taus"
+    if t.size == 1:
+        return f"1 tau {number(t[0])} s"
+    return f"{t.size} taus {number(t[0])}–{number(t[-1])} s"
+
+
+def source_name(source: str) -> str:
+    """A file's name without its folders (``"<bytes>"``-style sources unchanged)."""
+    return source if source.startswith("<") else PurePath(source).name
+
+
+def plural(count: int, word: str) -> str:
+    """``"1 gap"``, ``"2 gaps"``."""
+    return f"{count} {word}{'' if count == 1 else 's'}"
+
+
+def nonzero(counts: Mapping[str, int]) -> str:
+    """``"bad_checksum=3, bytes_skipped=12"``: the kinds that happened."""
+    return ", ".join(f"{k}={v}" for k, v in counts.items() if v)
+
+
+def per_channel(values, name: str) -> str:
+    """A count per channel: ``"name 0"`` when all are equal, else ``"name [3 0 5]"``."""
+    v = np.atleast_1d(np.asarray(values)).reshape(-1)
+    if v.size and np.all(v == v[0]):
+        return f"{name} {v[0]}"
+    return f"{name} [{' '.join(str(x) for x in v)}]"
+
+
+def lines(head: str, parts: Sequence[str], *, sep: str = "; ", close: str = ")") -> str:
+    """``head`` then ``parts``, each after ``sep`` (the first right after a ``head``
+    ending in ``(``), wrapped at :data:`LINE_WIDTH` into
+    at most :data:`MAX_LINES` lines; parts that do not fit are counted (``"… 3 more"``)."""
+    out = [head]
+    for i, part in enumerate(parts):
+        glue = "" if out[-1].endswith("(") else sep
+        if len(out[-1]) + len(glue) + len(part) <= LINE_WIDTH:
+            out[-1] += glue + part
+        elif len(out) < MAX_LINES:
+            out[-1] += sep.rstrip()
+            out.append("  " + part)
+        else:
+            out[-1] += f"{sep}… {len(parts) - i} more"
+            break
+    return "\n".join(out) + close
+
+
+def html_table(
+    header: Sequence[str],
+    rows: Iterable[Sequence[object]],
+    *,
+    caption: str = "",
+) -> str:
+    """A small HTML table (escaped text, numbers right-aligned by the notebook's style)."""
+    cells = "".join(f"<th>{html.escape(str(h))}</th>" for h in header)
+    body = "".join(
+        "<tr>" + "".join(f"<td>{html.escape(str(c))}</td>" for c in row) + "</tr>"
+        for row in rows
+    )
+    cap = f"<caption>{html.escape(caption)}</caption>" if caption else ""
+    return f"<table>{cap}<thead><tr>{cells}</tr></thead><tbody>{body}</tbody></table>"
