@@ -79,7 +79,7 @@ import warnings
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from types import MappingProxyType
-from typing import TypeAlias
+from typing import TYPE_CHECKING, TypeAlias
 
 import numpy as np
 import numpy.typing as npt
@@ -87,6 +87,11 @@ from scipy import stats as _stats
 
 from imunoise._core import allan as _core_allan
 from imunoise.taus import averaging_factors, keep_estimable
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+
+    from imunoise.noise import NoiseModel
 
 #: One-sigma confidence, erf(1/√2).
 ONE_SIGMA = 0.6826894921370859
@@ -283,6 +288,13 @@ class AllanResult:
 
     def __len__(self) -> int:
         return len(self.taus)
+
+    def plot(self, model: NoiseModel | None = None, **kwargs) -> Figure:
+        """The deviation with its error bars, and ``model`` (:func:`imunoise.fit`) with
+        its terms and read-off points when given: :func:`imunoise.plot.allan`."""
+        from imunoise import plot
+
+        return plot.allan(self, model, **kwargs)
 
 
 def adev(

@@ -64,6 +64,7 @@ import warnings
 from collections.abc import Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -71,6 +72,11 @@ from imunoise import _schema
 from imunoise import units as _units
 from imunoise._core import fit as _core_fit
 from imunoise._deprecation import old_call_forms
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+
+    from imunoise.allan import AllanResult
 
 __all__ = ["TERMS", "FLICKER", "NoiseModel", "Prediction", "fit", "model_variance"]
 
@@ -357,6 +363,13 @@ class NoiseModel:
             elif term == "K" and tau_c > 1.0:
                 total += 2.0 * q2 / tau_c
         return math.sqrt(max(total, 0.0))
+
+    def plot(self, result: AllanResult, **kwargs) -> Figure:
+        """The model over ``result``, the Allan result it was fitted to, with its terms,
+        read-off points and the data/model ratio: :func:`imunoise.plot.allan`."""
+        from imunoise import plot
+
+        return plot.allan(result, self, **kwargs)
 
     # -- units and tables ---------------------------------------------------
     @old_call_forms(keyword_only=("units", "input_unit"))

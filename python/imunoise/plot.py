@@ -4,6 +4,12 @@ Every function returns a :class:`matplotlib.figure.Figure`; :func:`save` writes 
 as PNG and SVG. One figure per sensor holds its three axes. Axis colours are the
 same in every figure (X blue, Y orange, Z green).
 
+The functions take the objects the API returns: :func:`allan` an
+:class:`~imunoise.AllanResult` and its :class:`~imunoise.NoiseModel`,
+:func:`time_series` an :class:`~imunoise.ImuLog` (or an array and its rate),
+:func:`histograms` :class:`~imunoise.Distribution` objects. ``result.plot(model)``,
+``model.plot(result)`` and ``log.plot()`` call them.
+
 Time series use min/max decimation: the samples are split into one bucket per
 pixel column and each bucket is drawn as a vertical stroke from its minimum to
 its maximum, so 10⁷ points draw in milliseconds and no spike disappears.
@@ -18,8 +24,12 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from imunoise._schema import axis_names
+from imunoise import _summary
+from imunoise._schema import ATTITUDE_NAMES, CHANNELS, axis_names
+from imunoise.allan import AllanResult
 from imunoise.noise import FLICKER, TERMS, NoiseModel, model_variance
+from imunoise.readers.log import ImuLog
+from imunoise.stats import Distribution
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -37,6 +47,9 @@ __all__ = [
 AXIS_COLORS = ("#1f77b4", "#ff7f0e", "#2ca02c", "#9467bd")
 #: Shading of missing samples (gaps) on time plots.
 GAP_COLOR = "#d62728"
+#: Gaps of a log :func:`time_series` shades (the longest; every one would cost a
+#: patch per panel).
+SHADED_GAPS = 200
 TERM_STYLES = {
     "Q": ("quantization Q", ":"),
     "N": ("white noise N", "--"),
@@ -131,61 +144,135 @@ def _draw_series(ax, t0: float, fs: float, y: np.ndarray, color: str, columns: i
 
 
 def time_series(
-    y: np.ndarray,
-    fs: float,
+    y: np.ndarray | ImuLog,
+    fs: float | None = None,
     *,
+    channels: str | Sequence[str] | None = None,
     title: str = "",
     unit: str = "",
     names: Sequence[str] | None = None,
     columns: int = 1600,
-    gaps: Sequence[tuple[float, float]] = (),
+    gaps: Sequence[tuple[float, float]] | None = None,
 ) -> Figure:
-    """Time series of a sensor's axes, one panel per axis, min/max decimated.
+    """Time series, one panel per axis, min/max decimated, missing samples shaded.
 
     Parameters
     ----------
-    y : ndarray, (n,) or (n, k)
-        Samples.
+    y : ndarray, (n,) or (n, k), or ImuLog
+        Samples of one sensor, or a log: then one column of panels per channel
+        (titled with the channel and its unit), at the log's rate, with the log's
+        longest :data:`SHADED_GAPS` gaps shaded.
     fs : float
-        Sample rate in Hz (the time axis is in seconds, minutes or hours by length).
+        Sample rate in Hz of an array (the time axis is in seconds, minutes or
+        hours by length); not given with a log.
+    channels : str or sequence of str, optional
+        With a log: the channels to draw (default every channel it has).
     title, unit : str
-        Figure title and y-axis unit.
+        Figure title and, for an array, the y-axis unit (a log's units are its
+        channels'; its default title is its file name).
     names : sequence of str, optional
-        Axis names; default X, Y, Z (``value`` for one column).
+        Axis names of an array; default X, Y, Z (``value`` for one column).
     columns : int
         Buckets per panel (≈ pixel width of the saved figure).
-    gaps : sequence of (start, duration)
-        Missing samples, in seconds from the first sample, shaded on every panel.
+    gaps : sequence of (start, duration), optional
+        Missing samples, in seconds from the first sample, shaded on every panel
+        (default: none for an array, the log's own for a log).
     """
-    new_figure = _plt()
+    if isinstance(y, ImuLog):
+        if fs is not None or unit or names is not None:
+            given = [k for k, v in (("fs", fs), ("unit", unit), ("names", names)) if v]
+            raise ValueError(f"fs, unit and names must not be given with an ImuLog (it has "
+                             f"its own); got {', '.join(given)}")
+        log = y
+        chosen = _log_channels(log, channels)
+        blocks = [(name, CHANNELS[name][1], _channel_axes(name), getattr(log, name))
+                  for name in chosen]
+        source = "" if log.source.startswith("<") else _summary.source_name(log.source)
+        if len(blocks) == 1:  # one sensor: the array layout, the channel in the title
+            name = blocks[0][0]
+            blocks = [("", *blocks[0][1:])]
+            source = f"{name} ({source})" if source else name
+        if gaps is None:
+            gaps = [(a - log.gaps.t0, d) for a, d, _k in log.gaps.largest(SHADED_GAPS).rows()]
+        return _series_figure(blocks, log.fs, title or source, columns, gaps)
+    if channels is not None:
+        raise ValueError(f"channels must be None for an array (it picks channels of an "
+                         f"ImuLog); got {channels!r}")
+    if fs is None:
+        raise ValueError("fs must be given for an array (the sample rate, Hz); got None")
     y = np.asarray(y, dtype=np.float64).reshape(len(y), -1)
-    k = y.shape[1]
-    names = list(names) if names is not None else axis_names(k)
-    duration = len(y) / fs
+    names = list(names) if names is not None else axis_names(y.shape[1])
+    return _series_figure([("", unit, names, y)], fs, title, columns, gaps or ())
+
+
+def _channel_axes(channel: str) -> list[str]:
+    """Panel labels of a log channel's columns (yaw, pitch, roll for ``ypr``)."""
+    if channel == "ypr":
+        return list(ATTITUDE_NAMES)
+    return axis_names(CHANNELS[channel][0])
+
+
+def _log_channels(log: ImuLog, channels: str | Sequence[str] | None) -> list[str]:
+    """The channels of ``log`` to draw, checked."""
+    if channels is None:
+        if not log.channels:
+            raise ValueError(f"log must have a channel to plot; got none in {log.source}")
+        return list(log.channels)
+    chosen = [channels] if isinstance(channels, str) else list(channels)
+    absent = [c for c in chosen if c not in log.channels]
+    if absent or not chosen:
+        raise ValueError(f"channels must be among the log's {list(log.channels)}; got "
+                         f"{chosen!r}")
+    return chosen
+
+
+def _series_figure(blocks, fs: float, title: str, columns: int, gaps) -> Figure:
+    """One column of panels per block ``(heading, unit, axis names, (n,) or (n, k))``;
+    a block without a heading labels its panels ``name [unit]``."""
+    new_figure = _plt()
+    blocks = [(head, unit, names, np.asarray(v, dtype=np.float64).reshape(len(v), -1))
+              for head, unit, names, v in blocks]
+    rows = max(v.shape[1] for *_, v in blocks)
+    n = len(blocks[0][3])
+    duration = n / fs
     scale, tunit = (1.0, "s") if duration < 600 else (60.0, "min")
     if duration >= 3 * 3600:
         scale, tunit = 3600.0, "h"
+    wide = len(blocks) > 1
     with style():
-        fig = new_figure(figsize=(9, 1.7 * k + 0.6))
-        axes = fig.subplots(k, 1, sharex=True, squeeze=False)[:, 0]
-        for j, ax in enumerate(axes):
-            _draw_series(ax, 0.0, fs * scale, y[:, j], AXIS_COLORS[j % 4], columns)
-            for start, length in gaps:
-                # at least a visible sliver, however short the gap
-                width = max(length, duration / columns) / scale
-                ax.axvspan(start / scale, start / scale + width, color=GAP_COLOR, alpha=0.35,
-                           linewidth=0)
-            ax.set_ylabel(f"{names[j]} [{unit}]" if unit else names[j])
-            ax.margins(x=0)
-        axes[-1].set_xlabel(f"time [{tunit}]")
-        _margins(fig, left=0.95, bottom=0.45, title=bool(title))
+        size = (min(3.4 * len(blocks), 16.0), 1.5 * rows + 0.9) if wide else (9, 1.7 * rows + 0.6)
+        fig = new_figure(figsize=size)
+        grid = fig.subplots(rows, len(blocks), sharex=True, squeeze=False)
+        for b, (head, unit, names, y) in enumerate(blocks):
+            k = y.shape[1]
+            for j in range(k):
+                ax = grid[j, b]
+                _draw_series(ax, 0.0, fs * scale, y[:, j], AXIS_COLORS[j % 4], columns)
+                for start, length in gaps:
+                    # at least a visible sliver, however short the gap
+                    width = max(length, duration / columns) / scale
+                    ax.axvspan(start / scale, start / scale + width, color=GAP_COLOR,
+                               alpha=0.35, linewidth=0)
+                ax.set_ylabel(names[j] if head or not unit else f"{names[j]} [{unit}]")
+                ax.margins(x=0)
+            if head:
+                grid[0, b].set_title(f"{head} [{unit}]" if unit else head)
+            for ax in grid[k:, b]:
+                ax.set_visible(False)
+            grid[k - 1, b].tick_params(labelbottom=True)
+            grid[k - 1, b].set_xlabel(f"time [{tunit}]")
+        if wide:
+            _margins(fig, left=0.9, bottom=0.45, top=0.45, wspace=0.45, hspace=0.2,
+                     title=bool(title))
+        else:
+            _margins(fig, left=0.95, bottom=0.45, title=bool(title))
         if title:
             fig.suptitle(title)
     return fig
 
 
 def histograms(
-    dists: Sequence,
+    dists: Distribution | Sequence[Distribution],
     *,
     title: str = "",
     unit: str = "",
@@ -195,10 +282,15 @@ def histograms(
 
     Parameters
     ----------
-    dists : sequence of :class:`imunoise.stats.Distribution`
-        One per axis.
+    dists : :class:`imunoise.stats.Distribution` or a sequence of them
+        One per axis (:func:`imunoise.distribution` of each column).
     """
     new_figure = _plt()
+    dists = [dists] if isinstance(dists, Distribution) else list(dists)
+    wrong = [type(d).__name__ for d in dists if not isinstance(d, Distribution)]
+    if wrong or not dists:
+        raise TypeError(f"dists must be Distribution objects (imunoise.distribution of each "
+                        f"axis); got {wrong or 'none'}")
     k = len(dists)
     names = list(names) if names is not None else axis_names(k)
     with style():
@@ -246,7 +338,7 @@ def _readoff_points(model: NoiseModel, channel: int) -> dict[str, float]:
 
 
 def allan(
-    result,
+    result: AllanResult,
     model: NoiseModel | None = None,
     *,
     coefficients: Sequence[Mapping[str, float]] | None = None,
@@ -277,8 +369,22 @@ def allan(
     new_figure = _plt()
     from matplotlib.ticker import NullFormatter
 
+    if not isinstance(result, AllanResult):
+        raise TypeError(f"result must be an AllanResult (imunoise.adev and its family); got "
+                        f"{type(result).__name__}")
+    if model is not None and not isinstance(model, NoiseModel):
+        raise TypeError(f"model must be a NoiseModel (imunoise.fit) or None; got "
+                        f"{type(model).__name__} (per-axis coefficients go in coefficients=)")
+    if model is not None and coefficients is not None:
+        raise ValueError("model and coefficients must not both be given; got both")
     taus = np.asarray(result.taus, dtype=np.float64)
     dev = np.asarray(result.dev, dtype=np.float64).reshape(len(taus), -1)
+    if model is not None and model.channels != dev.shape[1]:
+        raise ValueError(f"model must have the {dev.shape[1]} channel(s) of result; got "
+                         f"{model.channels}")
+    if coefficients is not None and len(coefficients) != dev.shape[1]:
+        raise ValueError(f"coefficients must have one mapping per channel of result "
+                         f"({dev.shape[1]}); got {len(coefficients)}")
     lo = np.asarray(result.ci_low, dtype=np.float64).reshape(dev.shape)
     hi = np.asarray(result.ci_high, dtype=np.float64).reshape(dev.shape)
     k = dev.shape[1]
