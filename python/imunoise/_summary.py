@@ -15,9 +15,11 @@ from pathlib import PurePath
 import numpy as np
 
 #: Characters of a repr line before the next part goes to a new line.
-LINE_WIDTH = 100
+LINE_WIDTH = 110
 #: Lines of a repr at the most (the first one included).
 MAX_LINES = 3
+#: Characters of a repr at the most (parts beyond are counted, not shown).
+MAX_CHARS = 300
 #: Rows of a long table (gaps) an HTML summary shows.
 HTML_ROWS = 10
 
@@ -67,29 +69,53 @@ def nonzero(counts: Mapping[str, int]) -> str:
 
 
 def per_channel(values, name: str) -> str:
-    """A count per channel: ``"name 0"`` when all are equal, else ``"name [3 0 5]"``."""
+    """A count per channel: ``"no name"``, ``"name 43"`` when all are equal, else
+    ``"name [3 0 5]"``."""
     v = np.atleast_1d(np.asarray(values)).reshape(-1)
-    if v.size and np.all(v == v[0]):
+    if not v.any():
+        return f"no {name}"
+    if np.all(v == v[0]):
         return f"{name} {v[0]}"
     return f"{name} [{' '.join(str(x) for x in v)}]"
 
 
 def lines(head: str, parts: Sequence[str], *, sep: str = "; ", close: str = ")") -> str:
     """``head`` then ``parts``, each after ``sep`` (the first right after a ``head``
-    ending in ``(``), wrapped at :data:`LINE_WIDTH` into
-    at most :data:`MAX_LINES` lines; parts that do not fit are counted (``"… 3 more"``)."""
+    ending in ``(``), wrapped at :data:`LINE_WIDTH` into at most :data:`MAX_LINES`
+    lines and :data:`MAX_CHARS` characters; parts that do not fit are counted
+    (``"… 3 more"``)."""
     out = [head]
     for i, part in enumerate(parts):
         glue = "" if out[-1].endswith("(") else sep
-        if len(out[-1]) + len(glue) + len(part) <= LINE_WIDTH:
+        room = MAX_CHARS - sum(len(line) + 1 for line in out) - len(close) - len(sep) - 12
+        fits_line = len(out[-1]) + len(glue) + len(part) <= LINE_WIDTH
+        if len(part) + 3 > room or not fits_line and len(out) == MAX_LINES:
+            out[-1] += f"{glue}… {len(parts) - i} more"
+            break
+        if fits_line:
             out[-1] += glue + part
-        elif len(out) < MAX_LINES:
+        else:
             out[-1] += sep.rstrip()
             out.append("  " + part)
-        else:
-            out[-1] += f"{sep}… {len(parts) - i} more"
-            break
     return "\n".join(out) + close
+
+
+def curve_rows(taus, dev, names: Sequence[str]) -> tuple[list[str], list[list[str]]]:
+    """Header and one row per channel of a deviation curve: its value at the first
+    tau, its smallest value and where, its value at the last tau."""
+    t = np.asarray(taus, dtype=float).reshape(-1)
+    d = np.asarray(dev, dtype=float).reshape(t.size, -1)
+    if not t.size:
+        return ["axis"], [[name] for name in names]
+    header = ["axis", f"σ({number(t[0])} s)", "min σ", "at τ [s]", f"σ({number(t[-1])} s)"]
+    rows = []
+    for j, name in enumerate(names):
+        col = d[:, j]
+        finite = np.isfinite(col)
+        i = int(np.argmin(np.where(finite, col, np.inf)))
+        low = [number(col[i]), number(t[i])] if finite.any() else ["—", "—"]
+        rows.append([name, number(col[0]), *low, number(col[-1])])
+    return header, rows
 
 
 def html_table(

@@ -85,6 +85,7 @@ import numpy as np
 import numpy.typing as npt
 from scipy import stats as _stats
 
+from imunoise import _schema, _summary
 from imunoise._core import allan as _core_allan
 from imunoise.taus import averaging_factors, keep_estimable
 
@@ -197,7 +198,7 @@ __all__ = ["AllanResult", *KINDS, "KINDS", "GAPS", "ONE_SIGMA", "chi2_interval"]
 _SKIPS_GAPS = frozenset(_core_allan.GAP_SKIPPING)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class AllanResult:
     """A deviation evaluated at a set of taus.
 
@@ -288,6 +289,36 @@ class AllanResult:
 
     def __len__(self) -> int:
         return len(self.taus)
+
+    def _facts(self) -> list[str]:
+        """Channels, taus, rate, length, missing samples, gaps mode and confidence."""
+        return [
+            _summary.plural(self.channels, "channel"),
+            _summary.tau_span(self.taus),
+            f"fs {_summary.number(self.fs)} Hz",
+            f"{self.n_samples} samples = {_summary.duration(self.n_samples / self.fs)}",
+            _summary.per_channel(self.missing, "missing"),
+            f"gaps={self.gaps}",
+            f"{100 * self.confidence:.3g} % CI",
+        ]
+
+    def _title(self) -> str:
+        return f"{self.kind} {'overlapping' if self.overlapping else 'non-overlapping'}"
+
+    def __repr__(self) -> str:
+        return _summary.lines(f"AllanResult({self._title()}", self._facts(), sep=", ")
+
+    def _repr_html_(self) -> str:
+        """The facts, and per channel the deviation at the first and last tau and its
+        minimum."""
+        header, rows = _summary.curve_rows(self.taus, self.dev,
+                                           _schema.axis_names(self.channels))
+        missing = np.broadcast_to(self.missing, (self.channels,))
+        return _summary.html_table(
+            [*header, "missing"],
+            [[*row, int(k)] for row, k in zip(rows, missing, strict=True)],
+            caption=f"AllanResult: {self._title()}, " + ", ".join(self._facts()),
+        )
 
     def plot(self, model: NoiseModel | None = None, **kwargs) -> Figure:
         """The deviation with its error bars, and ``model`` (:func:`imunoise.fit`) with

@@ -68,7 +68,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from imunoise import _schema
+from imunoise import _schema, _summary
 from imunoise import units as _units
 from imunoise._core import fit as _core_fit
 from imunoise._deprecation import old_call_forms
@@ -138,7 +138,7 @@ def model_variance(taus, Q=0.0, N=0.0, B=0.0, K=0.0, R=0.0) -> np.ndarray:
     return _terms(taus, 1.0, (Q, N, B, K, R)).sum(axis=1)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class Prediction:
     """Model Allan deviation: the total curve and each term's curve.
 
@@ -151,8 +151,28 @@ class Prediction:
     dev: np.ndarray
     terms: dict[str, np.ndarray]
 
+    @property
+    def channels(self) -> int:
+        """Number of channels (1 for a one-channel model)."""
+        return 1 if np.ndim(self.dev) == 1 else int(np.shape(self.dev)[1])
 
-@dataclass(frozen=True)
+    def _facts(self) -> list[str]:
+        drawn = [k for k, v in self.terms.items() if np.any(np.asarray(v) > 0)]
+        return [_summary.plural(self.channels, "channel"), _summary.tau_span(self.taus),
+                "terms " + (" ".join(drawn) or "none")]
+
+    def __repr__(self) -> str:
+        return _summary.lines("Prediction(", self._facts(), sep=", ")
+
+    def _repr_html_(self) -> str:
+        """Per channel: the model deviation at the first and last tau and its minimum."""
+        header, rows = _summary.curve_rows(self.taus, self.dev,
+                                           _schema.axis_names(self.channels))
+        return _summary.html_table(header, rows,
+                                   caption="Prediction: " + ", ".join(self._facts()))
+
+
+@dataclass(frozen=True, repr=False)
 class NoiseModel:
     """Fitted noise coefficients, per channel, in the input's units.
 
@@ -370,6 +390,46 @@ class NoiseModel:
         from imunoise import plot
 
         return plot.allan(result, self, **kwargs)
+
+    # -- summaries ----------------------------------------------------------
+    def _axis_facts(self, channel: int) -> str:
+        """``"N=0.0001234 B=1.2e-05, 1 GM, covers 85 %"``: one channel, input units."""
+        terms = [f"{t}={_summary.number(self.value(t)[channel])}" for t in TERMS
+                 if np.atleast_1d(self.supported[t])[channel]]
+        gm = len(self.gauss_markov(channel))
+        return (" ".join(terms) or "no term resolved") + (f", {gm} GM" if gm else "") + (
+            f", covers {100 * float(np.atleast_1d(self.coverage)[channel]):.3g} %")
+
+    def _title(self) -> str:
+        return (f"{self.method} fit of {self.kind} at {_summary.number(self.fs)} Hz, "
+                f"{_summary.plural(self.channels, 'channel')}")
+
+    def __repr__(self) -> str:
+        names = _schema.axis_names(self.channels)
+        axes = [self._axis_facts(c) if self.one_channel else f"{names[c]}: {self._axis_facts(c)}"
+                for c in range(self.channels)]
+        return _summary.lines(f"NoiseModel({self._title()}", axes)
+
+    def _repr_html_(self) -> str:
+        """One row per axis: each term's value ± standard uncertainty in the input's
+        units (``not resolved`` where the data do not resolve it), the Gauss–Markov
+        terms and the coverage."""
+        units = self.to_dict()["units"]
+        rows = []
+        for c, name in enumerate(_schema.axis_names(self.channels)):
+            row: list[object] = [name]
+            for t in TERMS:
+                v, e = self.value(t)[c], self.std(t)[c]
+                resolved = np.atleast_1d(self.supported[t])[c]
+                row.append("not resolved" if not resolved else _summary.number(v) + (
+                    f" ± {e:.2g}" if np.isfinite(e) else ""))
+            row.append(", ".join(f"σ {_summary.number(sg)}, τc {_summary.number(tc)} s"
+                                 for sg, tc in self.gauss_markov(c)) or "—")
+            row.append(f"{100 * float(np.atleast_1d(self.coverage)[c]):.3g} %")
+            rows.append(row)
+        return _summary.html_table(
+            ["axis", *(f"{t} [{units[t]}]" for t in TERMS), "Gauss–Markov", "coverage"],
+            rows, caption=f"NoiseModel: {self._title()}, {_summary.tau_span(self.taus)}")
 
     # -- units and tables ---------------------------------------------------
     @old_call_forms(keyword_only=("units", "input_unit"))
