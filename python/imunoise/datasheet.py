@@ -26,6 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
+from imunoise import _summary
 from imunoise import units as _units
 from imunoise._schema import axis_names
 
@@ -116,7 +117,7 @@ def load_spec(spec) -> Spec:
                 items=tuple(items))
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class Comparison:
     """Measured vs specified, one row per (quantity, axis).
 
@@ -130,6 +131,33 @@ class Comparison:
 
     spec: Spec
     rows: tuple[dict, ...]
+
+    def _verdicts(self) -> str:
+        """``"pass=8, fail=1, unresolved=3"``: rows per verdict, in order of appearance."""
+        counts: dict[str, int] = {}
+        for r in self.rows:
+            counts[r["verdict"]] = counts.get(r["verdict"], 0) + 1
+        return _summary.nonzero(counts)
+
+    def __repr__(self) -> str:
+        return _summary.lines(f"Comparison({self.spec.name!r}", [
+            f"{_summary.plural(len(self.rows), 'row')}: {self._verdicts()}",
+            "passed" if self.passed else "not passed"], sep=", ")
+
+    def _repr_html_(self) -> str:
+        """One row per (quantity, axis): measured ± standard uncertainty, the spec,
+        the ratio and the verdict."""
+        body = []
+        for r in self.rows:
+            measured = _summary.number(r["measured"])
+            if np.isfinite(r["std"]) and np.isfinite(r["measured"]):
+                measured += f" ± {r['std']:.2g}"
+            body.append([r["sensor"], f"{r['quantity']} ({r['term']})", r["axis"], measured,
+                         f"{r['limit']} {r['spec']:g} {r['label']}", _summary.number(r["ratio"]),
+                         r["verdict"]])
+        return _summary.html_table(
+            ["sensor", "quantity", "axis", "measured", "spec", "ratio", "verdict"], body,
+            caption=f"Comparison with {self.spec.name}: {self._verdicts()}")
 
     @property
     def passed(self) -> bool:

@@ -44,7 +44,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import stats as _sstats
 
-from imunoise import _schema
+from imunoise import _schema, _summary
 from imunoise._deprecation import old_call_forms
 from imunoise._validate import sample_rate
 from imunoise.readers.log import ImuLog
@@ -73,7 +73,7 @@ _AD_NORM = np.array([0.576, 0.656, 0.787, 0.918, 1.092])
 _AD_LEVELS = np.array([15.0, 10.0, 5.0, 2.5, 1.0])
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class Description:
     """Per-channel sample statistics (see :func:`describe`).
 
@@ -157,6 +157,34 @@ class Description:
 
     def __str__(self) -> str:
         return self.table()
+
+    def _facts(self) -> list[str]:
+        """Length, rate, channels grouped by sensor (``gyro X Y Z``), missing samples."""
+        groups: dict[str, list[str]] = {}
+        for name, sensor in zip(self.names, self.sensors, strict=True):
+            if not name.startswith(sensor):  # an array's columns: no sensor
+                sensor = ""
+            groups.setdefault(sensor, []).append(name[len(sensor):].strip())
+        rate = f" at {_summary.number(self.fs)} Hz" if self.fs else ", rate unknown"
+        return [
+            f"{self.n} samples{rate}",
+            _summary.plural(len(self.names), "channel") + ": "
+            + ", ".join(" ".join([sensor, *axes]).strip() for sensor, axes in groups.items()),
+            _summary.per_channel(self.missing, "missing"),
+        ]
+
+    def __repr__(self) -> str:
+        return _summary.lines("Description(", self._facts(), sep=", ")
+
+    def _repr_html_(self) -> str:
+        """:meth:`rows` as a table, four significant digits."""
+        keys = ("mean", "std", "var", "min", "max", "drift_per_hour")
+        return _summary.html_table(
+            ["channel", "unit", "mean", "std", "var", "min", "max", "drift/h", "missing"],
+            [[r["name"], r["unit"], *(_summary.number(r[k]) for k in keys), r["missing"]]
+             for r in self.rows()],
+            caption="Description: " + ", ".join(self._facts()),
+        )
 
 
 def _fmt(v: float) -> str:
@@ -324,7 +352,7 @@ def _step_of_levels(v: np.ndarray, rtol: float = 1e-3) -> float | None:
     return None
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class Distribution:
     """Histogram, normal fit and normality statistics (see :func:`distribution`).
 
@@ -394,6 +422,29 @@ class Distribution:
         """Histogram normalised to a density (integrates to 1), comparable to :meth:`pdf`."""
         widths = np.diff(self.edges)
         return self.counts / (self.counts.sum() * widths)
+
+    def _items(self) -> list[tuple[str, str]]:
+        """(quantity, value) pairs of the summary, four significant digits."""
+        num = _summary.number
+        bins = f"{len(self.counts)}"
+        if self.step:
+            bins += f" (step {num(self.step)}"
+            bins += (f", levels {num(self.level_spacing)} apart)"
+                     if self.level_spacing and self.level_spacing != self.step else ")")
+        items = [("n", str(self.n)), ("normal fit", f"μ={num(self.mu)} σ={num(self.sigma)}"),
+                 ("KS", f"D={num(self.ks_statistic)} p={num(self.ks_pvalue)}"),
+                 ("AD", f"A²={num(self.ad_statistic)}"),
+                 ("skewness", num(self.skewness)),
+                 ("excess kurtosis", num(self.excess_kurtosis)), ("bins", bins)]
+        return items + ([("missing", str(self.missing))] if self.missing else [])
+
+    def __repr__(self) -> str:
+        return _summary.lines("Distribution(", [f"{k} {v}" if k != "n" else f"n={v}"
+                                                 for k, v in self._items()], sep=", ")
+
+    def _repr_html_(self) -> str:
+        return _summary.html_table(["quantity", "value"], self._items(),
+                                   caption="Distribution: histogram, normal fit, normality")
 
 
 @old_call_forms(keyword_only=("bins",))
