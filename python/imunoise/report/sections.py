@@ -43,7 +43,7 @@ __all__ = [
 GAP_WARN_SHARE = 0.01
 #: Gaps listed in the summary table / shaded on the time plots (the largest).
 GAP_ROWS = 10
-GAP_SHADE = 200
+GAP_SHADE = plot.SHADED_GAPS
 
 
 def _which(label: str) -> str:
