@@ -1,0 +1,82 @@
+"""Numbers as text: a value with its uncertainty, GUM style, in one place.
+
+The standard uncertainty is rounded to two significant digits and the value to
+the same decimal place ("0.21004 ± 0.000112762" → "0.21004 ± 0.00011"). When
+plain decimals get unreadable (magnitude below 1e-2 or at least 1e5) value and
+uncertainty share a power of ten: "(3.50 ± 0.12)e-3". A value without an
+uncertainty is printed to ``digits`` significant digits. NaN, inf and missing
+values print as a word, never as "nan".
+
+Text only: exports (YAML/JSON) keep full-precision numbers, they are data.
+"""
+from __future__ import annotations
+
+import math
+
+#: The word for a value that could not be estimated (e.g. an unresolved term).
+NOT_RESOLVED = "not resolved"
+#: The word for an empty table cell.
+EMPTY = "—"
+
+
+def _finite(x) -> bool:
+    return x is not None and math.isfinite(float(x))
+
+
+def _exponent(x: float) -> int:
+    return math.floor(math.log10(abs(x)))
+
+
+def _plain(x: float) -> bool:
+    return x == 0 or 1e-2 <= abs(x) < 1e5
+
+
+def format_value(value, std=None, *, unit: str | None = None, digits: int = 4,
+                 missing: str = NOT_RESOLVED) -> str:
+    """``value ± std`` rounded GUM style, or ``value`` to ``digits`` significant digits.
+
+    ``std`` None, NaN, inf or ≤ 0 means no usable uncertainty. A non-finite or None
+    ``value`` gives ``missing``. ``unit`` is appended after a space.
+    """
+    if not isinstance(digits, int) or digits < 1:
+        raise ValueError(f"digits must be a positive integer; got {digits!r}")
+    if not _finite(value):
+        return missing
+    value = float(value)
+    if _finite(std) and float(std) > 0:
+        text = _with_uncertainty(value, float(std))
+    else:
+        text = _significant(value, digits)
+    return f"{text} {unit}" if unit else text
+
+
+def _significant(value: float, digits: int) -> str:
+    if value == 0:
+        return "0"
+    if _plain(value):
+        decimals = max(digits - 1 - _exponent(value), 0)
+        return f"{value:.{decimals}f}"
+    return f"{value:.{digits - 1}e}".replace("e+0", "e").replace("e-0", "e-").replace("e+", "e")
+
+
+def _with_uncertainty(value: float, std: float) -> str:
+    # Two significant digits of the uncertainty; the value to the same place.
+    place = _exponent(std) - 1
+    std_r = round(std, -place)
+    if std_r >= 10.0 ** (place + 2):        # 0.0999 rounds to 0.10: one place less
+        place += 1
+        std_r = round(std, -place)
+    ref = value if abs(value) >= std_r else std_r
+    if _plain(ref) and place >= -6:
+        decimals = max(-place, 0)
+        v = round(value, -place)
+        return f"{v:.{decimals}f} ± {std_r:.{decimals}f}"
+    power = _exponent(ref)
+    scale = 10.0 ** power
+    decimals = max(power - place, 0)
+    return f"({value / scale:.{decimals}f} ± {std_r / scale:.{decimals}f})e{power}"
+
+
+def cell(value, std=None, *, digits: int = 4) -> str:
+    """A table cell: as :func:`format_value`, with "—" for a missing value."""
+    return format_value(value, std, digits=digits, missing=EMPTY)
