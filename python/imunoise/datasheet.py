@@ -27,6 +27,7 @@ from pathlib import Path
 import numpy as np
 
 from imunoise import _summary
+from imunoise import numbers as _numbers
 from imunoise import units as _units
 from imunoise._schema import axis_names
 
@@ -35,12 +36,13 @@ if sys.version_info >= (3, 11):
 else:  # pragma: no cover - exercised on 3.10 only
     import tomli as tomllib
 
-__all__ = ["Spec", "SpecItem", "Comparison", "load_spec", "compare", "available_specs"]
+__all__ = ["Spec", "SpecItem", "Comparison", "load_spec", "compare", "available_specs",
+           "verdict", "LIMITS", "VERDICTS", "COVERAGE_K", "TYPICAL_FACTOR"]
 
 
 @dataclass(frozen=True)
 class SpecItem:
-    """One specified quantity: term, value in ``unit``, ``limit`` ("max"/"typical")."""
+    """One specified quantity: term, value in ``unit``, ``limit`` ("max"/"typical"/"min")."""
 
     sensor: str
     term: str
@@ -101,12 +103,14 @@ def load_spec(spec) -> Spec:
                     quantity=str(entry.get("quantity", entry["term"])),
                     value=float(entry["value"]),
                     unit=str(entry["unit"]),
-                    limit=str(entry.get("limit", "max")),
+                    limit=_LIMIT_ALIASES.get(str(entry.get("limit", "max")),
+                                             str(entry.get("limit", "max"))),
                 )
             except (KeyError, TypeError, ValueError) as exc:
                 raise ValueError(f"{where}: needs term, value and unit ({exc})") from None
-            if item.limit not in ("max", "typical"):
-                raise ValueError(f"{where}: limit must be 'max' or 'typical'; got {item.limit!r}")
+            if item.limit not in LIMITS:
+                raise ValueError(
+                    f"{where}: limit must be 'max', 'typical' or 'min'; got {item.limit!r}")
             if not (math.isfinite(item.value) and item.value > 0):
                 raise ValueError(f"{where}: value must be finite and > 0; got {item.value!r}")
             _units.unit_info(item.term, item.unit, sensor)  # validates term and unit
@@ -123,17 +127,20 @@ class Comparison:
 
     Each row is a dict: ``sensor, term, quantity, unit, limit, spec, axis,
     measured, std, ratio, verdict`` where ``ratio = measured/spec`` and
-    ``verdict`` is ``"pass"`` (measured ≤ spec), ``"marginal"`` (above the spec
-    but within two standard uncertainties of it), ``"fail"``, or
-    ``"unresolved"`` (the data do not resolve that term, e.g. too short a log
-    for B).
+    ``verdict`` follows the kind of spec (rules in docs/report.md): for a
+    ``max`` (``min``) limit ``"pass"``, ``"fail"`` or ``"not significant"``
+    (the one-sided 95 % interval straddles the limit); for a ``typical`` value
+    ``"typical"`` (within a factor :data:`TYPICAL_FACTOR` of it), ``"above
+    typical"`` or ``"below typical"``; ``"not resolved"`` when the data do not
+    resolve that term (e.g. too short a log for B). ``remark`` says it in
+    words ("within a factor 1.5 of typical", "2.3× typical", "no uncertainty").
     """
 
     spec: Spec
     rows: tuple[dict, ...]
 
     def _verdicts(self) -> str:
-        """``"pass=8, fail=1, unresolved=3"``: rows per verdict, in order of appearance."""
+        """``"pass=8, fail=1, not resolved=3"``: rows per verdict, in order of appearance."""
         counts: dict[str, int] = {}
         for r in self.rows:
             counts[r["verdict"]] = counts.get(r["verdict"], 0) + 1
@@ -161,23 +168,23 @@ class Comparison:
 
     @property
     def passed(self) -> bool:
-        """True when no row fails (marginal and unresolved rows do not fail)."""
+        """True when no row fails: "not significant", typical and "not resolved"
+        rows do not fail (a typical value is not a limit)."""
         return all(r["verdict"] != "fail" for r in self.rows)
 
     def text(self) -> str:
-        """Fixed-width text rendering."""
+        """Fixed-width text rendering; measured values rounded to their uncertainty."""
         header = ["sensor", "quantity", "axis", "measured", "spec", "ratio", "verdict"]
         body = []
         for r in self.rows:
-            meas = "—" if r["verdict"] == "unresolved" else f"{r['measured']:.4g}"
-            if r["verdict"] != "unresolved" and np.isfinite(r["std"]):
-                meas += f" ± {r['std']:.2g}"
-            bound = "<" if r["limit"] == "max" else "typ."
+            bound = {"max": "<", "min": ">"}.get(r["limit"], "typ.")
+            word = r["verdict"] + (f" ({r['remark']})" if r.get("remark") else "")
             body.append([
-                r["sensor"], f"{r['quantity']} ({r['term']})", r["axis"], meas,
+                r["sensor"], f"{r['quantity']} ({r['term']})", r["axis"],
+                _numbers.format_value(r["measured"], r["std"]),
                 f"{bound} {r['spec']:g} {r['label']}",
-                "—" if not np.isfinite(r["ratio"]) else f"{r['ratio']:.2f}",
-                r["verdict"],
+                _numbers.cell(r["ratio"], digits=3),
+                word,
             ])
         widths = [max(len(x[i]) for x in [header, *body]) for i in range(len(header))]
         lines = [f"{self.spec.name} — {self.spec.source}"]
@@ -187,14 +194,48 @@ class Comparison:
         return "\n".join(lines)
 
 
-def _verdict(resolved: bool, measured: float, std: float, spec: float) -> str:
-    if not resolved:
-        return "unresolved"
-    if measured <= spec:
-        return "pass"
-    if np.isfinite(std) and measured - 2.0 * std <= spec:
-        return "marginal"
-    return "fail"
+#: Kinds of spec entry; "typ" is read as "typical".
+LIMITS = ("max", "typical", "min")
+_LIMIT_ALIASES = {"typ": "typical", "maximum": "max", "minimum": "min"}
+#: Coverage factor of the max/min verdicts: one-sided 95 % for a normal estimate.
+COVERAGE_K = 1.645
+#: A measured value within this factor of a typical one (either way) is "typical".
+TYPICAL_FACTOR = 1.5
+#: Every verdict word, in order of decreasing concern (scale.batch ranks with it).
+VERDICTS = ("fail", "not significant", "above typical", "pass", "typical",
+            "below typical", "not resolved")
+
+
+def verdict(measured: float, std: float | None, spec: float, limit: str) -> tuple[str, str]:
+    """``(verdict, remark)`` for one measured value against one spec entry.
+
+    ``max``: "pass" when ``measured + k·u ≤ spec``, "fail" when ``measured − k·u
+    > spec``, else "not significant" (k = :data:`COVERAGE_K`); without a usable
+    uncertainty ``u`` pass/fail on the value, remarked "no uncertainty". ``min``
+    mirrors ``max``. ``typical``: no pass/fail; "typical" within a factor
+    :data:`TYPICAL_FACTOR`, else "above typical"/"below typical", the remark
+    giving the ratio. A non-finite or non-positive ``measured`` is "not resolved".
+    """
+    if limit not in LIMITS:
+        raise ValueError(f"limit must be one of {LIMITS}; got {limit!r}")
+    if not (math.isfinite(spec) and spec > 0):
+        raise ValueError(f"spec must be finite and > 0; got {spec!r}")
+    if measured is None or not math.isfinite(measured) or measured <= 0:
+        return "not resolved", ""
+    if limit == "typical":
+        ratio = measured / spec
+        if 1.0 / TYPICAL_FACTOR <= ratio <= TYPICAL_FACTOR:
+            return "typical", f"within a factor {TYPICAL_FACTOR:g} of typical"
+        return ("above typical" if ratio > 1 else "below typical"), f"{ratio:.2g}× typical"
+    sign = 1.0 if limit == "max" else -1.0     # min: the mirror image of max
+    has_u = std is not None and math.isfinite(std) and std > 0
+    margin = COVERAGE_K * std if has_u else 0.0
+    remark = "" if has_u else "no uncertainty"
+    if sign * (measured - spec) + margin <= 0:
+        return "pass", remark
+    if sign * (measured - spec) - margin > 0:
+        return "fail", remark
+    return "not significant", remark
 
 
 def compare(models, spec="vn100", *, sensor: str = "gyro", input_units: dict | None = None,
@@ -254,6 +295,8 @@ def compare(models, spec="vn100", *, sensor: str = "gyro", input_units: dict | N
             measured = float(values[i])
             ok = bool(sup[i])
             ratio = measured / item.value if ok else math.nan
+            word, remark = verdict(measured if ok else math.nan, float(stds[i]),
+                                   item.value, item.limit)
             rows.append({
                 "sensor": item.sensor,
                 "term": item.term,
@@ -266,7 +309,8 @@ def compare(models, spec="vn100", *, sensor: str = "gyro", input_units: dict | N
                 "measured": measured if ok else math.nan,
                 "std": float(stds[i]) if ok else math.nan,
                 "ratio": ratio,
-                "verdict": _verdict(ok, measured, float(stds[i]), item.value),
+                "verdict": word,
+                "remark": remark,
             })
     if not rows:
         raise ValueError(

@@ -16,7 +16,7 @@ import numpy as np
 from imunoise import _schema
 from imunoise._progress import Progress
 from imunoise.allan import adev
-from imunoise.datasheet import compare, load_spec
+from imunoise.datasheet import VERDICTS, compare, load_spec
 from imunoise.noise import fit
 from imunoise.readers.log import ISSUE_KINDS
 from imunoise.readers.read import read
@@ -27,7 +27,8 @@ __all__ = ["BATCH_SENSORS", "BATCH_TAUS", "analyse_log", "batch"]
 #: Sensors analysed by :func:`batch`.
 BATCH_SENSORS = _schema.ALLAN_SENSORS
 _TERM_ORDER = ("N", "B", "K", "Q", "R")
-_VERDICT_RANK = {"fail": 3, "marginal": 2, "pass": 1, "unresolved": 0}
+#: Worst verdict first: a row shows its most concerning term (datasheet.VERDICTS order).
+_VERDICT_RANK = {w: len(VERDICTS) - i for i, w in enumerate(VERDICTS)}
 #: Averaging times of the batch analysis: log-spaced points per decade (as the report).
 BATCH_TAUS = _schema.TAUS_PER_DECADE
 
@@ -168,7 +169,7 @@ def batch(
         Q, R`` in the log's units (rad/s or m/s² per √s ... as
         :class:`~imunoise.noise.NoiseModel`), their standard uncertainties
         ``<term>_std`` and ``<term>_supported``, the datasheet ``verdict`` (worst
-        over the specified terms: fail, marginal, pass, unresolved) and per term
+        over the specified terms, in datasheet.VERDICTS order: fail first, not resolved last) and per term
         ``verdict_<term>``, and ``error``. A log that cannot be analysed has one
         row with ``sensor`` empty and the exception in ``error``.
 
