@@ -69,6 +69,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from imunoise import _schema, _summary
+from imunoise import numbers as _numbers
 from imunoise import units as _units
 from imunoise._core import fit as _core_fit
 from imunoise._deprecation import old_call_forms
@@ -574,13 +575,13 @@ def format_table(rows: list[dict], axes: Sequence[str]) -> str:
     """Render :meth:`NoiseModel.table` rows as fixed-width text.
 
     Terms the data do not resolve print as ``not resolved`` (the report's and
-    ``imunoise fit``'s wording too); values carry ``± std``.
+    ``imunoise fit``'s wording too); values carry ``± std``, rounded to it
+    (:func:`imunoise.numbers.format_value`).
     """
     def cell(row, ax):
         if not row[ax + "_supported"]:
-            return "not resolved"
-        v, s = row[ax], row[ax + "_std"]
-        return f"{v:.4g} ± {s:.2g}" if np.isfinite(s) else f"{v:.4g}"
+            return _numbers.NOT_RESOLVED
+        return _numbers.format_value(row[ax], row[ax + "_std"])
 
     header = ["coefficient", "unit", *axes]
     body = [[f"{r['term']} {r['quantity']}", r["label"], *(cell(r, a) for a in axes)]

@@ -3,16 +3,18 @@ term counts and missing samples as text."""
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
+
+from imunoise import numbers as _numbers
 
 __all__ = ["format_duration", "format_number", "gap_note", "missing_text", "terms_used"]
 
 
-def format_number(v: float) -> str:
-    """Six significant digits, or ``—`` for NaN and infinities."""
-    return "—" if not math.isfinite(v) else f"{v:.6g}"
+def format_number(v: float, std: float | None = None) -> str:
+    """``v ± std`` rounded to the uncertainty (GUM style,
+    :func:`imunoise.numbers.format_value`), a bare ``v`` to six significant digits
+    (report tables are compared with the API's numbers), ``—`` for NaN and inf."""
+    return _numbers.cell(v, std, digits=6)
 
 
 def format_duration(seconds: float) -> str:

@@ -33,7 +33,7 @@ def datasheet_rows(model: NoiseModel, sensor: str) -> tuple[list[str], list[list
             if not r[f"{a}_supported"]:
                 cells.append("not resolved")
             else:
-                cells.append(f"{format_number(r[a])} ± {format_number(r[f'{a}_std'])}")
+                cells.append(format_number(r[a], r[f"{a}_std"]))
         out.append(cells)
     return ["quantity", "term", "unit", *axes], out
 
@@ -89,10 +89,11 @@ def comparison_rows(models: dict[str, NoiseModel], spec) -> tuple[list[str], lis
     header = ["sensor", "quantity", "axis", "unit", "measured", "spec", "ratio", "verdict"]
     out = []
     for r in cmp.rows:
-        bound = "<" if r["limit"] == "max" else "typ."
+        bound = {"max": "<", "min": ">"}.get(r["limit"], "typ.")
         out.append([
             r["sensor"], f"{r['quantity']} ({r['term']})", r["axis"], r["unit"],
-            format_number(r["measured"]), f"{bound} {format_number(r['spec'])}",
-            format_number(r["ratio"]), r["verdict"],
+            format_number(r["measured"], r["std"]), f"{bound} {format_number(r['spec'])}",
+            format_number(r["ratio"]),
+            r["verdict"] + (f" ({r['remark']})" if r.get("remark") else ""),
         ])
     return header, out

@@ -169,7 +169,8 @@ def batch(
         Q, R`` in the log's units (rad/s or m/s² per √s ... as
         :class:`~imunoise.noise.NoiseModel`), their standard uncertainties
         ``<term>_std`` and ``<term>_supported``, the datasheet ``verdict`` (worst
-        over the specified terms, in datasheet.VERDICTS order: fail first, not resolved last) and per term
+        over the specified terms in datasheet.VERDICTS order: fail first, not
+        resolved last) and per term
         ``verdict_<term>``, and ``error``. A log that cannot be analysed has one
         row with ``sensor`` empty and the exception in ``error``.
 
