@@ -53,10 +53,16 @@ def format_value(value, std=None, *, unit: str | None = None, digits: int = 4,
 def _significant(value: float, digits: int) -> str:
     if value == 0:
         return "0"
+    # Without an uncertainty trailing zeros carry no information: drop them ("250", not "250.0").
     if _plain(value):
         decimals = max(digits - 1 - _exponent(value), 0)
-        return f"{value:.{decimals}f}"
-    return f"{value:.{digits - 1}e}".replace("e+0", "e").replace("e-0", "e-").replace("e+", "e")
+        return _strip(f"{value:.{decimals}f}")
+    mant, exp = f"{value:.{digits - 1}e}".split("e")
+    return f"{_strip(mant)}e{int(exp)}"
+
+
+def _strip(text: str) -> str:
+    return text.rstrip("0").rstrip(".") if "." in text else text
 
 
 def _with_uncertainty(value: float, std: float) -> str:

@@ -7,6 +7,7 @@ import imunoise
 import numpy as np
 import pytest
 from imunoise.cli import main
+from imunoise.numbers import format_value
 
 
 @pytest.fixture
@@ -168,7 +169,7 @@ def test_fit_prints_datasheet_table(capsys, read):
     assert lines[0] == "# gyro"
     n_row = next(line for line in lines if " N " in f" {line} " and "deg/sqrt(h)" in line)
     want = next(r for r in model.table("gyro") if r["term"] == "N")
-    assert f"{want['X']:.6g}" in n_row
+    assert format_value(want["X"], want["X_std"]) in n_row  # rounded to its uncertainty
 
 
 def test_fit_with_bootstrap_uncertainties(capsys, read):
@@ -183,7 +184,7 @@ def test_fit_with_bootstrap_uncertainties(capsys, read):
     model = imunoise.fit(result, uncertainty="bootstrap", replicates=6, seed=0)
     n_row = next(line for line in out.splitlines() if " N " in f" {line} ")
     want = next(r for r in model.table("gyro") if r["term"] == "N")
-    assert f"± {want['X_std']:.6g}" in n_row
+    assert format_value(want["X"], want["X_std"]) in n_row
 
     code, _, err = _run(args[:-1] + ["3"], capsys)
     assert code == 2 and "--bootstrap must be >= 5" in _one_line_error(err)
