@@ -857,8 +857,8 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
             f"the noise model follows the Allan deviation of channel {c} at only "
             f"{cover[c]:.0%} of the taus (inside the 95 % interval or within 5 %); its "
             "coefficients summarise a curve they do not describe: plot it with "
-            "imunoise.plot.allan(result, model=model)",
-            RuntimeWarning, stacklevel=2,
+            "result.plot(model) or imunoise.plot.allan(result, model=model)",
+            RuntimeWarning, stacklevel=3,  # past old_call_forms' wrapper
         )
     return model
 
