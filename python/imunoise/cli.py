@@ -21,7 +21,10 @@ from imunoise._schema import (
     column_names,
     sensor_label,
 )
-from imunoise.allan import KINDS  # the --kind choices: every public Allan-family statistic
+from imunoise.allan import KINDS
+from imunoise.readers.csv_reader import (
+    LAYOUT_CHANNELS,  # the --kind choices: every public Allan-family statistic
+)
 
 __all__ = ["bundled_log", "main"]
 
@@ -182,7 +185,7 @@ def _channel_assignment(text: str) -> tuple[str, str]:
     """``CHANNEL=VALUE`` of --columns/--units, the channel checked."""
     channel, sep, value = text.partition("=")
     channel, value = channel.strip(), value.strip()
-    known = (*CHANNELS, "time", "raw")
+    known = LAYOUT_CHANNELS
     if not sep or not value:
         raise argparse.ArgumentTypeError(f"expected CHANNEL=VALUE; got {text!r}")
     if channel not in known:

@@ -26,7 +26,10 @@ from imunoise.readers._sentences import IssueTally, sentence_rows
 from imunoise.readers.log import ImuLog, log_on_grid
 from imunoise.readers.probe import Confidence, Probe
 
-__all__ = ["SUFFIXES", "UNITS", "read_csv", "sniff"]
+__all__ = ["LAYOUT_CHANNELS", "SUFFIXES", "UNITS", "read_csv", "sniff"]
+
+#: Names ``columns=`` may map: the log's channels, its time, a column of VN sentences.
+LAYOUT_CHANNELS = (*CHANNELS, "time", "raw")
 
 #: Extensions read as delimited text whatever the content.
 SUFFIXES = (".csv", ".tsv")
@@ -329,10 +332,8 @@ def read_csv(
     if time_column is not None:
         columns["time"] = time_column
     for ch in columns:
-        if ch not in CHANNELS and ch not in ("time", "raw"):
-            raise ValueError(
-                f"columns: unknown channel {ch!r}; use {list(CHANNELS) + ['time', 'raw']}"
-            )
+        if ch not in LAYOUT_CHANNELS:
+            raise ValueError(f"columns: unknown channel {ch!r}; use {list(LAYOUT_CHANNELS)}")
     for ch in units:
         if ch not in _FAMILY:
             raise ValueError(f"units: unknown channel {ch!r}; use {list(_FAMILY)}")
