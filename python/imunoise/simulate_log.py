@@ -4,11 +4,19 @@ The noise of each inertial channel comes from :func:`imunoise.simulate` with the
 coefficients of a datasheet (the N and B it specifies; K, which datasheets of MEMS
 parts rarely give, from ``DEFAULT_K``), on top of what a still sensor reads:
 gravity on −Z, a constant attitude and a constant Earth field.
+
+A datasheet's bias instability is the floor of the Allan curve, σ_min/0.6643, and
+the white noise and rate random walk lift that floor above the flicker term alone.
+The simulated flicker coefficient is therefore the one whose model floor, with the
+datasheet's other terms, equals the datasheet value: a sensor simulated "at its
+datasheet" then reads its datasheet value back (:func:`imunoise.compare` measures
+the same floor), instead of 6 % above it.
 """
 
 from __future__ import annotations
 
 import os
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -17,12 +25,13 @@ from imunoise import _schema
 from imunoise._deprecation import old_call_forms
 from imunoise._validate import positive_finite, sample_rate
 from imunoise.datasheet import load_spec
+from imunoise.noise import FLICKER, model_variance
 from imunoise.readers.log import ImuLog
 from imunoise.simulate import simulate
 from imunoise.units import convert_back
 from imunoise.writers.vn import write_vn_ascii, write_vn_binary
 
-__all__ = ["DEFAULT_K", "noise_of_spec", "simulate_log", "still_log"]
+__all__ = ["DEFAULT_K", "flicker_for_floor", "noise_of_spec", "simulate_log", "still_log"]
 
 #: Rate random walk used where the datasheet gives none (typical MEMS values):
 #: gyro rad/s/√s, accelerometer m/s²/√s.
@@ -54,7 +63,42 @@ def noise_of_spec(spec="vn100") -> dict[str, dict[str, float]]:
             noise[item.sensor][item.term] = float(
                 convert_back(item.value, item.term, item.unit, sensor=item.sensor)
             )
+    for sensor, terms in noise.items():
+        if "B" in terms:
+            others = {t: v for t, v in terms.items() if t != "B"}
+            terms["B"] = flicker_for_floor(terms["B"], sensor=sensor, **others)
     return noise
+
+
+def flicker_for_floor(floor: float, *, sensor: str = "", **terms: float) -> float:
+    r"""The flicker coefficient B whose Allan floor, with the other ``terms``, is ``floor``.
+
+    The floor is the datasheet's bias instability, :math:`\min_\tau \sigma(\tau)/0.6643`.
+    B adds the constant :math:`0.6643^2 B^2` to the Allan variance, so the minimum
+    stays where the other terms put it and
+    :math:`B^2 = \text{floor}^2 - \min_\tau \sigma^2_\text{others}(\tau)/0.6643^2`.
+    Where the other terms alone already lift the floor above ``floor`` no B can
+    reach it: B is 0 and a warning says so.
+
+    Parameters
+    ----------
+    floor : float
+        Bias instability, rate units (rad/s or m/s²).
+    sensor : str, optional
+        Named in the warning.
+    **terms : float
+        The other coefficients (Q, N, K, R) in SI units.
+    """
+    floor = float(floor)
+    taus = np.logspace(-4, 8, 2401)  # 200 per decade: the minimum to ~1e-5 relative
+    others = float(np.min(model_variance(taus, **terms))) / FLICKER**2
+    if others >= floor**2:
+        warnings.warn(
+            f"{sensor or 'sensor'}: the datasheet's other terms alone put the Allan floor at "
+            f"{np.sqrt(others):.3g}, above its bias instability {floor:.3g}; simulating B = 0",
+            stacklevel=3)
+        return 0.0
+    return float(np.sqrt(floor**2 - others))
 
 
 def still_log(hours: float, fs: float = 40.0, *, spec="vn100", seed=None) -> ImuLog:

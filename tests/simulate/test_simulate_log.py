@@ -3,16 +3,33 @@
 import imunoise
 import numpy as np
 import pytest
-from imunoise.simulate_log import noise_of_spec, simulate_log, still_log
+from imunoise.noise import FLICKER, model_variance
+from imunoise.simulate_log import flicker_for_floor, noise_of_spec, simulate_log, still_log
+
+
+def _floor(terms):
+    """σ_min/0.6643 of the model with these coefficients (the datasheet's B)."""
+    taus = np.logspace(-3, 7, 20001)
+    return np.sqrt(np.min(model_variance(taus, **terms))) / FLICKER
 
 
 def test_noise_of_the_vn100_datasheet_in_si_units():
     noise = noise_of_spec("vn100")
     # 0.0035 °/s/√Hz and 10 °/h; 0.14 mg/√Hz and 0.04 mg
     assert noise["gyro"]["N"] == pytest.approx(0.0035 * np.pi / 180)
-    assert noise["gyro"]["B"] == pytest.approx(10 * np.pi / 180 / 3600)
     assert noise["accel"]["N"] == pytest.approx(0.14e-3 * 9.80665)
-    assert noise["accel"]["B"] == pytest.approx(0.04e-3 * 9.80665)
+    # B is the flicker coefficient whose Allan floor, N and K included, is the datasheet's
+    assert _floor(noise["gyro"]) == pytest.approx(10 * np.pi / 180 / 3600, rel=1e-4)
+    assert _floor(noise["accel"]) == pytest.approx(0.04e-3 * 9.80665, rel=1e-4)
+    assert noise["gyro"]["B"] < 10 * np.pi / 180 / 3600
+    # without the lift of N and K the coefficient is the floor itself
+    assert flicker_for_floor(3e-5) == pytest.approx(3e-5)
+
+
+def test_flicker_for_a_floor_the_other_terms_already_exceed_is_zero_with_a_warning():
+    with pytest.warns(UserWarning, match="gyro: the datasheet's other terms alone put the Allan "
+                                         "floor at .* above its bias instability 1e-06"):
+        assert flicker_for_floor(1e-6, sensor="gyro", N=1e-4, K=1e-5) == 0.0
 
 
 @pytest.mark.parametrize("fmt", ["vn-ascii", "vn-binary"])
