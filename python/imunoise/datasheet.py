@@ -126,7 +126,8 @@ class Comparison:
     """Measured vs specified, one row per (quantity, axis).
 
     Each row is a dict: ``sensor, term, quantity, unit, limit, spec, axis,
-    measured, std, ratio, verdict`` where ``ratio = measured/spec`` and
+    measured, std, ratio, ratio_std, verdict`` where ``ratio = measured/spec``
+    (``ratio_std`` its standard uncertainty, ``std/spec``) and
     ``verdict`` follows the kind of spec (rules in docs/report.md): for a
     ``max`` (``min``) limit ``"pass"``, ``"fail"`` or ``"not significant"``
     (the one-sided 95 % interval straddles the limit); for a ``typical`` value
@@ -156,12 +157,11 @@ class Comparison:
         the ratio and the verdict."""
         body = []
         for r in self.rows:
-            measured = _summary.number(r["measured"])
-            if np.isfinite(r["std"]) and np.isfinite(r["measured"]):
-                measured += f" ± {r['std']:.2g}"
-            body.append([r["sensor"], f"{r['quantity']} ({r['term']})", r["axis"], measured,
-                         f"{r['limit']} {r['spec']:g} {r['label']}", _summary.number(r["ratio"]),
-                         r["verdict"]])
+            spec = _numbers.cell(r["spec"])
+            body.append([r["sensor"], f"{r['quantity']} ({r['term']})", r["axis"],
+                         _numbers.cell(r["measured"], r["std"]),
+                         f"{r['limit']} {spec} {r['label']}",
+                         _numbers.cell(r["ratio"], r["ratio_std"]), r["verdict"]])
         return _summary.html_table(
             ["sensor", "quantity", "axis", "measured", "spec", "ratio", "verdict"], body,
             caption=f"Comparison with {self.spec.name}: {self._verdicts()}")
@@ -183,7 +183,7 @@ class Comparison:
                 r["sensor"], f"{r['quantity']} ({r['term']})", r["axis"],
                 _numbers.format_value(r["measured"], r["std"]),
                 f"{bound} {r['spec']:g} {r['label']}",
-                _numbers.cell(r["ratio"], digits=3),
+                _numbers.cell(r["ratio"], r["ratio_std"]),
                 word,
             ])
         widths = [max(len(x[i]) for x in [header, *body]) for i in range(len(header))]
@@ -309,6 +309,7 @@ def compare(models, spec="vn100", *, sensor: str = "gyro", input_units: dict | N
                 "measured": measured if ok else math.nan,
                 "std": float(stds[i]) if ok else math.nan,
                 "ratio": ratio,
+                "ratio_std": float(stds[i]) / item.value if ok else math.nan,
                 "verdict": word,
                 "remark": remark,
             })

@@ -120,12 +120,18 @@ def test_compare_verdicts(gyro_model, accel_model):
         assert by[("gyro", "N", ax)]["ratio"] == pytest.approx(0.5, rel=0.05)
         assert by[("gyro", "B", ax)]["verdict"] == "pass"
         assert by[("gyro", "B", ax)]["ratio"] == pytest.approx(0.3, rel=0.3)
+        b = by[("gyro", "B", ax)]
+        assert b["ratio_std"] == pytest.approx(b["std"] / b["spec"])
         assert by[("accel", "N", ax)]["verdict"] == "above typical"  # a typical value is no limit
         assert by[("accel", "N", ax)]["ratio"] == pytest.approx(2.0, rel=0.05)
         # accel white noise only: bias instability not resolved, not a number
         assert by[("accel", "B", ax)]["verdict"] == "not resolved"
     assert cmp.passed  # no max/min limit is clearly exceeded
     assert "above typical (2× typical)" in cmp.text() and "not resolved" in cmp.text()
+    # the ratio is rounded to its uncertainty like the measured value (GUM), not to noise digits
+    b = by[("gyro", "B", "X")]
+    assert imunoise.numbers.format_value(b["ratio"], b["ratio_std"]) in cmp.text()
+    assert imunoise.numbers.format_value(b["ratio"], b["ratio_std"]) in cmp._repr_html_()
     only = imunoise.compare(mg, "vn100")
     assert only.passed and {r["sensor"] for r in only.rows} == {"gyro"}
 

@@ -93,7 +93,7 @@ def comparison_rows(models: dict[str, NoiseModel], spec) -> tuple[list[str], lis
         out.append([
             r["sensor"], f"{r['quantity']} ({r['term']})", r["axis"], r["unit"],
             format_number(r["measured"], r["std"]), f"{bound} {format_number(r['spec'])}",
-            format_number(r["ratio"]),
+            format_number(r["ratio"], r["ratio_std"]),
             r["verdict"] + (f" ({r['remark']})" if r.get("remark") else ""),
         ])
     return header, out
