@@ -57,14 +57,23 @@ def model_sentences(model: NoiseModel, sensor: str) -> list[str]:
         if cover < POOR_COVERAGE:
             parts.append("**the model does not describe this curve: read its coefficients "
                          "as a summary only** (see the data/model panel)")
-        for sigma, tau_c in gm:
-            value = units.convert(sigma, "B", b_unit.name, sensor=sensor)
-            parts.append(f"Gauss–Markov bias σ = {format_number(value)} {b_unit.label}, "
-                         f"τc = {format_number(tau_c)} s")
+        for sigma, sigma_std, tau_c, tau_std in _gauss_markov_with_std(model, c):
+            value, value_std = units.convert(np.array([sigma, sigma_std]), "B", b_unit.name,
+                                             sensor=sensor)
+            parts.append(f"Gauss–Markov bias σ = {format_number(value, value_std)} "
+                         f"{b_unit.label}, τc = {format_number(tau_c, tau_std)} s")
         for term, unit in (("N", n_unit), ("B", b_unit)):
             parts += _readoff_agreement(model, c, term, unit, sensor)
         out.append("; ".join(parts) + ".")
     return out
+
+
+def _gauss_markov_with_std(model: NoiseModel, c: int) -> list[tuple[float, ...]]:
+    """(σ, std of σ, τc, std of τc) of each Gauss–Markov term of channel ``c``."""
+    columns = [np.reshape(a, (model.channels, -1))[c] for a in
+               (model.gm_sigma, model.gm_sigma_std, model.gm_tau, model.gm_tau_std)]
+    return [tuple(map(float, row)) for row in zip(*columns, strict=True)
+            if np.isfinite(row[0])]
 
 
 def _readoff_agreement(model: NoiseModel, c: int, term: str, unit, sensor: str) -> list[str]:
@@ -75,12 +84,14 @@ def _readoff_agreement(model: NoiseModel, c: int, term: str, unit, sensor: str) 
     eq = float(np.atleast_1d(model.equivalent(term))[c])
     if not (np.isfinite(read) and eq > 0):
         return []
-    conv = units.convert(np.array([read, eq, std]), term, unit.name, sensor=sensor)
+    eq_std = float(np.atleast_1d(model.equivalent_std(term))[c])
+    read_c, std_c, eq_c, eq_std_c = units.convert(np.array([read, std, eq, eq_std]), term,
+                                                  unit.name, sensor=sensor)
     diff = abs(read - eq) / max(std, 1e-300)
     verdict = ("agree" if diff <= 2 or abs(read / eq - 1) <= 0.05 else
                "differ: the curve is not the ideal slope there (filter, bumps)")
-    return [f"{term} read-off {format_number(conv[0])} vs model {format_number(conv[1])} "
-            f"{unit.label} ({verdict})"]
+    return [f"{term} read-off {format_number(read_c, std_c)} vs model "
+            f"{format_number(eq_c, eq_std_c)} {unit.label} ({verdict})"]
 
 
 def comparison_rows(models: dict[str, NoiseModel], spec) -> tuple[list[str], list[list[str]]]:
