@@ -258,7 +258,7 @@ def _cmd_report(args) -> int:
 
 
 def _cmd_adev(args) -> int:
-    from imunoise import allan, report
+    from imunoise import allan, numbers, report
 
     log = _read(args)
     y = getattr(log, args.sensor)
@@ -274,7 +274,7 @@ def _cmd_adev(args) -> int:
     for i, tau in enumerate(r.taus):
         row = [f"{tau:.6g}", report.terms_used(r, i)]
         for j in range(r.dev.shape[1]):
-            row += [f"{r.dev[i, j]:.6e}", f"{r.ci_low[i, j]:.6e}", f"{r.ci_high[i, j]:.6e}"]
+            row += numbers.interval_cells(r.dev[i, j], r.ci_low[i, j], r.ci_high[i, j])
         rows.append(row)
     print(f"# {args.kind} of {args.sensor}, {len(y)} samples at {log.fs:.6g} Hz, "
           f"CI {r.confidence:.1%}")
@@ -308,7 +308,7 @@ def _cmd_fit(args) -> int:
 
 
 def _cmd_stats(args) -> int:
-    from imunoise import stats
+    from imunoise import numbers, stats
 
     log = _read(args)
     desc = stats.describe(log)
@@ -327,9 +327,10 @@ def _cmd_stats(args) -> int:
                 sensor_label(sensor, j, y.shape[1]),
                 f"{d.step:.6g}" if d.step else "-",
                 f"{d.level_spacing:.6g}" if d.level_spacing else "-",
+                numbers.cell(d.mu, d.mu_std), numbers.cell(d.sigma, d.sigma_std),
             ] + [
-                f"{v:.6g}" for v in (d.mu, d.sigma, d.ks_statistic, d.ks_pvalue,
-                                     d.ad_statistic, d.skewness, d.excess_kurtosis)
+                numbers.cell(v) for v in (d.ks_statistic, d.ks_pvalue, d.ad_statistic,
+                                          d.skewness, d.excess_kurtosis)
             ])
     _print_table(head, rows)
     return 0

@@ -83,6 +83,30 @@ def _with_uncertainty(value: float, std: float) -> str:
     return f"({value / scale:.{decimals}f} ± {std_r / scale:.{decimals}f})e{power}"
 
 
+def interval_cells(value, low, high) -> tuple[str, str, str]:
+    """``value`` and its confidence bounds as three cells, GUM style: all three to
+    the decimal place of two significant digits of the shorter arm of the
+    interval (``min(value - low, high - value)``), in ``1.2345e-04`` notation so a
+    column of deviations spanning decades stays readable and machine-parseable.
+    Without a usable interval the value keeps four significant digits; a
+    non-finite entry is ``—``."""
+    arms = [float(value) - float(low), float(high) - float(value)] if all(
+        _finite(v) for v in (value, low, high)) else []
+    arm = min(arms) if arms and min(arms) > 0 else None
+    place = None if arm is None else _exponent(arm) - 1
+
+    def one(v) -> str:
+        if not _finite(v):
+            return EMPTY
+        v = float(v)
+        if v == 0:
+            return "0"
+        digits = 4 if place is None else max(_exponent(v) - place + 1, 1)
+        return f"{v:.{digits - 1}e}"
+
+    return one(value), one(low), one(high)
+
+
 def cell(value, std=None, *, digits: int = 4) -> str:
     """A table cell: as :func:`format_value`, with "—" for a missing value."""
     return format_value(value, std, digits=digits, missing=EMPTY)

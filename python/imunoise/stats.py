@@ -371,6 +371,10 @@ class Distribution:
         points (see the module notes).
     mu, sigma : float
         Maximum-likelihood normal fit (``scipy.stats.norm.fit``; sigma has ddof=0).
+    mu_std, sigma_std : float
+        Their standard uncertainties, correlation between samples included
+        (batch means, see :func:`distribution`); NaN below
+        :data:`UNCERTAINTY_BATCHES` · 10 samples.
     ks_statistic, ks_pvalue : float
         Kolmogorov–Smirnov test against N(mu, sigma).
     ad_statistic : float
@@ -402,6 +406,8 @@ class Distribution:
     qq_theoretical: np.ndarray
     qq_sample: np.ndarray
     missing: int = 0
+    mu_std: float = float("nan")
+    sigma_std: float = float("nan")
 
     def __post_init__(self) -> None:
         for name in (
@@ -477,6 +483,16 @@ def distribution(x, *, bins="auto", qq_points: int = 1001) -> Distribution:
     (``kstwobign``) above, where the exact one costs half a second per channel
     and differs in digits nobody reads. A² uses the sample standard deviation
     (ddof = 1) as ``scipy.stats.anderson`` does.
+
+    ``mu_std`` is the batch-means standard error: the valid samples, in time
+    order, cut into :data:`UNCERTAINTY_BATCHES` equal batches, and
+    :math:`u(\mu) = s_{\bar x_b}/\sqrt{b}`. Unlike :math:`\sigma/\sqrt{n}`
+    it grows with the correlation of the samples up to the batch length (a
+    sensor's filter, a wandering bias), which is what makes the mean of a still
+    log less certain than independent samples would. With the effective sample
+    count :math:`n_\mathrm{eff} = \min(n, \sigma^2/u(\mu)^2)`,
+    ``sigma_std`` is :math:`\sigma/\sqrt{2(n_\mathrm{eff}-1)}`. They round
+    the report's μ and σ (GUM style).
 
     The KS test uses the parameters fitted from the same data, so its p-value
     is optimistic (Lilliefors); on quantized data ties inflate the statistic
@@ -564,7 +580,24 @@ def distribution(x, *, bins="auto", qq_points: int = 1001) -> Distribution:
         qq_theoretical=_sstats.norm.ppf(p),
         qq_sample=xs[lo] + (h - lo) * (xs[hi] - xs[lo]),
         missing=missing,
+        **_fit_uncertainty(arr, sigma),
     )
+
+
+#: Batches of the batch-means standard error of the normal fit's mean.
+UNCERTAINTY_BATCHES = 20
+
+
+def _fit_uncertainty(v: np.ndarray, sigma: float) -> dict[str, float]:
+    """``mu_std`` (batch means over the samples ``v`` in time order) and ``sigma_std``."""
+    b = UNCERTAINTY_BATCHES
+    size = len(v) // b
+    if size < 10:
+        return {"mu_std": float("nan"), "sigma_std": float("nan")}
+    means = v[: b * size].reshape(b, size).mean(axis=1)
+    mu_std = float(np.std(means, ddof=1) / np.sqrt(b))
+    n_eff = min(float(len(v)), sigma**2 / mu_std**2) if mu_std > 0 else float(len(v))
+    return {"mu_std": mu_std, "sigma_std": sigma / np.sqrt(2.0 * max(n_eff - 1.0, 1.0))}
 
 
 def _level_spacing(xs: np.ndarray, levels: np.ndarray, step: float) -> float:

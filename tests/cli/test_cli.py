@@ -111,12 +111,21 @@ def test_stats_adev_convert_on_bundled_log(tmp_path, capsys, read):
     log = read(bundled_log())
     code, out, _ = _run(["stats", str(bundled_log())], capsys)
     assert code == 0 and "gyro X" in out
+    d = imunoise.distribution(log.accel[:, 2])
+    assert imunoise.numbers.format_value(d.mu, d.mu_std) in out  # μ rounded to its uncertainty
     code, out, _ = _run(["adev", str(bundled_log()), "--sensor", "gyro"], capsys)
     assert code == 0
     rows = [line.split() for line in out.splitlines()[2:]]
     r = imunoise.adev(log.gyro, log.fs)
     np.testing.assert_allclose([float(x[0]) for x in rows], r.taus, rtol=1e-5)
-    np.testing.assert_allclose([float(x[2]) for x in rows], r.dev[:, 0], rtol=1e-6)
+    dev, low, high = (np.array([float(x[k]) for x in rows]) for k in (2, 3, 4))
+    # GUM rounding: to two significant digits of the shorter arm of the interval
+    arm = np.minimum(r.dev[:, 0] - r.ci_low[:, 0], r.ci_high[:, 0] - r.dev[:, 0])
+    last_digit = 10.0 ** (np.floor(np.log10(arm)) - 1)
+    assert np.all(np.abs(dev - r.dev[:, 0]) <= 0.5 * last_digit * (1 + 1e-9))
+    assert np.all(np.abs(low - r.ci_low[:, 0]) <= 0.5 * last_digit * (1 + 1e-9))
+    assert np.all(np.abs(high - r.ci_high[:, 0]) <= 0.5 * last_digit * (1 + 1e-9))
+    assert np.all(last_digit > 1e-6 * r.dev[:, 0])  # not six noise digits
     for suffix in (".csv", ".npz", ".parquet"):
         out_file = tmp_path / f"log{suffix}"
         code, _, _ = _run(["convert", str(bundled_log()), "-o", str(out_file)], capsys)

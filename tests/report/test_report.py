@@ -7,7 +7,7 @@ from pathlib import Path
 import imunoise
 import numpy as np
 import pytest
-from imunoise import datasheet, report
+from imunoise import datasheet, numbers, report
 from imunoise.stats import describe, distribution
 
 FS = 40.0
@@ -104,10 +104,12 @@ def test_distribution_table_matches_api(built):
             assert float(r[2]) == pytest.approx(step, rel=1e-4)
             assert float(r[3]) == pytest.approx(d.level_spacing, rel=1e-5)
             assert int(r[4]) == len(d.counts)
-            got = [float(v) for v in (r[5], r[6], r[7], r[9], r[10], r[11])]
-            want = [d.mu, d.sigma, d.ks_statistic, d.ad_statistic, d.skewness,
-                    d.excess_kurtosis]
-            np.testing.assert_allclose(got, want, rtol=5e-6)
+            # μ and σ rounded to their uncertainties (GUM), the statistics to 4 digits
+            assert r[5] == numbers.format_value(d.mu, d.mu_std)
+            assert r[6] == numbers.format_value(d.sigma, d.sigma_std)
+            got = [float(v) for v in (r[7], r[9], r[10], r[11])]
+            want = [d.ks_statistic, d.ad_statistic, d.skewness, d.excess_kurtosis]
+            np.testing.assert_allclose(got, want, rtol=5e-4)
 
 
 def test_allan_table_matches_adev(built):

@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from imunoise import plot
+from imunoise import numbers, plot
 from imunoise._schema import CHANNELS, SAMPLE_SENSORS, axis_names
 from imunoise.report.formatting import (
     format_duration,
@@ -126,8 +126,9 @@ def distribution_fits(ctx: Context, doc: Doc) -> None:
             rows.append([
                 name, unit, format_number(d.step) if d.step else "—",
                 format_number(d.level_spacing) if d.level_spacing else "—",
-                str(len(d.counts)), *(format_number(v) for v in (
-                    d.mu, d.sigma, d.ks_statistic, d.ks_pvalue, d.ad_statistic, d.skewness,
+                str(len(d.counts)), format_number(d.mu, d.mu_std),
+                format_number(d.sigma, d.sigma_std), *(numbers.cell(v) for v in (
+                    d.ks_statistic, d.ks_pvalue, d.ad_statistic, d.skewness,
                     d.excess_kurtosis)),
             ])
         fig = plot.histograms(list(per_axis.values()),
