@@ -14,6 +14,8 @@ from pathlib import PurePath
 
 import numpy as np
 
+from imunoise import numbers as _numbers
+
 #: Characters of a repr line before the next part goes to a new line.
 LINE_WIDTH = 110
 #: Lines of a repr at the most (the first one included).
@@ -30,6 +32,12 @@ def number(value) -> str:
         return "—"
     v = float(value)
     return f"{v:.4g}" if math.isfinite(v) else "—"
+
+
+def estimate(value, std) -> str:
+    """``value ± std`` rounded to the uncertainty (GUM, :func:`imunoise.numbers.format_value`),
+    ``value`` to four significant digits without one, ``—`` when missing."""
+    return _numbers.cell(value, std)
 
 
 def duration(seconds: float) -> str:

@@ -394,12 +394,16 @@ class NoiseModel:
 
     # -- summaries ----------------------------------------------------------
     def _axis_facts(self, channel: int) -> str:
-        """``"N=0.0001234 B=1.2e-05, 1 GM, covers 85 %"``: one channel, input units."""
-        terms = [f"{t}={_summary.number(self.value(t)[channel])}" for t in TERMS
+        """``"N=(1.234 ± 0.012)e-4 B=(1.2 ± 0.3)e-5, 1 GM, covers 85 %"``: one channel,
+        input units, each value rounded to its uncertainty."""
+        terms = [f"{t}={_summary.estimate(*self._value_std(t, channel))}" for t in TERMS
                  if np.atleast_1d(self.supported[t])[channel]]
         gm = len(self.gauss_markov(channel))
         return (" ".join(terms) or "no term resolved") + (f", {gm} GM" if gm else "") + (
             f", covers {100 * float(np.atleast_1d(self.coverage)[channel]):.3g} %")
+
+    def _value_std(self, term: str, channel: int) -> tuple[float, float]:
+        return float(np.ravel(self.value(term))[channel]), float(np.ravel(self.std(term))[channel])
 
     def _title(self) -> str:
         return (f"{self.method} fit of {self.kind} at {_summary.number(self.fs)} Hz, "

@@ -430,14 +430,16 @@ class Distribution:
         return self.counts / (self.counts.sum() * widths)
 
     def _items(self) -> list[tuple[str, str]]:
-        """(quantity, value) pairs of the summary, four significant digits."""
+        """(quantity, value) pairs of the summary: μ and σ rounded to their
+        uncertainties, the rest to four significant digits."""
         num = _summary.number
         bins = f"{len(self.counts)}"
         if self.step:
             bins += f" (step {num(self.step)}"
             bins += (f", levels {num(self.level_spacing)} apart)"
                      if self.level_spacing and self.level_spacing != self.step else ")")
-        items = [("n", str(self.n)), ("normal fit", f"μ={num(self.mu)} σ={num(self.sigma)}"),
+        items = [("n", str(self.n)), ("normal fit", f"μ={_summary.estimate(self.mu, self.mu_std)} "
+                                       f"σ={_summary.estimate(self.sigma, self.sigma_std)}"),
                  ("KS", f"D={num(self.ks_statistic)} p={num(self.ks_pvalue)}"),
                  ("AD", f"A²={num(self.ad_statistic)}"),
                  ("skewness", num(self.skewness)),

@@ -110,6 +110,13 @@ def test_reprs_say_what_matters(objects):
     assert "terms Q N GM1" in repr(objects["prediction"])
     assert "gyro X Y Z, accel X Y Z, mag X Y Z" in repr(objects["description"])
     assert "bins" in repr(objects["distribution"])
+    # values with an uncertainty are rounded to it (GUM), not printed to fixed digits
+    d = objects["distribution"]
+    assert f"μ={imunoise.numbers.format_value(d.mu, d.mu_std)} " in repr(d)
+    m = objects["model"]
+    term = next(t for t in imunoise.noise.TERMS if np.atleast_1d(m.supported[t])[0])
+    shown = imunoise.numbers.format_value(np.ravel(m.value(term))[0], np.ravel(m.std(term))[0])
+    assert f"X: {term}={shown}" in model and " ± " in shown
     assert repr(objects["comparison"]).startswith("Comparison('VectorNav VN-100', 12 rows: ")
 
 
