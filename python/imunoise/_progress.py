@@ -57,6 +57,12 @@ class Progress:
             self._bar.set_description(what)
         self._bar.update(1)
 
+    def set_total(self, total: int) -> None:
+        """Change the number of steps once it is known (e.g. which report sections apply)."""
+        if self._bar is not None:
+            self._bar.total = total
+            self._bar.refresh()
+
     def bytes(self, label: str) -> Callable[[int, int], None] | None:
         """A :func:`byte_bar` callback when this bar is shown, else None."""
         return byte_bar(label) if self._bar is not None else None

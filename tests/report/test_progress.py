@@ -19,3 +19,13 @@ def test_byte_bar_closes_itself(capsys):
     update(50, 100)
     update(100, 100)
     assert "reading x" in capsys.readouterr().err
+
+
+def test_total_can_shrink_to_the_steps_that_apply(capsys):
+    # the report sets it once it knows which sections the logs have: no empty steps
+    with Progress(True, total=9, leave=True) as bar:
+        bar.set_total(2)
+        bar.step("one")
+        bar.step("two")
+    err = capsys.readouterr().err
+    assert "2/2" in err and "/9" not in err.rsplit("\r", 1)[-1]
