@@ -93,8 +93,8 @@ class Departure:
     channel : int
         The channel.
     ratio : float
-        The largest deviation ratio (block ADEV / median block ADEV) in the stretch at
-        the taus searched; > 1 noisier, < 1 quieter.
+        Block ADEV / median block ADEV where the departure is clearest (largest |z|
+        over the stretch's blocks and the taus searched); > 1 noisier, < 1 quieter.
     """
 
     start: float
@@ -454,28 +454,28 @@ def _departures(d: DynamicAllan) -> tuple[Departure, ...]:
     tests = sum(b[1].shape[0] * b[1].shape[1] for b in d._blocks)
     limit = _stats.norm.isf(_ALARM / (2 * max(tests, 1)))
     flagged = None
-    ratio = None
+    ratio = score = None
     for t, sums, counts in d._blocks:
         mm = int(d.m[t])
         with np.errstate(invalid="ignore", divide="ignore"):
             var = np.where(counts >= 2, sums / (2.0 * mm * mm * counts), np.nan)
             typical = np.nanmedian(var, axis=0)
-            edf = _edf(stride + 1, alpha[t:t + 1], d.m[t:t + 1])[0] * counts / (stride + 1 - 2 * mm)
-            z = _chi2_score(var / typical, edf)
+            full = stride + 1 - 2 * mm
+            edf = _edf(stride + 1, alpha[t:t + 1], d.m[t:t + 1])[0] * counts / full
+            z = np.abs(np.nan_to_num(_chi2_score(var / typical, edf)))
             r = np.sqrt(var / typical)
-        hit = np.abs(np.nan_to_num(z)) > limit
-        flagged = hit if flagged is None else flagged | hit
         if ratio is None:
-            ratio = r
-        ratio = np.where(np.abs(np.log(r)) > np.abs(np.log(ratio)), r, ratio)
+            flagged, ratio, score = z > limit, r, z
+        flagged |= z > limit
+        ratio = np.where(z > score, r, ratio)  # the ratio where the departure is clearest
+        score = np.maximum(z, score)
     out = []
     for j in range(flagged.shape[1]):
         edges = np.diff(np.r_[0, flagged[:, j].astype(np.int8), 0])
         for a, b in zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1), strict=True):
-            stretch = ratio[a:b, j]
-            k = int(np.nanargmax(np.abs(np.log(stretch))))
+            k = a + int(np.argmax(score[a:b, j]))
             out.append(Departure(start=a * stride / d.fs, end=min(b * stride, d.n_samples) / d.fs,
-                                 channel=j, ratio=float(stretch[k])))
+                                 channel=j, ratio=float(ratio[k, j])))
     return tuple(sorted(out, key=lambda dep: (dep.start, dep.channel)))
 
 
