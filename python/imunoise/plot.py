@@ -632,6 +632,7 @@ def dynamic(
                 if d.channel == j:
                     ax.axvspan(d.start / scale, d.end / scale, ymin=0.97, ymax=1.0,
                                color="k", linewidth=0)
+            ax.set_xlim(0, result.n_samples / result.fs / scale)  # the record's time
             ax.set_title(names[j])
             ax.set_xlabel(f"window centre [{tunit}]")
         axes[0].set_ylabel("τ [s]")
