@@ -36,7 +36,7 @@ Stationarity
 
 - for each window and tau, :math:`z` is the standard-normal score of the window's
   variance against the whole-record one under the window's χ² law
-  (ν·σ²_w/σ²_whole ~ χ²_ν if the noise is stationary);
+  (ν·σ²_w/σ²_whole ~ χ²_ν if the noise is stationary; Wilson–Hilferty's cube root);
 - ``outside``: the share of windows × taus where the whole-record ADEV lies outside the
   window's interval (about 1 − confidence for stationary noise, a little less as the
   windows overlap the whole record);
@@ -480,10 +480,11 @@ def _departures(d: DynamicAllan) -> tuple[Departure, ...]:
 
 
 def _chi2_score(ratio, edf):
-    """Standard-normal score of ν·ratio under χ²_ν (positive: above the reference)."""
-    upper = _stats.chi2.sf(ratio * edf, edf)
-    lower = _stats.chi2.cdf(ratio * edf, edf)
-    return np.where(upper < lower, _stats.norm.isf(upper), _stats.norm.ppf(lower))
+    """Standard-normal score of ``ratio`` = χ²_ν/ν (positive: above the reference), by
+    the Wilson–Hilferty cube-root transform (accurate to ~0.01 for ν ≥ 3, and unlike
+    the exact tail it does not saturate at |z| ≈ 38 where the tail underflows)."""
+    spread = 2.0 / (9.0 * edf)
+    return (np.cbrt(ratio) - (1.0 - spread)) / np.sqrt(spread)
 
 
 # -- arguments ------------------------------------------------------------------------
