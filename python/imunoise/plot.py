@@ -578,7 +578,8 @@ def spectrum(
                 ax.set_ylim(np.nanmin(lo[:, j]) / 3, np.nanmax(hi[:, j]) * 3)
             ax.set_title(names[j])
             ax.set_xlabel("frequency [Hz]")
-            ax.legend(loc="lower left", fontsize=6.5, ncol=2 if terms else 1)
+            if j == 0:
+                ax.legend(loc="best", fontsize=6.5)
         axes[0].set_ylabel(("ASD " if amplitude else "PSD ") + f"[{level_unit}]")
         if title:
             fig.suptitle(title)
