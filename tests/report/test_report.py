@@ -60,8 +60,8 @@ def test_files_exist(built):
     assert (out / "report.md").is_file()
     pngs = sorted((out / "figures").glob("*.png"))
     svgs = sorted((out / "figures").glob("*.svg"))
-    # time series (3 short + 3 long), histograms (3), Allan (2)
-    assert len(pngs) == 11 and len(svgs) == 11
+    # time series (3 short + 3 long), histograms (3), Allan (2), PSD (2), dynamic ADEV (2)
+    assert len(pngs) == 15 and len(svgs) == 15
     for p in pngs:
         assert p.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     for s in svgs:
@@ -143,7 +143,7 @@ def test_html_embeds_every_image(built):
     html = rep.html.read_text()
     srcs = re.findall(r'src="([^"]*)"', html)
     md_figs = re.findall(r"^!\[.*\]\((figures/[^)]*)\)$", rep.markdown.read_text(), re.M)
-    assert len(srcs) == len(md_figs) == 11
+    assert len(srcs) == len(md_figs) == 15
     assert all(s.startswith("data:image/png;base64,") for s in srcs)
     assert "<script" not in html and "<link" not in html and "href=" not in html
     for s in md_figs:
@@ -218,7 +218,7 @@ def test_missing_file_is_oserror(tmp_path):
 def test_figures_listed(built):
     rep, _, _ = built
     assert all(Path(p).is_file() for p in rep.figures)
-    assert len(rep.figures) == 22
+    assert len(rep.figures) == 30
 
 
 def test_sections_are_numbered_from_the_list(built):
@@ -227,3 +227,12 @@ def test_sections_are_numbered_from_the_list(built):
     # These logs carry no attitude: that section is absent and the numbers close up.
     present = [s.title for s in report.SECTIONS if not s.title.startswith("Attitude")]
     assert headings == [(str(i), t) for i, t in enumerate(present, start=1)]
+
+
+def test_psd_and_dynamic_sections(built):
+    rep, _, _ = built
+    md = rep.markdown.read_text()
+    psd = md.split("Power spectral density")[1].split("\n## ")[0]
+    assert psd.count("| X |") == 2 and "N PSD" in psd  # gyro and accel tables
+    dadev = md.split("Dynamic Allan deviation")[1].split("\n## ")[0]
+    assert dadev.count("noise is stationary") + dadev.count("noise is not stationary") == 2
