@@ -161,3 +161,16 @@ def test_bad_samples():
         imunoise.dynamic_adev(np.array(["a"] * 100), 1.0)
     with pytest.raises(ValueError, match="fs must be positive"):
         imunoise.dynamic_adev(np.ones(100), 0.0)
+
+
+def test_plot_heat_map():
+    from imunoise import plot
+
+    d = imunoise.dynamic_adev(imunoise.simulate(20_000, 10.0, N=1.0, channels=3, seed=1),
+                              10.0, window=300.0, step=100.0)
+    fig = d.plot()
+    assert len(fig.axes) == 4  # three panels and the colour bar
+    with pytest.raises(ValueError, match="limit must be"):
+        plot.dynamic(d, limit=1.0)
+    with pytest.raises(TypeError, match="DynamicAllan"):
+        plot.dynamic(d.whole)

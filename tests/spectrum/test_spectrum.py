@@ -207,3 +207,18 @@ def test_real_vn100_bundled_log():
     # Y: a line at 17–19 Hz raises the ADEV; the spectrum shows it above the band
     above = s.f > s.band[1, 1]
     assert s.psd[above, 1].max() > 3 * s.white[1]
+
+
+def test_plot_with_model_and_asd():
+    from imunoise import plot
+
+    y = imunoise.simulate(2**15, FS, N=1e-3, K=1e-4, channels=2, seed=1)
+    s = imunoise.psd(y, FS)
+    model = imunoise.fit(imunoise.adev(y, FS))
+    fig = s.plot(model, unit="rad/s")
+    assert len(fig.axes) == 2
+    assert any(line.get_label().startswith("N = ") for line in fig.axes[0].lines)
+    fig = plot.spectrum(s, amplitude=True)
+    assert "ASD" in fig.axes[0].get_ylabel()
+    with pytest.raises(TypeError, match="Spectrum"):
+        plot.spectrum(model)
