@@ -65,6 +65,8 @@ def compare(y, fs):
 
 
 def why(s, j):
+    if s.lines[j].size:
+        return "lines at " + ", ".join(f"{v:.3g}" for v in s.lines[j][:3]) + " Hz"
     p = np.reshape(s.psd, (len(s.f), -1))[:, j]
     top = np.reshape(s.band, (-1, 2))[j, 1]
     white = np.atleast_1d(s.white)[j]

@@ -567,6 +567,9 @@ def spectrum(
             level = (2 * white_n[j] ** 2) ** power
             label = f"N = {format_value(white_n[j], white_std[j])} {unit}/√Hz".replace("  ", " ")
             ax.plot(bands[j], [level, level], color="k", linewidth=1.6, label=label)
+            for k, line in enumerate(result.lines[j]):
+                ax.axvline(line, color="0.3", linestyle=":", linewidth=0.8,
+                           label="line (left out)" if k == 0 else None)
             if terms:
                 total = sum(np.reshape(v, shape)[:, j] for v in terms.values())
                 ax.loglog(s.f, total ** power, color="k", linestyle="-", linewidth=0.8,

@@ -117,6 +117,9 @@ POWER_LAWS: Mapping[str, PowerLaw] = MappingProxyType({
 _BAND_TOLERANCE = 0.01
 # Bins per decade of the internal log-binned spectrum the read-off fits.
 _FIT_BINS_PER_DECADE = 20
+# A binned value this many times the median of its _LINE_NEIGHBOURS neighbours is a line.
+_LINE_RATIO = 1.5
+_LINE_NEIGHBOURS = 7
 # Fewest binned points the automatic white band keeps.
 _MIN_BAND_BINS = 8
 # Binned points at the band's top that must all follow the fit (a quarter decade: one
@@ -160,6 +163,12 @@ class Spectrum:
         Frequencies (Hz) the read-off used.
     band_auto : bool
         Whether ``band`` was chosen automatically.
+    lines : tuple of ndarray
+        Per channel, the frequencies (Hz, log-bin centres) of the spectral lines the
+        automatic read-off left out: bins above 1.5 times the median of their seven
+        neighbours and at least twice the fitted level (a resonance, a vibration; the
+        Allan deviation counts them as noise at the taus near 1/(2f)). Empty for a
+        user ``band``.
     fs : float
         Sample rate, Hz.
     nperseg : int
@@ -184,6 +193,7 @@ class Spectrum:
     walk: np.ndarray
     band: np.ndarray
     band_auto: bool
+    lines: tuple[np.ndarray, ...]
     fs: float
     nperseg: int
     n_samples: int
@@ -337,7 +347,8 @@ def psd(
     low, high = _chi2_band(p, edf, confidence)
     fb, pb, edfb = _log_bins(f, p, edf, _FIT_BINS_PER_DECADE, _window_bin_correlation(seg))
     reads = [_read_white(fb, pb[:, j], edfb, user_band) for j in range(p.shape[1])]
-    h, h_std, bands = (np.array(v) for v in zip(*reads, strict=True))
+    h, h_std, bands, lines = (list(v) for v in zip(*reads, strict=True))
+    h, h_std, bands = np.array(h), np.array(h_std), np.array(bands)
     N = np.sqrt(h[:, 0] / 2)
     with np.errstate(divide="ignore", invalid="ignore"):
         N_std = np.where(N > 0, h_std / (4 * N), np.nan)
@@ -348,7 +359,8 @@ def psd(
         N=np.asarray(scalar(N)), N_std=np.asarray(scalar(N_std)),
         white=np.asarray(scalar(h[:, 0])), flicker=np.asarray(scalar(h[:, 1])),
         walk=np.asarray(scalar(h[:, 2])), band=np.asarray(scalar(bands)),
-        band_auto=user_band is None, fs=fs, nperseg=seg, n_samples=n, confidence=confidence,
+        band_auto=user_band is None, lines=tuple(lines), fs=fs, nperseg=seg, n_samples=n,
+        confidence=confidence,
     )
 
 
@@ -475,17 +487,35 @@ def _read_white(f, p, edf, user_band):
                 f"({f[0]:.4g}–{f[-1]:.4g} Hz)"
             )
         h, std = _fit_levels(f[inside], p[inside], edf[inside], columns=1)
-        return np.r_[h, 0.0, 0.0], std, np.array(user_band, dtype=float)
+        return np.r_[h, 0.0, 0.0], std, np.array(user_band, dtype=float), np.empty(0)
+    lines = _lines(p)
+    keep = ~lines
     top = f.size
     while True:
-        h, std = _fit_levels(f[:top], p[:top], edf[:top], columns=3)
-        edge = slice(max(top - _EDGE_BINS, 0), top)
+        band = keep[:top]
+        h, std = _fit_levels(f[:top][band], p[:top][band], edf[:top][band], columns=3)
+        edge = np.flatnonzero(band)[-_EDGE_BINS:]
         model = h[0] + h[1] / f[edge] + h[2] / f[edge] ** 2
         scatter = np.sqrt(2 / edf[edge] + _BAND_TOLERANCE**2)
-        if top <= _MIN_BAND_BINS or np.all(np.abs(p[edge] / model - 1) <= 3 * scatter):
+        if np.count_nonzero(band) <= _MIN_BAND_BINS or np.all(
+                np.abs(p[edge] / model - 1) <= 3 * scatter):
             break
         top -= 1
-    return h, std, np.array([f[0], f[top - 1]])
+    level = h[0] + h[1] / f + h[2] / f**2
+    strong = lines & (p > 2 * level) & (f <= f[top - 1])
+    return h, std, np.array([f[0], f[top - 1]]), f[strong]
+
+
+def _lines(p: np.ndarray) -> np.ndarray:
+    """Bins of a log-binned spectrum that hold a spectral line (a resonance, vibration):
+    above 1.5 times the median of the seven bins around them, and their neighbours (the
+    window leaks a line into them). The white-band fit leaves them out instead of
+    ending the band below them."""
+    half = _LINE_NEIGHBOURS // 2
+    padded = np.pad(p, half, mode="edge")
+    local = np.median(np.lib.stride_tricks.sliding_window_view(padded, _LINE_NEIGHBOURS), axis=1)
+    peak = p > _LINE_RATIO * local
+    return peak | np.r_[peak[1:], False] | np.r_[False, peak[:-1]]
 
 
 def _fit_levels(f, p, edf, columns: int):

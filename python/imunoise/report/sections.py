@@ -268,6 +268,11 @@ def _n_remark(s, j: int, ratio: float) -> str:
         return "the ADEV fit resolves no white noise"
     if abs(ratio - 1) <= N_AGREEMENT:
         return f"agree within {N_AGREEMENT:.0%}"
+    lines = s.lines[j]
+    if ratio < 1 and lines.size:
+        where = ", ".join(f"{v:.3g}" for v in lines[:3])
+        return (f"spectral lines near {where} Hz, left out of the PSD read-off, add to the "
+                "ADEV's short taus")
     p = np.reshape(s.psd, (len(s.f), -1))[:, j]
     top = float(np.reshape(s.band, (-1, 2))[j, 1])
     white = float(np.atleast_1d(s.white)[j])
