@@ -399,7 +399,9 @@ def _cmd_psd(args) -> int:
     for j, a in enumerate(names):
         print(f"# N {a} = {format_value(np.atleast_1d(s.N)[j], np.atleast_1d(s.N_std)[j])} "
               f"{unit}/sqrt(Hz) (white band {bands[j, 0]:.4g}-{bands[j, 1]:.4g} Hz"
-              f"{'' if s.band_auto else ', given'})")
+              f"{'' if s.band_auto else ', given'}"
+              + (f"; lines left out at {', '.join(f'{v:.3g}' for v in s.lines[j])} Hz)"
+                 if s.lines[j].size else ")"))
     sm = s.smooth(args.bins)
     p = np.reshape(sm.psd, (len(sm.f), -1))
     _print_table(["f[Hz]", *[f"{a}_psd" for a in names]],
