@@ -208,6 +208,11 @@ def test_report_on_bundled_real_log(tmp_path):
     steps = {r[0]: r[2] for r in rows[1:]}
     assert float(steps["gyro X"]) == pytest.approx(1e-6, rel=1e-3)
     assert float(steps["accel X"]) == pytest.approx(1e-3, rel=1e-3)
+    # 5 minutes: a PSD section whose table explains the axes with lines; no dynamic map
+    psd = _md_table(md, "gyro: noise density from the spectrum and from the Allan fit")
+    remarks = {r[0]: r[-1] for r in psd[1:]}
+    assert remarks["X"].startswith("agree") and "18.9 Hz" in remarks["Y"]
+    assert "Dynamic Allan deviation" not in md
 
 
 def test_missing_file_is_oserror(tmp_path):
