@@ -56,7 +56,9 @@ from __future__ import annotations
 
 import math
 import numbers
+import warnings
 from dataclasses import dataclass
+from functools import cached_property
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -216,9 +218,9 @@ class DynamicAllan:
         whole = self.whole.dev
         return self.dev / (whole[None, :] if self.dev.ndim == 2 else whole[None, :, :])
 
-    @property
+    @cached_property
     def stationarity(self) -> Stationarity:
-        """The stationarity summary (module notes)."""
+        """The stationarity summary (module notes), computed on first use."""
         return _stationarity(self)
 
     def __len__(self) -> int:
@@ -517,8 +519,15 @@ def _samples_of(name: str, seconds, fs: float) -> int:
 def _window_factors(taus, fs: float, width: int) -> np.ndarray:
     if isinstance(taus, numbers.Real) and not isinstance(taus, (bool, numbers.Integral)):
         raise TypeError(f"taus must be a grid name, points per decade or an array; got {taus!r}")
-    m, _ = averaging_factors(taus, fs, width)
-    m = np.unique(m[(m >= 1) & (width + 1 - 2 * m >= 2)])
+    m, user_given = averaging_factors(taus, fs, width)
+    fits = (m >= 1) & (width + 1 - 2 * m >= 2)
+    if user_given and not fits.all():
+        warnings.warn(
+            f"{int(np.count_nonzero(~fits))} of {m.size} taus dropped: a window of {width} "
+            f"samples holds taus from {1 / fs:g} s to {math.floor((width - 1) / 2) / fs:g} s",
+            stacklevel=4,
+        )
+    m = np.unique(m[fits])
     if m.size == 0:
         raise ValueError(
             f"no tau fits a window of {width} samples: the largest is "

@@ -174,3 +174,11 @@ def test_plot_heat_map():
         plot.dynamic(d, limit=1.0)
     with pytest.raises(TypeError, match="DynamicAllan"):
         plot.dynamic(d.whole)
+
+
+def test_explicit_taus_beyond_the_window_are_dropped_with_a_warning():
+    y = np.random.default_rng(0).normal(size=5000)
+    with pytest.warns(UserWarning, match="1 of 3 taus dropped"):
+        d = imunoise.dynamic_adev(y, 1.0, window=100.0, taus=[1.0, 10.0, 80.0])
+    np.testing.assert_array_equal(d.taus, [1.0, 10.0])
+    assert d.stationarity is d.stationarity  # computed once
