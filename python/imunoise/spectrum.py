@@ -204,6 +204,8 @@ class Spectrum:
         for name in ("f", "psd", "ci_low", "ci_high", "edf", "N", "N_std", "white",
                      "flicker", "walk", "band"):
             getattr(self, name).flags.writeable = False
+        for found in self.lines:
+            found.flags.writeable = False
 
     @property
     def channels(self) -> int:
