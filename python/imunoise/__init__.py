@@ -22,6 +22,7 @@ from imunoise.allan import (
     ttotdev,
 )
 from imunoise.datasheet import compare
+from imunoise.dynamic import DynamicAllan, dynamic_adev
 from imunoise.errors import ParseError
 from imunoise.noise import NoiseModel, fit
 from imunoise.readers import Gaps, ImuLog, ParseIssues
@@ -29,22 +30,26 @@ from imunoise.readers.read import read
 from imunoise.scale import batch
 from imunoise.simulate import simulate
 from imunoise.simulate_log import simulate_log
+from imunoise.spectrum import Spectrum, psd
 from imunoise.stats import describe, distribution
 from imunoise.writers.vn import write_vn_ascii, write_vn_binary
 
 __all__ = [
     "__version__",
     "AllanResult",
+    "DynamicAllan",
     "Gaps",
     "ImuLog",
     "NoiseModel",
     "ParseError",
     "ParseIssues",
+    "Spectrum",
     "adev",
     "batch",
     "compare",
     "describe",
     "distribution",
+    "dynamic_adev",
     "export",
     "fit",
     "hdev",
@@ -52,6 +57,7 @@ __all__ = [
     "mdev",
     "mtotdev",
     "plot",
+    "psd",
     "read",
     "report",
     "scale",

@@ -135,6 +135,36 @@ def _build_parser() -> argparse.ArgumentParser:
     m.add_argument("--format", choices=("vn-ascii", "vn-binary"), default="vn-ascii")
     m.add_argument("--seed", type=int, default=None)
 
+    ps = sub.add_parser("psd", help="print the power spectral density and the noise density N",
+                        description="Welch one-sided PSD per axis, log-binned, and N read off "
+                        "its white region (automatic, or --band) with its uncertainty, in the "
+                        "channel's unit/√Hz (N = √(PSD/2), the IEEE convention of 'fit').")
+    ps.add_argument("log", metavar="LOG")
+    _shared_options(ps, fs=True, layout=True)
+    ps.add_argument("--sensor", choices=ALLAN_SENSORS, default="gyro")
+    ps.add_argument("--band", type=_positive_float, nargs=2, default=None, metavar=("LOW", "HIGH"),
+                    help="white band in Hz for N (default: chosen automatically)")
+    ps.add_argument("--nperseg", type=int, default=None, metavar="SAMPLES",
+                    help="samples per Welch segment (default: a power of two ~ n/8)")
+    ps.add_argument("--bins", type=int, default=10, metavar="PER_DECADE",
+                    help="log bins per decade of the printed table (default: %(default)s)")
+    ps.add_argument("--plot", default=None, metavar="PNG", help="also save the PSD figure")
+
+    dd = sub.add_parser("dadev", help="dynamic Allan deviation and a stationarity summary",
+                        description="Overlapping ADEV of a sliding window per axis: prints the "
+                        "stationarity summary and the stretches where the noise departs from "
+                        "its typical level; --plot saves the heat map.")
+    dd.add_argument("log", metavar="LOG")
+    _shared_options(dd, fs=True, layout=True)
+    dd.add_argument("--sensor", choices=ALLAN_SENSORS, default="gyro")
+    dd.add_argument("--window", type=_positive_float, default=None, metavar="SECONDS",
+                    help="window length (default: a tenth of the log)")
+    dd.add_argument("--step", type=_positive_float, default=None, metavar="SECONDS",
+                    help="step between windows (default: a sixth of the window)")
+    dd.add_argument("--taus", default="octave",
+                    help="octave, decade, all, or points per decade (default: %(default)s)")
+    dd.add_argument("--plot", default=None, metavar="PNG", help="also save the heat map")
+
     d = sub.add_parser("demo", help="run the report on bundled data",
                        description="Report on a real 5-minute VN-100 log shipped with imunoise "
                        "and a simulated 5-hour VN-100 log, then print where the report is.")
@@ -336,6 +366,83 @@ def _cmd_stats(args) -> int:
     return 0
 
 
+def _sensor_samples(args):
+    """The log and its ``--sensor`` samples, or a one-line failure."""
+    log = _read(args)
+    y = getattr(log, args.sensor)
+    if y is None:
+        _fail(f"{args.log}: the log has no {args.sensor} channel (has {', '.join(log.channels)})")
+    return log, y
+
+
+def _cmd_psd(args) -> int:
+    from imunoise import plot, spectrum
+    from imunoise.numbers import format_value
+
+    log, y = _sensor_samples(args)
+    rows_ok = ~np.isnan(y).any(axis=1)
+    if not rows_ok.all():  # a spectrum needs an unbroken record
+        edges = np.diff(np.r_[0, rows_ok.astype(np.int8), 0])
+        starts, ends = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
+        i = int(np.argmax(ends - starts))
+        y = y[starts[i]:ends[i]]
+        print(f"imunoise: note: missing samples; the spectrum uses the longest gap-free run, "
+              f"{len(y)} samples", file=sys.stderr)
+    if args.bins < 1:
+        _fail(f"--bins must be >= 1; got {args.bins}")
+    band = tuple(args.band) if args.band else None
+    s = spectrum.psd(y, log.fs, nperseg=args.nperseg, band=band)
+    unit = CHANNELS[args.sensor][1]
+    names = axis_names(s.channels)
+    print(f"# one-sided PSD of {args.sensor} [({unit})^2/Hz], {s.n_samples} samples at "
+          f"{log.fs:.6g} Hz, Welch nperseg {s.nperseg}")
+    bands = np.reshape(s.band, (-1, 2))
+    for j, a in enumerate(names):
+        print(f"# N {a} = {format_value(np.atleast_1d(s.N)[j], np.atleast_1d(s.N_std)[j])} "
+              f"{unit}/sqrt(Hz) (white band {bands[j, 0]:.4g}-{bands[j, 1]:.4g} Hz"
+              f"{'' if s.band_auto else ', given'}"
+              + (f"; lines left out at {', '.join(f'{v:.3g}' for v in s.lines[j])} Hz)"
+                 if s.lines[j].size else ")"))
+    sm = s.smooth(args.bins)
+    p = np.reshape(sm.psd, (len(sm.f), -1))
+    _print_table(["f[Hz]", *[f"{a}_psd" for a in names]],
+                 [[f"{f:.6g}", *[f"{v:.6e}" for v in p[i]]] for i, f in enumerate(sm.f)])
+    if args.plot:
+        written = plot.save(plot.spectrum(s, unit=unit, title=f"{args.sensor} PSD"),
+                            Path(args.plot).with_suffix(""), formats=("png",))
+        print(f"# figure: {written[0]}")
+    return 0
+
+
+def _cmd_dadev(args) -> int:
+    from imunoise import dynamic, plot
+
+    log, y = _sensor_samples(args)
+    taus = int(args.taus) if args.taus.isdigit() else args.taus
+    d = dynamic.dynamic_adev(y, log.fs, window=args.window, step=args.step, taus=taus)
+    st = d.stationarity
+    names = axis_names(d.channels)
+    print(f"# dynamic ADEV of {args.sensor}: {len(d.times)} windows of {d.window:.6g} s every "
+          f"{d.step:.6g} s, {len(d.taus)} taus {d.taus[0]:.4g}-{d.taus[-1]:.4g} s")
+    outside, worst = np.atleast_1d(st.outside), np.atleast_1d(st.worst_z)
+    at_t, at_tau = np.atleast_1d(st.worst_time), np.atleast_1d(st.worst_tau)
+    _print_table(["axis", "outside_CI", "expected", "max|z|", "at_t[s]", "at_tau[s]"],
+                 [[a, f"{outside[j]:.3f}", f"{st.expected_outside:.3f}", f"{worst[j]:.3g}",
+                   f"{at_t[j]:.6g}", f"{at_tau[j]:.4g}"] for j, a in enumerate(names)])
+    if st.intervals:
+        print("# departures from the typical noise level (1 % family-wise false alarms)")
+        _print_table(["axis", "start[s]", "end[s]", "adev_ratio"],
+                     [[names[v.channel], f"{v.start:.6g}", f"{v.end:.6g}", f"{v.ratio:.3g}"]
+                      for v in st.intervals])
+    else:
+        print("# no departure: the noise level is the same along the log (to one step)")
+    if args.plot:
+        written = plot.save(plot.dynamic(d, title=f"{args.sensor} dynamic ADEV"),
+                            Path(args.plot).with_suffix(""), formats=("png",))
+        print(f"# figure: {written[0]}")
+    return 0
+
+
 def _columns(log) -> tuple[list[str], list[np.ndarray]]:
     names, cols = [], []
     if log.time is not None:
@@ -460,6 +567,8 @@ _COMMANDS = {
     "batch": _cmd_batch,
     "simulate": _cmd_simulate,
     "demo": _cmd_demo,
+    "psd": _cmd_psd,
+    "dadev": _cmd_dadev,
 }
 
 

@@ -28,18 +28,24 @@ from imunoise import _summary
 from imunoise._schema import ATTITUDE_NAMES, CHANNELS, axis_names
 from imunoise.allan import AllanResult
 from imunoise.noise import FLICKER, TERMS, NoiseModel, model_variance
+from imunoise.numbers import format_value
 from imunoise.readers.log import ImuLog
 from imunoise.stats import Distribution
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
+    from imunoise.dynamic import DynamicAllan
+    from imunoise.spectrum import Spectrum
+
 __all__ = [
     "AXIS_COLORS",
     "allan",
     "decimate_minmax",
+    "dynamic",
     "histograms",
     "save",
+    "spectrum",
     "style",
     "time_series",
 ]
@@ -512,3 +518,139 @@ def save(fig: Figure, path, *, formats: Sequence[str] = ("png", "svg")) -> list[
             fig.savefig(out, format=fmt)
             written.append(out)
     return written
+
+
+# -- spectrum and dynamic ADEV (imunoise.spectrum, imunoise.dynamic) -------------------
+
+
+def spectrum(
+    result: Spectrum,
+    model: NoiseModel | None = None,
+    *,
+    amplitude: bool = False,
+    bins_per_decade: int = 20,
+    title: str = "",
+    unit: str = "",
+    names: Sequence[str] | None = None,
+) -> Figure:
+    """One-sided PSD (or ASD with ``amplitude``), log-binned, one panel per axis: the
+    ``confidence`` band, the white band the N read-off used (shaded) with its level
+    2N² and the value of N, and ``model``'s PSD (:func:`imunoise.spectrum.model_psd`,
+    total and terms) when given."""
+    from imunoise.spectrum import Spectrum, model_psd_terms
+
+    new_figure = _plt()
+    if not isinstance(result, Spectrum):
+        raise TypeError(f"result must be a Spectrum (imunoise.psd); got {type(result).__name__}")
+    if model is not None and not isinstance(model, NoiseModel):
+        raise TypeError(f"model must be a NoiseModel (imunoise.fit) or None; got "
+                        f"{type(model).__name__}")
+    s = result.smooth(bins_per_decade)
+    k = result.channels
+    shape = (len(s.f), k)
+    power = 0.5 if amplitude else 1.0
+    p, lo, hi = (np.reshape(a, shape) ** power for a in (s.psd, s.ci_low, s.ci_high))
+    white_n = np.atleast_1d(result.N)
+    white_std = np.atleast_1d(result.N_std)
+    bands = np.reshape(result.band, (k, 2))
+    terms = model_psd_terms(model, s.f) if model is not None else {}
+    names = list(names) if names is not None else axis_names(k)
+    level_unit = f"{unit}/√Hz" if amplitude else f"({unit})²/Hz"
+    with style():
+        fig = new_figure(figsize=(min(3.6 * k, 14.0), 3.4))
+        axes = np.atleast_1d(fig.subplots(1, k, sharey=True))
+        for j, ax in enumerate(axes):
+            color = AXIS_COLORS[j % 4]
+            ax.fill_between(s.f, lo[:, j], hi[:, j], color=color, alpha=0.25, linewidth=0)
+            ax.loglog(s.f, p[:, j], color=color, label="PSD" if not amplitude else "ASD")
+            ax.axvspan(*bands[j], color="0.85", alpha=0.5, linewidth=0, label="white band")
+            level = (2 * white_n[j] ** 2) ** power
+            label = f"N = {format_value(white_n[j], white_std[j])} {unit}/√Hz".replace("  ", " ")
+            ax.plot(bands[j], [level, level], color="k", linewidth=1.6, label=label)
+            for k, line in enumerate(result.lines[j]):
+                ax.axvline(line, color="0.3", linestyle=":", linewidth=0.8,
+                           label="line (left out)" if k == 0 else None)
+            if terms:
+                total = sum(np.reshape(v, shape)[:, j] for v in terms.values())
+                ax.loglog(s.f, total ** power, color="k", linestyle="-", linewidth=0.8,
+                          alpha=0.7, label="model")
+                for name, values in terms.items():
+                    text, dash = TERM_STYLES.get(name, (name, (0, (2, 2))))
+                    ax.loglog(s.f, np.reshape(values, shape)[:, j] ** power, color="0.4",
+                              linestyle=dash, linewidth=0.8, label=text)
+                ax.set_ylim(np.nanmin(lo[:, j]) / 3, np.nanmax(hi[:, j]) * 3)
+            ax.set_title(names[j])
+            ax.set_xlabel("frequency [Hz]")
+            if j == 0:
+                ax.legend(loc="best", fontsize=6.5)
+        axes[0].set_ylabel(("ASD " if amplitude else "PSD ") + f"[{level_unit}]")
+        if title:
+            fig.suptitle(title)
+        _margins(fig, title=bool(title))
+    return fig
+
+
+def dynamic(
+    result: DynamicAllan,
+    *,
+    title: str = "",
+    names: Sequence[str] | None = None,
+    limit: float = 4.0,
+) -> Figure:
+    """Dynamic Allan deviation as a heat map, one panel per axis: time (window centre)
+    across, tau up, colour the window's ADEV over the whole-record ADEV on a log scale
+    (1 white, noisier red, quieter blue, clipped at ``limit`` and 1/``limit``); the
+    stationarity summary's departures are marked above each panel."""
+    from matplotlib.colors import LogNorm
+
+    from imunoise.dynamic import DynamicAllan
+
+    new_figure = _plt()
+    if not isinstance(result, DynamicAllan):
+        raise TypeError(f"result must be a DynamicAllan (imunoise.dynamic_adev); got "
+                        f"{type(result).__name__}")
+    if not (isinstance(limit, (int, float)) and limit > 1):
+        raise ValueError(f"limit must be a number > 1; got {limit!r}")
+    k = result.channels
+    ratio = np.reshape(result.ratio, (len(result.times), len(result.taus), k))
+    names = list(names) if names is not None else axis_names(k)
+    span = result.times[-1] + result.window / 2
+    scale, tunit = (1.0, "s") if span < 600 else (60.0, "min")
+    if span >= 3 * 3600:
+        scale, tunit = 3600.0, "h"
+    t_edges = _edges(result.times, result.step) / scale
+    tau_edges = np.sqrt(result.taus[:-1] * result.taus[1:]) if len(result.taus) > 1 else None
+    tau_edges = (np.r_[result.taus[0] / 1.4, tau_edges, result.taus[-1] * 1.4]
+                 if tau_edges is not None else np.r_[result.taus[0] / 1.4, result.taus[0] * 1.4])
+    departures = result.stationarity.intervals
+    with style():
+        fig = new_figure(figsize=(min(3.8 * k, 14.0), 3.2))
+        axes = np.atleast_1d(fig.subplots(1, k, sharey=True))
+        norm = LogNorm(vmin=1 / limit, vmax=limit)
+        for j, ax in enumerate(axes):
+            mesh = ax.pcolormesh(t_edges, tau_edges, np.clip(ratio[:, :, j], 1 / limit, limit).T,
+                                 cmap="RdBu_r", norm=norm, shading="flat")
+            ax.set_yscale("log")
+            ax.grid(False)
+            for d in departures:
+                if d.channel == j:
+                    ax.axvspan(d.start / scale, d.end / scale, ymin=0.97, ymax=1.0,
+                               color="k", linewidth=0)
+            ax.set_xlim(0, result.n_samples / result.fs / scale)  # the record's time
+            ax.set_title(names[j])
+            ax.set_xlabel(f"window centre [{tunit}]")
+        axes[0].set_ylabel("τ [s]")
+        _margins(fig, right=0.9, title=bool(title))
+        bar = fig.colorbar(mesh, ax=list(axes), pad=0.02, fraction=0.04)
+        bar.set_label("ADEV / whole-record ADEV")
+        ticks = [v for v in (0.25, 0.5, 1.0, 2.0, 4.0, 8.0) if 1 / limit <= v <= limit]
+        bar.set_ticks(ticks, labels=[f"{v:g}" for v in ticks])
+        bar.minorticks_off()
+        if title:
+            fig.suptitle(title)
+    return fig
+
+
+def _edges(centres: np.ndarray, step: float) -> np.ndarray:
+    """Cell edges around evenly spaced centres."""
+    return np.r_[centres - step / 2, centres[-1] + step / 2]

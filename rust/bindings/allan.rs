@@ -151,6 +151,35 @@ fn estimator_terms<'py>(
     Ok(terms.into_pyarray(py))
 }
 
+/// estimator_edf(statistic, n_phase, alphas, ms) -> the EDF of a gap-free record of
+/// `n_phase` phase points for noise type `alphas[i]` at averaging factor `ms[i]`
+/// (the statistic's own EDF model, as `analyse` uses it)
+#[pyfunction]
+fn estimator_edf<'py>(
+    py: Python<'py>,
+    statistic: &str,
+    n_phase: usize,
+    alphas: PyReadonlyArray1<'py, i32>,
+    ms: PyReadonlyArray1<'py, u64>,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let statistic = parse_statistic(statistic)?;
+    let (alphas, ms) = (alphas.as_array(), ms.as_array());
+    if alphas.len() != ms.len() {
+        return Err(PyValueError::new_err(format!(
+            "alphas and ms must have the same length; got {} and {}",
+            alphas.len(),
+            ms.len()
+        )));
+    }
+    let model = statistic.spec().edf;
+    let edf: Vec<f64> = alphas
+        .iter()
+        .zip(ms.iter())
+        .map(|(&alpha, &m)| model.edf(alpha, m as usize, n_phase))
+        .collect();
+    Ok(edf.into_pyarray(py))
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let names = |keep: fn(&Statistic) -> bool| -> Vec<&'static str> {
         Statistic::ALL
@@ -168,6 +197,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<AnalysisArrays>()?;
     m.add_function(wrap_pyfunction!(analyse, m)?)?;
     m.add_function(wrap_pyfunction!(estimator_terms, m)?)?;
+    m.add_function(wrap_pyfunction!(estimator_edf, m)?)?;
     m.add_function(wrap_pyfunction!(analyse_plan, m)?)?;
     m.add_function(wrap_pyfunction!(theobr_seconds, m)?)?;
     Ok(())

@@ -237,3 +237,42 @@ def test_convert_quaternion_columns_round_trip(tmp_path, capsys, suffix):
         cols = {a: data[:, header.index(f"quaternion_{a}")] for a in "xyzw"}
     for j, a in enumerate("xyzw"):
         np.testing.assert_allclose(cols[a], q[:, j], atol=1e-9, err_msg=a)
+
+
+def test_psd_command(tmp_path, capsys):
+    from imunoise.cli import bundled_log
+
+    code, out, _ = _run(["psd", str(bundled_log()), "--fs", "40", "--bins", "5",
+                         "--plot", str(tmp_path / "psd.png")], capsys)
+    assert code == 0
+    n_lines = [line for line in out.splitlines() if line.startswith("# N ")]
+    assert len(n_lines) == 3 and all("rad/s/sqrt(Hz)" in line for line in n_lines)
+    log = imunoise.read(bundled_log(), fs=40.0)
+    s = imunoise.psd(log.gyro, 40.0)
+    assert format_value(s.N[0], s.N_std[0]) in n_lines[0]
+    assert (tmp_path / "psd.png").read_bytes()[:4] == b"\x89PNG"
+    code, out, _ = _run(["psd", str(bundled_log()), "--fs", "40", "--band", "1", "5"], capsys)
+    assert code == 0 and "white band 1-5 Hz, given" in out
+
+
+def test_dadev_command(tmp_path, capsys):
+    from imunoise.cli import bundled_log
+
+    code, out, _ = _run(["dadev", str(bundled_log()), "--fs", "40", "--window", "60",
+                         "--step", "10", "--plot", str(tmp_path / "d.png")], capsys)
+    assert code == 0
+    assert "28 windows of 60 s every 10 s" in out
+    assert "outside_CI" in out and (tmp_path / "d.png").is_file()
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["psd", "--bins", "0"], "--bins must be >= 1"),
+    (["psd", "--band", "5", "1"], "band must satisfy"),
+    (["dadev", "--window", "1000"], "window must hold between 3"),
+])
+def test_psd_dadev_errors(argv, message, capsys):
+    from imunoise.cli import bundled_log
+
+    code, _, err = _run([argv[0], str(bundled_log()), "--fs", "40", *argv[1:]], capsys)
+    assert code == 2
+    assert message in _one_line_error(err)

@@ -60,8 +60,8 @@ def test_files_exist(built):
     assert (out / "report.md").is_file()
     pngs = sorted((out / "figures").glob("*.png"))
     svgs = sorted((out / "figures").glob("*.svg"))
-    # time series (3 short + 3 long), histograms (3), Allan (2)
-    assert len(pngs) == 11 and len(svgs) == 11
+    # time series (3 short + 3 long), histograms (3), Allan (2), PSD (2), dynamic ADEV (2)
+    assert len(pngs) == 15 and len(svgs) == 15
     for p in pngs:
         assert p.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     for s in svgs:
@@ -145,7 +145,7 @@ def test_html_embeds_every_image(built):
     html = rep.html.read_text()
     srcs = re.findall(r'src="([^"]*)"', html)
     md_figs = re.findall(r"^!\[.*\]\((figures/[^)]*)\)$", rep.markdown.read_text(), re.M)
-    assert len(srcs) == len(md_figs) == 11
+    assert len(srcs) == len(md_figs) == 15
     assert all(s.startswith("data:image/png;base64,") for s in srcs)
     assert "<script" not in html and "<link" not in html and "href=" not in html
     for s in md_figs:
@@ -210,6 +210,11 @@ def test_report_on_bundled_real_log(tmp_path):
     steps = {r[0]: r[2] for r in rows[1:]}
     assert float(steps["gyro X"]) == pytest.approx(1e-6, rel=1e-3)
     assert float(steps["accel X"]) == pytest.approx(1e-3, rel=1e-3)
+    # 5 minutes: a PSD section whose table explains the axes with lines; no dynamic map
+    psd = _md_table(md, "gyro: noise density from the spectrum and from the Allan fit")
+    remarks = {r[0]: r[-1] for r in psd[1:]}
+    assert remarks["X"].startswith("agree") and "18.9 Hz" in remarks["Y"]
+    assert "Dynamic Allan deviation" not in md
 
 
 def test_missing_file_is_oserror(tmp_path):
@@ -220,7 +225,7 @@ def test_missing_file_is_oserror(tmp_path):
 def test_figures_listed(built):
     rep, _, _ = built
     assert all(Path(p).is_file() for p in rep.figures)
-    assert len(rep.figures) == 22
+    assert len(rep.figures) == 30
 
 
 def test_sections_are_numbered_from_the_list(built):
@@ -229,3 +234,12 @@ def test_sections_are_numbered_from_the_list(built):
     # These logs carry no attitude: that section is absent and the numbers close up.
     present = [s.title for s in report.SECTIONS if not s.title.startswith("Attitude")]
     assert headings == [(str(i), t) for i, t in enumerate(present, start=1)]
+
+
+def test_psd_and_dynamic_sections(built):
+    rep, _, _ = built
+    md = rep.markdown.read_text()
+    psd = md.split("Power spectral density")[1].split("\n## ")[0]
+    assert psd.count("| X |") == 2 and "N PSD" in psd  # gyro and accel tables
+    dadev = md.split("Dynamic Allan deviation")[1].split("\n## ")[0]
+    assert dadev.count("noise is stationary") + dadev.count("noise is not stationary") == 2

@@ -62,3 +62,12 @@ def estimator_terms(
     statistic: str, n_phase: int, ms: npt.NDArray[np.uint64]
 ) -> npt.NDArray[np.uint64]:
     """Terms each averaging factor's estimate averages (0: the tau does not fit)."""
+
+def estimator_edf(
+    statistic: str,
+    n_phase: int,
+    alphas: npt.NDArray[np.int32],
+    ms: npt.NDArray[np.uint64],
+) -> npt.NDArray[np.float64]:
+    """EDF of a gap-free record of n_phase phase points for noise type alphas[i] at
+    averaging factor ms[i], by the statistic's own EDF model (as :func:`analyse`)."""

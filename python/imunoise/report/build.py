@@ -135,6 +135,11 @@ SECTIONS: tuple[Section, ...] = (
     Section("Allan deviation", sections.allan_deviation),
     Section("Noise coefficients", sections.noise_coefficients),
     Section("Datasheet comparison", sections.datasheet_comparison),
+    Section("Power spectral density", sections.power_spectral_density,
+            applies=lambda ctx: any(getattr(ctx.short, s) is not None for s in ALLAN_SENSORS)),
+    Section("Dynamic Allan deviation", sections.dynamic_allan,
+            applies=lambda ctx: any(getattr(ctx.long, s) is not None for s in ALLAN_SENSORS)
+            and len(ctx.long) / ctx.long.fs >= sections.DYNAMIC_MIN_SECONDS),
 )
 
 

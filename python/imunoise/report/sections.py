@@ -12,8 +12,10 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from imunoise import numbers, plot
+from imunoise import allan as _allan
+from imunoise import noise, numbers, plot
 from imunoise._schema import CHANNELS, SAMPLE_SENSORS, axis_names
+from imunoise.numbers import format_value
 from imunoise.report.formatting import (
     format_duration,
     format_number,
@@ -34,7 +36,9 @@ __all__ = [
     "attitude",
     "datasheet_comparison",
     "distribution_fits",
+    "dynamic_allan",
     "noise_coefficients",
+    "power_spectral_density",
     "recording_summary",
     "sample_statistics",
 ]
@@ -238,3 +242,124 @@ def datasheet_comparison(ctx: Context, doc: Doc) -> None:
     header, rows = comparison_rows(ctx.models, ctx.spec)
     doc.table(header, rows, caption=f"Measured vs datasheet ({ctx.spec})")
 
+
+
+# -- spectrum and dynamic ADEV ---------------------------------------------------------
+
+#: Relative difference between the PSD and ADEV-fit N that the report explains.
+N_AGREEMENT = 0.05
+#: Shortest long log that gets a dynamic-ADEV map (its tenth is the window).
+DYNAMIC_MIN_SECONDS = 600.0
+
+
+def _longest_run(y: np.ndarray) -> np.ndarray:
+    """The longest stretch of rows without a missing sample."""
+    ok = ~np.isnan(y).any(axis=1)
+    edges = np.diff(np.r_[0, ok.astype(np.int8), 0])
+    starts, ends = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
+    if not starts.size:
+        return y[:0]
+    i = int(np.argmax(ends - starts))
+    return y[starts[i]:ends[i]]
+
+
+def _n_remark(s, j: int, ratio: float) -> str:
+    """Why the PSD's N and the ADEV fit's N differ by more than :data:`N_AGREEMENT`."""
+    if not np.isfinite(ratio):
+        return "the ADEV fit resolves no white noise"
+    if abs(ratio - 1) <= N_AGREEMENT:
+        return f"agree within {N_AGREEMENT:.0%}"
+    lines = s.lines[j]
+    if ratio < 1 and lines.size:
+        where = ", ".join(f"{v:.3g}" for v in lines[:3])
+        return (f"spectral lines near {where} Hz, left out of the PSD read-off, add to the "
+                "ADEV's short taus")
+    p = np.reshape(s.psd, (len(s.f), -1))[:, j]
+    top = float(np.reshape(s.band, (-1, 2))[j, 1])
+    white = float(np.atleast_1d(s.white)[j])
+    above = s.f > top
+    if ratio < 1 and above.any() and p[above].max() > 3 * white:
+        peak = float(s.f[above][np.argmax(p[above])])
+        return (f"a spectral line near {peak:.3g} Hz, above the white band, adds to the "
+                "ADEV's short taus")
+    if above.any() and p[above][-1] < 0.7 * white:
+        return (f"the sensor's low-pass filter bends the spectrum above {top:.3g} Hz and the "
+                "ADEV fit shares the white level with Gauss–Markov terms")
+    return "the ADEV fit shares the white level with its other terms (see the figure)"
+
+
+def power_spectral_density(ctx: Context, doc: Doc) -> None:
+    """Per sensor of the short log: the PSD with its white band, N read-off and the
+    long log's noise model overlaid; N from the PSD vs N from the ADEV fit, and why
+    they differ where they do."""
+    from imunoise import spectrum
+
+    doc.p("One-sided Welch PSD (Hann, 50 % overlap) of the "
+          f"{'only' if ctx.one_log else 'short'} log, log-binned, with its 68.3 % band. N is "
+          "read off the white region chosen automatically (below a sensor filter's bend or a "
+          "spectral line) as √(level/2), the IEEE convention of the noise model (the "
+          "one-sided ASD level is √2·N); the noise model fitted to the same log's Allan "
+          "deviation is drawn over it and its N compared (docs/spectrum.md).")
+    for sensor in ("gyro", "accel"):
+        y = getattr(ctx.short, sensor)
+        if y is None:
+            continue
+        y = _longest_run(y)
+        if len(y) < 256:
+            continue
+        s = spectrum.psd(y, ctx.short.fs)
+        model = ctx.models.get(sensor) if ctx.one_log else noise.fit(
+            _allan.adev(y, ctx.short.fs, taus=ctx.taus_per_decade), warn_coverage=False)
+        unit = CHANNELS[sensor][1]
+        doc.h(3, sensor)
+        ctx.add_figure(doc, plot.spectrum(s, model, unit=unit, title=f"{sensor} PSD"),
+                       f"psd_{sensor}", f"PSD of {sensor} [({unit})²/Hz], white band shaded, "
+                       "N read-off (black)" + (" and the noise model" if model else ""))
+        fitted = (np.atleast_1d(model.equivalent("N")) if model is not None
+                  else np.full(s.channels, np.nan))
+        n, n_std = np.atleast_1d(s.N), np.atleast_1d(s.N_std)
+        band = np.reshape(s.band, (-1, 2))
+        rows = []
+        for j, a in enumerate(axis_names(s.channels)):
+            with np.errstate(divide="ignore", invalid="ignore"):
+                ratio = n[j] / fitted[j] if fitted[j] > 0 else np.nan
+            rows.append([a, format_value(n[j], n_std[j]),
+                         f"{band[j, 0]:.3g} – {band[j, 1]:.3g}",
+                         format_value(fitted[j]), f"{ratio:.3g}",
+                         _n_remark(s, j, ratio)])
+        doc.table(["axis", f"N PSD [{unit}/√Hz]", "white band [Hz]", "N ADEV fit",
+                   "PSD/ADEV", "remark"], rows,
+                  caption=f"{sensor}: noise density from the spectrum and from the Allan fit")
+
+
+def dynamic_allan(ctx: Context, doc: Doc) -> None:
+    """Per sensor of the long log: the dynamic ADEV heat map and one sentence on what it
+    shows (stationary, or where the noise departs)."""
+    from imunoise import dynamic
+
+    log = ctx.long
+    for sensor in ("gyro", "accel"):
+        y = getattr(log, sensor)
+        if y is None:
+            continue
+        d = dynamic.dynamic_adev(y, log.fs)
+        st = d.stationarity
+        doc.h(3, sensor)
+        ctx.add_figure(doc, plot.dynamic(d, title=f"{sensor} dynamic Allan deviation"),
+                       f"dadev_{sensor}", f"ADEV of {format_duration(d.window)} windows every "
+                       f"{format_duration(d.step)} over the whole-record ADEV")
+        share = f"{float(np.max(st.outside)):.0%}"
+        if st.stationary:
+            doc.p(f"The {sensor} noise is stationary along the log: no stretch departs from "
+                  f"the typical level (1 % false-alarm rate), and {share} of the window "
+                  f"intervals exclude the whole-record ADEV (about "
+                  f"{st.expected_outside:.0%} expected).")
+            continue
+        names = axis_names(d.channels)
+        where = "; ".join(
+            f"{format_duration(v.start)} – {format_duration(v.end)} ({names[v.channel]}, "
+            f"ADEV ×{format_number(v.ratio)})" for v in st.intervals[:6])
+        more = f" and {len(st.intervals) - 6} more" if len(st.intervals) > 6 else ""
+        doc.p(f"The {sensor} noise is not stationary: it departs from its typical level at "
+              f"{where}{more} (from the first sample; {share} of the window intervals exclude "
+              f"the whole-record ADEV, about {st.expected_outside:.0%} expected).")

@@ -1,0 +1,238 @@
+"""imunoise.psd: the one-sided convention, its bands, the N read-off and the power laws,
+checked against scipy, SP 1065's integral, allantools, imunoise.fit and real logs."""
+
+import math
+import warnings
+
+import imunoise
+import numpy as np
+import pytest
+from allantools import psd2allan
+from helpers.data import shared_file
+from imunoise import spectrum
+from imunoise.cli import bundled_log
+from imunoise.noise import model_variance
+from scipy import integrate, signal
+
+FS = 100.0
+
+
+def test_matches_scipy_welch_and_parseval():
+    y = imunoise.simulate(2**16, FS, N=0.01, B=1e-3, seed=4)
+    s = imunoise.psd(y, FS, nperseg=4096)
+    f, p = signal.welch(y, fs=FS, nperseg=4096, noverlap=2048, window="hann")
+    np.testing.assert_allclose(s.f, f[1:])
+    np.testing.assert_allclose(s.psd, p[1:], rtol=1e-12)
+    # one-sided: the density integrates to the variance of the (mean-removed) samples
+    assert np.sum(s.psd) * (s.f[1] - s.f[0]) == pytest.approx(np.var(y), rel=0.05)
+    assert s.asd == pytest.approx(np.sqrt(s.psd))
+
+
+def test_white_level_is_twice_n_squared():
+    # simulate draws white samples of std N·√fs (two-sided density N²); the one-sided
+    # level must be 2N², and N = √(level/2) must give back N and agree with the ADEV fit
+    n_true = 2e-3
+    y = imunoise.simulate(400_000, FS, N=n_true, seed=11)
+    s = imunoise.psd(y, FS)
+    assert np.median(s.psd) == pytest.approx(2 * n_true**2, rel=0.02)
+    assert abs(s.N - n_true) < 4 * s.N_std
+    model = imunoise.fit(imunoise.adev(y, FS), terms=["N"])
+    assert abs(s.N - model.N) < 2 * math.hypot(s.N_std, model.N_std)
+    # the datasheet unit of docs/noise.md: N in rad/s/√Hz converts like rad/√s
+    assert imunoise.units.convert(s.N, "N", "deg/s/sqrt(Hz)") == pytest.approx(
+        np.degrees(s.N))
+
+
+def test_n_agrees_with_adev_fit_on_40_records():
+    # white + rate random walk + flicker: each N within the combined uncertainty
+    scores = []
+    for seed in range(40):
+        y = imunoise.simulate(2**17, FS, N=1e-3, B=1e-4, K=2e-5, seed=seed)
+        s = imunoise.psd(y, FS)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            model = imunoise.fit(imunoise.adev(y, FS))
+        scores.append((s.N - model.N) / math.hypot(s.N_std, model.N_std))
+    scores = np.array(scores)
+    assert np.mean(np.abs(scores) < 2) >= 0.9, scores
+    assert np.mean(scores**2) < 2.0, scores
+    assert abs(np.mean(scores)) < 0.5, scores
+
+
+def test_confidence_band_covers_the_true_level():
+    y = imunoise.simulate(2**17, FS, N=1e-3, seed=3)
+    s = imunoise.psd(y, FS, confidence=0.9)
+    inside = (s.ci_low <= 2e-6) & (2e-6 <= s.ci_high)
+    assert 0.85 < inside.mean() < 0.95
+    smooth = s.smooth(10)
+    assert np.all(smooth.edf >= s.edf[0] * 0.99) and smooth.edf[-2] > 100 * s.edf[0]
+    inside = (smooth.ci_low <= 2e-6) & (2e-6 <= smooth.ci_high)
+    assert inside.mean() > 0.75
+
+
+@pytest.mark.parametrize("term", ["N", "B", "K"])
+def test_power_laws_match_sp1065_integral(term):
+    # σ²(τ) = 2∫ S_y(f) sin⁴(πfτ)/(πfτ)² df (SP 1065 eq. 65) of each term's one-sided PSD
+    tau, c = 2.0, 0.3
+    law = spectrum.POWER_LAWS[term]
+
+    def integrand(f):
+        return 2 * spectrum.term_psd(term, c, f) * np.sin(np.pi * f * tau) ** 4 / (
+            np.pi * f * tau) ** 2
+
+    value = sum(integrate.quad(integrand, a, b, limit=400)[0]
+                for a, b in ((1e-9, 1e-3), (1e-3, 1.0), (1.0, 200.0)))
+    expected = law.avar_factor * c**2 * tau**law.mu
+    assert value == pytest.approx(expected, rel=2e-3)
+    assert model_variance(np.array([tau]), **{term: c})[0] == pytest.approx(expected, rel=1e-12)
+
+
+def test_white_law_matches_allantools_psd2allan():
+    h0 = 2 * 0.01**2
+    f = np.linspace(0, 50.0, 5001)
+    taus, ad = psd2allan(np.full(f.size, h0), f)
+    n = spectrum.coefficient_from_psd("N", h0, 1.0)
+    keep = (taus > 0.05) & (taus < 5)
+    np.testing.assert_allclose(ad[keep], n / np.sqrt(taus[keep]), rtol=0.02)
+
+
+def test_quantization_law_matches_simulation():
+    y = imunoise.simulate(2**17, FS, Q=1e-3, seed=8)
+    s = imunoise.psd(y, FS).smooth(10)
+    expected = spectrum.term_psd("Q", 1e-3, s.f, fs=FS)
+    assert np.median(s.psd / expected) == pytest.approx(1.0, rel=0.03)
+    assert spectrum.coefficient_from_psd("Q", expected, s.f, fs=FS) == pytest.approx(1e-3)
+
+
+def test_model_overlay_follows_the_spectrum():
+    y = imunoise.simulate(2**18, FS, N=1e-3, K=1e-4, B=2e-4, seed=2)
+    model = imunoise.fit(imunoise.adev(y, FS))
+    s = imunoise.psd(y, FS).smooth(10)
+    ratio = s.psd / spectrum.model_psd(model, s.f)
+    assert np.median(np.abs(np.log(ratio))) < 0.1
+
+
+def test_band_stops_below_a_low_pass_filter():
+    # white noise through a 4th-order low-pass at 20 Hz: the top bends down, and the
+    # automatic band must end below the bend with the unfiltered level
+    rng = np.random.default_rng(5)
+    white = rng.normal(size=2**18) * 1e-3 * math.sqrt(FS)
+    b, a = signal.butter(4, 20.0, fs=FS)
+    s = imunoise.psd(signal.lfilter(b, a, white), FS)
+    assert s.band[1] < 20.0
+    assert s.N == pytest.approx(1e-3, rel=0.02)
+
+
+def test_spectral_line_is_left_out_not_a_band_edge():
+    # white noise plus a 7 Hz sinusoid of 20× the white variance per bin: N unchanged,
+    # the band still reaches the top, and the line is reported
+    rng = np.random.default_rng(12)
+    n = 2**18
+    t = np.arange(n) / FS
+    y = rng.normal(size=n) * 1e-3 * math.sqrt(FS) + 0.02 * np.sin(2 * np.pi * 7.0 * t)
+    s = imunoise.psd(y, FS)
+    assert s.N == pytest.approx(1e-3, rel=0.01)
+    assert s.band[1] > 40.0
+    assert np.any(np.abs(s.lines[0] - 7.0) < 0.5), s.lines
+    assert imunoise.psd(y, FS, band=(1.0, 5.0)).lines[0].size == 0
+
+
+def test_band_stops_below_quantization_noise():
+    y = imunoise.simulate(2**18, FS, N=1e-3, Q=1e-4, seed=6)
+    s = imunoise.psd(y, FS)
+    assert s.band[1] < FS / 2 * 0.9
+    assert abs(s.N - 1e-3) < max(4 * s.N_std, 0.02e-3)
+
+
+def test_user_band_and_channels():
+    y = imunoise.simulate(2**16, FS, N=1e-3, channels=3, seed=9)
+    s = imunoise.psd(y, FS, band=(1.0, 10.0))
+    assert s.psd.shape == (len(s.f), 3) and s.N.shape == (3,)
+    np.testing.assert_allclose(s.band, [[1.0, 10.0]] * 3)
+    assert not s.band_auto and np.all(s.flicker == 0)
+    np.testing.assert_allclose(s.N, 1e-3, rtol=0.05)
+    one = imunoise.psd(y[:, 1], FS, band=(1.0, 10.0))
+    assert one.N == pytest.approx(s.N[1])
+
+
+def test_repr_and_html():
+    s = imunoise.psd(imunoise.simulate(4096, FS, N=1.0, channels=3, seed=1), FS)
+    text = repr(s)
+    assert len(text.splitlines()) <= 3 and len(text) <= 300
+    assert "Spectrum" in text and "<table>" in s._repr_html_()
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    ({"x": [1.0] * 8}, "at least 16"),
+    ({"x": np.r_[np.ones(100), np.nan]}, "finite"),
+    ({"fs": -1.0}, "fs must be positive"),
+    ({"nperseg": 10**6}, "nperseg must be <="),
+    ({"nperseg": 4}, "nperseg must be >= 16"),
+    ({"band": (10.0, 1.0)}, "band must satisfy"),
+    ({"band": (1.0, 80.0)}, "fs/2"),
+    ({"confidence": 1.5}, "confidence must be in"),
+])
+def test_errors_name_the_argument(kwargs, message):
+    args = {"x": np.random.default_rng(0).normal(size=1000), "fs": FS, **kwargs}
+    with pytest.raises(ValueError, match=message):
+        imunoise.psd(args.pop("x"), args.pop("fs"), **args)
+
+
+def test_type_errors():
+    with pytest.raises(TypeError, match="band must be a pair"):
+        imunoise.psd(np.ones(100), FS, band=3.0)
+    with pytest.raises(TypeError, match="nperseg must be an integer"):
+        imunoise.psd(np.ones(100), FS, nperseg=32.0)
+    with pytest.raises(ValueError, match="term must be one of"):
+        spectrum.term_psd("X", 1.0, 1.0)
+    with pytest.raises(ValueError, match="fs is required"):
+        spectrum.term_psd("Q", 1.0, 1.0)
+
+
+def _adis_gyro():
+    d = np.load(shared_file("data/other-imu/adis16405_static_2h47m.npz"))
+    return d["gyro_counts"] * float(d["gyro_scale_dps_per_count"]), float(d["sample_rate_hz"])
+
+
+def test_real_adis16405_n_agrees_with_adev_where_no_line():
+    # X and Y: PSD and ADEV-fit N (the model's N read-off) within 5 %. Z carries a
+    # spectral line near 20 Hz, above the white band, that the ADEV's short taus add
+    # to N: the disagreement is explained by the spectrum itself.
+    g, fs = _adis_gyro()
+    s = imunoise.psd(g, fs)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        model = imunoise.fit(imunoise.adev(g, fs))
+    ratio = s.N / model.equivalent("N")
+    assert np.all(np.abs(ratio[:2] - 1) < 0.05), ratio
+    assert np.all(s.band[:, 1] < 20.0)  # the gyro filter bends the top: excluded
+    above = s.f > s.band[2, 1]
+    assert s.psd[above, 2].max() > 3 * s.white[2] or np.any(s.lines[2] > 15)
+
+
+def test_real_vn100_bundled_log():
+    log = imunoise.read(bundled_log(), fs=40.0)
+    s = imunoise.psd(log.gyro, log.fs)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        model = imunoise.fit(imunoise.adev(log.gyro, log.fs))
+    ratio = s.N / model.equivalent("N")
+    assert abs(ratio[0] - 1) < 0.05 and abs(ratio[2] - 1) < 0.05, ratio
+    # Y: a line at 17–19 Hz raises the ADEV; the read-off found it and left it out
+    assert np.any((s.lines[1] > 16) & (s.lines[1] < 20)), s.lines
+    assert abs(ratio[1] - 1) > 0.05
+
+
+def test_plot_with_model_and_asd():
+    from imunoise import plot
+
+    y = imunoise.simulate(2**15, FS, N=1e-3, K=1e-4, channels=2, seed=1)
+    s = imunoise.psd(y, FS)
+    model = imunoise.fit(imunoise.adev(y, FS))
+    fig = s.plot(model, unit="rad/s")
+    assert len(fig.axes) == 2
+    assert any(line.get_label().startswith("N = ") for line in fig.axes[0].lines)
+    fig = plot.spectrum(s, amplitude=True)
+    assert "ASD" in fig.axes[0].get_ylabel()
+    with pytest.raises(TypeError, match="Spectrum"):
+        plot.spectrum(model)
