@@ -43,8 +43,9 @@ from dataclasses import dataclass, replace
 import numpy as np
 from scipy import stats as _sstats
 
-from imunoise import _schema, _summary
-from imunoise._validate import positive_finite, sample_rate
+from imunoise import _summary
+from imunoise._channels import rate_channels
+from imunoise._validate import positive_finite
 from imunoise.readers.log import ImuLog
 
 __all__ = ["Events", "events", "FALSE_ALARM", "OVERLAP_FACTOR"]
@@ -272,7 +273,7 @@ def events(
     whole channel: a log whose noise level changes (a sensor switched to a
     different filter) needs to be split first.
     """
-    x, fs, names = _samples(data, fs, channels)
+    x, fs, names = rate_channels(data, fs, channels)
     if isinstance(false_alarm, bool) or not (0 < float(false_alarm) < 0.01):
         raise ValueError(f"false_alarm must be in (0, 0.01) per sample; got {false_alarm!r}")
     false_alarm = float(false_alarm)
@@ -302,45 +303,6 @@ def events(
         window=w,
         false_alarm=false_alarm,
     )
-
-
-def _samples(data, fs, channels) -> tuple[np.ndarray, float, tuple[str, ...]]:
-    """(n, k) float samples, the rate and the channel names."""
-    if isinstance(data, ImuLog):
-        fs = data.fs if fs is None else fs
-        wanted = [c for c in _schema.ALLAN_SENSORS if getattr(data, c) is not None]
-        if channels is not None:
-            wanted = [channels] if isinstance(channels, str) else list(channels)
-            missing = [c for c in wanted if c not in data.channels]
-            if missing:
-                raise ValueError(
-                    f"channels {missing} are not in the log; it has {list(data.channels)}"
-                )
-        if not wanted:
-            raise ValueError(f"data has no gyro or accel channel; got {list(data.channels)}")
-        blocks, names = [], []
-        for c in wanted:
-            arr = np.asarray(getattr(data, c), dtype=np.float64)
-            arr = arr.reshape(len(arr), -1)
-            blocks.append(arr)
-            names += [_schema.sensor_label(c, j, arr.shape[1]) for j in range(arr.shape[1])]
-        x = np.hstack(blocks)
-    else:
-        if channels is not None:
-            raise ValueError("channels= selects log channels; data is an array")
-        if fs is None:
-            raise ValueError("fs is required when data is an array")
-        try:
-            x = np.asarray(data, dtype=np.float64)
-        except (TypeError, ValueError) as exc:
-            raise TypeError(f"data must be an ImuLog or numeric array; got {exc}") from None
-        if x.ndim not in (1, 2):
-            raise ValueError(f"data must have shape (n,) or (n, k); got {x.shape}")
-        if np.isinf(x).any():
-            raise ValueError("data has infinite values (NaN marks a missing sample)")
-        x = x.reshape(len(x), -1)
-        names = ["x"] if x.shape[1] == 1 else [f"ch{j}" for j in range(x.shape[1])]
-    return x, sample_rate(fs), tuple(names)
 
 
 def _standardise(col: np.ndarray, block: int) -> tuple[np.ndarray, float]:
