@@ -23,6 +23,7 @@ from imunoise.allan import (
 )
 from imunoise.datasheet import compare
 from imunoise.errors import ParseError
+from imunoise.events import Events, events
 from imunoise.noise import NoiseModel, fit
 from imunoise.readers import Gaps, ImuLog, ParseIssues
 from imunoise.readers.read import read
@@ -30,11 +31,16 @@ from imunoise.scale import batch
 from imunoise.simulate import simulate
 from imunoise.simulate_log import simulate_log
 from imunoise.stats import describe, distribution
+from imunoise.thermal import Thermal, thermal
+from imunoise.warmup import Warmup, warmup
 from imunoise.writers.vn import write_vn_ascii, write_vn_binary
 
 __all__ = [
     "__version__",
     "AllanResult",
+    "Events",
+    "Thermal",
+    "Warmup",
     "Gaps",
     "ImuLog",
     "NoiseModel",
@@ -45,6 +51,7 @@ __all__ = [
     "compare",
     "describe",
     "distribution",
+    "events",
     "export",
     "fit",
     "hdev",
@@ -60,10 +67,12 @@ __all__ = [
     "tdev",
     "theo1",
     "theobr",
+    "thermal",
     "theoh",
     "totdev",
     "ttotdev",
     "units",
+    "warmup",
     "write_vn_ascii",
     "write_vn_binary",
 ]

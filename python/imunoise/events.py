@@ -294,7 +294,9 @@ def events(
     sigma = np.empty(x.shape[1])
     for j in range(x.shape[1]):
         z, sigma[j] = _standardise(x[:, j], block)
-        spans = _spikes(z, k_spike) + _bursts(z, w, p_window)
+        # the burst test sees z clipped at the spike threshold: one spike, however
+        # large, is a spike, not a burst
+        spans = _spikes(z, k_spike) + _bursts(np.clip(z, -k_spike, k_spike), w, p_window)
         per_channel.append((_join(spans, gap), z))
     return _merge_channels(
         per_channel, names, fs, n, gap, sigma,
@@ -354,15 +356,29 @@ def _bursts(z: np.ndarray, w: int, p_window: float) -> list[tuple[int, int, str]
     out = []
     for a, b in _runs(hot):  # windows a .. b-1 flagged: samples a .. b+w-2 involved
         lo, hi = max(0, a - w // 2), min(n, b - 1 + w + w // 2)
-        seg = z2[lo:hi]
-        v = max(float(seg.mean()), 1.0 + 1e-9)
-        ell = seg * (1 - 1 / v) - np.log(v)
-        s = np.concatenate(([0.0], np.cumsum(ell)))
-        end = int(np.argmax(s))
-        start = int(np.argmin(s[: end + 1])) if end > 0 else 0
+        start, end = _change_points(z2[lo:hi])
         if end > start:
             out.append((lo + start, lo + end, "burst"))
     return out
+
+
+def _change_points(seg: np.ndarray) -> tuple[int, int]:
+    """The segment of ``seg`` (squared standardised samples) whose variance v > 1
+    maximises the log-likelihood ratio Σ z²(1 − 1/v) − ln v. v is first the mean
+    over all of ``seg`` (diluted by the noise around the burst), then the mean
+    over the segment found; a second pass that loses the first segment (a
+    decaying burst's variance is not one number) keeps the first."""
+    start, end = 0, len(seg)
+    found = (0, 0)
+    for _ in range(2):
+        v = max(float(seg[start:end].mean()), 1.0 + 1e-9)
+        s = np.concatenate(([0.0], np.cumsum(seg * (1 - 1 / v) - np.log(v))))
+        new_end = int(np.argmax(s))
+        new_start = int(np.argmin(s[: new_end + 1]))
+        if new_end <= new_start or (found[1] and (new_end <= found[0] or new_start >= found[1])):
+            break
+        start, end = found = (new_start, new_end)
+    return found
 
 
 def _peak(z: np.ndarray) -> float:
