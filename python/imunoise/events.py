@@ -293,10 +293,13 @@ def events(
     per_channel = []
     sigma = np.empty(x.shape[1])
     for j in range(x.shape[1]):
-        z, sigma[j] = _standardise(x[:, j], block)
+        z, mad_sigma = _standardise(x[:, j], block)
+        scale, dof = _energy_law(z, w)
+        z /= np.sqrt(scale)
+        sigma[j] = mad_sigma * np.sqrt(scale)
         # the burst test sees z clipped at the spike threshold: one spike, however
         # large, is a spike, not a burst
-        spans = _spikes(z, k_spike) + _bursts(np.clip(z, -k_spike, k_spike), w, p_window)
+        spans = _spikes(z, k_spike) + _bursts(np.clip(z, -k_spike, k_spike), w, p_window, dof)
         per_channel.append((_join(spans, gap), z))
     return _merge_channels(
         per_channel, names, fs, n, gap, sigma,
@@ -339,8 +342,8 @@ def _spikes(z: np.ndarray, k: float) -> list[tuple[int, int, str]]:
     return [(int(i), int(i) + 1, "spike") for i in np.flatnonzero(np.abs(z) > k)]
 
 
-def _bursts(z: np.ndarray, w: int, p_window: float) -> list[tuple[int, int, str]]:
-    """Stretches where the sliding χ² energy exceeds its threshold, cut to the
+def _bursts(z: np.ndarray, w: int, p_window: float, dof: float) -> list[tuple[int, int, str]]:
+    """Stretches where the sliding energy exceeds its threshold, cut to the
     maximum-likelihood segment of raised variance."""
     n = len(z)
     valid = np.isfinite(z)
@@ -349,9 +352,11 @@ def _bursts(z: np.ndarray, w: int, p_window: float) -> list[tuple[int, int, str]
     count = np.concatenate(([0], np.cumsum(valid)))
     energy = csum[w:] - csum[:-w]  # window j covers samples j .. j+w-1
     used = count[w:] - count[:-w]
-    thresholds = {m: _sstats.chi2.isf(p_window, m) for m in np.unique(used) if m > 0}
-    limit = np.array([thresholds.get(m, np.inf) for m in used]) if len(thresholds) > 1 \
-        else np.full(len(used), next(iter(thresholds.values()), np.inf))
+    # a window of m valid samples: energy·ν_m/m ~ χ²(ν_m), ν_m = ν·m/w
+    limits = {m: _sstats.chi2.isf(p_window, dof * m / w) * w / dof
+              for m in np.unique(used).tolist() if m > 0}
+    limit = np.array([limits.get(m, np.inf) for m in used.tolist()]) if len(limits) > 1 \
+        else np.full(len(used), next(iter(limits.values()), np.inf))
     hot = energy > limit
     out = []
     for a, b in _runs(hot):  # windows a .. b-1 flagged: samples a .. b+w-2 involved
@@ -360,6 +365,43 @@ def _bursts(z: np.ndarray, w: int, p_window: float) -> list[tuple[int, int, str]
         if end > start:
             out.append((lo + start, lo + end, "burst"))
     return out
+
+
+def _energy_law(z: np.ndarray, w: int) -> tuple[float, float]:
+    """Scale s and degrees of freedom ν of the window energy of a quiet record:
+    Σ_window z² ≈ s·(w/ν)·χ²(ν) (Satterthwaite).
+
+    Real sensor noise is not white: correlated samples (a sensor's own filter,
+    bias wander faster than the baseline) make the window energy vary more than
+    χ²(w), which a white-noise threshold would take for bursts all along the log.
+    ν = w / (1 + 2 Σ_{k<w} (1 − k/w) ρ_k²) for a Gaussian process with
+    autocorrelation ρ_k (ν = w for white noise); s is the median window mean of
+    z² over the median of χ²(ν)/ν: σ̂·√s is the RMS of the quiet noise even where
+    the MAD misjudges it (heavy tails, quantization), and both tests use it.
+    Both are robust to a few events: ρ is computed from z clipped at ±3, s from
+    a median.
+    """
+    valid = np.isfinite(z)
+    m = int(valid.sum())
+    z = np.where(valid, z, 0.0)
+    c = np.clip(z, -3.0, 3.0)
+    c = np.where(valid, c - c[valid].mean() if m else 0.0, 0.0)
+    size = 1 << int(np.ceil(np.log2(2 * len(c))))
+    spec = np.fft.rfft(c, size)
+    acf = np.fft.irfft(spec * np.conj(spec), size)[:w]
+    pairs = np.fft.irfft(np.abs(np.fft.rfft(valid.astype(float), size)) ** 2, size)[:w]
+    rho = acf / np.maximum(pairs, 1.0) / (acf[0] / max(pairs[0], 1.0)) if acf[0] > 0 \
+        else np.zeros(w)
+    k = np.arange(1, w)
+    dof = w / (1 + 2 * np.sum((1 - k / w) * rho[1:] ** 2))
+    full = len(z) // w
+    blocks = (z[: full * w] ** 2).reshape(full, w)
+    complete = valid[: full * w].reshape(full, w).all(axis=1)
+    if not complete.any():
+        return 1.0, float(dof)
+    median = float(np.median(blocks[complete].mean(axis=1)))
+    expected = float(_sstats.chi2.median(dof)) / dof
+    return (median / expected if median > 0 else 1.0), float(dof)
 
 
 def _change_points(seg: np.ndarray) -> tuple[int, int]:
