@@ -14,7 +14,10 @@ Method
    ``scipy.optimize.curve_fit`` for the covariance of :math:`A, \tau`).
 3. The transient is **significant** when the exponential beats a constant by an
    F-test at ``alpha`` (default 10⁻³) and τ is shorter than half the log (a
-   longer "transient" is drift the log cannot separate from bias wander).
+   longer "transient" is drift the log cannot separate from bias wander). The
+   block means of a real sensor are correlated (bias wander): F and the
+   uncertainties are corrected by the AR(1) variance inflation
+   :math:`(1+\rho_1)/(1-\rho_1)` of the residuals (lag-1 autocorrelation :math:`\rho_1`).
 4. The channel has **settled** when the fitted transient has fallen below the
    tolerance :math:`\varepsilon`: :math:`t_s = \tau \ln(|A|/\varepsilon)`
    (0 when :math:`|A| \le \varepsilon`), with its uncertainty propagated from the
@@ -317,9 +320,15 @@ def _fit_exponential(t, y, duration):
             sd = np.array([np.nan, np.nan, np.nan])
     except RuntimeError:
         sd = np.array([np.nan, np.nan, np.nan])
-    rss1 = float(np.sum((y - _exp_model(t, c, a, tau)) ** 2))
+    resid = y - _exp_model(t, c, a, tau)
+    rss1 = float(np.sum(resid**2))
     dof = y.size - 3
-    f = ((rss0 - rss1) / 2) / (rss1 / dof) if rss1 > 0 else np.inf
+    # correlated residuals (bias wander) carry less evidence than their count:
+    # the AR(1) variance inflation (1 + ρ)/(1 − ρ) deflates F (and widens u(A), u(τ))
+    rho = float(np.clip(np.dot(resid[:-1], resid[1:]) / rss1, 0.0, 0.95)) if rss1 > 0 else 0.0
+    inflation = (1 + rho) / (1 - rho)
+    sd = sd * np.sqrt(inflation)
+    f = ((rss0 - rss1) / 2) / (rss1 / dof) / inflation if rss1 > 0 else np.inf
     p = float(_sstats.f.sf(f, 2, dof)) if np.isfinite(f) else 0.0
     return float(c), float(a), float(tau), float(sd[1]), float(sd[2]), p
 
