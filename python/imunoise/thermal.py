@@ -261,11 +261,11 @@ def _temperature(data, temperature, n) -> np.ndarray:
 
 
 def _lag1(r: np.ndarray) -> float:
-    """Lag-1 autocorrelation, clipped to [0, 0.95] (negative: no inflation)."""
+    """Lag-1 autocorrelation, clipped to [0, 0.99] (negative: no inflation)."""
     r = r - r.mean()
     den = float(np.dot(r, r))
     rho = float(np.dot(r[:-1], r[1:])) / den if den > 0 else 0.0
-    return min(max(rho, 0.0), 0.95)
+    return min(max(rho, 0.0), 0.99)
 
 
 def _fill(temp: np.ndarray) -> np.ndarray:

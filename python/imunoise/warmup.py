@@ -252,12 +252,12 @@ def warmup(
         warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN blocks stay NaN
         bias = np.nanmean(x[: m * size].reshape(m, size, -1), axis=1)
     k = x.shape[1]
+    temp = _temperature(data, temperature, n)
     fits = [_fit_exponential(t, bias[:, j], duration) for j in range(k)]
     final, amp, tau, amp_sd, tau_sd, p = (np.array(v) for v in zip(*fits, strict=True))
     significant = (p < alpha) & (tau < duration / 2)
     tol = _tolerance(tolerance, x, fs, final, amp, tau, k)
     ts, ts_sd = _settle_times(amp, tau, amp_sd, tau_sd, tol, significant)
-    temp = _temperature(data, temperature, n)
     t_fit = (np.nan, np.nan, np.nan)
     temp_blocks = None
     if temp is not None:
