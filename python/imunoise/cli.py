@@ -71,6 +71,9 @@ def _build_parser() -> argparse.ArgumentParser:
     r.add_argument("-o", "--output", default="imunoise-report", metavar="DIR",
                    help="output directory (default: %(default)s)")
     _shared_options(r, spec=True, fs=True, progress=True, layout=True)
+    r.add_argument("--trim", choices=["auto"], default=None,
+                   help="'auto': analyse the long log from the end of its warm-up transient "
+                   "(the report states what was cut)")
 
     a = sub.add_parser("adev", help="print an Allan-family deviation table",
                        description="Print tau, deviation, confidence interval and number of "
@@ -250,7 +253,7 @@ def _cmd_report(args) -> int:
 
     spec = None if args.spec.lower() == "none" else args.spec
     rep = report.build(args.short_log, args.long_log, args.output, spec=spec, fs=args.fs,
-                       progress=args.progress, read_options=_read_options(args))
+                       progress=args.progress, read_options=_read_options(args), trim=args.trim)
     for log in rep.logs:
         _note_gaps(log.source, log)
     print(f"report written to {rep.html}")

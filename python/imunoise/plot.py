@@ -37,6 +37,7 @@ if TYPE_CHECKING:
 __all__ = [
     "AXIS_COLORS",
     "allan",
+    "compensation",
     "decimate_minmax",
     "events",
     "histograms",
@@ -619,4 +620,27 @@ def thermal(result, *, title: str = "") -> Figure:
             axes[j // cols, j % cols].set_visible(False)
         fig.suptitle(title or "Bias against temperature")
         _margins(fig, left=0.8, bottom=0.5, top=0.3, wspace=0.45, hspace=0.6, title=True)
+    return fig
+
+
+def compensation(before: AllanResult, after: AllanResult, *, title: str = "",
+                 unit: str = "") -> Figure:
+    """Allan deviation per axis before (solid) and after (dashed) a correction, e.g.
+    the temperature compensation of :func:`imunoise.thermal`."""
+    new_figure = _plt()
+    b = np.asarray(before.dev).reshape(len(before.taus), -1)
+    a = np.asarray(after.dev).reshape(len(after.taus), -1)
+    names = axis_names(b.shape[1])
+    with style():
+        fig = new_figure(figsize=(6.5, 4.2))
+        ax = fig.subplots()
+        for j, name in enumerate(names):
+            color = AXIS_COLORS[j % 4]
+            ax.loglog(before.taus, b[:, j], color=color, label=f"{name} before")
+            ax.loglog(after.taus, a[:, j], color=color, linestyle="--", label=f"{name} after")
+        ax.set_xlabel("τ [s]")
+        ax.set_ylabel(f"σ(τ) [{unit}]" if unit else "σ(τ)")
+        ax.legend(ncol=2)
+        fig.suptitle(title or "Allan deviation before and after compensation")
+        _margins(fig, left=0.9, bottom=0.5, title=True)
     return fig

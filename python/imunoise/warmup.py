@@ -310,8 +310,8 @@ def _fit_exponential(t, y, duration):
             best = (rss, coef[0], coef[1], tau)
     _rss, c, a, tau = best
     try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", _opt.OptimizeWarning)
+        with warnings.catch_warnings(), np.errstate(over="ignore", invalid="ignore"):
+            warnings.simplefilter("ignore", _opt.OptimizeWarning)  # trial τ may go negative
             popt, pcov = _opt.curve_fit(_exp_model, t, y, p0=(c, a, tau), maxfev=2000)
         if popt[2] > 0 and np.all(np.isfinite(pcov)):
             c, a, tau = popt
