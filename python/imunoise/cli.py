@@ -102,6 +102,23 @@ def _build_parser() -> argparse.ArgumentParser:
     s.add_argument("log", metavar="LOG")
     _shared_options(s, fs=True, layout=True)
 
+    e = sub.add_parser("events", help="list spikes and bursts (vibration, shocks)",
+                       description="Per event: start, end, kind, channels, peak in sigmas "
+                       "(imunoise.events; docs/events.md).")
+    e.add_argument("log", metavar="LOG")
+    _shared_options(e, fs=True, layout=True)
+    e.add_argument("--false-alarm", type=_positive_float, default=1e-7, metavar="P",
+                   help="design false events per sample and channel (default: %(default)g)")
+
+    t = sub.add_parser("thermal", help="bias vs temperature and warm-up per axis",
+                       description="Warm-up transient and settle time, and the bias "
+                       "temperature sensitivity per axis in °/h/°C and mg/°C "
+                       "(imunoise.warmup, imunoise.thermal).")
+    t.add_argument("log", metavar="LOG")
+    _shared_options(t, fs=True, layout=True)
+    t.add_argument("--degree", type=int, choices=(1, 2), default=1,
+                   help="1: linear, 2: quadratic in temperature (default: %(default)s)")
+
     c = sub.add_parser("convert", help="convert a log to .npy, Parquet, CSV or NPZ",
                        description="Write the log's channels to OUTPUT; the format follows the "
                        "suffix: a directory (no suffix: one memory-mappable .npy per channel "
@@ -447,6 +464,44 @@ def _cmd_demo(args) -> int:
     return 0
 
 
+def _cmd_events(args) -> int:
+    from imunoise import events
+
+    log = _read(args)
+    found = events(log, false_alarm=args.false_alarm)
+    print(f"# {log.source}: {len(found)} events, {100 * found.share:.3g} % of {len(log)} "
+          f"samples (false_alarm {found.false_alarm:g} per sample and channel)")
+    _print_table(["start_s", "end_s", "kind", "peak_sigma", "channels"],
+                 [[f"{r['start']:.6g}", f"{r['end']:.6g}", r["kind"], f"{r['peak']:.3g}",
+                   r["channels"].replace(" ", "_").replace(",_", ",")] for r in found.rows()])
+    return 0
+
+
+def _cmd_thermal(args) -> int:
+    from imunoise import thermal, warmup
+    from imunoise.numbers import format_value
+
+    log = _read(args)
+    w = warmup(log)
+    print(f"# {log.source}: warm-up: " + (f"settled after {w.settle:.6g} s" if w.settle > 0
+                                           else "no transient"))
+    if log.temperature is None:
+        _fail(f"{args.log}: the log has no temperature channel; no thermal fit")
+    fit = thermal(log, degree=args.degree)
+    lo, hi = fit.temperature_range
+    print(f"# bias vs temperature over {lo:.2f}-{hi:.2f} degC, |r(T, t)| = "
+          f"{fit.time_correlation:.2f}")
+    rows = []
+    for r in fit.rows():
+        row = [r["name"].replace(" ", "_"), format_value(r["slope"], r["slope_std"]), r["unit"]]
+        if fit.degree == 2:
+            row.append(format_value(r["quadratic"], r["quadratic_std"]))
+        rows.append(row)
+    head = ["channel", "slope", "unit"] + (["quadratic"] if fit.degree == 2 else [])
+    _print_table(head, rows)
+    return 0
+
+
 def _print_table(head, rows) -> None:
     widths = [max(len(str(x)) for x in col) for col in zip(head, *rows, strict=True)]
     for line in [head, *rows]:
@@ -458,6 +513,8 @@ _COMMANDS = {
     "adev": _cmd_adev,
     "fit": _cmd_fit,
     "stats": _cmd_stats,
+    "events": _cmd_events,
+    "thermal": _cmd_thermal,
     "convert": _cmd_convert,
     "batch": _cmd_batch,
     "simulate": _cmd_simulate,
