@@ -345,13 +345,16 @@ def _tolerance(tolerance, x, fs, final, amp, tau, k) -> np.ndarray:
     r = adev(x - transient, fs)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)
-        return np.nanmin(np.asarray(r.dev).reshape(len(r.taus), -1), axis=0)
+        floor = np.nanmin(np.asarray(r.dev).reshape(len(r.taus), -1), axis=0)
+    # a constant channel has no floor: nothing in it ever needs to settle
+    return np.where(np.isfinite(floor) & (floor > 0), floor, np.inf)
 
 
 def _settle_times(amp, tau, amp_sd, tau_sd, tol, significant):
     ratio = np.abs(amp) / tol
     on = significant & (ratio > 1)
     log_ratio = np.log(np.where(on, ratio, 1.0))
-    ts = np.where(on, tau * log_ratio, 0.0)
+    tau, tau_sd, amp_sd = (np.where(on, v, 0.0) for v in (tau, tau_sd, amp_sd))
+    ts = tau * log_ratio
     sd = np.where(on, np.hypot(log_ratio * tau_sd, tau * amp_sd / np.where(on, amp, 1.0)), 0.0)
     return ts, np.abs(sd)

@@ -44,6 +44,15 @@ def test_trim_cuts_at_the_settle_point_and_says_how_much():
     np.testing.assert_array_equal(cut.gyro, log.gyro[found.settle_index:])
     assert found.names == ("gyro X", "gyro Y", "gyro Z")
     assert "settled at" in repr(found) and len(repr(found)) <= 300
+    assert repr(found).count("\n") <= 2 and "<table>" in found._repr_html_()
+    assert [r["name"] for r in found.rows()] == list(found.names)
+
+
+def test_constant_channel_never_needs_to_settle():
+    x = np.zeros((20_000, 2))
+    x[:, 1] = np.random.default_rng(0).standard_normal(20_000)
+    found = imunoise.warmup(x, FS)
+    assert found.settle == 0 and found.tolerance[0] == np.inf
 
 
 @pytest.mark.parametrize("seed", [11, 12])
