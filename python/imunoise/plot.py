@@ -522,12 +522,15 @@ def save(fig: Figure, path, *, formats: Sequence[str] = ("png", "svg")) -> list[
 
 #: Shading of detected events on time plots.
 EVENT_COLOR = "#9467bd"
+#: Events whose peak (σ) :func:`events` writes on the first panel (the largest).
+EVENT_LABELS = 12
 
 
 def events(y, found, fs: float | None = None, *, title: str = "", unit: str = "",
            names: Sequence[str] | None = None, columns: int = 1600) -> Figure:
     """Time series with the events of :func:`imunoise.events` shaded (purple) on
-    every panel and each event's peak (in sigmas) written at its start.
+    every panel and the peak (in sigmas) of the :data:`EVENT_LABELS` largest written at
+    their start.
 
     ``y`` is an array (n,) or (n, k) with its ``fs``, or an ImuLog (then its
     channels searched by ``found``, gyro and accel, are drawn).
@@ -549,9 +552,10 @@ def events(y, found, fs: float | None = None, *, title: str = "", unit: str = ""
             ax.axvspan(a / scale, (a + max(b - a, width)) / scale, color=EVENT_COLOR,
                        alpha=0.3, linewidth=0)
     top = fig.axes[0]
-    for a, peak in list(zip(found.start, found.peak, strict=True))[:40]:
-        top.annotate(f"{peak:.0f}σ", (a / scale, 1.0), xycoords=("data", "axes fraction"),
-                     fontsize=6, color=EVENT_COLOR, va="bottom", ha="center")
+    for i in np.argsort(found.peak)[::-1][:EVENT_LABELS]:  # the largest, inside the panel
+        top.annotate(f"{found.peak[i]:.0f}σ", (found.start[i] / scale, 0.97),
+                     xycoords=("data", "axes fraction"), fontsize=6, color=EVENT_COLOR,
+                     va="top", ha="center")
     return fig
 
 
