@@ -44,3 +44,17 @@ def test_csv_temperature_column(tmp_path):
     path.write_text("\n".join(rows) + "\n")
     log = imunoise.read(path)
     np.testing.assert_allclose(log.temperature, 20 + np.arange(50) / 100)
+
+
+def test_csv_with_raw_vn_sentences_keeps_their_temperature(tmp_path):
+    """A CSV exported from a ROS bag with the raw sentence in a column (the lab-driver
+    layout): the sentence's temperature reaches the log (ROS VN topics share this path)."""
+    temps = 25 + np.arange(30) / 10
+    rows = ["t,raw"] + [
+        f'{i / 40:.3f},"' + sentence(",".join(["VNIMU", *["0.1"] * 9, f"{t:.2f}", "101.3"]))
+        .decode().strip() + '"'
+        for i, t in enumerate(temps)]
+    path = tmp_path / "raw.csv"
+    path.write_text("\n".join(rows) + "\n")
+    log = imunoise.read(path)
+    np.testing.assert_allclose(log.temperature, temps)
