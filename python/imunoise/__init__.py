@@ -24,6 +24,7 @@ from imunoise.allan import (
 from imunoise.datasheet import compare
 from imunoise.dynamic import DynamicAllan, dynamic_adev
 from imunoise.errors import ParseError
+from imunoise.events import Events, events
 from imunoise.noise import NoiseModel, fit
 from imunoise.readers import Gaps, ImuLog, ParseIssues
 from imunoise.readers.read import read
@@ -32,12 +33,17 @@ from imunoise.simulate import simulate
 from imunoise.simulate_log import simulate_log
 from imunoise.spectrum import Spectrum, psd
 from imunoise.stats import describe, distribution
+from imunoise.thermal import Thermal, thermal
+from imunoise.warmup import Warmup, warmup
 from imunoise.writers.vn import write_vn_ascii, write_vn_binary
 
 __all__ = [
     "__version__",
     "AllanResult",
     "DynamicAllan",
+    "Events",
+    "Thermal",
+    "Warmup",
     "Gaps",
     "ImuLog",
     "NoiseModel",
@@ -50,6 +56,7 @@ __all__ = [
     "describe",
     "distribution",
     "dynamic_adev",
+    "events",
     "export",
     "fit",
     "hdev",
@@ -66,10 +73,12 @@ __all__ = [
     "tdev",
     "theo1",
     "theobr",
+    "thermal",
     "theoh",
     "totdev",
     "ttotdev",
     "units",
+    "warmup",
     "write_vn_ascii",
     "write_vn_binary",
 ]

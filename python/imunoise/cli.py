@@ -71,6 +71,9 @@ def _build_parser() -> argparse.ArgumentParser:
     r.add_argument("-o", "--output", default="imunoise-report", metavar="DIR",
                    help="output directory (default: %(default)s)")
     _shared_options(r, spec=True, fs=True, progress=True, layout=True)
+    r.add_argument("--trim", choices=["auto"], default=None,
+                   help="'auto': analyse the long log from the end of its warm-up transient "
+                   "(the report states what was cut)")
 
     a = sub.add_parser("adev", help="print an Allan-family deviation table",
                        description="Print tau, deviation, confidence interval and number of "
@@ -98,6 +101,23 @@ def _build_parser() -> argparse.ArgumentParser:
                        "per axis normal fit and normality statistics.")
     s.add_argument("log", metavar="LOG")
     _shared_options(s, fs=True, layout=True)
+
+    e = sub.add_parser("events", help="list spikes and bursts (vibration, shocks)",
+                       description="Per event: start, end, kind, channels, peak in sigmas "
+                       "(imunoise.events; docs/events.md).")
+    e.add_argument("log", metavar="LOG")
+    _shared_options(e, fs=True, layout=True)
+    e.add_argument("--false-alarm", type=_positive_float, default=1e-7, metavar="P",
+                   help="design false events per sample and channel (default: %(default)g)")
+
+    t = sub.add_parser("thermal", help="bias vs temperature and warm-up per axis",
+                       description="Warm-up transient and settle time, and the bias "
+                       "temperature sensitivity per axis in °/h/°C and mg/°C "
+                       "(imunoise.warmup, imunoise.thermal).")
+    t.add_argument("log", metavar="LOG")
+    _shared_options(t, fs=True, layout=True)
+    t.add_argument("--degree", type=int, choices=(1, 2), default=1,
+                   help="1: linear, 2: quadratic in temperature (default: %(default)s)")
 
     c = sub.add_parser("convert", help="convert a log to .npy, Parquet, CSV or NPZ",
                        description="Write the log's channels to OUTPUT; the format follows the "
@@ -280,7 +300,7 @@ def _cmd_report(args) -> int:
 
     spec = None if args.spec.lower() == "none" else args.spec
     rep = report.build(args.short_log, args.long_log, args.output, spec=spec, fs=args.fs,
-                       progress=args.progress, read_options=_read_options(args))
+                       progress=args.progress, read_options=_read_options(args), trim=args.trim)
     for log in rep.logs:
         _note_gaps(log.source, log)
     print(f"report written to {rep.html}")
@@ -552,6 +572,44 @@ def _cmd_demo(args) -> int:
     return 0
 
 
+def _cmd_events(args) -> int:
+    from imunoise import events
+
+    log = _read(args)
+    found = events(log, false_alarm=args.false_alarm)
+    print(f"# {log.source}: {len(found)} events, {100 * found.share:.3g} % of {len(log)} "
+          f"samples (false_alarm {found.false_alarm:g} per sample and channel)")
+    _print_table(["start_s", "end_s", "kind", "peak_sigma", "channels"],
+                 [[f"{r['start']:.6g}", f"{r['end']:.6g}", r["kind"], f"{r['peak']:.3g}",
+                   r["channels"].replace(" ", "_").replace(",_", ",")] for r in found.rows()])
+    return 0
+
+
+def _cmd_thermal(args) -> int:
+    from imunoise import thermal, warmup
+    from imunoise.numbers import format_value
+
+    log = _read(args)
+    w = warmup(log)
+    print(f"# {log.source}: warm-up: " + (f"settled after {w.settle:.6g} s" if w.settle > 0
+                                           else "no transient"))
+    if log.temperature is None:
+        _fail(f"{args.log}: the log has no temperature channel; no thermal fit")
+    fit = thermal(log, degree=args.degree)
+    lo, hi = fit.temperature_range
+    print(f"# bias vs temperature over {lo:.2f}-{hi:.2f} degC, |r(T, t)| = "
+          f"{fit.time_correlation:.2f}")
+    rows = []
+    for r in fit.rows():
+        row = [r["name"].replace(" ", "_"), format_value(r["slope"], r["slope_std"]), r["unit"]]
+        if fit.degree == 2:
+            row.append(format_value(r["quadratic"], r["quadratic_std"]))
+        rows.append(row)
+    head = ["channel", "slope", "unit"] + (["quadratic"] if fit.degree == 2 else [])
+    _print_table(head, rows)
+    return 0
+
+
 def _print_table(head, rows) -> None:
     widths = [max(len(str(x)) for x in col) for col in zip(head, *rows, strict=True)]
     for line in [head, *rows]:
@@ -563,6 +621,8 @@ _COMMANDS = {
     "adev": _cmd_adev,
     "fit": _cmd_fit,
     "stats": _cmd_stats,
+    "events": _cmd_events,
+    "thermal": _cmd_thermal,
     "convert": _cmd_convert,
     "batch": _cmd_batch,
     "simulate": _cmd_simulate,

@@ -41,13 +41,17 @@ if TYPE_CHECKING:
 __all__ = [
     "AXIS_COLORS",
     "allan",
+    "compensation",
     "decimate_minmax",
     "dynamic",
+    "events",
     "histograms",
     "save",
     "spectrum",
     "style",
+    "thermal",
     "time_series",
+    "warmup",
 ]
 
 AXIS_COLORS = ("#1f77b4", "#ff7f0e", "#2ca02c", "#9467bd")
@@ -654,3 +658,135 @@ def dynamic(
 def _edges(centres: np.ndarray, step: float) -> np.ndarray:
     """Cell edges around evenly spaced centres."""
     return np.r_[centres - step / 2, centres[-1] + step / 2]
+
+
+# --- events, warm-up and temperature (issue 13) -------------------------------------
+
+#: Shading of detected events on time plots.
+EVENT_COLOR = "#9467bd"
+#: Events whose peak (σ) :func:`events` writes on the first panel (the largest).
+EVENT_LABELS = 12
+
+
+def events(y, found, fs: float | None = None, *, title: str = "", unit: str = "",
+           names: Sequence[str] | None = None, columns: int = 1600) -> Figure:
+    """Time series with the events of :func:`imunoise.events` shaded (purple) on
+    every panel and the peak (in sigmas) of the :data:`EVENT_LABELS` largest written at
+    their start.
+
+    ``y`` is an array (n,) or (n, k) with its ``fs``, or an ImuLog (then its
+    channels searched by ``found``, gyro and accel, are drawn).
+    """
+    if isinstance(y, ImuLog):
+        sensors = [s for s in ("gyro", "accel") if getattr(y, s) is not None
+                   and any(n.startswith(s) for n in found.names)]
+        fig = time_series(y, channels=sensors, title=title, columns=columns)
+    else:
+        fig = time_series(y, fs if fs is not None else found.fs, title=title, unit=unit,
+                          names=names, columns=columns)
+    duration = found.n_samples / found.fs
+    scale = 1.0 if duration < 600 else 60.0 if duration < 3 * 3600 else 3600.0
+    width = duration / columns
+    for ax in fig.axes:
+        if not ax.get_visible():
+            continue
+        for a, b in zip(found.start, found.end, strict=True):
+            ax.axvspan(a / scale, (a + max(b - a, width)) / scale, color=EVENT_COLOR,
+                       alpha=0.3, linewidth=0)
+    top = fig.axes[0]
+    for i in np.argsort(found.peak)[::-1][:EVENT_LABELS]:  # the largest, inside the panel
+        top.annotate(f"{found.peak[i]:.0f}σ", (found.start[i] / scale, 0.97),
+                     xycoords=("data", "axes fraction"), fontsize=6, color=EVENT_COLOR,
+                     va="top", ha="center")
+    return fig
+
+
+def warmup(result, *, title: str = "", unit: str = "") -> Figure:
+    """Moving-average bias of each channel over the whole log with the fitted
+    exponential transient and the settle point (dashed line; the part before it
+    shaded), and the temperature under them when the log has it."""
+    new_figure = _plt()
+    k = len(result.names)
+    rows = k + (result.temperature is not None)
+    scale, tunit = (60.0, "min") if result.time[-1] < 3 * 3600 else (3600.0, "h")
+    t = result.time / scale
+    fitted = result.fitted()
+    with style():
+        fig = new_figure(figsize=(9, 1.45 * rows + 0.7))
+        axes = fig.subplots(rows, 1, sharex=True, squeeze=False)[:, 0]
+        for j, name in enumerate(result.names):
+            ax = axes[j]
+            ax.plot(t, result.bias[:, j], color=AXIS_COLORS[j % 3], linewidth=0.9,
+                    label=f"{_summary.number(result.block)} s mean")
+            if result.significant[j]:
+                ax.plot(t, fitted[:, j], color="k", linewidth=0.8, linestyle="--",
+                        label=f"τ {_summary.duration(result.tau[j])}")
+                ax.legend(loc="upper right")
+            ax.set_ylabel(f"{name}" + (f" [{unit}]" if unit else ""))
+        if result.temperature is not None:
+            axes[-1].plot(t, result.temperature, color="#d62728", linewidth=0.9)
+            axes[-1].set_ylabel("temperature [°C]")
+        for ax in axes:
+            if result.settle > 0:
+                ax.axvspan(0, result.settle / scale, color="0.85", linewidth=0)
+                ax.axvline(result.settle / scale, color="k", linewidth=0.8, linestyle=":")
+            ax.margins(x=0)
+        axes[-1].set_xlabel(f"time [{tunit}]")
+        where = (f"settled at {_summary.duration(result.settle)}" if result.settle > 0
+                 else "no warm-up transient")
+        fig.suptitle(title or f"Bias over time: {where}")
+        _margins(fig, left=1.0, bottom=0.45, title=True)
+    return fig
+
+
+def thermal(result, *, title: str = "") -> Figure:
+    """Block-mean bias against block-mean temperature per channel, with the fit and
+    its slope in datasheet units."""
+    new_figure = _plt()
+    k = len(result.names)
+    cols = min(k, 3)
+    rows = -(-k // cols)
+    slope, slope_std, units = result.datasheet(1)
+    order = np.argsort(result.block_temperature)
+    grid_t = np.linspace(*result.temperature_range, 100)
+    curve = result.predict(grid_t)
+    with style():
+        fig = new_figure(figsize=(3.3 * cols, 2.4 * rows + 0.6))
+        axes = fig.subplots(rows, cols, squeeze=False)
+        for j, name in enumerate(result.names):
+            ax = axes[j // cols, j % cols]
+            ax.plot(result.block_temperature[order], result.block_bias[order, j], ".",
+                    color=AXIS_COLORS[j % 3], markersize=2.5)
+            ax.plot(grid_t, curve[:, j], color="k", linewidth=1.0,
+                    label=f"{slope[j]:.3g} ± {slope_std[j]:.2g} {units[j]}")
+            ax.set_title(name)
+            ax.set_xlabel("temperature [°C]")
+            ax.legend(loc="best")
+        for j in range(k, rows * cols):
+            axes[j // cols, j % cols].set_visible(False)
+        fig.suptitle(title or "Bias against temperature")
+        _margins(fig, left=0.8, bottom=0.5, top=0.3, wspace=0.45, hspace=0.6, title=True)
+    return fig
+
+
+def compensation(before: AllanResult, after: AllanResult, *, title: str = "",
+                 unit: str = "") -> Figure:
+    """Allan deviation per axis before (solid) and after (dashed) a correction, e.g.
+    the temperature compensation of :func:`imunoise.thermal`."""
+    new_figure = _plt()
+    b = np.asarray(before.dev).reshape(len(before.taus), -1)
+    a = np.asarray(after.dev).reshape(len(after.taus), -1)
+    names = axis_names(b.shape[1])
+    with style():
+        fig = new_figure(figsize=(6.5, 4.2))
+        ax = fig.subplots()
+        for j, name in enumerate(names):
+            color = AXIS_COLORS[j % 4]
+            ax.loglog(before.taus, b[:, j], color=color, label=f"{name} before")
+            ax.loglog(after.taus, a[:, j], color=color, linestyle="--", label=f"{name} after")
+        ax.set_xlabel("τ [s]")
+        ax.set_ylabel(f"σ(τ) [{unit}]" if unit else "σ(τ)")
+        ax.legend(ncol=2)
+        fig.suptitle(title or "Allan deviation before and after compensation")
+        _margins(fig, left=0.9, bottom=0.5, title=True)
+    return fig

@@ -292,3 +292,30 @@ def test_strict_error_names_the_message(tmp_path):
     with pytest.raises(ParseError) as info:
         read_rosbag(mcap.read_bytes(), strict=True)
     assert (info.value.line, info.value.source) == (3, None)  # bytes in memory
+
+
+def test_temperature_topic_is_merged_onto_the_imu_stamps(tmp_path):
+    """A sensor_msgs Temperature topic at 1 Hz next to a 100 Hz Imu topic: the log's
+    temperature is the linear interpolation on the IMU stamps (held at the ends)."""
+    store = get_typestore(Stores.ROS2_HUMBLE)
+    Temp = store.types["sensor_msgs/msg/Temperature"]
+    t0 = 1_700_000_000_000_000_000
+    n = 500
+    ns = t0 + np.arange(n) * 10_000_000
+    imu = [(int(t), _imu(store, int(t), (0.0, 0.0, 0.0), (0.0, 0.0, 9.81), (0, 0, 0, 1)))
+           for t in ns]
+    temp_ns = t0 + 500_000_000 + np.arange(4) * 1_000_000_000
+    temp_c = np.array([30.0, 30.5, 31.5, 31.0])
+    temps = [(int(t), Temp(header=_header(store, int(t)), temperature=float(c), variance=0.0))
+             for t, c in zip(temp_ns, temp_c, strict=True)]
+    _write(tmp_path / "bag", store, {"/imu/data": ("sensor_msgs/msg/Imu", imu),
+                                     "/imu/temperature": ("sensor_msgs/msg/Temperature", temps)})
+    log = read_rosbag(tmp_path / "bag")
+    assert "temperature" in log.channels
+    assert log.messages["sensor_msgs/msg/Temperature"] == 4
+    expected = np.interp(ns - t0, temp_ns - t0, temp_c)
+    np.testing.assert_allclose(log.temperature, expected)
+    assert log.temperature[0] == 30.0 and log.temperature[-1] == 31.0
+    assert log.temperature[100] == pytest.approx(30.25)  # 1.0 s: halfway 0.5 s -> 1.5 s
+    with pytest.raises(ValueError, match="is a Temperature topic; choose the Imu topic"):
+        read_rosbag(tmp_path / "bag", topic="/imu/temperature")

@@ -5,7 +5,10 @@
 * ``sensor_msgs/msg/Imu``: gyro (rad/s), accel (m/s²), orientation quaternion
   (x, y, z, w; left out when the driver marks it absent with covariance[0] = -1 or
   sends zeros), time from ``header.stamp``. A single ``sensor_msgs/msg/MagneticField``
-  topic with the same stamps is merged in as ``mag`` (Tesla -> Gauss).
+  topic with the same stamps is merged in as ``mag`` (Tesla -> Gauss), and a single
+  ``sensor_msgs/msg/Temperature`` topic as ``temperature`` (°C; usually published
+  slower than the IMU, so interpolated linearly onto the IMU stamps and held
+  constant before its first and after its last message).
 * ``sensor_msgs/msg/MagneticField`` alone (``topic=`` it, or when it is the only one).
 * Any message type with a string field carrying a raw VN-100 sentence (the usual
   lab-driver format, e.g. ``vn_driver/msg/Vectornav`` with ``string raw``): the
@@ -45,6 +48,7 @@ __all__ = ["SIGNATURES", "read_rosbag", "sniff"]
 
 IMU = "sensor_msgs/msg/Imu"
 MAG = "sensor_msgs/msg/MagneticField"
+TEMPERATURE = "sensor_msgs/msg/Temperature"
 TESLA_TO_GAUSS = 1e4
 _BATCH = 20_000  # messages per call of the VN parser
 
@@ -255,6 +259,8 @@ def _classify_topics(reader) -> tuple[dict[str, list], dict[str, _Kind]]:
             kinds[tp] = ("imu", None)
         elif msgtype == MAG:
             kinds[tp] = ("mag", None)
+        elif msgtype == TEMPERATURE:
+            kinds[tp] = ("temperature", None)
         else:
             raw = next((raw for _c, _t, raw in reader.messages(connections=conns)), None)
             if raw is None:
@@ -291,6 +297,9 @@ def _choose_topic(topics, kinds, topic, known, name) -> str:
                 f"{name}: no IMU topic (sensor_msgs/msg/Imu, MagneticField or a message "
                 f"with a $VN sentence); topics are {listing}"
             )
+    if kinds[chosen][0] == "temperature":
+        raise ValueError(f"{name}: topic {chosen!r} is a Temperature topic; choose the Imu "
+                         "topic (the temperature is merged into it)")
     if kinds[chosen][0] == "other":
         msgtype = topics[chosen][0].msgtype
         if msgtype not in known:
@@ -344,7 +353,34 @@ def _read_sensor_topic(
             channels["mag"] = mag
             messages[MAG] = len(stamps)
             read.append(mags[0])
+    temps = [tp for tp, (k, _f) in kinds.items() if k == "temperature"]
+    if len(temps) == 1 and len(stamps):
+        tstamps, values = _temperature_arrays(reader, topics[temps[0]])
+        if len(tstamps):
+            # interpolate on stamps relative to the first IMU stamp (float64 keeps ns)
+            order = np.argsort(tstamps, kind="stable")
+            channels["temperature"] = np.interp(
+                (stamps - stamps[0]).astype(np.float64),
+                (tstamps[order] - stamps[0]).astype(np.float64), values[order])
+            messages[TEMPERATURE] = len(tstamps)
+            read.append(temps[0])
     return _TopicData(channels, messages, stamps, tuple(read))
+
+
+def _temperature_arrays(reader, conns) -> tuple[np.ndarray, np.ndarray]:
+    """Stamps (ns) and temperatures (°C) of a sensor_msgs Temperature topic; messages
+    that do not decode or are not finite are left out (the IMU rows stay)."""
+    stamps, values = [], []
+    for _conn, t, raw in reader.messages(connections=conns):
+        try:
+            msg = reader.deserialize(raw, TEMPERATURE)
+            value = float(msg.temperature)
+        except Exception:  # a damaged temperature message only costs its own value
+            continue
+        if np.isfinite(value):
+            stamps.append(_stamp(msg) or t)
+            values.append(value)
+    return np.asarray(stamps, dtype=np.int64), np.asarray(values, dtype=np.float64)
 
 
 def _read_vn_topic(reader, conns, kind, field, tally, strict, name, tick) -> _TopicData:

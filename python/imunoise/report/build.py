@@ -20,10 +20,14 @@ from imunoise import allan as _allan
 from imunoise._core import __version__
 from imunoise._progress import Progress
 from imunoise._schema import ALLAN_SENSORS, ATTITUDE_NAMES, SAMPLE_SENSORS, sensor_label
+from imunoise.events import Events, events
 from imunoise.readers.log import ImuLog
 from imunoise.report import sections
 from imunoise.report.document import Doc
+from imunoise.report.formatting import format_duration
 from imunoise.report.inputs import read_log
+from imunoise.thermal import Thermal, thermal
+from imunoise.warmup import Warmup, warmup
 
 __all__ = ["SECTIONS", "TAUS_PER_DECADE", "TITLE", "Context", "Report", "Section", "build"]
 
@@ -44,6 +48,10 @@ class Context:
     out_dir: Path
     taus_per_decade: int = TAUS_PER_DECADE
     figures: list[Path] = field(default_factory=list)
+    #: The long log before ``--trim auto`` cut its warm-up (None: not trimmed).
+    untrimmed: ImuLog | None = None
+    #: What ``--trim auto`` cut, in words ("" when nothing was cut).
+    trim_note: str = ""
 
     @property
     def logs(self) -> list[tuple[str, ImuLog]]:
@@ -104,6 +112,37 @@ class Context:
         (:func:`~imunoise.report.model_sentences`), not warned about."""
         return {sensor: noise.fit(r, warn_coverage=False) for sensor, r in self.allan.items()}
 
+    @cached_property
+    def events(self) -> Events | None:
+        """Events of the short log's gyro and accel (None without them)."""
+        if not any(getattr(self.short, s) is not None for s in ALLAN_SENSORS):
+            return None
+        return events(self.short)
+
+    @cached_property
+    def warmup(self) -> Warmup | None:
+        """Warm-up of the whole long log (before any trim); None when it is shorter
+        than ``sections.WARMUP_MIN_DURATION`` or has no gyro/accel."""
+        log = self.untrimmed or self.long
+        if log.duration < sections.WARMUP_MIN_DURATION or not any(
+                getattr(log, s) is not None for s in ALLAN_SENSORS):
+            return None
+        return warmup(log)
+
+    @cached_property
+    def thermal(self) -> Thermal | None:
+        """Bias-vs-temperature fit of the long log; None without temperature or
+        with less than ``sections.THERMAL_MIN_RANGE`` °C of it."""
+        log = self.untrimmed or self.long  # the warm-up holds most of the range
+        t = log.temperature
+        if t is None or not np.isfinite(t).any() or np.nanmax(t) - np.nanmin(t) < \
+                sections.THERMAL_MIN_RANGE or not any(
+                getattr(log, s) is not None for s in ALLAN_SENSORS):
+            return None
+        fit = thermal(log)
+        lo, hi = fit.temperature_range
+        return fit if hi - lo >= sections.THERMAL_MIN_RANGE else None
+
     def add_figure(self, doc: Doc, fig, name: str, caption: str) -> None:
         """Save ``fig`` as ``figures/<name>.png`` and ``.svg`` and show it in ``doc``."""
         path = self.out_dir / "figures" / name
@@ -132,6 +171,11 @@ SECTIONS: tuple[Section, ...] = (
     Section("Distribution fits", sections.distribution_fits),
     Section("Attitude (yaw, pitch, roll)", sections.attitude,
             applies=lambda ctx: ctx.attitude is not None),
+    Section("Events (vibration, shocks, spikes)", sections.events_section,
+            applies=lambda ctx: ctx.events is not None and len(ctx.events) > 0),
+    Section("Warm-up", sections.warmup_section, applies=lambda ctx: ctx.warmup is not None),
+    Section("Temperature", sections.thermal_section,
+            applies=lambda ctx: ctx.thermal is not None),
     Section("Allan deviation", sections.allan_deviation),
     Section("Noise coefficients", sections.noise_coefficients),
     Section("Datasheet comparison", sections.datasheet_comparison),
@@ -191,6 +235,7 @@ def build(
     fs: float | None = None,
     progress: bool | None = None,
     read_options: Mapping[str, object] | None = None,
+    trim: str | None = None,
 ) -> Report:
     """Analyse the logs and write the report directory.
 
@@ -213,7 +258,13 @@ def build(
         Layout of text logs whose header does not say it, passed to
         :func:`imunoise.read`: ``{"columns": {"gyro": [6, 7, 8]}, "units": {"gyro":
         "deg/s"}}`` (also ``delimiter``, ``time_column``).
+    trim : {None, "auto"}
+        ``"auto"``: analyse the long log from the settle point of its warm-up
+        (:func:`imunoise.warmup`); the report says what was cut, at its top and in
+        the warm-up section. None (default): the whole log.
     """
+    if trim not in (None, "auto"):
+        raise ValueError(f"trim must be None or 'auto'; got {trim!r}")
     out = Path(out_dir)
     with Progress(progress, total=len(SECTIONS) + 1) as bar:
         options = dict(read_options or {})
@@ -223,10 +274,14 @@ def build(
         (out / "figures").mkdir(parents=True, exist_ok=True)
         ctx = Context(short=short_log, long=long_log, one_log=long is None, spec=spec,
                       out_dir=out)
+        if trim == "auto":
+            _trim_warmup(ctx)
         doc = Doc()
         doc.h(1, TITLE)
         stamp = _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
         doc.p(f"Generated by imunoise {__version__} on {stamp}.")
+        if ctx.trim_note:
+            doc.p(f"**Trim**: {ctx.trim_note}")
         present = [s for s in SECTIONS if s.applies(ctx)]
         bar.set_total(len(present) + 1)  # absent sections take no step
         for number, section in enumerate(present, start=1):
@@ -251,6 +306,27 @@ def build(
         logs=tuple(log for _label, log in ctx.logs),
         attitude=ctx.attitude_distributions,
     )
+
+
+def _trim_warmup(ctx: Context) -> None:
+    """``--trim auto``: start the long log (and the short one, when it is the same
+    log) at the warm-up's settle point, and say so."""
+    w = ctx.warmup
+    if w is None or w.settle <= 0:
+        ctx.trim_note = ("`--trim auto`: no warm-up transient found" if w is not None else
+                         "`--trim auto`: the log is too short to examine its warm-up") + \
+            "; nothing was cut."
+        return
+    full = ctx.long
+    ctx.untrimmed = full
+    ctx.long = w.trim(full)
+    if ctx.one_log:
+        ctx.short = ctx.long
+    ctx.trim_note = (f"`--trim auto` cut the first {w.settle_index} samples "
+                     f"({format_duration(w.settle)}, "
+                     f"{100 * w.settle_index / len(full):.3g} % of the log) before the "
+                     f"sensor settled; every analysis below uses the remaining "
+                     f"{format_duration(ctx.long.duration)}.")
 
 
 def _write_model_files(models: dict, out_dir: Path, fs: float) -> list[Path]:

@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from imunoise import allan as _allan
-from imunoise import noise, numbers, plot
+from imunoise import noise, numbers, plot, stats
 from imunoise._schema import CHANNELS, SAMPLE_SENSORS, axis_names
 from imunoise.numbers import format_value
 from imunoise.report.formatting import (
@@ -37,10 +37,13 @@ __all__ = [
     "datasheet_comparison",
     "distribution_fits",
     "dynamic_allan",
+    "events_section",
     "noise_coefficients",
     "power_spectral_density",
     "recording_summary",
     "sample_statistics",
+    "thermal_section",
+    "warmup_section",
 ]
 
 #: Share of missing samples above which the report prints a warning line.
@@ -363,3 +366,133 @@ def dynamic_allan(ctx: Context, doc: Doc) -> None:
         doc.p(f"The {sensor} noise is not stationary: it departs from its typical level at "
               f"{where}{more} (from the first sample; {share} of the window intervals exclude "
               f"the whole-record ADEV, about {st.expected_outside:.0%} expected).")
+
+
+# --- events, warm-up and temperature (issue 13) -------------------------------------
+
+#: Events listed in the report's table (the largest by peak).
+EVENT_ROWS = 20
+#: Shortest long log whose warm-up the report examines, s.
+WARMUP_MIN_DURATION = 1200.0
+#: Smallest temperature range (°C) of a log the report fits bias against.
+THERMAL_MIN_RANGE = 0.5
+
+
+def events_section(ctx: Context, doc: Doc) -> None:
+    """Events of the short log: table, time series with them marked, statistics
+    and normal fits with and without them."""
+    found, log = ctx.events, ctx.short
+    doc.p(f"Spikes (Hampel test) and bursts (sliding energy, window "
+          f"{format_duration(found.window / found.fs)}) per channel of the short log, "
+          f"thresholds set for {found.false_alarm:.0e} false events per sample and channel "
+          "(measured on white noise: docs/events.md). "
+          f"{len(found)} events cover {100 * found.share:.3g} % of the samples.")
+    # with --trim auto on one log the short log starts at the settle point: times
+    # are given from the first sample of the recording
+    offset = (len(ctx.untrimmed) - len(log)) / log.fs if ctx.one_log and ctx.untrimmed else 0.0
+    order = np.argsort(found.peak)[::-1][:EVENT_ROWS]
+    doc.table(
+        ["start [s]", "end [s]", "kind", "channels", "peak [σ]"],
+        [[format_number(found.start[i] + offset), format_number(found.end[i] + offset),
+          found.kind[i],
+          ", ".join(found.channels[i]), f"{found.peak[i]:.3g}"] for i in sorted(order)],
+        caption=f"Events of the short log ({min(len(found), EVENT_ROWS)} largest of "
+                f"{len(found)})",
+    )
+    cut = found.exclude(log)
+    rows = []
+    for sensor in ("gyro", "accel"):
+        y, z = getattr(log, sensor), getattr(cut, sensor)
+        if y is None:
+            continue
+        fig = plot.events(y, found, log.fs, title=f"{sensor} with events (short log)",
+                          unit=CHANNELS[sensor][1])
+        ctx.add_figure(doc, fig, f"events_{sensor}",
+                       f"{sensor} of the short log, events shaded, peak in sigmas above")
+        kept = []
+        for j, axis in enumerate(axis_names(y.shape[1])):
+            with_, without = stats.distribution(y[:, j]), stats.distribution(
+                z[:, j][np.isfinite(z[:, j])])
+            kept.append(without)
+            rows.append([f"{sensor} {axis}", *(format_number(v) for v in (
+                np.nanstd(y[:, j], ddof=1), np.nanstd(z[:, j], ddof=1), with_.excess_kurtosis,
+                without.excess_kurtosis, with_.ks_statistic, without.ks_statistic))])
+        fig = plot.histograms(kept, title=f"{sensor} without events (short log)",
+                              unit=CHANNELS[sensor][1])
+        ctx.add_figure(doc, fig, f"hist_{sensor}_no_events",
+                       f"Histogram of {sensor} with the events left out, fitted normal")
+    doc.table(["channel", "std", "std without events", "excess kurtosis",
+               "without events", "KS D", "without events"], rows,
+              caption="Statistics and normal fits with and without the events (short log)")
+    doc.p("`imunoise.events(log).exclude(log)` makes the events missing samples; the "
+          "Allan statistics then skip every term that touches one (docs/gaps.md).")
+
+
+def warmup_section(ctx: Context, doc: Doc) -> None:
+    """Bias over time of the long log, the fitted transient and the settle point, and
+    what ``--trim auto`` cut."""
+    w = ctx.warmup
+    doc.p(f"Bias of the {'only' if ctx.one_log else 'long'} log over time "
+          f"({format_duration(w.block)} means), fitted with b∞ + A·exp(−t/τ) per channel; "
+          f"a transient counts when it beats a constant bias (F-test, p < {w.alpha:g}, "
+          "corrected for correlated means) and has settled when what is left of it is below "
+          "the channel's Allan-deviation floor (docs/events.md).")
+    doc.table(
+        ["channel", "A", "τ", "p", "tolerance", "settled after"],
+        [[r["name"],
+          format_number(r["amplitude"], r["amplitude_std"]) if r["significant"] else "—",
+          format_duration(r["tau"]) if r["significant"] else "—", f"{r['p_value']:.2g}",
+          format_number(r["tolerance"]),
+          format_duration(r["settle_time"]) if r["significant"] else
+          "slow drift (τ > half the log)" if r["p_value"] < w.alpha else "no transient"]
+         for r in w.rows()],
+        caption="Warm-up transient per channel",
+    )
+    if w.temperature is not None:
+        doc.p(f"Temperature: τ {format_duration(w.temperature_tau)}, final "
+              f"{w.temperature_final:.2f} °C, within 0.1 °C of it after "
+              f"{format_duration(w.temperature_settle)}.")
+    verdict = (f"The sensor settled after {format_duration(w.settle)} "
+               f"({100 * w.settle_index / w.n_samples:.3g} % of the log)." if w.settle > 0
+               else "No warm-up transient: the log is analysed whole.")
+    doc.p(verdict)
+    doc.p(ctx.trim_note or ("The analysis uses the whole log (`--trim auto` would start it "
+                            "at the settle point)." if w.settle > 0 else ""))
+    ctx.add_figure(doc, plot.warmup(w), "warmup",
+                   "Bias over time (block means), fitted transient, settle point (dotted; "
+                   "before it shaded)")
+
+
+def thermal_section(ctx: Context, doc: Doc) -> None:
+    """Bias against temperature per axis of the long log, and the Allan deviation
+    before and after compensation."""
+    th = ctx.thermal
+    lo, hi = th.temperature_range
+    doc.p(f"Linear fit of the bias against temperature over {lo:.2f}–{hi:.2f} °C "
+          f"({format_duration(len(th.compensated) / th.fs / len(th.block_temperature))} "
+          "means), "
+          "uncertainties corrected for correlated residuals. Temperature and time "
+          f"correlate with |r| = {th.time_correlation:.2f} (at 1 a thermal bias and a "
+          "warm-up or drift cannot be told apart; a log with temperature cycles separates "
+          "them).")
+    doc.table(["channel", "slope", "unit", "R²"],
+              [[r["name"], format_number(r["slope"], r["slope_std"]), r["unit"],
+                format_number(r["r_squared"])] for r in th.rows()],
+              caption="Bias temperature sensitivity (datasheet units)")
+    ctx.add_figure(doc, plot.thermal(th), "thermal", "Bias against temperature with the fit")
+    log = ctx.untrimmed or ctx.long
+    if ctx.untrimmed is not None:
+        doc.p("The fit and the Allan deviations of this section use the whole log, warm-up "
+              "included (it holds most of the temperature range).")
+    k = 0
+    for sensor in ("gyro", "accel"):
+        y = getattr(log, sensor)
+        if y is None:
+            continue
+        before = _allan.adev(y, log.fs, taus=ctx.taus_per_decade)
+        after = _allan.adev(th.compensated[:, k:k + 3], log.fs, taus=before.taus)
+        k += 3
+        fig = plot.compensation(before, after, title=f"{sensor}: temperature compensation",
+                                unit=CHANNELS[sensor][1])
+        ctx.add_figure(doc, fig, f"thermal_adev_{sensor}",
+                       f"Allan deviation of {sensor} before and after compensation")

@@ -1,0 +1,50 @@
+"""The rate channels an analysis of still logs works on: a log's gyro/accel columns
+or an array's, with their names and the sample rate (events, warm-up, thermal)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from imunoise import _schema
+from imunoise._validate import sample_rate
+from imunoise.readers.log import ImuLog
+
+
+def rate_channels(data, fs, channels) -> tuple[np.ndarray, float, tuple[str, ...]]:
+    """(n, k) float samples, the rate and the channel names (``"gyro X"`` …) of a log's
+    ``channels`` (default: its gyro and accel) or of an array (``fs`` required)."""
+    if isinstance(data, ImuLog):
+        fs = data.fs if fs is None else fs
+        wanted = [c for c in _schema.ALLAN_SENSORS if getattr(data, c) is not None]
+        if channels is not None:
+            wanted = [channels] if isinstance(channels, str) else list(channels)
+            missing = [c for c in wanted if c not in data.channels]
+            if missing:
+                raise ValueError(
+                    f"channels {missing} are not in the log; it has {list(data.channels)}"
+                )
+        if not wanted:
+            raise ValueError(f"data has no gyro or accel channel; got {list(data.channels)}")
+        blocks, names = [], []
+        for c in wanted:
+            arr = np.asarray(getattr(data, c), dtype=np.float64)
+            arr = arr.reshape(len(arr), -1)
+            blocks.append(arr)
+            names += [_schema.sensor_label(c, j, arr.shape[1]) for j in range(arr.shape[1])]
+        x = np.hstack(blocks)
+    else:
+        if channels is not None:
+            raise ValueError("channels= selects log channels; data is an array")
+        if fs is None:
+            raise ValueError("fs is required when data is an array")
+        try:
+            x = np.asarray(data, dtype=np.float64)
+        except (TypeError, ValueError) as exc:
+            raise TypeError(f"data must be an ImuLog or numeric array; got {exc}") from None
+        if x.ndim not in (1, 2):
+            raise ValueError(f"data must have shape (n,) or (n, k); got {x.shape}")
+        if np.isinf(x).any():
+            raise ValueError("data has infinite values (NaN marks a missing sample)")
+        x = x.reshape(len(x), -1)
+        names = ["x"] if x.shape[1] == 1 else [f"ch{j}" for j in range(x.shape[1])]
+    return x, sample_rate(fs), tuple(names)

@@ -1,0 +1,485 @@
+r"""Events in a still recording: spikes (single outliers) and bursts (vibration, shocks).
+
+A still log is meant to hold sensor noise only; a door slam, a footstep or a
+glitch adds samples that inflate the standard deviation, bend the histogram and
+add power at short averaging times. :func:`events` finds them per channel and
+merges them across channels.
+
+Detector
+--------
+Per channel, after removing a robust baseline (medians of ``baseline``-second
+blocks, interpolated linearly, so slow bias drift is not an event):
+
+1. **Spikes** (Hampel test): :math:`|z_i| > k` with :math:`z_i = r_i/\hat\sigma`,
+   :math:`\hat\sigma = 1.4826\,\mathrm{MAD}(r)` (consistent for Gaussian noise
+   and unmoved by the events themselves), :math:`k = \Phi^{-1}(1 - p/4)`.
+2. **Bursts** (windowed energy): :math:`S_j = \sum_{i\in W_j} z_i^2` over a
+   sliding window of ``window`` seconds (:math:`w` samples). Under white Gaussian
+   noise :math:`S_j \sim \chi^2_w`; a window is flagged when
+   :math:`S_j > \chi^{2}_{w}{}^{-1}(1 - p_w)`, with
+   :math:`p_w = p\,w/(2\,c)`, :math:`c =` :data:`OVERLAP_FACTOR` (overlapping windows
+   cross the threshold in clusters; the factor was measured, see below).
+   The start and end of a burst are then placed by maximum likelihood of a
+   variance change inside the flagged stretch: with :math:`v` the stretch's mean
+   :math:`z^2`, each sample adds :math:`\ell_i = z_i^2(1-1/v) - \ln v` to the
+   log-likelihood ratio, and the burst is the segment maximising
+   :math:`\sum \ell_i` (the CUSUM change-point estimate, Page 1954).
+
+``false_alarm`` (:math:`p`, default :data:`FALSE_ALARM`) is the design rate of
+false events per sample and channel, split evenly between the two tests.
+Measured on white Gaussian noise (``benches/bench_events.py``, 2·10⁷ samples):
+see ``docs/events.md`` for the numbers; the target is at most one false event
+per 10⁶ samples at the default.
+
+Events closer than ``merge`` seconds are joined, per channel and then across
+channels. :meth:`Events.exclude` turns the events into missing samples (NaN),
+which the Allan-family statistics skip (``docs/gaps.md``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+from scipy import stats as _sstats
+
+from imunoise import _summary
+from imunoise._channels import rate_channels
+from imunoise._validate import positive_finite
+from imunoise.readers.log import ImuLog
+
+__all__ = ["Events", "events", "FALSE_ALARM", "OVERLAP_FACTOR"]
+
+#: Default design rate of false events per sample and channel.
+FALSE_ALARM = 1e-7
+#: Threshold crossings of a sliding energy window per independent window under
+#: white noise, relative to ``n/w·p_w`` (measured: about 2.5–3.5 for w = 10–400;
+#: 4 keeps the design rate an upper bound).
+OVERLAP_FACTOR = 4.0
+#: Smallest energy window, samples (fewer makes the χ² test a spike test).
+MIN_WINDOW = 4
+
+
+@dataclass(frozen=True, repr=False)
+class Events:
+    r"""Events found in a record (see :func:`events`).
+
+    Attributes
+    ----------
+    fs : float
+        Sample rate, Hz.
+    n_samples : int
+        Samples of the record.
+    names : tuple of str
+        The channels searched (``"gyro X"`` …, ``"x"``/``"ch0"`` for arrays).
+    start_index, end_index : ndarray of int
+        First sample of each event and one past its last (grid rows).
+    channels : tuple of tuple of str
+        The channels each event was found in.
+    peak : ndarray
+        Largest :math:`|x - \text{baseline}|/\hat\sigma` inside each event, over its channels.
+    kind : tuple of str
+        ``"spike"`` (one to a few samples above the Hampel threshold) or ``"burst"``.
+    sigma : ndarray
+        Robust noise level :math:`\hat\sigma = 1.4826\,\mathrm{MAD}` of each channel,
+        in the channel's unit.
+    spike_threshold : float
+        :math:`k`, sigmas.
+    energy_threshold : float
+        Mean :math:`z^2` over a full window that flags a burst.
+    window : int
+        Energy window, samples.
+    false_alarm : float
+        Design rate of false events per sample and channel.
+    """
+
+    fs: float
+    n_samples: int
+    names: tuple[str, ...]
+    start_index: np.ndarray
+    end_index: np.ndarray
+    channels: tuple[tuple[str, ...], ...]
+    peak: np.ndarray
+    kind: tuple[str, ...]
+    sigma: np.ndarray
+    spike_threshold: float
+    energy_threshold: float
+    window: int
+    false_alarm: float
+
+    def __post_init__(self) -> None:
+        for name in ("start_index", "end_index", "peak", "sigma"):
+            getattr(self, name).flags.writeable = False
+
+    def __len__(self) -> int:
+        return len(self.start_index)
+
+    @property
+    def start(self) -> np.ndarray:
+        """Start of each event, s from the first sample."""
+        return self.start_index / self.fs
+
+    @property
+    def end(self) -> np.ndarray:
+        """End of each event (one sample past its last), s."""
+        return self.end_index / self.fs
+
+    @property
+    def duration(self) -> np.ndarray:
+        """Length of each event, s."""
+        return (self.end_index - self.start_index) / self.fs
+
+    @property
+    def mask(self) -> np.ndarray:
+        """Boolean (n_samples,): ``True`` inside an event (any channel)."""
+        return self.padded_mask(0.0)
+
+    @property
+    def share(self) -> float:
+        """Fraction of the samples inside events."""
+        return float(self.mask.mean()) if self.n_samples else 0.0
+
+    def padded_mask(self, pad: float = 0.0) -> np.ndarray:
+        """:attr:`mask` with every event widened by ``pad`` seconds on each side."""
+        if pad < 0 or not np.isfinite(pad):
+            raise ValueError(f"pad must be >= 0 and finite (s); got {pad!r}")
+        extra = int(np.ceil(pad * self.fs))
+        mark = np.zeros(self.n_samples + 1, dtype=np.int64)
+        lo = np.clip(self.start_index - extra, 0, self.n_samples)
+        hi = np.clip(self.end_index + extra, 0, self.n_samples)
+        np.add.at(mark, lo, 1)
+        np.add.at(mark, hi, -1)
+        return np.cumsum(mark[:-1]) > 0
+
+    def exclude(self, data, *, pad: float = 0.0):
+        """``data`` with the events' samples missing (NaN), every channel of the row.
+
+        Parameters
+        ----------
+        data : ImuLog or array_like, shape (n_samples,) or (n_samples, k)
+            The record the events were found in (or another one on the same grid).
+        pad : float
+            Seconds added on each side of every event.
+
+        Returns
+        -------
+        ImuLog or ndarray
+            A log whose event rows are NaN in every channel (its ``gaps`` now list
+            them), or a float copy of the array with NaN rows. The gap-aware
+            Allan statistics (``docs/gaps.md``) then leave out every term that
+            touches an event.
+        """
+        mask = self.padded_mask(pad)
+        if isinstance(data, ImuLog):
+            if len(data) != self.n_samples:
+                raise ValueError(
+                    f"data has {len(data)} samples; the events are for {self.n_samples}"
+                )
+            changed = {}
+            for name in data.channels:
+                arr = np.array(getattr(data, name), dtype=np.float64)
+                arr[mask] = np.nan
+                changed[name] = arr
+            return replace(data, gaps=None, **changed)
+        arr = np.array(data, dtype=np.float64)
+        if arr.ndim not in (1, 2) or arr.shape[0] != self.n_samples:
+            raise ValueError(
+                f"data must have shape ({self.n_samples},) or ({self.n_samples}, k); "
+                f"got {arr.shape}"
+            )
+        arr[mask] = np.nan
+        return arr
+
+    def rows(self) -> list[dict]:
+        """One dict per event: start, end, duration (s), kind, channels, peak (sigmas)."""
+        return [
+            {
+                "start": float(self.start[i]),
+                "end": float(self.end[i]),
+                "duration": float(self.duration[i]),
+                "kind": self.kind[i],
+                "channels": ", ".join(self.channels[i]),
+                "peak": float(self.peak[i]),
+            }
+            for i in range(len(self))
+        ]
+
+    def _facts(self) -> list[str]:
+        bursts = sum(k == "burst" for k in self.kind)
+        parts = [
+            f"{_summary.plural(len(self), 'event')} ({bursts} bursts, {len(self) - bursts} spikes)",
+            f"{100 * self.share:.3g} % of {self.n_samples} samples",
+        ]
+        parts += [
+            f"{r['start']:.4g}–{r['end']:.4g} s {r['kind']} {r['peak']:.3g}σ" for r in self.rows()
+        ]
+        return parts
+
+    def __repr__(self) -> str:
+        return _summary.lines("Events(", self._facts(), sep=", ")
+
+    def _repr_html_(self) -> str:
+        rows = [
+            [_summary.number(r["start"]), _summary.number(r["end"]), r["kind"], r["channels"],
+             _summary.number(r["peak"])]
+            for r in self.rows()[: _summary.HTML_ROWS]
+        ]
+        caption = "Events: " + ", ".join(self._facts()[:2])
+        if len(self) > _summary.HTML_ROWS:
+            caption += f" (first {_summary.HTML_ROWS} shown)"
+        return _summary.html_table(
+            ["start [s]", "end [s]", "kind", "channels", "peak [σ]"], rows, caption=caption
+        )
+
+
+def events(
+    data,
+    fs: float | None = None,
+    *,
+    channels=None,
+    false_alarm: float = FALSE_ALARM,
+    window: float = 1.0,
+    baseline: float = 10.0,
+    merge: float = 0.5,
+) -> Events:
+    r"""Find spikes and bursts in a still recording, per channel.
+
+    Parameters
+    ----------
+    data : ImuLog or array_like, shape (n,) or (n, k)
+        A log (its gyro and accel channels are searched) or samples (NaN = missing).
+    fs : float, optional
+        Sample rate, Hz; required for arrays, ``log.fs`` for a log.
+    channels : str or sequence of str, optional
+        Log channels to search (default: those of ``gyro``, ``accel`` the log has).
+    false_alarm : float
+        Design rate of false events per sample and channel (both tests together);
+        sets the thresholds. Default :data:`FALSE_ALARM`.
+    window : float
+        Energy window of the burst test, s (at least :data:`MIN_WINDOW` samples).
+    baseline : float
+        Block length of the median baseline, s: slower changes are not events.
+    merge : float
+        Events closer than this (s) are joined.
+
+    Returns
+    -------
+    Events
+
+    Notes
+    -----
+    See the module documentation for the tests and ``docs/events.md`` for their
+    measured false-alarm and detection rates. The noise level is the MAD of each
+    whole channel: a log whose noise level changes (a sensor switched to a
+    different filter) needs to be split first.
+    """
+    x, fs, names = rate_channels(data, fs, channels)
+    if isinstance(false_alarm, bool) or not (0 < float(false_alarm) < 0.01):
+        raise ValueError(f"false_alarm must be in (0, 0.01) per sample; got {false_alarm!r}")
+    false_alarm = float(false_alarm)
+    window = positive_finite(window, "window", unit="s")
+    baseline = positive_finite(baseline, "baseline", unit="s")
+    if isinstance(merge, bool) or not (np.isfinite(merge) and merge >= 0):
+        raise ValueError(f"merge must be >= 0 and finite (s); got {merge!r}")
+    n = x.shape[0]
+    w = max(MIN_WINDOW, int(round(window * fs)))
+    if n < 2 * w:
+        raise ValueError(f"data needs at least 2·window = {2 * w} samples; got {n}")
+    block = max(2 * w, int(round(baseline * fs)))
+    k_spike = float(_sstats.norm.isf(false_alarm / 4))
+    p_window = min(0.5, false_alarm * w / (2 * OVERLAP_FACTOR))
+    gap = int(round(merge * fs))
+
+    per_channel = []
+    sigma = np.empty(x.shape[1])
+    for j in range(x.shape[1]):
+        z, mad_sigma = _standardise(x[:, j], block)
+        scale, dof = _energy_law(z, w)
+        z /= np.sqrt(scale)
+        sigma[j] = mad_sigma * np.sqrt(scale)
+        # the burst test sees z clipped at the spike threshold: one spike, however
+        # large, is a spike, not a burst
+        spans = _spikes(z, k_spike) + _bursts(np.clip(z, -k_spike, k_spike), w, p_window, dof)
+        per_channel.append((_join(spans, gap), z))
+    return _merge_channels(
+        per_channel, names, fs, n, gap, sigma,
+        k_spike=k_spike,
+        energy=float(_sstats.chi2.isf(p_window, w)) / w,
+        window=w,
+        false_alarm=false_alarm,
+    )
+
+
+def _standardise(col: np.ndarray, block: int) -> tuple[np.ndarray, float]:
+    """``(x - baseline)/σ̂`` (NaN where missing) and σ̂ of one channel."""
+    n = len(col)
+    starts = np.arange(0, n, block)
+    with np.errstate(all="ignore"):
+        medians = np.array([_nanmedian(col[s:s + block]) for s in starts])
+    centres = np.minimum(starts + block / 2, n) - 0.5
+    ok = np.isfinite(medians)
+    if not ok.any():
+        return np.full(n, np.nan), float("nan")
+    base = np.interp(np.arange(n), centres[ok], medians[ok])
+    r = col - base
+    valid = np.isfinite(r)
+    rv = r[valid]
+    sigma = 1.4826 * float(np.median(np.abs(rv)))
+    if sigma == 0:  # coarse quantization: most samples on one level
+        q75, q25 = np.percentile(rv, [75, 25])
+        sigma = 0.7413 * float(q75 - q25) or float(np.std(rv))
+    if sigma == 0:
+        return np.where(valid, 0.0, np.nan), 0.0
+    return r / sigma, sigma
+
+
+def _nanmedian(v: np.ndarray) -> float:
+    v = v[np.isfinite(v)]
+    return float(np.median(v)) if v.size else float("nan")
+
+
+def _spikes(z: np.ndarray, k: float) -> list[tuple[int, int, str]]:
+    return [(int(i), int(i) + 1, "spike") for i in np.flatnonzero(np.abs(z) > k)]
+
+
+def _bursts(z: np.ndarray, w: int, p_window: float, dof: float) -> list[tuple[int, int, str]]:
+    """Stretches where the sliding energy exceeds its threshold, cut to the
+    maximum-likelihood segment of raised variance."""
+    n = len(z)
+    valid = np.isfinite(z)
+    z2 = np.where(valid, z * z, 0.0)
+    csum = np.concatenate(([0.0], np.cumsum(z2)))
+    count = np.concatenate(([0], np.cumsum(valid)))
+    energy = csum[w:] - csum[:-w]  # window j covers samples j .. j+w-1
+    used = count[w:] - count[:-w]
+    # a window of m valid samples: energy·ν_m/m ~ χ²(ν_m), ν_m = ν·m/w
+    limits = {m: _sstats.chi2.isf(p_window, dof * m / w) * w / dof
+              for m in np.unique(used).tolist() if m > 0}
+    limit = np.array([limits.get(m, np.inf) for m in used.tolist()]) if len(limits) > 1 \
+        else np.full(len(used), next(iter(limits.values()), np.inf))
+    hot = energy > limit
+    out = []
+    for a, b in _runs(hot):  # windows a .. b-1 flagged: samples a .. b+w-2 involved
+        lo, hi = max(0, a - w // 2), min(n, b - 1 + w + w // 2)
+        start, end = _change_points(z2[lo:hi])
+        if end > start:
+            out.append((lo + start, lo + end, "burst"))
+    return out
+
+
+def _energy_law(z: np.ndarray, w: int) -> tuple[float, float]:
+    """Scale s and degrees of freedom ν of the window energy of a quiet record:
+    Σ_window z² ≈ s·(w/ν)·χ²(ν) (Satterthwaite).
+
+    Real sensor noise is not white: correlated samples (a sensor's own filter,
+    bias wander faster than the baseline) make the window energy vary more than
+    χ²(w), which a white-noise threshold would take for bursts all along the log.
+    ν = w / (1 + 2 Σ_{k<w} (1 − k/w) ρ_k²) for a Gaussian process with
+    autocorrelation ρ_k (ν = w for white noise); s is the median window mean of
+    z² over the median of χ²(ν)/ν: σ̂·√s is the RMS of the quiet noise even where
+    the MAD misjudges it (heavy tails, quantization), and both tests use it.
+    Both are robust to a few events: ρ is computed from z clipped at ±3, s from
+    a median.
+    """
+    valid = np.isfinite(z)
+    m = int(valid.sum())
+    z = np.where(valid, z, 0.0)
+    c = np.clip(z, -3.0, 3.0)
+    c = np.where(valid, c - c[valid].mean() if m else 0.0, 0.0)
+    size = 1 << int(np.ceil(np.log2(2 * len(c))))
+    spec = np.fft.rfft(c, size)
+    acf = np.fft.irfft(spec * np.conj(spec), size)[:w]
+    pairs = np.fft.irfft(np.abs(np.fft.rfft(valid.astype(float), size)) ** 2, size)[:w]
+    rho = acf / np.maximum(pairs, 1.0) / (acf[0] / max(pairs[0], 1.0)) if acf[0] > 0 \
+        else np.zeros(w)
+    k = np.arange(1, w)
+    dof = w / (1 + 2 * np.sum((1 - k / w) * rho[1:] ** 2))
+    full = len(z) // w
+    blocks = (z[: full * w] ** 2).reshape(full, w)
+    complete = valid[: full * w].reshape(full, w).all(axis=1)
+    if not complete.any():
+        return 1.0, float(dof)
+    median = float(np.median(blocks[complete].mean(axis=1)))
+    expected = float(_sstats.chi2.median(dof)) / dof
+    return (median / expected if median > 0 else 1.0), float(dof)
+
+
+def _change_points(seg: np.ndarray) -> tuple[int, int]:
+    """The segment of ``seg`` (squared standardised samples) whose variance v > 1
+    maximises the log-likelihood ratio Σ z²(1 − 1/v) − ln v. v is first the mean
+    over all of ``seg`` (diluted by the noise around the burst), then the mean
+    over the segment found; a second pass that loses the first segment (a
+    decaying burst's variance is not one number) keeps the first."""
+    start, end = 0, len(seg)
+    found = (0, 0)
+    for _ in range(2):
+        v = max(float(seg[start:end].mean()), 1.0 + 1e-9)
+        s = np.concatenate(([0.0], np.cumsum(seg * (1 - 1 / v) - np.log(v))))
+        new_end = int(np.argmax(s))
+        new_start = int(np.argmin(s[: new_end + 1]))
+        if new_end <= new_start or (found[1] and (new_end <= found[0] or new_start >= found[1])):
+            break
+        start, end = found = (new_start, new_end)
+    return found
+
+
+def _peak(z: np.ndarray) -> float:
+    a = np.abs(z[np.isfinite(z)])
+    return float(a.max()) if a.size else float("nan")
+
+
+def _runs(flags: np.ndarray) -> list[tuple[int, int]]:
+    """(start, stop) of each run of True."""
+    d = np.diff(np.concatenate(([0], flags.astype(np.int8), [0])))
+    return list(zip(np.flatnonzero(d == 1).tolist(), np.flatnonzero(d == -1).tolist(),
+                    strict=True))
+
+
+def _join(spans: list[tuple[int, int, str]], gap: int) -> list[tuple[int, int, str]]:
+    """Spans sorted and joined when closer than ``gap`` samples; a join with a burst
+    is a burst."""
+    out: list[list] = []
+    for a, b, kind in sorted(spans):
+        if out and a - out[-1][1] <= gap:
+            last = out[-1]
+            last[1] = max(last[1], b)
+            if kind == "burst":
+                last[2] = "burst"
+        else:
+            out.append([a, b, kind])
+    return [tuple(s) for s in out]
+
+
+def _merge_channels(per_channel, names, fs, n, gap, sigma, **thresholds) -> Events:
+    """One event per overlapping group of the channels' events."""
+    tagged = sorted(
+        (a, b, kind, j) for j, (spans, _z) in enumerate(per_channel) for a, b, kind in spans
+    )
+    groups: list[list] = []
+    for a, b, kind, j in tagged:
+        if groups and a - groups[-1][1] <= gap:
+            g = groups[-1]
+            g[1] = max(g[1], b)
+            g[2] = "burst" if kind == "burst" else g[2]
+            g[3].add(j)
+        else:
+            groups.append([a, b, kind, {j}])
+    peaks = [
+        max(_peak(per_channel[j][1][a:b]) for j in chans)
+        for a, b, _k, chans in groups
+    ]
+    return Events(
+        fs=fs,
+        n_samples=n,
+        names=names,
+        start_index=np.array([g[0] for g in groups], dtype=np.int64),
+        end_index=np.array([g[1] for g in groups], dtype=np.int64),
+        channels=tuple(tuple(names[j] for j in sorted(g[3])) for g in groups),
+        peak=np.array(peaks, dtype=np.float64),
+        kind=tuple(g[2] for g in groups),
+        sigma=sigma,
+        spike_threshold=thresholds["k_spike"],
+        energy_threshold=thresholds["energy"],
+        window=thresholds["window"],
+        false_alarm=thresholds["false_alarm"],
+    )

@@ -1,0 +1,360 @@
+r"""Warm-up: the settling transient at the start of a still log.
+
+A sensor switched on drifts while it warms: the bias follows roughly
+:math:`b(t) = b_\infty + A\,e^{-t/\tau}`. Left in the record, the transient looks
+like rate random walk or rate ramp at long averaging times. :func:`warmup`
+finds it per channel and says where the sensor settled, with the evidence.
+
+Method
+------
+1. The bias over time: means of ``block``-second blocks (default: 1/300 of the
+   log, at least 1 s) — the moving-average bias the report plots.
+2. Per channel, :math:`b_\infty + A e^{-t/\tau}` is fitted to the block means by
+   least squares (a grid over τ with the linear parameters solved exactly, then
+   ``scipy.optimize.curve_fit`` for the covariance of :math:`A, \tau`).
+3. The transient is **significant** when the exponential beats a constant by an
+   F-test at ``alpha`` (default 10⁻³) and τ is shorter than half the log (a
+   longer "transient" is drift the log cannot separate from bias wander). The
+   block means of a real sensor are correlated (bias wander): F and the
+   uncertainties are corrected by the AR(1) variance inflation
+   :math:`(1+\rho_1)/(1-\rho_1)` of the residuals (lag-1 autocorrelation :math:`\rho_1`).
+4. The channel has **settled** when the fitted transient has fallen below the
+   tolerance :math:`\varepsilon`: :math:`t_s = \tau \ln(|A|/\varepsilon)`
+   (0 when :math:`|A| \le \varepsilon`), with its uncertainty propagated from the
+   covariance of :math:`(A, \tau)`. The default :math:`\varepsilon` is the
+   floor of the Allan deviation of the channel with the transient removed
+   (its bias-instability level): after :math:`t_s` what is left of the
+   transient is smaller than the bias wander any analysis will report.
+5. The log's settle point is the latest :math:`t_s` over the significant channels.
+
+Where the log has temperature, its own exponential fit (τ, the final temperature
+and the time it is within ``temperature_tolerance`` of it) is part of the
+evidence: a bias transient with the temperature's time constant is thermal.
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import optimize as _opt
+from scipy import stats as _sstats
+
+from imunoise import _summary
+from imunoise._channels import rate_channels
+from imunoise.allan import adev
+from imunoise.readers.log import ImuLog
+
+__all__ = ["Warmup", "warmup", "ALPHA"]
+
+#: Significance level of the test "exponential transient vs constant bias".
+ALPHA = 1e-3
+#: Blocks of the default bias series (the log's length / this).
+BLOCKS = 300
+#: Fewest blocks a fit needs.
+MIN_BLOCKS = 20
+
+
+@dataclass(frozen=True, repr=False)
+class Warmup:
+    r"""Where a still log settled (see :func:`warmup`).
+
+    Per-channel arrays follow ``names``.
+
+    Attributes
+    ----------
+    fs : float
+        Sample rate, Hz.
+    n_samples : int
+        Samples of the log.
+    names : tuple of str
+        Channels analysed.
+    time : ndarray, (m,)
+        Centre of each block, s.
+    bias : ndarray, (m, k)
+        Block-mean bias of each channel (the moving-average bias).
+    block : float
+        Block length, s.
+    final, amplitude, tau : ndarray
+        Fitted :math:`b_\infty`, :math:`A`, :math:`\tau` (s) per channel.
+    amplitude_std, tau_std : ndarray
+        Their standard uncertainties (from the fit's covariance, residual-scaled).
+    p_value : ndarray
+        F-test p-value of the exponential against a constant bias.
+    significant : ndarray of bool
+        ``p_value < alpha`` and :math:`\tau` < half the log.
+    tolerance : ndarray
+        :math:`\varepsilon` per channel, channel unit.
+    settle_time, settle_time_std : ndarray
+        :math:`t_s` per channel (0 where not significant) and its uncertainty, s.
+    settle : float
+        The log's settle point: the latest significant :math:`t_s`, s (0: no transient).
+    temperature : ndarray or None
+        Block-mean temperature, °C, when the log has it.
+    temperature_tau, temperature_final, temperature_settle : float
+        Exponential fit of the temperature (τ s, final °C) and the time it is
+        within ``temperature_tolerance`` of the final value (NaN without temperature).
+    alpha : float
+        Significance level used.
+    """
+
+    fs: float
+    n_samples: int
+    names: tuple[str, ...]
+    time: np.ndarray
+    bias: np.ndarray
+    block: float
+    final: np.ndarray
+    amplitude: np.ndarray
+    tau: np.ndarray
+    amplitude_std: np.ndarray
+    tau_std: np.ndarray
+    p_value: np.ndarray
+    significant: np.ndarray
+    tolerance: np.ndarray
+    settle_time: np.ndarray
+    settle_time_std: np.ndarray
+    settle: float
+    temperature: np.ndarray | None
+    temperature_tau: float
+    temperature_final: float
+    temperature_settle: float
+    alpha: float
+
+    @property
+    def settle_index(self) -> int:
+        """First sample after the settle point."""
+        return min(self.n_samples, int(np.ceil(self.settle * self.fs)))
+
+    @property
+    def settled(self) -> bool:
+        """True when the settle point leaves at least half the log."""
+        return self.settle <= 0.5 * self.n_samples / self.fs
+
+    def fitted(self, t=None) -> np.ndarray:
+        """The fitted bias :math:`b_\\infty + A e^{-t/\\tau}` at ``t`` (default: the
+        block centres), (len(t), k)."""
+        t = self.time if t is None else np.asarray(t, dtype=float)
+        return self.final + self.amplitude * np.exp(-t[:, None] / self.tau)
+
+    def trim(self, data):
+        """``data`` from the settle point on (an ImuLog, or an array of the log's
+        samples on the same grid)."""
+        i = self.settle_index
+        if isinstance(data, ImuLog):
+            if len(data) != self.n_samples:
+                raise ValueError(f"data has {len(data)} samples; warm-up was found on "
+                                 f"{self.n_samples}")
+            return _slice_log(data, i)
+        arr = np.asarray(data)
+        if arr.shape[0] != self.n_samples:
+            raise ValueError(f"data has {arr.shape[0]} samples; warm-up was found on "
+                             f"{self.n_samples}")
+        return arr[i:]
+
+    def rows(self) -> list[dict]:
+        """One dict per channel: name, amplitude, tau, their std, p_value, significant,
+        tolerance, settle_time, settle_time_std."""
+        keys = ("amplitude", "amplitude_std", "tau", "tau_std", "p_value", "tolerance",
+                "settle_time", "settle_time_std")
+        return [
+            {"name": n, **{k: float(getattr(self, k)[j]) for k in keys},
+             "significant": bool(self.significant[j])}
+            for j, n in enumerate(self.names)
+        ]
+
+    def _facts(self) -> list[str]:
+        parts = [
+            f"settled at {_summary.duration(self.settle)}" if self.settle > 0
+            else "no warm-up transient",
+            f"of {_summary.duration(self.n_samples / self.fs)}",
+        ]
+        parts += [f"{r['name']} τ {_summary.duration(r['tau'])} t_s "
+                  f"{_summary.duration(r['settle_time'])}" for r in self.rows() if r["significant"]]
+        if self.temperature is not None:
+            parts.append(f"temperature τ {_summary.duration(self.temperature_tau)}")
+        return parts
+
+    def __repr__(self) -> str:
+        return _summary.lines("Warmup(", self._facts(), sep=", ")
+
+    def _repr_html_(self) -> str:
+        rows = [[r["name"], _summary.number(r["amplitude"]), _summary.number(r["tau"]),
+                 f"{r['p_value']:.2g}", _summary.number(r["tolerance"]),
+                 _summary.number(r["settle_time"])] for r in self.rows()]
+        return _summary.html_table(
+            ["channel", "A", "τ [s]", "p", "tolerance", "t_s [s]"], rows,
+            caption="Warmup: " + ", ".join(self._facts()[:2]),
+        )
+
+
+def _slice_log(log: ImuLog, start: int) -> ImuLog:
+    arrays = {name: getattr(log, name)[start:] for name in log.channels}
+    time = None if log.time is None else log.time[start:]
+    return ImuLog(fs=log.fs, source=log.source, format=log.format,
+                  issues=type(log.issues).none(), time=time, messages=log.messages, **arrays)
+
+
+def warmup(
+    data,
+    fs: float | None = None,
+    *,
+    channels=None,
+    block: float | None = None,
+    tolerance=None,
+    alpha: float = ALPHA,
+    temperature=None,
+    temperature_tolerance: float = 0.1,
+) -> Warmup:
+    r"""Detect the warm-up transient of a still log and where it settled.
+
+    Parameters
+    ----------
+    data : ImuLog or array_like, shape (n,) or (n, k)
+        A log (gyro and accel are analysed) or rate samples (NaN = missing).
+    fs : float, optional
+        Sample rate, Hz (required for arrays).
+    channels : str or sequence of str, optional
+        Log channels to analyse (default gyro and accel).
+    block : float, optional
+        Block length of the bias series, s (default: the log's length / 300, ≥ 1 s).
+    tolerance : float or array_like, optional
+        :math:`\varepsilon` per channel (or one for all), channel unit. Default: the
+        floor of each channel's Allan deviation with the fitted transient removed.
+    alpha : float
+        Significance level of the F-test (default :data:`ALPHA`).
+    temperature : array_like, optional
+        Temperature samples, °C (default: the log's).
+    temperature_tolerance : float
+        °C: the temperature has settled within this of its fitted final value.
+
+    Returns
+    -------
+    Warmup
+    """
+    x, fs, names = rate_channels(data, fs, channels)
+    n = x.shape[0]
+    duration = n / fs
+    if not 0 < alpha < 1:
+        raise ValueError(f"alpha must be in (0, 1); got {alpha!r}")
+    if block is None:
+        block = max(1.0, duration / BLOCKS)
+    elif isinstance(block, bool) or not (np.isfinite(block) and block > 0):
+        raise ValueError(f"block must be positive and finite (s); got {block!r}")
+    size = max(1, int(round(block * fs)))
+    m = n // size
+    if m < MIN_BLOCKS:
+        raise ValueError(f"data must hold at least {MIN_BLOCKS} blocks of {block:g} s "
+                         f"({MIN_BLOCKS * size} samples); got {n}")
+    t = (np.arange(m) + 0.5) * size / fs
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN blocks stay NaN
+        bias = np.nanmean(x[: m * size].reshape(m, size, -1), axis=1)
+    k = x.shape[1]
+    temp = _temperature(data, temperature, n)
+    fits = [_fit_exponential(t, bias[:, j], duration) for j in range(k)]
+    final, amp, tau, amp_sd, tau_sd, p = (np.array(v) for v in zip(*fits, strict=True))
+    significant = (p < alpha) & (tau < duration / 2)
+    tol = _tolerance(tolerance, x, fs, final, amp, tau, k)
+    ts, ts_sd = _settle_times(amp, tau, amp_sd, tau_sd, tol, significant)
+    t_fit = (np.nan, np.nan, np.nan)
+    temp_blocks = None
+    if temp is not None:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)
+            temp_blocks = np.nanmean(temp[: m * size].reshape(m, size), axis=1)
+        c, a, ttau, _sa, _st, _p = _fit_exponential(t, temp_blocks, duration)
+        settle_t = ttau * np.log(abs(a) / temperature_tolerance) if abs(a) > temperature_tolerance \
+            else 0.0
+        t_fit = (ttau, c, float(settle_t))
+    return Warmup(
+        fs=fs, n_samples=n, names=names, time=t, bias=bias, block=size / fs,
+        final=final, amplitude=amp, tau=tau, amplitude_std=amp_sd, tau_std=tau_sd,
+        p_value=p, significant=significant, tolerance=tol, settle_time=ts,
+        settle_time_std=ts_sd, settle=float(ts.max()) if ts.size else 0.0,
+        temperature=temp_blocks, temperature_tau=t_fit[0], temperature_final=t_fit[1],
+        temperature_settle=t_fit[2], alpha=float(alpha),
+    )
+
+
+def _temperature(data, temperature, n) -> np.ndarray | None:
+    if temperature is None:
+        if isinstance(data, ImuLog) and data.temperature is not None:
+            return np.asarray(data.temperature, dtype=float)
+        return None
+    temp = np.asarray(temperature, dtype=float).reshape(-1)
+    if temp.shape[0] != n:
+        raise ValueError(f"temperature must have {n} samples (one per row); got {temp.shape[0]}")
+    return temp
+
+
+def _exp_model(t, c, a, tau):
+    return c + a * np.exp(-t / tau)
+
+
+def _fit_exponential(t, y, duration):
+    """(final, A, τ, u(A), u(τ), p) of c + A e^{-t/τ} fitted to y (NaN blocks left out)."""
+    ok = np.isfinite(y)
+    t, y = t[ok], y[ok]
+    nan = (float(np.nanmean(y)) if y.size else np.nan, 0.0, np.inf, np.nan, np.nan, 1.0)
+    if y.size < MIN_BLOCKS or np.ptp(y) == 0:
+        return nan
+    rss0 = float(np.sum((y - y.mean()) ** 2))
+    best = None
+    for tau in np.geomspace(t[1] - t[0], 2 * duration, 80):
+        design = np.column_stack([np.ones_like(t), np.exp(-t / tau)])
+        coef, *_ = np.linalg.lstsq(design, y, rcond=None)
+        rss = float(np.sum((y - design @ coef) ** 2))
+        if best is None or rss < best[0]:
+            best = (rss, coef[0], coef[1], tau)
+    _rss, c, a, tau = best
+    try:
+        with warnings.catch_warnings(), np.errstate(over="ignore", invalid="ignore"):
+            warnings.simplefilter("ignore", _opt.OptimizeWarning)  # trial τ may go negative
+            popt, pcov = _opt.curve_fit(_exp_model, t, y, p0=(c, a, tau), maxfev=2000)
+        if popt[2] > 0 and np.all(np.isfinite(pcov)):
+            c, a, tau = popt
+            sd = np.sqrt(np.diag(pcov))
+        else:
+            sd = np.array([np.nan, np.nan, np.nan])
+    except RuntimeError:
+        sd = np.array([np.nan, np.nan, np.nan])
+    resid = y - _exp_model(t, c, a, tau)
+    rss1 = float(np.sum(resid**2))
+    dof = y.size - 3
+    # correlated residuals (bias wander) carry less evidence than their count:
+    # the AR(1) variance inflation (1 + ρ)/(1 − ρ) deflates F (and widens u(A), u(τ))
+    rho = float(np.clip(np.dot(resid[:-1], resid[1:]) / rss1, 0.0, 0.95)) if rss1 > 0 else 0.0
+    inflation = (1 + rho) / (1 - rho)
+    sd = sd * np.sqrt(inflation)
+    f = ((rss0 - rss1) / 2) / (rss1 / dof) / inflation if rss1 > 0 else np.inf
+    p = float(_sstats.f.sf(f, 2, dof)) if np.isfinite(f) else 0.0
+    return float(c), float(a), float(tau), float(sd[1]), float(sd[2]), p
+
+
+def _tolerance(tolerance, x, fs, final, amp, tau, k) -> np.ndarray:
+    if tolerance is not None:
+        tol = np.broadcast_to(np.asarray(tolerance, dtype=float), (k,)).copy()
+        if not np.all(np.isfinite(tol) & (tol > 0)):
+            raise ValueError(f"tolerance must be positive and finite; got {tolerance!r}")
+        return tol
+    t = np.arange(x.shape[0]) / fs
+    transient = np.where(np.isfinite(tau), amp * np.exp(-t[:, None] / np.where(
+        np.isfinite(tau), tau, 1.0)), 0.0)
+    r = adev(x - transient, fs)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        floor = np.nanmin(np.asarray(r.dev).reshape(len(r.taus), -1), axis=0)
+    # a constant channel has no floor: nothing in it ever needs to settle
+    return np.where(np.isfinite(floor) & (floor > 0), floor, np.inf)
+
+
+def _settle_times(amp, tau, amp_sd, tau_sd, tol, significant):
+    ratio = np.abs(amp) / tol
+    on = significant & (ratio > 1)
+    log_ratio = np.log(np.where(on, ratio, 1.0))
+    tau, tau_sd, amp_sd = (np.where(on, v, 0.0) for v in (tau, tau_sd, amp_sd))
+    ts = tau * log_ratio
+    sd = np.where(on, np.hypot(log_ratio * tau_sd, tau * amp_sd / np.where(on, amp, 1.0)), 0.0)
+    return ts, np.abs(sd)

@@ -1,0 +1,49 @@
+"""imunoise events / imunoise thermal on the command line."""
+
+from importlib import resources
+
+import numpy as np
+from imunoise.cli import main
+
+VN_LOG = str(resources.files("imunoise") / "data" / "vn100_stationary_5min.txt")
+
+
+def test_events_lists_the_gyro_x_bursts(capsys):
+    assert main(["events", VN_LOG, "--fs", "40"]) == 0
+    out = capsys.readouterr().out.splitlines()
+    assert out[0].startswith("# ") and "events" in out[0]
+    rows = [line.split() for line in out[2:]]
+    gyro_x = [(float(r[0]), float(r[1])) for r in rows if "gyro_X" in r[4]]
+    for visible in (5, 90, 140, 185):
+        assert any(a - 3 <= visible <= b + 3 for a, b in gyro_x)
+
+
+def test_thermal_prints_slopes_in_datasheet_units(tmp_path, capsys):
+    fs, n = 10.0, 36_000
+    rng = np.random.default_rng(2)
+    temp = 30 + 10 * (1 - np.exp(-np.arange(n) / fs / 900))
+    gyro = 1e-4 * rng.standard_normal((n, 3)) + 2e-5 * (temp - 35)[:, None]
+    rows = ["time,gyro_x,gyro_y,gyro_z,temperature"]
+    rows += [f"{i / fs:.1f},{g[0]:.8f},{g[1]:.8f},{g[2]:.8f},{t:.4f}"
+             for i, (g, t) in enumerate(zip(gyro, temp, strict=True))]
+    path = tmp_path / "warm.csv"
+    path.write_text("\n".join(rows) + "\n")
+    assert main(["thermal", str(path), "--degree", "2"]) == 0
+    out = capsys.readouterr().out
+    assert "bias vs temperature over 30" in out
+    expected = 2e-5 * 180 / np.pi * 3600  # 4.125 °/h/°C
+    slopes = [float(line.split()[1]) for line in out.splitlines() if line.strip().startswith(
+        "gyro_")]
+    assert len(slopes) == 3 and np.allclose(slopes, expected, rtol=0.05)
+    assert "°/h/°C" in out and "quadratic" in out
+
+
+def test_thermal_without_temperature_fails_in_one_line(capsys):
+    assert main(["thermal", VN_LOG, "--fs", "40"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "no temperature channel" in err[0]
+
+
+def test_events_bad_false_alarm(capsys):
+    assert main(["events", VN_LOG, "--fs", "40", "--false-alarm", "0.5"]) == 2
+    assert "false_alarm must be in (0, 0.01)" in capsys.readouterr().err
