@@ -97,3 +97,24 @@ def test_temperature_evidence():
 def test_bad_arguments(kwargs, message):
     with pytest.raises(ValueError, match=message):
         imunoise.warmup(np.zeros(20_000), FS, **kwargs)
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_still_vn100_noise_with_rate_random_walk_has_no_transient(seed):
+    """Rate random walk and flicker wander fit exponentials well by chance: the
+    bootstrap null of the sensor's own noise must not call that a warm-up (an F-test
+    gave p < 1e-10 on these logs and a settle point past their end)."""
+    from imunoise.simulate_log import still_log
+
+    log = still_log(5.0, 40.0, seed=seed)
+    found = imunoise.warmup(log)
+    assert not found.significant.any() and found.settle == 0
+    assert np.mean(found.p_value > 0.01) >= 0.5  # p-values of stationary noise are not tiny
+
+
+def test_settle_point_never_passes_the_end_of_the_log():
+    x = transient_log(900.0, seed=7, hours=0.6, amplitude=5e-2)
+    found = imunoise.warmup(x, FS, tolerance=1e-7)
+    assert found.significant[0]
+    assert found.settle == len(x) / FS and found.settle_index == len(x)
+    assert len(found.trim(x)) == 0 and not found.settled

@@ -317,6 +317,10 @@ def _trim_warmup(ctx: Context) -> None:
                          "`--trim auto`: the log is too short to examine its warm-up") + \
             "; nothing was cut."
         return
+    if w.settle_index >= w.n_samples:
+        ctx.trim_note = ("`--trim auto`: the warm-up has not settled by the end of the log; "
+                         "nothing was cut, the analyses below include the transient.")
+        return
     full = ctx.long
     ctx.untrimmed = full
     ctx.long = w.trim(full)

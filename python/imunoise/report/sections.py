@@ -452,9 +452,16 @@ def warmup_section(ctx: Context, doc: Doc) -> None:
         doc.p(f"Temperature: τ {format_duration(w.temperature_tau)}, final "
               f"{w.temperature_final:.2f} °C, within 0.1 °C of it after "
               f"{format_duration(w.temperature_settle)}.")
-    verdict = (f"The sensor settled after {format_duration(w.settle)} "
-               f"({100 * w.settle_index / w.n_samples:.3g} % of the log)." if w.settle > 0
-               else "No warm-up transient: the log is analysed whole.")
+    if w.settle <= 0:
+        verdict = "No warm-up transient: the log is analysed whole."
+    elif w.settle_index < w.n_samples:
+        verdict = (f"The sensor settled after {format_duration(w.settle)} "
+                   f"({100 * w.settle_index / w.n_samples:.3g} % of the log)."
+                   + ("" if w.settled else " Less than half the log is settled: the long-tau "
+                      "analysis of what is left has few averaging times."))
+    else:
+        verdict = ("The transient has not settled by the end of the log: `--trim auto` does "
+                   "not cut it, and the long-tau analysis includes it.")
     doc.p(verdict)
     doc.p(ctx.trim_note or ("The analysis uses the whole log (`--trim auto` would start it "
                             "at the settle point)." if w.settle > 0 else ""))
