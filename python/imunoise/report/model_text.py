@@ -61,6 +61,10 @@ def model_sentences(model: NoiseModel, sensor: str) -> list[str]:
             value = units.convert(sigma, "B", b_unit.name, sensor=sensor)
             parts.append(f"Gauss–Markov bias σ = {format_number(value)} {b_unit.label}, "
                          f"τc = {format_number(tau_c)} s")
+        for amplitude, f0 in model.sine(c):
+            value = units.convert(amplitude, "B", b_unit.name, sensor=sensor)
+            parts.append(f"a tone of amplitude {format_number(value)} {b_unit.label} at "
+                         f"{format_number(f0)} Hz")
         for term, unit in (("N", n_unit), ("B", b_unit)):
             parts += _readoff_agreement(model, c, term, unit, sensor)
         out.append("; ".join(parts) + ".")
