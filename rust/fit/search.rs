@@ -37,6 +37,14 @@ const MIN_RATIO: f64 = 2.0;
 /// where a tone under white noise has faded (its variance falls as 1/τ²).
 const FREQ_PER_DECADE: f64 = 96.0;
 
+/// Most steps of the fine frequency scan around the best grid point.
+const FINE_SCAN: f64 = 200.0;
+
+/// Golden-section tolerances in ln τc and ln f₀: a correlation time to 1 %; a
+/// frequency to 10⁻⁷, since its phase πf₀τ at long τ depends on it.
+const TIME_TOL: f64 = 1e-2;
+const FREQ_TOL: f64 = 1e-7;
+
 /// Fewest periods of a tone in the longest tau: slower ones would explain the
 /// scatter of the last few, least independent estimates (their bump at
 /// τ ≈ 0.37/f₀ stays more than a decade inside the curve).
@@ -83,9 +91,9 @@ pub fn frequency_grid(data: &Data, fs: f64) -> Vec<f64> {
     grid
 }
 
-/// Golden-section search of f(e^x) over x in [ln lo, ln hi]; returns the best
-/// point found, or `start` when nothing beats it.
-fn golden(lo: f64, hi: f64, start: f64, f: impl Fn(f64) -> f64) -> f64 {
+/// Golden-section search of f(e^x) over x in [ln lo, ln hi] down to an interval
+/// of `tol` in x; returns the best point found, or `start` when nothing beats it.
+fn golden(lo: f64, hi: f64, start: f64, tol: f64, f: impl Fn(f64) -> f64) -> f64 {
     let g = 0.5 * (5f64.sqrt() - 1.0);
     let (mut a, mut b) = (lo.ln(), hi.ln());
     let at = |x: f64| f(x.exp());
@@ -94,7 +102,7 @@ fn golden(lo: f64, hi: f64, start: f64, f: impl Fn(f64) -> f64) -> f64 {
     let mut d = a + g * (b - a);
     let mut fc = at(c);
     let mut fd = at(d);
-    while b - a > 1e-2 {
+    while b - a > tol {
         if fc < fd {
             b = d;
             d = c;
@@ -166,7 +174,7 @@ impl Searcher<'_> {
     /// Golden-section search of time `which` in [lo, hi] (others fixed).
     fn refine(&self, times: &mut [f64], which: usize, lo: f64, hi: f64) {
         let base = times.to_vec();
-        times[which] = golden(lo, hi, base[which], |t| {
+        times[which] = golden(lo, hi, base[which], TIME_TOL, |t| {
             let mut probe = base.clone();
             probe[which] = t;
             self.loss(&probe)
@@ -194,20 +202,34 @@ impl Searcher<'_> {
         }
     }
 
-    /// Best tone frequency with these times: grid, then golden section within
-    /// one grid step. None when the curve is too short for any.
+    /// Best tone frequency with these times: the grid, then a finer scan within
+    /// one grid step, then golden section. The tone's curve at τ has phase
+    /// πf₀τ, so at the longest tau the loss oscillates in ln f₀ with a period
+    /// of about 1/(f₀τ_max): the fine scan steps a tenth of that (at most
+    /// [`FINE_SCAN`] steps; beyond, the tone has faded under the other terms
+    /// long before τ_max). None when the curve is too short for any tone.
     fn frequency(&self, times: &[f64]) -> Option<f64> {
-        let grid = frequency_grid(self.data, self.fs);
-        let best = grid
-            .iter()
-            .map(|&f| (self.loss_with(times, Some(f)), f))
-            .min_by(|a, b| a.0.total_cmp(&b.0))?
-            .1;
-        let step = 10f64.powf(1.0 / FREQ_PER_DECADE);
-        let hi = (best * step).min(0.5 * self.fs);
-        Some(golden(best / step, hi, best, |f| {
-            self.loss_with(times, Some(f))
-        }))
+        let loss = |f: f64| self.loss_with(times, Some(f));
+        let best_of = |cands: &mut dyn Iterator<Item = f64>| {
+            cands
+                .map(|f| (loss(f), f))
+                .min_by(|a, b| a.0.total_cmp(&b.0))
+                .map(|(_, f)| f)
+        };
+        let nyquist = 0.5 * self.fs;
+        let coarse = best_of(&mut frequency_grid(self.data, self.fs).into_iter())?;
+        let span = std::f64::consts::LN_10 / FREQ_PER_DECADE;
+        let tau_max = self.data.taus[self.data.len() - 1];
+        let step = (0.1 / (std::f64::consts::PI * coarse * tau_max)).max(2.0 * span / FINE_SCAN);
+        let n = (span / step).ceil() as i64;
+        let fine = best_of(
+            &mut (-n..=n)
+                .map(|j| coarse * (j as f64 * step).exp())
+                .filter(|&f| f <= nyquist),
+        )
+        .unwrap_or(coarse);
+        let hi = (fine * step.exp()).min(nyquist);
+        Some(golden(fine * (-step).exp(), hi, fine, FREQ_TOL, loss))
     }
 
     /// Best `count` correlation times (ascending); for three, `seed` is the best
