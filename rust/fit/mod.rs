@@ -446,6 +446,25 @@ mod tests {
     }
 
     #[test]
+    fn tone_frequencies_stay_where_the_grid_resolves_them() {
+        let dense = grid(10.0, 0.01, 1000.0);
+        let data = Data::new(&dense, &vec![1.0; dense.len()], &vec![1e3; dense.len()], FS).unwrap();
+        let f = search::frequency_grid(&data, FS);
+        assert!(f[0] >= search::SINE_PERIODS / 1000.0, "{}", f[0]);
+        // Peak (τ·f₀ = 0.371) no earlier than the first tau: at most 37.1 Hz.
+        assert!((f[f.len() - 1] - 37.1).abs() < 1e-9, "{}", f[f.len() - 1]);
+        let sparse = grid(1.0, 0.01, 1000.0);
+        let data = Data::new(
+            &sparse,
+            &vec![1.0; sparse.len()],
+            &vec![1e3; sparse.len()],
+            FS,
+        )
+        .unwrap();
+        assert!(search::frequency_grid(&data, FS).is_empty());
+    }
+
+    #[test]
     fn covariance_shrinks_with_edf() {
         let truth = [0.0, 4e-6, 1e-6, 1e-10, 0.0];
         let taus = grid(5.0, 0.01, 2000.0);

@@ -16,7 +16,8 @@
 //! A sinusoid (a tone: a sensor's dither, a fan, a supply ripple) is one more
 //! column, linear in its variance for a fixed frequency: the frequency is found
 //! by a grid of [`FREQ_PER_DECADE`] per decade from [`SINE_PERIODS`] periods
-//! in the longest tau to fs/2 and golden-section refinement, the
+//! in the longest tau to the frequency whose Allan-variance peak lies at the
+//! shortest tau, a finer scan and golden-section refinement, the
 //! Gauss–Markov times are then refined with the tone in place, and the toned
 //! structure competes by the same BIC (two parameters: variance, frequency).
 
@@ -72,11 +73,27 @@ fn allowed_with(ieee: &[bool; IEEE_TERMS], extra: usize) -> Vec<bool> {
     a
 }
 
+/// τ·f₀ at the peak of a tone's Allan variance: sin⁴x/x² is largest at
+/// x = πf₀τ ≈ 1.1656.
+const SINE_PEAK: f64 = 0.371;
+
+/// Fewest taus per decade for a tone: on a sparser grid a free frequency
+/// places the curve's oscillation to fit any few points.
+const SINE_MIN_DENSITY: f64 = 3.0;
+
 /// Candidate tone frequencies (Hz): 10^(j/96) from [`SINE_PERIODS`] periods in
-/// the longest tau up to fs/2, and fs/2 itself.
+/// the longest tau up to the frequency whose peak is at the shortest tau (a
+/// faster tone only falls as 1/τ² there, which quantization noise also does),
+/// at most fs/2. Empty on grids sparser than [`SINE_MIN_DENSITY`].
 pub fn frequency_grid(data: &Data, fs: f64) -> Vec<f64> {
-    let lo = (SINE_PERIODS / data.taus[data.len() - 1]).log10();
-    let hi = (0.5 * fs).log10();
+    let (first, last) = (data.taus[0], data.taus[data.len() - 1]);
+    let decades = (last / first).log10();
+    if data.len() < 2 || (data.len() - 1) as f64 / decades < SINE_MIN_DENSITY {
+        return Vec::new();
+    }
+    let top = (SINE_PEAK / first).min(0.5 * fs);
+    let lo = (SINE_PERIODS / last).log10();
+    let hi = top.log10();
     if lo >= hi {
         return Vec::new();
     }
@@ -87,7 +104,7 @@ pub fn frequency_grid(data: &Data, fs: f64) -> Vec<f64> {
     let mut grid: Vec<f64> = (a..=b)
         .map(|j| 10f64.powf(j as f64 / FREQ_PER_DECADE))
         .collect();
-    grid.push(0.5 * fs);
+    grid.push(top);
     grid
 }
 
@@ -216,7 +233,7 @@ impl Searcher<'_> {
                 .min_by(|a, b| a.0.total_cmp(&b.0))
                 .map(|(_, f)| f)
         };
-        let nyquist = 0.5 * self.fs;
+        let top = (SINE_PEAK / self.data.taus[0]).min(0.5 * self.fs);
         let coarse = best_of(&mut frequency_grid(self.data, self.fs).into_iter())?;
         let span = std::f64::consts::LN_10 / FREQ_PER_DECADE;
         let tau_max = self.data.taus[self.data.len() - 1];
@@ -225,10 +242,10 @@ impl Searcher<'_> {
         let fine = best_of(
             &mut (-n..=n)
                 .map(|j| coarse * (j as f64 * step).exp())
-                .filter(|&f| f <= nyquist),
+                .filter(|&f| f <= top),
         )
         .unwrap_or(coarse);
-        let hi = (fine * step.exp()).min(nyquist);
+        let hi = (fine * step.exp()).min(top);
         Some(golden(fine * (-step).exp(), hi, fine, FREQ_TOL, loss))
     }
 
