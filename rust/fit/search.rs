@@ -16,8 +16,7 @@
 //! A sinusoid (a tone: a sensor's dither, a fan, a supply ripple) is one more
 //! column, linear in its variance for a fixed frequency: the frequency is found
 //! by a grid of [`FREQ_PER_DECADE`] per decade from [`SINE_PERIODS`] periods
-//! in the longest tau to the frequency whose Allan-variance peak lies at the
-//! shortest tau, a finer scan and golden-section refinement, the
+//! in the longest tau to fs/2, a finer scan and golden-section refinement, the
 //! Gauss–Markov times are then refined with the tone in place, and the toned
 //! structure competes by the same BIC (two parameters: variance, frequency).
 
@@ -73,25 +72,21 @@ fn allowed_with(ieee: &[bool; IEEE_TERMS], extra: usize) -> Vec<bool> {
     a
 }
 
-/// τ·f₀ at the peak of a tone's Allan variance: sin⁴x/x² is largest at
-/// x = πf₀τ ≈ 1.1656.
-const SINE_PEAK: f64 = 0.371;
-
 /// Fewest taus per decade for a tone: on a sparser grid a free frequency
 /// places the curve's oscillation to fit any few points.
 const SINE_MIN_DENSITY: f64 = 3.0;
 
 /// Candidate tone frequencies (Hz): 10^(j/96) from [`SINE_PERIODS`] periods in
-/// the longest tau up to the frequency whose peak is at the shortest tau (a
-/// faster tone only falls as 1/τ² there, which quantization noise also does),
-/// at most fs/2. Empty on grids sparser than [`SINE_MIN_DENSITY`].
+/// the longest tau up to fs/2, and fs/2 itself. Empty on grids sparser than
+/// [`SINE_MIN_DENSITY`]. (A tone near fs/2 falls as 1/τ² like quantization
+/// noise, but only at odd cluster sizes: the even ones tell the two apart.)
 pub fn frequency_grid(data: &Data, fs: f64) -> Vec<f64> {
     let (first, last) = (data.taus[0], data.taus[data.len() - 1]);
     let decades = (last / first).log10();
     if data.len() < 2 || (data.len() - 1) as f64 / decades < SINE_MIN_DENSITY {
         return Vec::new();
     }
-    let top = (SINE_PEAK / first).min(0.5 * fs);
+    let top = 0.5 * fs;
     let lo = (SINE_PERIODS / last).log10();
     let hi = top.log10();
     if lo >= hi {
@@ -233,7 +228,7 @@ impl Searcher<'_> {
                 .min_by(|a, b| a.0.total_cmp(&b.0))
                 .map(|(_, f)| f)
         };
-        let top = (SINE_PEAK / self.data.taus[0]).min(0.5 * self.fs);
+        let top = 0.5 * self.fs;
         let coarse = best_of(&mut frequency_grid(self.data, self.fs).into_iter())?;
         let span = std::f64::consts::LN_10 / FREQ_PER_DECADE;
         let tau_max = self.data.taus[self.data.len() - 1];
