@@ -32,13 +32,13 @@ const PER_DECADE: f64 = 6.0;
 /// Smallest ratio between the correlation times of two Gauss–Markov terms.
 const MIN_RATIO: f64 = 2.0;
 
-/// Grid of candidate tone frequencies per decade: 2.4 % apart, so the grid point
-/// next to a tone is within a quarter radian of its phase πf₀τ up to τ ≈ 10/f₀,
-/// where a tone under white noise has faded (its variance falls as 1/τ²).
-const FREQ_PER_DECADE: f64 = 96.0;
+/// Grid of candidate tone frequencies per decade: 4.9 % apart, so the grid point
+/// next to a tone is within a quarter radian of its phase πf₀τ up to τ ≈ 3/f₀,
+/// past the tone's peak; the fine scan then resolves the longer taus.
+const FREQ_PER_DECADE: f64 = 48.0;
 
 /// Most steps of the fine frequency scan around the best grid point.
-const FINE_SCAN: f64 = 200.0;
+const FINE_SCAN: f64 = 100.0;
 
 /// Golden-section tolerances in ln τc and ln f₀: a correlation time to 1 %; a
 /// frequency to 10⁻⁷, since its phase πf₀τ at long τ depends on it.
@@ -228,20 +228,26 @@ impl Searcher<'_> {
                 .min_by(|a, b| a.0.total_cmp(&b.0))
                 .map(|(_, f)| f)
         };
-        let top = 0.5 * self.fs;
         let coarse = best_of(&mut frequency_grid(self.data, self.fs).into_iter())?;
+        Some(self.refine_frequency(times, coarse))
+    }
+
+    /// The fine scan and golden section of [`Self::frequency`] around `f`.
+    fn refine_frequency(&self, times: &[f64], f: f64) -> f64 {
+        let loss = |f: f64| self.loss_with(times, Some(f));
+        let top = 0.5 * self.fs;
         let span = std::f64::consts::LN_10 / FREQ_PER_DECADE;
         let tau_max = self.data.taus[self.data.len() - 1];
-        let step = (0.1 / (std::f64::consts::PI * coarse * tau_max)).max(2.0 * span / FINE_SCAN);
+        let step = (0.1 / (std::f64::consts::PI * f * tau_max)).max(2.0 * span / FINE_SCAN);
         let n = (span / step).ceil() as i64;
-        let fine = best_of(
-            &mut (-n..=n)
-                .map(|j| coarse * (j as f64 * step).exp())
-                .filter(|&f| f <= top),
-        )
-        .unwrap_or(coarse);
+        let fine = (-n..=n)
+            .map(|j| f * (j as f64 * step).exp())
+            .filter(|&g| g <= top)
+            .map(|g| (loss(g), g))
+            .min_by(|a, b| a.0.total_cmp(&b.0))
+            .map_or(f, |(_, g)| g);
         let hi = (fine * step.exp()).min(top);
-        Some(golden(fine * (-step).exp(), hi, fine, FREQ_TOL, loss))
+        golden(fine * (-step).exp(), hi, fine, FREQ_TOL, loss)
     }
 
     /// Best `count` correlation times (ascending); for three, `seed` is the best
@@ -389,7 +395,7 @@ pub fn fit_structure(
 
 /// Add a tone to the Gauss–Markov times `gm_tau`: its frequency searched, then
 /// the times refined around theirs with the tone in place, the frequency once
-/// more; searched again at the discrepancy the toned fit settles on when that
+/// more; refined again at the discrepancy the toned fit settles on when that
 /// moved by more than a factor of two. None when no frequency fits the curve.
 pub fn with_sine(
     data: &Data,
@@ -399,36 +405,41 @@ pub fn with_sine(
     d2: f64,
 ) -> CoreResult<Option<Candidate>> {
     let step = 10f64.powf(1.0 / PER_DECADE);
-    let search = |d2: f64| -> CoreResult<Option<Candidate>> {
+    // Times and frequency polished at δ² from a start frequency.
+    let polish = |d2: f64, mut times: Vec<f64>, f: f64| -> CoreResult<Candidate> {
         let mut searcher = Searcher {
             data,
             fs,
             ieee,
             d2,
-            sine: None,
+            sine: Some(f),
         };
-        let mut times = gm_tau.to_vec();
-        let Some(f) = searcher.frequency(&times) else {
-            return Ok(None);
-        };
-        searcher.sine = Some(f);
         searcher.polish(&mut times, step);
         searcher.sine = None;
-        let f = searcher.frequency(&times).unwrap_or(f);
-        candidate(data, fs, ieee, times, Some(f), d2).map(Some)
+        let f = searcher.refine_frequency(&times, f);
+        candidate(data, fs, ieee, times, Some(f), d2)
     };
-    let Some(first) = search(d2)? else {
+    let searcher = Searcher {
+        data,
+        fs,
+        ieee,
+        d2,
+        sine: None,
+    };
+    let Some(f) = searcher.frequency(gm_tau) else {
         return Ok(None);
     };
+    let first = polish(d2, gm_tau.to_vec(), f)?;
     let settled = first.solution.d2;
     if settled <= 2.0 * d2 && settled >= 0.5 * d2 {
         return Ok(Some(first));
     }
-    let second = search(settled)?;
-    Ok(match second {
-        Some(s) if s.solution.loss < first.solution.loss => Some(s),
-        _ => Some(first),
-    })
+    let second = polish(settled, first.gm_tau.clone(), first.sine.unwrap_or(f))?;
+    Ok(Some(if second.solution.loss < first.solution.loss {
+        second
+    } else {
+        first
+    }))
 }
 
 /// Backward elimination of IEEE terms while the BIC decreases.
@@ -484,6 +495,13 @@ pub fn select(
         }
     }
     if sine {
+        // The tone on its own, and with the times of the best structure
+        // without one (refined around them): two searches, not one per count.
+        let best_times = best.gm_tau.clone();
+        times.retain(|t| t.is_empty() || *t == best_times);
+        if !best_times.is_empty() && !times.contains(&best_times) {
+            times.push(best_times);
+        }
         for gm_tau in &times {
             if let Some(toned) = with_sine(data, fs, ieee, gm_tau, base.solution.d2)? {
                 let reduced = eliminate(data, fs, toned)?;
