@@ -214,25 +214,21 @@ impl Searcher<'_> {
         }
     }
 
-    /// Best tone frequency with these times: the grid, then a finer scan within
-    /// one grid step, then golden section. The tone's curve at τ has phase
-    /// πf₀τ, so at the longest tau the loss oscillates in ln f₀ with a period
-    /// of about 1/(f₀τ_max): the fine scan steps a tenth of that (at most
-    /// [`FINE_SCAN`] steps; beyond, the tone has faded under the other terms
-    /// long before τ_max). None when the curve is too short for any tone.
-    fn frequency(&self, times: &[f64]) -> Option<f64> {
-        let loss = |f: f64| self.loss_with(times, Some(f));
-        let best_of = |cands: &mut dyn Iterator<Item = f64>| {
-            cands
-                .map(|f| (loss(f), f))
-                .min_by(|a, b| a.0.total_cmp(&b.0))
-                .map(|(_, f)| f)
-        };
-        let coarse = best_of(&mut frequency_grid(self.data, self.fs).into_iter())?;
-        Some(self.refine_frequency(times, coarse))
+    /// Best tone frequency on the grid with these times, and its loss (None
+    /// when the curve is too short for any tone); [`Self::refine_frequency`]
+    /// then refines it.
+    fn coarse_frequency(&self, times: &[f64]) -> Option<(f64, f64)> {
+        frequency_grid(self.data, self.fs)
+            .into_iter()
+            .map(|f| (f, self.loss_with(times, Some(f))))
+            .min_by(|a, b| a.1.total_cmp(&b.1))
     }
 
-    /// The fine scan and golden section of [`Self::frequency`] around `f`.
+    /// A finer scan within one grid step of `f`, then golden section. The
+    /// tone's curve at τ has phase πf₀τ, so at the longest tau the loss
+    /// oscillates in ln f₀ with a period of about 1/(f₀τ_max): the fine scan
+    /// steps a tenth of that (at most [`FINE_SCAN`] steps; beyond, the tone has
+    /// faded under the other terms long before τ_max).
     fn refine_frequency(&self, times: &[f64], f: f64) -> f64 {
         let loss = |f: f64| self.loss_with(times, Some(f));
         let top = 0.5 * self.fs;
@@ -426,9 +422,16 @@ pub fn with_sine(
         d2,
         sine: None,
     };
-    let Some(f) = searcher.frequency(gm_tau) else {
+    let Some((f, toned)) = searcher.coarse_frequency(gm_tau) else {
         return Ok(None);
     };
+    // A tone the grid finds no use for is not refined: the refinement cannot
+    // gain the ln n_eff per parameter that BIC asks of it where the grid's
+    // best tone (within a quarter radian of any real one up to 3/f₀) gains
+    // less than half that.
+    if toned > searcher.loss(gm_tau) - data.n_eff().max(2.0).ln() {
+        return Ok(None);
+    }
     let first = polish(d2, gm_tau.to_vec(), f)?;
     let settled = first.solution.d2;
     if settled <= 2.0 * d2 && settled >= 0.5 * d2 {
