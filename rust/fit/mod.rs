@@ -121,8 +121,15 @@ pub fn fit_noise(
             search::fit_structure(&data, fs, opts.ieee, opts.gm, base.solution.d2, &[])?
         };
         if opts.sine {
-            search::with_sine(&data, fs, opts.ieee, &fixed.gm_tau, fixed.solution.d2)?
-                .unwrap_or(fixed)
+            search::with_sine(
+                &data,
+                fs,
+                opts.ieee,
+                &fixed.gm_tau,
+                fixed.solution.d2,
+                false,
+            )?
+            .unwrap_or(fixed)
         } else {
             fixed
         }

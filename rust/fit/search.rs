@@ -32,10 +32,10 @@ const PER_DECADE: f64 = 6.0;
 /// Smallest ratio between the correlation times of two Gauss–Markov terms.
 const MIN_RATIO: f64 = 2.0;
 
-/// Grid of candidate tone frequencies per decade: 4.9 % apart, so the grid point
-/// next to a tone is within a quarter radian of its phase πf₀τ up to τ ≈ 3/f₀,
-/// past the tone's peak; the fine scan then resolves the longer taus.
-const FREQ_PER_DECADE: f64 = 48.0;
+/// Grid of candidate tone frequencies per decade: 2.4 % apart, so the grid point
+/// next to a tone is within a quarter radian of its phase πf₀τ up to τ ≈ 6/f₀,
+/// well past the tone's peak; the fine scan then resolves the longer taus.
+const FREQ_PER_DECADE: f64 = 96.0;
 
 /// Most steps of the fine frequency scan around the best grid point.
 const FINE_SCAN: f64 = 100.0;
@@ -392,13 +392,15 @@ pub fn fit_structure(
 /// Add a tone to the Gauss–Markov times `gm_tau`: its frequency searched, then
 /// the times refined around theirs with the tone in place, the frequency once
 /// more; refined again at the discrepancy the toned fit settles on when that
-/// moved by more than a factor of two. None when no frequency fits the curve.
+/// moved by more than a factor of two. None when the curve is too short for a
+/// tone or, when `gated` (model selection), the grid finds no use for one.
 pub fn with_sine(
     data: &Data,
     fs: f64,
     ieee: [bool; IEEE_TERMS],
     gm_tau: &[f64],
     d2: f64,
+    gated: bool,
 ) -> CoreResult<Option<Candidate>> {
     let step = 10f64.powf(1.0 / PER_DECADE);
     // Times and frequency polished at δ² from a start frequency.
@@ -425,11 +427,11 @@ pub fn with_sine(
     let Some((f, toned)) = searcher.coarse_frequency(gm_tau) else {
         return Ok(None);
     };
-    // A tone the grid finds no use for is not refined: the refinement cannot
-    // gain the ln n_eff per parameter that BIC asks of it where the grid's
-    // best tone (within a quarter radian of any real one up to 3/f₀) gains
-    // less than half that.
-    if toned > searcher.loss(gm_tau) - data.n_eff().max(2.0).ln() {
+    // A tone the grid finds no use for is not refined: where the grid's best
+    // tone (within a quarter radian of any real one up to 6/f₀) gains less
+    // than a quarter of the 2 ln n_eff that BIC asks of it, the refinement,
+    // which moves the frequency by at most a grid step, does not make it up.
+    if gated && toned > searcher.loss(gm_tau) - 0.5 * data.n_eff().max(2.0).ln() {
         return Ok(None);
     }
     let first = polish(d2, gm_tau.to_vec(), f)?;
@@ -506,7 +508,7 @@ pub fn select(
             times.push(best_times);
         }
         for gm_tau in &times {
-            if let Some(toned) = with_sine(data, fs, ieee, gm_tau, base.solution.d2)? {
+            if let Some(toned) = with_sine(data, fs, ieee, gm_tau, base.solution.d2, true)? {
                 let reduced = eliminate(data, fs, toned)?;
                 if reduced.bic < best.bic {
                     best = reduced;
