@@ -128,3 +128,14 @@ def test_explicit_sine_terms_are_checked(toned):
     only = _fit(r, terms=["N", "sine"])
     assert all(len(only.sine(c)) == 1 for c in range(2))
     assert not np.any(only.supported["K"])
+
+
+def test_bootstrap_simulates_and_refits_the_tone():
+    x = imunoise.simulate(int(1800 * FS), FS, N=1e-3, seed=9, sinusoid=(4e-3, 7.3))
+    r = imunoise.adev(x, FS, taus=10)
+    model = _fit(r, uncertainty="bootstrap", replicates=6, seed=2)
+    assert model.sine(0) != []
+    amp_std, f_std = float(model.sine_amplitude_std), float(model.sine_freq_std)
+    # The replicates' spread is small next to the tone yet not zero.
+    assert 0 < amp_std < 0.1 * float(model.sine_amplitude)
+    assert 0 < f_std < 0.01 * float(model.sine_freq)
