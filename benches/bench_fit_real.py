@@ -90,7 +90,8 @@ def allan_variance_dev(taus, var):
 def structure(model):
     terms = [t for t in imunoise.noise.TERMS if bool(model.supported[t])]
     gm = [f"GM({tc:.3g} s)" for _, tc in model.gauss_markov()]
-    return "+".join(terms + gm)
+    tone = [f"sine({f0:.3g} Hz)" for _, f0 in model.sine()]
+    return "+".join(terms + gm + tone)
 
 
 def main() -> int:

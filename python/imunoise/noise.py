@@ -17,7 +17,10 @@ taus and slowly wandering biases put bumps in the curve. The model therefore
 also has up to three first-order Gauss–Markov (exponentially correlated) bias
 terms, each with a standard deviation σ and a correlation time τc, whose Allan
 variance is the discrete AR1 form of IEEE 952 Annex C (slope +½ for τ ≪ τc, a
-peak near 1.9 τc, slope −½ for τ ≫ τc).
+peak near 1.9 τc, slope −½ for τ ≫ τc), and at most one tone A·sin(2πf₀t + ϕ)
+(a resonance, dither or ripple), IEEE 952 Annex C's sinusoidal term
+A²·sin⁴(πf₀τ)/(πf₀τ)² in its sampled form 2·(A²/2)·sin⁴(πνm)/(m² sin²πν),
+ν = f₀/fs, m = τ·fs, whose frequency is searched like the correlation times.
 
 :func:`fit` offers two estimators:
 
@@ -106,7 +109,10 @@ GM_MAX: int = _core_fit.MAX_GAUSS_MARKOV
 """Most first-order Gauss–Markov terms a model may have."""
 
 _PARAMS: int = _core_fit.PARAMETERS
-"""Parameter slots of the covariance: five IEEE variances, (σ², ln τc) per GM term."""
+"""Parameter slots of the covariance: five IEEE variances, (σ², ln τc) per GM term,
+then (A²/2, ln f0) of the tone."""
+_SINE: int = _core_fit.SINE_SLOT
+"""Slot of the tone's variance A²/2 in the covariance (its ln f0 follows)."""
 
 
 def gm_white_density(sigma: float, tau_c: float, fs: float) -> float:
@@ -125,13 +131,14 @@ _CLOSE = 0.05
 """A model within this relative distance of the measured deviation follows it."""
 
 
-def _terms(taus, fs: float, coef, markov=()) -> np.ndarray:
-    """Allan variance of each model term at ``taus``: (len(taus), 5 + len(markov)),
-    from the one implementation of the model (Rust); ``coef`` holds Q…R,
-    ``markov`` (sigma, tau_c) pairs."""
+def _terms(taus, fs: float, coef, markov=(), tone=()) -> np.ndarray:
+    """Allan variance of each model term at ``taus``: (len(taus), 5 + len(markov) +
+    len(tone)), from the one implementation of the model (Rust); ``coef`` holds Q…R,
+    ``markov`` (sigma, tau_c) pairs, ``tone`` (amplitude, f0) pairs."""
     t = np.ascontiguousarray(np.atleast_1d(np.asarray(taus, dtype=float)))
     return _core_fit.noise_terms(t, float(fs), [float(c) ** 2 for c in coef],
-                             [(s * s, tc) for s, tc in markov])
+                             [(s * s, tc) for s, tc in markov],
+                             [(a * a / 2, f0) for a, f0 in tone])
 
 
 def model_variance(taus, Q=0.0, N=0.0, B=0.0, K=0.0, R=0.0) -> np.ndarray:
@@ -193,6 +200,13 @@ class NoiseModel:
         NaN where a channel has fewer than two.
     gm_sigma_std, gm_tau_std : ndarray
         Their standard uncertainties.
+    sine_amplitude, sine_freq : ndarray
+        A tone A·sin(2πf0·t + ϕ) in the data (IEEE 952 Annex C's sinusoidal
+        term, Allan variance A²·sin⁴(πf0τ)/(πf0τ)², sampled form in
+        ``docs/noise.md``): peak amplitude (rate) and frequency (Hz), shape ()
+        or (channels,); NaN where a channel has none.
+    sine_amplitude_std, sine_freq_std : ndarray
+        Their standard uncertainties.
     supported : dict[str, ndarray of bool]
         Whether each IEEE term is in the model (``False``: the value is 0 and
         means "not resolved", not "absent").
@@ -227,8 +241,8 @@ class NoiseModel:
         no such part; ``"B"`` also has ``low``/``high`` (95 % interval).
     cov : ndarray
         ``"wls"``: covariance of (Q², N², B², K², R², then σ², ln τc of each
-        Gauss–Markov slot), shape (11, 11) or (channels, 11, 11); NaN for
-        ``"slopes"``.
+        Gauss–Markov slot, then A²/2, ln f0 of the tone), shape (13, 13) or
+        (channels, 13, 13); NaN for ``"slopes"``.
     """
 
     Q: np.ndarray
@@ -245,6 +259,10 @@ class NoiseModel:
     gm_tau: np.ndarray
     gm_sigma_std: np.ndarray
     gm_tau_std: np.ndarray
+    sine_amplitude: np.ndarray
+    sine_freq: np.ndarray
+    sine_amplitude_std: np.ndarray
+    sine_freq_std: np.ndarray
     supported: dict[str, np.ndarray]
     tau_range: dict[str, np.ndarray]
     method: str
@@ -286,25 +304,36 @@ class NoiseModel:
         tau = np.reshape(self.gm_tau, (-1, GM_MAX))[channel]
         return [(float(s), float(t)) for s, t in zip(sig, tau, strict=True) if np.isfinite(s)]
 
+    def sine(self, channel: int = 0) -> list[tuple[float, float]]:
+        """The (amplitude, f0) of the tone of ``channel``: one pair, or none."""
+        amp = float(np.atleast_1d(self.sine_amplitude)[channel])
+        f0 = float(np.atleast_1d(self.sine_freq)[channel])
+        return [(amp, f0)] if np.isfinite(amp) else []
+
     # -- curves -------------------------------------------------------------
     def predict(self, taus=None) -> Prediction:
         """Model Allan deviation at ``taus`` (default: the fitted taus).
 
         Returns the total curve σ(τ) and each term's own curve, e.g.
-        ``terms["N"] = N/√τ``, ``terms["GM1"]`` for the first Gauss–Markov term.
+        ``terms["N"] = N/√τ``, ``terms["GM1"]`` for the first Gauss–Markov term,
+        ``terms["sine"]`` for the tone (when a channel has one).
         """
         t = self.taus if taus is None else np.asarray(taus, dtype=float)
         if t.ndim != 1 or t.size == 0 or not np.all(np.isfinite(t)) or np.any(t <= 0):
             raise ValueError(f"taus must be a non-empty 1-D array of finite values > 0; got {t!r}")
-        names = [*TERMS, *(f"GM{k + 1}" for k in range(GM_MAX))]
+        gm_names = [f"GM{k + 1}" for k in range(GM_MAX)]
+        names = [*TERMS, *gm_names, "sine"]
         parts = np.zeros((t.size, len(names), self.channels))
         for c in range(self.channels):
-            var = _terms(t, self.fs, [self.value(k)[c] for k in TERMS], self.gauss_markov(c))
-            parts[:, : var.shape[1], c] = var
+            markov, tone = self.gauss_markov(c), self.sine(c)
+            var = _terms(t, self.fs, [self.value(k)[c] for k in TERMS], markov, tone)
+            cols = [*range(len(TERMS) + len(markov)), *([names.index("sine")] if tone else [])]
+            parts[:, cols, c] = var
         total = np.sqrt(parts.sum(axis=1))
-        used = names[: len(TERMS) + max(len(self.gauss_markov(c)) for c in
-                                         range(self.channels))]
-        terms = {k: np.sqrt(parts[:, i, :]) for i, k in enumerate(used)}
+        channels = range(self.channels)
+        used = [*TERMS, *gm_names[: max(len(self.gauss_markov(c)) for c in channels)],
+                *(["sine"] if any(self.sine(c) for c in channels) else [])]
+        terms = {k: np.sqrt(parts[:, names.index(k), :]) for k in used}
         if self.one_channel:
             total = total[:, 0]
             terms = {k: v[:, 0] for k, v in terms.items()}
@@ -358,18 +387,25 @@ class NoiseModel:
         return values, stds
 
     def _parameters(self, channel: int) -> np.ndarray:
-        """(Q², N², B², K², R², then σ², ln τc per Gauss–Markov slot) of a channel."""
+        """(Q², N², B², K², R², then σ², ln τc per Gauss–Markov slot, then A²/2,
+        ln f0 of the tone) of a channel."""
         p = np.zeros(_PARAMS)
         p[:5] = [float(self.value(t)[channel]) ** 2 for t in TERMS]
         for k, (sigma, tau_c) in enumerate(self.gauss_markov(channel)):
             p[5 + 2 * k], p[6 + 2 * k] = sigma**2, math.log(tau_c)
+        for amplitude, f0 in self.sine(channel):
+            p[_SINE], p[_SINE + 1] = amplitude**2 / 2, math.log(f0)
         return p
 
     def _equivalent_of(self, term: str, p: np.ndarray) -> float:
         gm = [(p[5 + 2 * k], math.exp(p[6 + 2 * k])) for k in range(GM_MAX) if p[5 + 2 * k] > 0]
         if term == "B":
+            # The tone is part of the curve whose floor B is read from; it is
+            # neither white nor a walk, so N and K leave it out.
+            tone = [(p[_SINE], math.exp(p[_SINE + 1]))] if p[_SINE] > 0 else []
             grid = np.geomspace(self.taus[0], self.taus[-1], 200)
-            dev = np.sqrt(_core_fit.noise_terms(grid, self.fs, list(p[:5]), gm).sum(axis=1))
+            dev = np.sqrt(_core_fit.noise_terms(grid, self.fs, list(p[:5]), gm, tone).sum(
+                axis=1))
             i = int(np.argmin(dev))
             # A minimum at the longest tau is a floor only where the curve has
             # flattened (log-log slope above −¼ there); else it is still falling.
@@ -399,7 +435,8 @@ class NoiseModel:
         terms = [f"{t}={_summary.estimate(*self._value_std(t, channel))}" for t in TERMS
                  if np.atleast_1d(self.supported[t])[channel]]
         gm = len(self.gauss_markov(channel))
-        return (" ".join(terms) or "no term resolved") + (f", {gm} GM" if gm else "") + (
+        tone = "".join(f", tone {_summary.number(f0)} Hz" for _, f0 in self.sine(channel))
+        return (" ".join(terms) or "no term resolved") + (f", {gm} GM" if gm else "") + tone + (
             f", covers {100 * float(np.atleast_1d(self.coverage)[channel]):.3g} %")
 
     def _value_std(self, term: str, channel: int) -> tuple[float, float]:
@@ -430,10 +467,13 @@ class NoiseModel:
                     f" ± {e:.2g}" if np.isfinite(e) else ""))
             row.append(", ".join(f"σ {_summary.number(sg)}, τc {_summary.number(tc)} s"
                                  for sg, tc in self.gauss_markov(c)) or "—")
+            row.append(", ".join(f"A {_summary.number(a)}, f0 {_summary.number(f0)} Hz"
+                                 for a, f0 in self.sine(c)) or "—")
             row.append(f"{100 * float(np.atleast_1d(self.coverage)[c]):.3g} %")
             rows.append(row)
         return _summary.html_table(
-            ["axis", *(f"{t} [{units[t]}]" for t in TERMS), "Gauss–Markov", "coverage"],
+            ["axis", *(f"{t} [{units[t]}]" for t in TERMS), "Gauss–Markov", "tone",
+             "coverage"],
             rows, caption=f"NoiseModel: {self._title()}, {_summary.tau_span(self.taus)}")
 
     # -- units and tables ---------------------------------------------------
@@ -565,6 +605,10 @@ class NoiseModel:
             [{"sigma": sg, "tau_c": tc} for sg, tc in self.gauss_markov(c)]
             for c in range(self.channels)
         ]
+        d["sine"] = [
+            [{"amplitude": a, "frequency": f0} for a, f0 in self.sine(c)]
+            for c in range(self.channels)
+        ]
         d["coverage"] = np.atleast_1d(self.coverage).tolist()
         d["discrepancy"] = np.atleast_1d(self.discrepancy).tolist()
         d["readoff"] = {
@@ -685,20 +729,20 @@ def _edf_cap(result, taus):
     return np.where(np.isfinite(cap) & (cap > 1.0), cap, 1.0)
 
 
-def _parse_terms(terms) -> tuple[np.ndarray, int, bool]:
-    """``terms`` → (IEEE mask, Gauss–Markov count, select by BIC)."""
+def _parse_terms(terms) -> tuple[np.ndarray, int, bool, bool]:
+    """``terms`` → (IEEE mask, Gauss–Markov count, tone, select by BIC)."""
     if isinstance(terms, str) and terms == "auto":
-        return np.ones(len(TERMS), dtype=bool), GM_MAX, True
+        return np.ones(len(TERMS), dtype=bool), GM_MAX, True, True
     names = tuple(terms) if not isinstance(terms, str) else tuple(terms)
-    allowed = (*TERMS, "GM")
+    allowed = (*TERMS, "GM", "sine")
     bad = [t for t in names if t not in allowed]
     gm = names.count("GM")
-    if bad or not names or gm > GM_MAX:
+    if bad or not names or gm > GM_MAX or names.count("sine") > 1:
         raise ValueError(
             f"terms must be 'auto' or a non-empty sequence of {allowed} with 'GM' at most "
-            f"{GM_MAX} times; got {terms!r}"
+            f"{GM_MAX} times and 'sine' at most once; got {terms!r}"
         )
-    return np.array([t in names for t in TERMS]), gm, False
+    return np.array([t in names for t in TERMS]), gm, "sine" in names, False
 
 
 @old_call_forms(keyword_only=("method", "terms", "tau_range"))
@@ -716,11 +760,12 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
     method : {"wls", "slopes"}
         Log-space weighted least squares (default) or the IEEE 952 / MATLAB
         slope read-off (see the module docstring).
-    terms : "auto" or sequence of {"Q", "N", "B", "K", "R", "GM"}
-        ``"auto"`` (default): the IEEE terms and up to three Gauss–Markov terms,
-        the structure with the lowest BIC (the fewest terms that describe the
-        curve). A sequence fits exactly those terms (``"GM"`` once or twice for
-        Gauss–Markov terms); a term the data push below zero is still 0.
+    terms : "auto" or sequence of {"Q", "N", "B", "K", "R", "GM", "sine"}
+        ``"auto"`` (default): the IEEE terms, up to three Gauss–Markov terms
+        and a tone, the structure with the lowest BIC (the fewest terms that
+        describe the curve). A sequence fits exactly those terms (``"GM"`` up to
+        three times for Gauss–Markov terms, ``"sine"`` once for a tone); a term
+        the data push below zero is still 0.
     tau_range : (float, float), optional
         Only use taus in [min, max] seconds.
     uncertainty : {"independent", "bootstrap"}
@@ -770,7 +815,7 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
             raise TypeError(f"replicates must be an integer; got {replicates!r}")
         if replicates < 5:
             raise ValueError(f"replicates must be >= 5; got {replicates}")
-    mask, gm_count, select = _parse_terms(terms)
+    mask, gm_count, tone, select = _parse_terms(terms)
     taus, var, edf, one = _extract(result, tau_range)
     dev_all, edf_raw = _measured(result, taus)
     channels = var.shape[1]
@@ -780,6 +825,8 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
     rng = np.full((channels, 5, 2), np.nan)
     gm = np.full((channels, GM_MAX, 2), np.nan)
     gm_std = np.full((channels, GM_MAX, 2), np.nan)
+    sine = np.full((channels, 2), np.nan)  # amplitude, f0
+    sine_std = np.full((channels, 2), np.nan)
     stats = np.full((channels, 3), np.nan)  # discrepancy, chi2, n_eff
     cov = np.full((channels, _PARAMS, _PARAMS), np.nan)
     usable = []
@@ -800,14 +847,16 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
         def fit_channel(c):
             ok = usable[c]
             return _fit_wls(taus[ok], var[ok, c], edf[ok, c], float(result.fs), mask,
-                            gm_count, select)
+                            gm_count, tone, select)
 
         with ThreadPoolExecutor(max_workers=min(channels, os.cpu_count() or 1)) as pool:
             fits = list(pool.map(fit_channel, range(channels)))
         for c, out in enumerate(fits):
-            coef[c], std[c], sup[c], gm[c], gm_std[c], stats[c], cov[c] = out
+            coef[c], std[c], sup[c], gm[c], gm_std[c], sine[c], sine_std[c], stats[c], \
+                cov[c] = out
             markov = [(a, b) for a, b in gm[c] if np.isfinite(a)]
-            rng[c] = _support_range(_terms(taus[usable[c]], result.fs, coef[c], markov),
+            tones = [tuple(sine[c])] if np.isfinite(sine[c, 0]) else []
+            rng[c] = _support_range(_terms(taus[usable[c]], result.fs, coef[c], markov, tones),
                                     taus[usable[c]], sup[c])
     else:
         for c in range(channels):
@@ -818,12 +867,13 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
         for c in range(channels):
             kept = [t for t, keep in zip(TERMS, sup[c], strict=True) if keep]
             markov = [(float(a), float(b)) for a, b in gm[c] if np.isfinite(a)]
-            if not kept and not markov:
+            tones = [(float(sine[c, 0]), float(sine[c, 1]))] if np.isfinite(sine[c, 0]) else []
+            if not kept and not markov and not tones:
                 continue
-            options = dict(method=method, terms=[*kept, *["GM"] * len(markov)],
-                           tau_range=tau_range)
-            std[c], gm_std[c] = _bootstrap_std(result, coef[c], markov, int(replicates),
-                                               generator, options)
+            options = dict(method=method, terms=[*kept, *["GM"] * len(markov),
+                                                 *["sine"] * len(tones)], tau_range=tau_range)
+            std[c], gm_std[c], sine_std[c] = _bootstrap_std(
+                result, coef[c], markov, tones, int(replicates), generator, options)
     std[~sup] = np.nan
 
     def shaped(a):
@@ -840,6 +890,10 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
         gm_tau=shaped(gm[:, :, 1]),
         gm_sigma_std=shaped(gm_std[:, :, 0]),
         gm_tau_std=shaped(gm_std[:, :, 1]),
+        sine_amplitude=shaped(sine[:, 0]),
+        sine_freq=shaped(sine[:, 1]),
+        sine_amplitude_std=shaped(sine_std[:, 0]),
+        sine_freq_std=shaped(sine_std[:, 1]),
         supported={k: shaped(sup[:, i]) for i, k in enumerate(TERMS)},
         tau_range={k: shaped(rng[:, i, :]) for i, k in enumerate(TERMS)},
         method=method,
@@ -951,14 +1005,16 @@ def _record_length(result) -> int:
     return n0 + 2 * m0 - 1 if overlapping else (n0 + 1) * m0
 
 
-def _bootstrap_std(result, coef, markov, replicates, rng, options):
-    """Standard deviation of each coefficient (and Gauss–Markov σ, τc) over fits to
-    records simulated from the model with the length, rate and taus of ``result``."""
+def _bootstrap_std(result, coef, markov, tones, replicates, rng, options):
+    """Standard deviation of each coefficient (and Gauss–Markov σ, τc, and tone A,
+    f0) over fits to records simulated from the model with the length, rate and
+    taus of ``result``."""
     from imunoise.allan import adev
     from imunoise.simulate import simulate
 
     n = _record_length(result)
-    sims = simulate(n, result.fs, *coef, channels=replicates, seed=rng, gm=markov)
+    sims = simulate(n, result.fs, *coef, channels=replicates, seed=rng, gm=markov,
+                    sinusoid=tones[0] if tones else None)
     again = adev(sims, result.fs, taus=np.asarray(result.taus), overlapping=result.overlapping,
                  confidence=result.confidence)
     with warnings.catch_warnings():
@@ -967,7 +1023,12 @@ def _bootstrap_std(result, coef, markov, replicates, rng, options):
     values = np.stack([np.atleast_1d(refit.value(t)) for t in TERMS], axis=1)
     gm = np.stack([np.reshape(refit.gm_sigma, (-1, GM_MAX)),
                    np.reshape(refit.gm_tau, (-1, GM_MAX))], axis=-1)
-    return values.std(axis=0, ddof=1), np.nanstd(gm, axis=0, ddof=1)
+    tone = np.stack([np.atleast_1d(refit.sine_amplitude), np.atleast_1d(refit.sine_freq)],
+                    axis=-1)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN: no tone
+        return (values.std(axis=0, ddof=1), np.nanstd(gm, axis=0, ddof=1),
+                np.nanstd(tone, axis=0, ddof=1))
 
 
 def _readonly(a):
@@ -976,11 +1037,11 @@ def _readonly(a):
     return out
 
 
-def _fit_wls(t, v, e, fs, mask, gm_count, select):
+def _fit_wls(t, v, e, fs, mask, gm_count, tone, select):
     try:
         r = _core_fit.fit_noise(
             np.ascontiguousarray(t), np.ascontiguousarray(v), np.ascontiguousarray(e), fs,
-            [bool(m) for m in mask], gm_count, select,
+            [bool(m) for m in mask], gm_count, select, tone,
         )
     except ValueError as exc:
         raise ValueError(f"cannot fit the noise model to result: {exc}") from None
@@ -999,7 +1060,15 @@ def _fit_wls(t, v, e, fs, mask, gm_count, select):
         u_q2, u_log_tau = cov[5 + 2 * k, 5 + 2 * k], cov[6 + 2 * k, 6 + 2 * k]
         markov_std[k] = math.sqrt(max(u_q2, 0.0)) / (2 * sigma), tau_c * math.sqrt(
             max(u_log_tau, 0.0))
-    return (np.where(supported, coef, 0.0), std, supported, markov, markov_std,
+    sine = np.full(2, np.nan)
+    sine_std = np.full(2, np.nan)
+    for s2, f0 in r.sine:
+        # s² = A²/2, so u(A) = u(s²)/A.
+        amplitude = math.sqrt(2 * s2)
+        sine[:] = amplitude, f0
+        sine_std[:] = (math.sqrt(max(cov[_SINE, _SINE], 0.0)) / amplitude,
+                       f0 * math.sqrt(max(cov[_SINE + 1, _SINE + 1], 0.0)))
+    return (np.where(supported, coef, 0.0), std, supported, markov, markov_std, sine, sine_std,
             (delta, chi2, n_eff), cov)
 
 

@@ -438,10 +438,15 @@ def allan(
                     if term in curves and np.any(curves[term] > 0):
                         ax.plot(grid, curves[term], color="0.45", linestyle=ls,
                                 linewidth=0.9, label=f"{label}")
-                for g, ls in (("GM1", (0, (1, 1))), ("GM2", (0, (3, 1, 1, 1)))):
+                for g, ls in (("GM1", (0, (1, 1))), ("GM2", (0, (3, 1, 1, 1))),
+                              ("GM3", (0, (5, 2)))):
                     if g in curves and np.any(curves[g] > 0):
                         ax.plot(grid, curves[g], color="tab:brown", linestyle=ls,
                                 linewidth=0.9, label="Gauss–Markov bias")
+                if "sine" in curves and np.any(curves["sine"] > 0):
+                    # Zeros at whole periods: masked on the log axis.
+                    tone = np.where(curves["sine"] > 0, curves["sine"], np.nan)
+                    ax.plot(grid, tone, color="tab:olive", linewidth=0.9, label="tone")
                 if marks.get("N", 0.0) > 0:
                     ax.plot([1.0], [marks["N"]], marker="s", color="crimson", ms=5,
                             linestyle="none", label="N at τ=1 s")

@@ -116,7 +116,8 @@ def flicker(n_samples: int, scale: float, rng: np.random.Generator, *,
 @old_call_forms(keyword_only=("channels", "seed"), renamed={"n": "n_samples"})
 def simulate(n_samples: int, fs: float, Q: float = 0.0, N: float = 0.0, B: float = 0.0,
              K: float = 0.0, R: float = 0.0, *, channels: int = 1, seed=None,
-             gm: Sequence[tuple[float, float]] = ()) -> np.ndarray:
+             gm: Sequence[tuple[float, float]] = (),
+             sinusoid: tuple[float, float] | None = None) -> np.ndarray:
     """Rate noise with the given IEEE 952 coefficients.
 
     Parameters
@@ -137,6 +138,10 @@ def simulate(n_samples: int, fs: float, Q: float = 0.0, N: float = 0.0, B: float
         x[t] = φ·x[t−1] + w[t] with standard deviation ``sigma`` (rate) and
         correlation time ``tau_c`` (s), φ = exp(−1/(fs·tau_c)) — the process whose
         Allan variance :func:`imunoise.fit` models.
+    sinusoid : (amplitude, f0), optional
+        A tone A·sin(2π·f0·t + ϕ) of peak amplitude A (rate) and frequency f0
+        (Hz), a random phase ϕ per channel: IEEE 952 Annex C's sinusoidal term,
+        Allan variance A²·sin⁴(πf0τ)/(πf0τ)².
 
     Returns
     -------
@@ -156,6 +161,7 @@ def simulate(n_samples: int, fs: float, Q: float = 0.0, N: float = 0.0, B: float
     fs = sample_rate(fs)
     Q, N, B, K, R = (_check_coef(k, v) for k, v in zip("QNBKR", (Q, N, B, K, R), strict=True))
     markov = _check_gm(gm)
+    tone = _check_sinusoid(sinusoid)
     rng = np.random.default_rng(seed)
     out = np.zeros((n, channels))
     sqfs = math.sqrt(fs)
@@ -186,7 +192,26 @@ def simulate(n_samples: int, fs: float, Q: float = 0.0, N: float = 0.0, B: float
             flicker(n, B, rng, out=col)
         for sigma, tau_c in markov:
             col += gauss_markov(n, fs, sigma, tau_c, rng)
+        if tone is not None and tone[0] > 0:
+            amplitude, f0 = tone
+            phase = rng.uniform(0.0, 2 * math.pi)
+            col += amplitude * np.sin(2 * math.pi * f0 / fs * np.arange(n) + phase)
     return out[:, 0].copy() if channels == 1 else out
+
+
+def _check_sinusoid(sinusoid) -> tuple[float, float] | None:
+    if sinusoid is None:
+        return None
+    try:
+        amplitude, f0 = (float(v) for v in sinusoid)
+    except (TypeError, ValueError):
+        raise TypeError(
+            f"sinusoid must be an (amplitude, f0) pair or None; got {sinusoid!r}") from None
+    if not (math.isfinite(amplitude) and amplitude >= 0):
+        raise ValueError(f"sinusoid amplitude must be finite and >= 0; got {amplitude!r}")
+    if not (math.isfinite(f0) and f0 > 0):
+        raise ValueError(f"sinusoid f0 must be finite and > 0 Hz; got {f0!r}")
+    return amplitude, f0
 
 
 def _check_gm(gm) -> list[tuple[float, float]]:

@@ -9,7 +9,9 @@ use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
-use crate::fit::{self, Options, FLICKER_FACTOR, IEEE_TERMS, IEEE_TERM_NAMES, MAX_GM, PARAMETERS};
+use crate::fit::{
+    self, Options, FLICKER_FACTOR, IEEE_TERMS, IEEE_TERM_NAMES, MAX_GM, PARAMETERS, SINE_SLOT,
+};
 
 /// The fit of one channel, as `_core.fit.NoiseFit`.
 #[pyclass(name = "NoiseFit", module = "imunoise._core.fit", frozen, get_all)]
@@ -18,7 +20,10 @@ struct PyNoiseFit {
     ieee: Py<PyArray1<f64>>,
     /// (k, 2) rows of (q², τc), one per Gauss–Markov term.
     gm: Py<PyArray2<f64>>,
-    /// PARAMETERS × PARAMETERS covariance of (Q²…R², then q², ln τc per slot).
+    /// (k, 2) rows of (s², f₀), k ≤ 1: the tone.
+    sine: Py<PyArray2<f64>>,
+    /// PARAMETERS × PARAMETERS covariance of (Q²…R², then q², ln τc per slot,
+    /// then s², ln f₀).
     cov: Py<PyArray2<f64>>,
     /// δ, the relative model discrepancy.
     discrepancy: f64,
@@ -50,10 +55,10 @@ fn to_matrix(rows: Vec<Vec<f64>>, cols: usize) -> PyResult<Array2<f64>> {
         .map_err(|e| PyValueError::new_err(e.to_string()))
 }
 
-/// fit_noise(taus, var, edf, fs, terms, gm, select) -> NoiseFit
+/// fit_noise(taus, var, edf, fs, terms, gm, select, sine) -> NoiseFit
 #[pyfunction]
 #[allow(clippy::too_many_arguments)] // mirrors the Python keyword arguments
-#[pyo3(signature = (taus, var, edf, fs, terms, gm=3, select=true))]
+#[pyo3(signature = (taus, var, edf, fs, terms, gm=3, select=true, sine=true))]
 fn fit_noise<'py>(
     py: Python<'py>,
     taus: PyReadonlyArray1<'py, f64>,
@@ -63,10 +68,12 @@ fn fit_noise<'py>(
     terms: Vec<bool>,
     gm: usize,
     select: bool,
+    sine: bool,
 ) -> PyResult<PyNoiseFit> {
     let opts = Options {
         ieee: ieee_flags(&terms)?,
         gm,
+        sine,
         select,
     };
     let taus = taus.as_array().to_vec();
@@ -74,9 +81,11 @@ fn fit_noise<'py>(
     let edf = edf.as_array().to_vec();
     let r = py.detach(|| fit::fit_noise(&taus, &var, &edf, fs, &opts))?;
     let gm_rows: Vec<Vec<f64>> = r.gm.iter().map(|&(q2, tc)| vec![q2, tc]).collect();
+    let sine_rows: Vec<Vec<f64>> = r.sine.iter().map(|&(s2, f0)| vec![s2, f0]).collect();
     Ok(PyNoiseFit {
         ieee: r.ieee.to_vec().into_pyarray(py).unbind(),
         gm: to_matrix(gm_rows, 2)?.into_pyarray(py).unbind(),
+        sine: to_matrix(sine_rows, 2)?.into_pyarray(py).unbind(),
         cov: to_matrix(r.cov, PARAMETERS)?.into_pyarray(py).unbind(),
         discrepancy: r.discrepancy,
         chi2: r.chi2,
@@ -86,14 +95,17 @@ fn fit_noise<'py>(
     })
 }
 
-/// noise_terms(taus, fs, ieee, gm) -> (len(taus), 5 + k) Allan variance of each term
+/// noise_terms(taus, fs, ieee, gm, sine) -> (len(taus), 5 + k + j) Allan variance of
+/// each term
 #[pyfunction]
+#[pyo3(signature = (taus, fs, ieee, gm, sine=Vec::new()))]
 fn noise_terms<'py>(
     py: Python<'py>,
     taus: PyReadonlyArray1<'py, f64>,
     fs: f64,
     ieee: Vec<f64>,
     gm: Vec<(f64, f64)>,
+    sine: Vec<(f64, f64)>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     if ieee.len() != IEEE_TERMS {
         return Err(PyValueError::new_err(format!(
@@ -108,9 +120,14 @@ fn noise_terms<'py>(
     }
     let mut coef = [0.0; IEEE_TERMS];
     coef.copy_from_slice(&ieee);
-    let cols = IEEE_TERMS + gm.len();
+    if let Some(&(_, f0)) = sine.iter().find(|s| !(s.1.is_finite() && s.1 > 0.0)) {
+        return Err(PyValueError::new_err(format!(
+            "sine frequencies must be finite and > 0 Hz; got {f0}"
+        )));
+    }
+    let cols = IEEE_TERMS + gm.len() + sine.len();
     let taus = taus.as_array().to_vec();
-    let rows = fit::terms(&taus, fs, &coef, &gm);
+    let rows = fit::terms(&taus, fs, &coef, &gm, &sine);
     Ok(to_matrix(rows, cols)?.into_pyarray(py))
 }
 
@@ -118,6 +135,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("IEEE_TERM_NAMES", IEEE_TERM_NAMES.to_vec())?;
     m.add("MAX_GAUSS_MARKOV", MAX_GM)?;
     m.add("PARAMETERS", PARAMETERS)?;
+    m.add("SINE_SLOT", SINE_SLOT)?;
     m.add("FLICKER_FACTOR", FLICKER_FACTOR)?;
     m.add_class::<PyNoiseFit>()?;
     m.add_function(wrap_pyfunction!(fit_noise, m)?)?;

@@ -70,6 +70,25 @@ pub fn gauss_markov(m: f64, u: f64) -> f64 {
     (numerator / (m * m * d * d)).max(0.0)
 }
 
+/// Allan variance at cluster size `m` of a unit-variance sinusoid of random
+/// phase at `nu` = f₀/fs cycles per sample (autocovariance γ(h) = cos 2πνh):
+///
+/// ```text
+/// σ²(m) = 2 sin⁴(πνm) / (m² sin²(πν))
+/// ```
+///
+/// (the cluster mean of sin(2πνn + ϕ) over m samples has amplitude
+/// sin(πνm)/(m sin πν), the difference of two adjacent means 2 sin(πνm) times
+/// that). The sampled form of IEEE 952 Annex C's sinusoidal term
+/// Ω₀² sin⁴(πf₀τ)/(πf₀τ)² (variance Ω₀²/2 = 1 here), to which it tends for
+/// f₀ ≪ fs; near fs/2 the two differ by a factor up to π²/4, and frequencies
+/// above fs/2 alias onto fs − f₀.
+pub fn sinusoid(m: f64, nu: f64) -> f64 {
+    let s = (std::f64::consts::PI * nu * m).sin();
+    let d = m * (std::f64::consts::PI * nu).sin();
+    2.0 * s.powi(4) / (d * d)
+}
+
 /// u = τ₀/τc of a Gauss–Markov term of correlation time `tau_c` at rate `fs`.
 pub fn gm_rate(tau_c: f64, fs: f64) -> f64 {
     1.0 / (fs * tau_c)
@@ -81,7 +100,12 @@ mod tests {
 
     /// σ²(m) from the autocovariance γ(h) = φʰ, summed directly (DESIGN.md).
     fn direct(m: usize, phi: f64) -> f64 {
-        let g = |h: usize| phi.powi(h as i32);
+        direct_from(m, |h| phi.powi(h as i32))
+    }
+
+    /// σ²(m) = var(S₂ − S₁)/(2m²) of adjacent m-sample sums, written as a sum
+    /// over lags of any autocovariance γ with γ(0) = 1.
+    fn direct_from(m: usize, g: impl Fn(usize) -> f64) -> f64 {
         let mf = m as f64;
         let mut s = mf;
         for h in 1..m {
@@ -106,6 +130,38 @@ mod tests {
                     "phi {phi} m {m}: {got} vs {want}"
                 );
             }
+        }
+    }
+
+    #[test]
+    fn sinusoid_matches_the_autocovariance_sum() {
+        for &nu in &[1e-4, 0.013, 0.1, 0.2, 0.25, 0.37, 0.5] {
+            let g = |h: usize| (2.0 * std::f64::consts::PI * nu * h as f64).cos();
+            for &m in &[1usize, 2, 3, 5, 7, 10, 64, 300, 2000] {
+                let want = direct_from(m, g);
+                let got = sinusoid(m as f64, nu);
+                // Absolute floor: the direct sum's rounding at the nulls.
+                assert!(
+                    (got - want).abs() <= 1e-9 * want.abs() + 1e-13,
+                    "nu {nu} m {m}: {got} vs {want}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn sinusoid_tends_to_the_ieee_form_and_has_nulls() {
+        // IEEE 952 Annex C: Ω₀² sin⁴(πf₀τ)/(πf₀τ)² with Ω₀² = 2 (unit variance).
+        let (fs, f0) = (1000.0, 0.7);
+        for tau in [0.1, 0.5, 1.0, 3.3] {
+            let x = std::f64::consts::PI * f0 * tau;
+            let ieee = 2.0 * x.sin().powi(4) / (x * x);
+            let got = sinusoid(tau * fs, f0 / fs);
+            assert!((got / ieee - 1.0).abs() < 1e-5, "tau {tau}: {got} {ieee}");
+        }
+        // Zero at whole periods: a tone at fs/5 vanishes at m = 5, 10, …
+        for m in [5.0, 10.0, 55.0] {
+            assert!(sinusoid(m, 0.2) < 1e-25, "m {m}");
         }
     }
 

@@ -2,11 +2,14 @@
 //!
 //! ```text
 //! σ²(τ) = 3Q²/τ² + N²/τ + (2 ln2/π)·B² + K²τ/3 + R²τ²/2 + Σₖ qₖ²·g(τ; τcₖ)
+//!         + s²·h(τ; f₀)
 //! ```
 //!
 //! the IEEE Std 952 / 1293 terms plus up to [`MAX_GM`] = 3 first-order
 //! Gauss–Markov bias terms of variance qₖ² and correlation time τcₖ (three: a
-//! MEMS sensor's own filter, a bump of correlated bias, and slow wander) (`basis`). The estimator
+//! MEMS sensor's own filter, a bump of correlated bias, and slow wander), and
+//! at most one sinusoid (tone) of variance s² (amplitude √2·s) and frequency f₀
+//! (`basis`). The estimator
 //! (`estimate`) is a weighted least-squares fit of ln σ̂² with weights from the
 //! EDF, the share of an octave each tau stands for, and a model-discrepancy
 //! variance fitted by maximum likelihood; the structure (`search`) is chosen by
@@ -35,9 +38,12 @@ use search::Candidate;
 /// Most Gauss–Markov terms a model may have.
 pub const MAX_GM: usize = 3;
 
+/// First slot of the tone in the parameter covariance: s², then ln f₀.
+pub const SINE_SLOT: usize = IEEE_TERMS + 2 * MAX_GM;
+
 /// Slots of the parameter covariance: Q², N², B², K², R², then (q², ln τc) per
-/// Gauss–Markov term.
-pub const PARAMETERS: usize = IEEE_TERMS + 2 * MAX_GM;
+/// Gauss–Markov term, then (s², ln f₀) of the tone.
+pub const PARAMETERS: usize = SINE_SLOT + 2;
 
 /// What [`fit_noise`] may use.
 #[derive(Debug, Clone, Copy)]
@@ -46,6 +52,8 @@ pub struct Options {
     pub ieee: [bool; IEEE_TERMS],
     /// Gauss–Markov terms: the most allowed (`select`) or the exact number.
     pub gm: usize,
+    /// A tone: may enter (`select`) or is fitted (not `select`).
+    pub sine: bool,
     /// Choose the structure by BIC (`true`), or fit exactly the terms given.
     pub select: bool,
 }
@@ -55,6 +63,7 @@ impl Default for Options {
         Options {
             ieee: [true; IEEE_TERMS],
             gm: MAX_GM,
+            sine: true,
             select: true,
         }
     }
@@ -68,6 +77,8 @@ pub struct NoiseFit {
     /// Variance q² and correlation time τc (s) of each Gauss–Markov term in the
     /// model, by increasing τc.
     pub gm: Vec<(f64, f64)>,
+    /// Variance s² and frequency f₀ (Hz) of the tone, if the model has one.
+    pub sine: Vec<(f64, f64)>,
     /// Covariance over [`PARAMETERS`] slots (0 for parameters not in the model).
     pub cov: Vec<Vec<f64>>,
     /// Model discrepancy δ: relative standard deviation of the Allan variance
@@ -100,14 +111,27 @@ pub fn fit_noise(
     }
     let data = Data::new(taus, var, edf, fs)?;
     let chosen = if opts.select {
-        let best = search::select(&data, fs, opts.ieee, opts.gm)?;
+        let best = search::select(&data, fs, opts.ieee, opts.gm, opts.sine)?;
         prune_insignificant(&data, fs, best)?
     } else {
         let base = search::fit_structure(&data, fs, opts.ieee, 0, 0.0, &[])?;
-        if opts.gm == 0 {
+        let fixed = if opts.gm == 0 {
             base
         } else {
             search::fit_structure(&data, fs, opts.ieee, opts.gm, base.solution.d2, &[])?
+        };
+        if opts.sine {
+            search::with_sine(
+                &data,
+                fs,
+                opts.ieee,
+                &fixed.gm_tau,
+                fixed.solution.d2,
+                false,
+            )?
+            .unwrap_or(fixed)
+        } else {
+            fixed
         }
     };
     Ok(summarise(&data, fs, &chosen))
@@ -128,7 +152,8 @@ const PRUNE_PENALTIES: f64 = 2.0;
 /// long-tau estimates (they are less independent than an octave each), this
 /// keeps only terms the data constrain. Gauss–Markov terms are tried before
 /// IEEE terms (where a fast one looks white or a slow one like a walk, the
-/// datasheet term is kept), each group by increasing z. The last term stays.
+/// datasheet term is kept), each group by increasing z; a tone before either.
+/// The last term stays.
 fn prune_insignificant(data: &Data, fs: f64, mut best: Candidate) -> CoreResult<Candidate> {
     // The allowance is cumulative against the selected fit: each removal raises
     // δ and so makes the next one look cheaper; without this, terms fall in a
@@ -138,7 +163,7 @@ fn prune_insignificant(data: &Data, fs: f64, mut best: Candidate) -> CoreResult<
     let mut removed = 0.0;
     'outer: loop {
         let fit = summarise(data, fs, &best);
-        let active = fit.ieee.iter().filter(|v| **v > 0.0).count() + fit.gm.len();
+        let active = fit.ieee.iter().filter(|v| **v > 0.0).count() + fit.gm.len() + fit.sine.len();
         if active <= 1 {
             return Ok(best);
         }
@@ -158,17 +183,22 @@ fn prune_insignificant(data: &Data, fs: f64, mut best: Candidate) -> CoreResult<
             .filter(|&j| fit.ieee[j] > 0.0)
             .map(|j| (j, fit.ieee[j]))
             .collect();
-        let mut order = weak(gm_slots);
+        let sine_slots = fit.sine.iter().map(|s| (SINE_SLOT, s.0)).collect();
+        let mut order = weak(sine_slots);
+        order.extend(weak(gm_slots));
         order.extend(weak(ieee_slots));
         for (slot, _) in order {
             let mut ieee = best.ieee;
             let mut times: Vec<f64> = fit.gm.iter().map(|g| g.1).collect();
+            let mut sine = fit.sine.first().map(|s| s.1);
             if slot < IEEE_TERMS {
                 ieee[slot] = false;
+            } else if slot == SINE_SLOT {
+                sine = None;
             } else {
                 times.remove((slot - IEEE_TERMS) / 2);
             }
-            if let Ok(next) = search::candidate(data, fs, ieee, times, best.solution.d2) {
+            if let Ok(next) = search::candidate(data, fs, ieee, times, sine, best.solution.d2) {
                 if next.solution.loss - selected < allowance * (removed + 1.0) {
                     best = next;
                     removed += 1.0;
@@ -191,13 +221,20 @@ fn summarise(data: &Data, fs: f64, c: &Candidate) -> NoiseFit {
         .filter(|(k, _)| theta[IEEE_TERMS + k] > 0.0)
         .map(|(k, &t)| (theta[IEEE_TERMS + k], t))
         .collect();
+    let sine: Vec<(f64, f64)> = c
+        .sine
+        .map(|f| (theta[IEEE_TERMS + c.gm_tau.len()], f))
+        .filter(|s| s.0 > 0.0)
+        .into_iter()
+        .collect();
     let chi2 = (0..data.len())
         .map(|i| data.omega[i] * (data.y[i] - c.solution.model[i].ln()).powi(2) / data.v[i])
         .sum();
     NoiseFit {
-        cov: covariance(data, fs, &ieee, &gm, c.solution.d2),
+        cov: covariance(data, fs, &ieee, &gm, &sine, c.solution.d2),
         ieee,
         gm,
+        sine,
         discrepancy: c.solution.d2.sqrt(),
         chi2,
         n_eff: data.n_eff(),
@@ -207,8 +244,15 @@ fn summarise(data: &Data, fs: f64, c: &Candidate) -> NoiseFit {
 }
 
 /// Model Allan variance of every term at `taus`: row i holds the five IEEE
-/// terms, then one value per Gauss–Markov term.
-pub fn terms(taus: &[f64], fs: f64, ieee: &[f64; IEEE_TERMS], gm: &[(f64, f64)]) -> Vec<Vec<f64>> {
+/// terms, then one value per Gauss–Markov term (q², τc), then one per tone
+/// (s², f₀).
+pub fn terms(
+    taus: &[f64],
+    fs: f64,
+    ieee: &[f64; IEEE_TERMS],
+    gm: &[(f64, f64)],
+    sine: &[(f64, f64)],
+) -> Vec<Vec<f64>> {
     taus.iter()
         .map(|&t| {
             let b = basis::ieee(t);
@@ -216,6 +260,10 @@ pub fn terms(taus: &[f64], fs: f64, ieee: &[f64; IEEE_TERMS], gm: &[(f64, f64)])
             row.extend(
                 gm.iter()
                     .map(|&(q2, tc)| q2 * basis::gauss_markov(t * fs, basis::gm_rate(tc, fs))),
+            );
+            row.extend(
+                sine.iter()
+                    .map(|&(s2, f0)| s2 * basis::sinusoid(t * fs, f0 / fs)),
             );
             row
         })
@@ -228,6 +276,7 @@ fn covariance(
     fs: f64,
     ieee: &[f64; IEEE_TERMS],
     gm: &[(f64, f64)],
+    sine: &[(f64, f64)],
     d2: f64,
 ) -> Vec<Vec<f64>> {
     // Parameter slots in use and, per tau, ∂M/∂p.
@@ -236,6 +285,10 @@ fn covariance(
         slots.push(IEEE_TERMS + 2 * k);
         slots.push(IEEE_TERMS + 2 * k + 1);
     }
+    if !sine.is_empty() {
+        slots.push(SINE_SLOT);
+        slots.push(SINE_SLOT + 1);
+    }
     let h: f64 = 1e-4;
     let rows: Vec<(f64, Vec<f64>)> = (0..data.len())
         .map(|i| {
@@ -243,13 +296,20 @@ fn covariance(
             let b = basis::ieee(t);
             let gmv =
                 |q2: f64, tc: f64| q2 * basis::gauss_markov(data.m[i], basis::gm_rate(tc, fs));
+            let tone = |s2: f64, f0: f64| s2 * basis::sinusoid(data.m[i], f0 / fs);
             let model: f64 = (0..IEEE_TERMS).map(|j| b[j] * ieee[j]).sum::<f64>()
-                + gm.iter().map(|&(q2, tc)| gmv(q2, tc)).sum::<f64>();
+                + gm.iter().map(|&(q2, tc)| gmv(q2, tc)).sum::<f64>()
+                + sine.iter().map(|&(s2, f0)| tone(s2, f0)).sum::<f64>();
             let grad = slots
                 .iter()
                 .map(|&s| {
                     if s < IEEE_TERMS {
                         b[s]
+                    } else if s == SINE_SLOT {
+                        tone(1.0, sine[0].1)
+                    } else if s == SINE_SLOT + 1 {
+                        let (s2, f0) = sine[0];
+                        (tone(s2, f0 * h.exp()) - tone(s2, f0 * (-h).exp())) / (2.0 * h)
                     } else {
                         let (q2, tc) = gm[(s - IEEE_TERMS) / 2];
                         if (s - IEEE_TERMS).is_multiple_of(2) {
@@ -309,7 +369,7 @@ mod tests {
     }
 
     fn curve(taus: &[f64], ieee: &[f64; 5], gm: &[(f64, f64)]) -> Vec<f64> {
-        terms(taus, FS, ieee, gm)
+        terms(taus, FS, ieee, gm, &[])
             .iter()
             .map(|r| r.iter().sum())
             .collect()
@@ -333,6 +393,7 @@ mod tests {
         let var = curve(&taus, &truth, &[]);
         let fit = fit_exact(&taus, &var);
         assert!(fit.gm.is_empty(), "{:?}", fit.gm);
+        assert!(fit.sine.is_empty(), "{:?}", fit.sine);
         for j in [1, 2, 3] {
             assert!(
                 (fit.ieee[j] / truth[j] - 1.0).abs() < 1e-3,
@@ -354,6 +415,7 @@ mod tests {
             let var = curve(&taus, &ieee, &truth_gm);
             let fit = fit_exact(&taus, &var);
             assert_eq!(fit.gm.len(), 2, "{per_decade}: {fit:?}");
+            assert!(fit.sine.is_empty(), "{per_decade}: {fit:?}");
             for (got, want) in fit.gm.iter().zip(truth_gm) {
                 assert!(
                     (got.0 / want.0 - 1.0).abs() < 0.01,
@@ -369,6 +431,46 @@ mod tests {
     }
 
     #[test]
+    fn a_tone_is_recovered_on_every_grid() {
+        let ieee = [0.0, 1e-6, 0.0, 1e-10, 0.0];
+        let tone = [(2e-5, 17.0)];
+        for per_decade in [5.0, 10.0, 20.0, 50.0] {
+            let taus = grid(per_decade, 0.01, 1000.0);
+            let var: Vec<f64> = terms(&taus, FS, &ieee, &[], &tone)
+                .iter()
+                .map(|r| r.iter().sum())
+                .collect();
+            let fit = fit_exact(&taus, &var);
+            assert_eq!(fit.sine.len(), 1, "{per_decade}: {fit:?}");
+            assert!(fit.gm.is_empty(), "{per_decade}: {fit:?}");
+            let (s2, f0) = fit.sine[0];
+            assert!((s2 / tone[0].0 - 1.0).abs() < 0.01, "{per_decade}: {s2}");
+            assert!((f0 / tone[0].1 - 1.0).abs() < 1e-3, "{per_decade}: {f0}");
+            assert!((fit.ieee[1] / ieee[1] - 1.0).abs() < 0.01);
+            let u = fit.cov[SINE_SLOT][SINE_SLOT].sqrt();
+            assert!(u.is_finite() && u < s2, "{per_decade}: {u}");
+        }
+    }
+
+    #[test]
+    fn tone_frequencies_stay_where_the_grid_resolves_them() {
+        let dense = grid(10.0, 0.01, 1000.0);
+        let data = Data::new(&dense, &vec![1.0; dense.len()], &vec![1e3; dense.len()], FS).unwrap();
+        let f = search::frequency_grid(&data, FS);
+        assert!(f[0] >= search::SINE_PERIODS / 1000.0, "{}", f[0]);
+        assert_eq!(f[f.len() - 1], FS / 2.0);
+        let sparse = grid(1.0, 0.01, 1000.0);
+        let data = Data::new(
+            &sparse,
+            &vec![1.0; sparse.len()],
+            &vec![1e3; sparse.len()],
+            FS,
+        )
+        .unwrap();
+        assert!(search::frequency_grid(&data, FS).is_empty());
+    }
+
+    #[test]
     fn covariance_shrinks_with_edf() {
         let truth = [0.0, 4e-6, 1e-6, 1e-10, 0.0];
         let taus = grid(5.0, 0.01, 2000.0);
@@ -380,6 +482,7 @@ mod tests {
         let opts = Options {
             select: false,
             gm: 0,
+            sine: false,
             ieee: [false, true, true, true, false],
         };
         let lo = fit_noise(&taus, &var, &edf_white(&taus, 1e4), FS, &opts).unwrap();

@@ -12,6 +12,13 @@
 //! joint minimum (−2 log-likelihood), p the number of non-zero variance
 //! parameters plus one per correlation time, and n_eff = Σω the number of
 //! octaves of evidence. The structure with the lowest BIC is kept.
+//!
+//! A sinusoid (a tone: a sensor's dither, a fan, a supply ripple) is one more
+//! column, linear in its variance for a fixed frequency: the frequency is found
+//! by a grid of [`FREQ_PER_DECADE`] per decade from [`SINE_PERIODS`] periods
+//! in the longest tau to fs/2, a finer scan and golden-section refinement, the
+//! Gauss–Markov times are then refined with the tone in place, and the toned
+//! structure competes by the same BIC (two parameters: variance, frequency).
 
 use faer::Mat;
 
@@ -25,22 +32,109 @@ const PER_DECADE: f64 = 6.0;
 /// Smallest ratio between the correlation times of two Gauss–Markov terms.
 const MIN_RATIO: f64 = 2.0;
 
-/// The basis of a structure: IEEE columns, then one column per GM time.
-pub fn design(data: &Data, fs: f64, gm_tau: &[f64]) -> Mat<f64> {
-    let k = IEEE_TERMS + gm_tau.len();
+/// Grid of candidate tone frequencies per decade: 2.4 % apart, so the grid point
+/// next to a tone is within a quarter radian of its phase πf₀τ up to τ ≈ 6/f₀,
+/// well past the tone's peak; the fine scan then resolves the longer taus.
+const FREQ_PER_DECADE: f64 = 96.0;
+
+/// Most steps of the fine frequency scan around the best grid point.
+const FINE_SCAN: f64 = 100.0;
+
+/// Golden-section tolerances in ln τc and ln f₀: a correlation time to 1 %; a
+/// frequency to 10⁻⁷, since its phase πf₀τ at long τ depends on it.
+const TIME_TOL: f64 = 1e-2;
+const FREQ_TOL: f64 = 1e-7;
+
+/// Fewest periods of a tone in the longest tau: slower ones would explain the
+/// scatter of the last few, least independent estimates (their bump at
+/// τ ≈ 0.37/f₀ stays more than a decade inside the curve).
+pub const SINE_PERIODS: f64 = 10.0;
+
+/// The basis of a structure: IEEE columns, one column per GM time, then the
+/// tone if any.
+pub fn design(data: &Data, fs: f64, gm_tau: &[f64], sine: Option<f64>) -> Mat<f64> {
+    let g = gm_tau.len();
+    let k = IEEE_TERMS + g + usize::from(sine.is_some());
     Mat::from_fn(data.len(), k, |i, j| {
         if j < IEEE_TERMS {
             basis::ieee(data.taus[i])[j]
-        } else {
+        } else if j < IEEE_TERMS + g {
             basis::gauss_markov(data.m[i], basis::gm_rate(gm_tau[j - IEEE_TERMS], fs))
+        } else {
+            basis::sinusoid(data.m[i], sine.unwrap_or(0.0) / fs)
         }
     })
 }
 
-fn allowed_with_gm(ieee: &[bool; IEEE_TERMS], gm: usize) -> Vec<bool> {
+fn allowed_with(ieee: &[bool; IEEE_TERMS], extra: usize) -> Vec<bool> {
     let mut a = ieee.to_vec();
-    a.extend(std::iter::repeat_n(true, gm));
+    a.extend(std::iter::repeat_n(true, extra));
     a
+}
+
+/// Fewest taus per decade for a tone: on a sparser grid a free frequency
+/// places the curve's oscillation to fit any few points.
+const SINE_MIN_DENSITY: f64 = 3.0;
+
+/// Candidate tone frequencies (Hz): 10^(j/96) from [`SINE_PERIODS`] periods in
+/// the longest tau up to fs/2, and fs/2 itself. Empty on grids sparser than
+/// [`SINE_MIN_DENSITY`]. (A tone near fs/2 falls as 1/τ² like quantization
+/// noise, but only at odd cluster sizes: the even ones tell the two apart.)
+pub fn frequency_grid(data: &Data, fs: f64) -> Vec<f64> {
+    let (first, last) = (data.taus[0], data.taus[data.len() - 1]);
+    let decades = (last / first).log10();
+    if data.len() < 2 || (data.len() - 1) as f64 / decades < SINE_MIN_DENSITY {
+        return Vec::new();
+    }
+    let top = 0.5 * fs;
+    let lo = (SINE_PERIODS / last).log10();
+    let hi = top.log10();
+    if lo >= hi {
+        return Vec::new();
+    }
+    let (a, b) = (
+        (lo * FREQ_PER_DECADE).ceil() as i64,
+        (hi * FREQ_PER_DECADE).floor() as i64,
+    );
+    let mut grid: Vec<f64> = (a..=b)
+        .map(|j| 10f64.powf(j as f64 / FREQ_PER_DECADE))
+        .collect();
+    grid.push(top);
+    grid
+}
+
+/// Golden-section search of f(e^x) over x in [ln lo, ln hi] down to an interval
+/// of `tol` in x; returns the best point found, or `start` when nothing beats it.
+fn golden(lo: f64, hi: f64, start: f64, tol: f64, f: impl Fn(f64) -> f64) -> f64 {
+    let g = 0.5 * (5f64.sqrt() - 1.0);
+    let (mut a, mut b) = (lo.ln(), hi.ln());
+    let at = |x: f64| f(x.exp());
+    let best_start = at(start.ln());
+    let mut c = b - g * (b - a);
+    let mut d = a + g * (b - a);
+    let mut fc = at(c);
+    let mut fd = at(d);
+    while b - a > tol {
+        if fc < fd {
+            b = d;
+            d = c;
+            fd = fc;
+            c = b - g * (b - a);
+            fc = at(c);
+        } else {
+            a = c;
+            c = d;
+            fc = fd;
+            d = a + g * (b - a);
+            fd = at(d);
+        }
+    }
+    let (x, fx) = if fc < fd { (c, fc) } else { (d, fd) };
+    if fx <= best_start {
+        x.exp()
+    } else {
+        start
+    }
 }
 
 /// Candidate correlation times: 10^(j/6) s from half a sample (φ = e⁻² ≈ 0.14;
@@ -60,13 +154,20 @@ struct Searcher<'a> {
     fs: f64,
     ieee: [bool; IEEE_TERMS],
     d2: f64,
+    /// The tone's frequency, held fixed while the times are searched.
+    sine: Option<f64>,
 }
 
 impl Searcher<'_> {
     /// Loss of the best θ for these times at the searcher's fixed δ².
     fn loss(&self, times: &[f64]) -> f64 {
-        let basis = design(self.data, self.fs, times);
-        let allowed = allowed_with_gm(&self.ieee, times.len());
+        self.loss_with(times, self.sine)
+    }
+
+    /// Loss of the best θ for these times and this tone.
+    fn loss_with(&self, times: &[f64], sine: Option<f64>) -> f64 {
+        let basis = design(self.data, self.fs, times, sine);
+        let allowed = allowed_with(&self.ieee, times.len() + usize::from(sine.is_some()));
         match estimate::solve_theta(
             estimate::Problem {
                 data: self.data,
@@ -84,34 +185,65 @@ impl Searcher<'_> {
 
     /// Golden-section search of time `which` in [lo, hi] (others fixed).
     fn refine(&self, times: &mut [f64], which: usize, lo: f64, hi: f64) {
-        let g = 0.5 * (5f64.sqrt() - 1.0);
-        let (mut a, mut b) = (lo.ln(), hi.ln());
-        let at = |x: f64, times: &mut [f64]| {
-            times[which] = x.exp();
-            self.loss(times)
-        };
-        let best_start = (times[which].ln(), self.loss(times));
-        let mut c = b - g * (b - a);
-        let mut d = a + g * (b - a);
-        let mut fc = at(c, times);
-        let mut fd = at(d, times);
-        while b - a > 1e-2 {
-            if fc < fd {
-                b = d;
-                d = c;
-                fd = fc;
-                c = b - g * (b - a);
-                fc = at(c, times);
-            } else {
-                a = c;
-                c = d;
-                fc = fd;
-                d = a + g * (b - a);
-                fd = at(d, times);
+        let base = times.to_vec();
+        times[which] = golden(lo, hi, base[which], TIME_TOL, |t| {
+            let mut probe = base.clone();
+            probe[which] = t;
+            self.loss(&probe)
+        });
+    }
+
+    /// Refine each time in turn within a factor `span`, twice, keeping the
+    /// times at least [`MIN_RATIO`] apart.
+    fn polish(&self, times: &mut [f64], span: f64) {
+        for _round in 0..2 {
+            for which in 0..times.len() {
+                let mut lo = times[which] / span;
+                let mut hi = times[which] * span;
+                // Two terms closer than a factor of 2 in τc are one term.
+                if which > 0 {
+                    lo = lo.max(times[which - 1] * MIN_RATIO);
+                }
+                if which + 1 < times.len() {
+                    hi = hi.min(times[which + 1] / MIN_RATIO);
+                }
+                if lo < hi {
+                    self.refine(times, which, lo, hi);
+                }
             }
         }
-        let (x, f) = if fc < fd { (c, fc) } else { (d, fd) };
-        times[which] = if f <= best_start.1 { x } else { best_start.0 }.exp();
+    }
+
+    /// Best tone frequency on the grid with these times, and its loss (None
+    /// when the curve is too short for any tone); [`Self::refine_frequency`]
+    /// then refines it.
+    fn coarse_frequency(&self, times: &[f64]) -> Option<(f64, f64)> {
+        frequency_grid(self.data, self.fs)
+            .into_iter()
+            .map(|f| (f, self.loss_with(times, Some(f))))
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+    }
+
+    /// A finer scan within one grid step of `f`, then golden section. The
+    /// tone's curve at τ has phase πf₀τ, so at the longest tau the loss
+    /// oscillates in ln f₀ with a period of about 1/(f₀τ_max): the fine scan
+    /// steps a tenth of that (at most [`FINE_SCAN`] steps; beyond, the tone has
+    /// faded under the other terms long before τ_max).
+    fn refine_frequency(&self, times: &[f64], f: f64) -> f64 {
+        let loss = |f: f64| self.loss_with(times, Some(f));
+        let top = 0.5 * self.fs;
+        let span = std::f64::consts::LN_10 / FREQ_PER_DECADE;
+        let tau_max = self.data.taus[self.data.len() - 1];
+        let step = (0.1 / (std::f64::consts::PI * f * tau_max)).max(2.0 * span / FINE_SCAN);
+        let n = (span / step).ceil() as i64;
+        let fine = (-n..=n)
+            .map(|j| f * (j as f64 * step).exp())
+            .filter(|&g| g <= top)
+            .map(|g| (loss(g), g))
+            .min_by(|a, b| a.0.total_cmp(&b.0))
+            .map_or(f, |(_, g)| g);
+        let hi = (fine * step.exp()).min(top);
+        golden(fine * (-step).exp(), hi, fine, FREQ_TOL, loss)
     }
 
     /// Best `count` correlation times (ascending); for three, `seed` is the best
@@ -165,22 +297,7 @@ impl Searcher<'_> {
             }
         };
         let span = if count == 2 { step * step * step } else { step };
-        for _round in 0..2 {
-            for which in 0..times.len() {
-                let mut lo = times[which] / span;
-                let mut hi = times[which] * span;
-                // Two terms closer than a factor of 2 in τc are one term.
-                if which > 0 {
-                    lo = lo.max(times[which - 1] * MIN_RATIO);
-                }
-                if which + 1 < times.len() {
-                    hi = hi.min(times[which + 1] / MIN_RATIO);
-                }
-                if lo < hi {
-                    self.refine(&mut times, which, lo, hi);
-                }
-            }
-        }
+        self.polish(&mut times, span);
         times
     }
 }
@@ -190,29 +307,32 @@ impl Searcher<'_> {
 #[derive(Debug, Clone)]
 pub struct Candidate {
     pub gm_tau: Vec<f64>,
+    /// Frequency (Hz) of the tone, if the structure has one.
+    pub sine: Option<f64>,
     pub ieee: [bool; IEEE_TERMS],
     pub solution: Solution,
     pub bic: f64,
 }
 
 /// Number of free parameters of a solution: non-zero variances, and a time
-/// for every Gauss–Markov term in use.
+/// (or frequency) for every Gauss–Markov term (or tone) in use.
 pub fn parameters(theta: &[f64]) -> usize {
     let used = theta.iter().filter(|t| **t > 0.0).count();
     let times = theta[IEEE_TERMS..].iter().filter(|t| **t > 0.0).count();
     used + times
 }
 
-/// Fit a structure with given correlation times (no search).
+/// Fit a structure with given correlation times and tone (no search).
 pub fn candidate(
     data: &Data,
     fs: f64,
     ieee: [bool; IEEE_TERMS],
     gm_tau: Vec<f64>,
+    sine: Option<f64>,
     d2: f64,
 ) -> CoreResult<Candidate> {
-    let basis = design(data, fs, &gm_tau);
-    let allowed = allowed_with_gm(&ieee, gm_tau.len());
+    let basis = design(data, fs, &gm_tau, sine);
+    let allowed = allowed_with(&ieee, gm_tau.len() + usize::from(sine.is_some()));
     let solution = estimate::solve_joint(
         estimate::Problem {
             data,
@@ -225,6 +345,7 @@ pub fn candidate(
     let bic = solution.loss + parameters(&solution.theta) as f64 * data.n_eff().max(2.0).ln();
     Ok(Candidate {
         gm_tau,
+        sine,
         ieee,
         solution,
         bic,
@@ -241,9 +362,15 @@ pub fn fit_structure(
     d2: f64,
     seed: &[f64],
 ) -> CoreResult<Candidate> {
-    let searcher = Searcher { data, fs, ieee, d2 };
+    let searcher = Searcher {
+        data,
+        fs,
+        ieee,
+        d2,
+        sine: None,
+    };
     let times = searcher.times(gm, seed);
-    let first = candidate(data, fs, ieee, times, d2)?;
+    let first = candidate(data, fs, ieee, times, None, d2)?;
     let settled = first.solution.d2;
     if gm == 0 || (settled <= 2.0 * d2 && settled >= 0.5 * d2) {
         return Ok(first);
@@ -254,12 +381,70 @@ pub fn fit_structure(
         ..searcher
     };
     let times = again.times(gm, seed);
-    let second = candidate(data, fs, ieee, times, first.solution.d2)?;
+    let second = candidate(data, fs, ieee, times, None, first.solution.d2)?;
     Ok(if second.solution.loss < first.solution.loss {
         second
     } else {
         first
     })
+}
+
+/// Add a tone to the Gauss–Markov times `gm_tau`: its frequency searched, then
+/// the times refined around theirs with the tone in place, the frequency once
+/// more; refined again at the discrepancy the toned fit settles on when that
+/// moved by more than a factor of two. None when the curve is too short for a
+/// tone or, when `gated` (model selection), the grid finds no use for one.
+pub fn with_sine(
+    data: &Data,
+    fs: f64,
+    ieee: [bool; IEEE_TERMS],
+    gm_tau: &[f64],
+    d2: f64,
+    gated: bool,
+) -> CoreResult<Option<Candidate>> {
+    let step = 10f64.powf(1.0 / PER_DECADE);
+    // Times and frequency polished at δ² from a start frequency.
+    let polish = |d2: f64, mut times: Vec<f64>, f: f64| -> CoreResult<Candidate> {
+        let mut searcher = Searcher {
+            data,
+            fs,
+            ieee,
+            d2,
+            sine: Some(f),
+        };
+        searcher.polish(&mut times, step);
+        searcher.sine = None;
+        let f = searcher.refine_frequency(&times, f);
+        candidate(data, fs, ieee, times, Some(f), d2)
+    };
+    let searcher = Searcher {
+        data,
+        fs,
+        ieee,
+        d2,
+        sine: None,
+    };
+    let Some((f, toned)) = searcher.coarse_frequency(gm_tau) else {
+        return Ok(None);
+    };
+    // A tone the grid finds no use for is not refined: where the grid's best
+    // tone (within a quarter radian of any real one up to 6/f₀) gains less
+    // than a quarter of the 2 ln n_eff that BIC asks of it, the refinement,
+    // which moves the frequency by at most a grid step, does not make it up.
+    if gated && toned > searcher.loss(gm_tau) - 0.5 * data.n_eff().max(2.0).ln() {
+        return Ok(None);
+    }
+    let first = polish(d2, gm_tau.to_vec(), f)?;
+    let settled = first.solution.d2;
+    if settled <= 2.0 * d2 && settled >= 0.5 * d2 {
+        return Ok(Some(first));
+    }
+    let second = polish(settled, first.gm_tau.clone(), first.sine.unwrap_or(f))?;
+    Ok(Some(if second.solution.loss < first.solution.loss {
+        second
+    } else {
+        first
+    }))
 }
 
 /// Backward elimination of IEEE terms while the BIC decreases.
@@ -272,7 +457,14 @@ fn eliminate(data: &Data, fs: f64, mut best: Candidate) -> CoreResult<Candidate>
         for j in active {
             let mut ieee = best.ieee;
             ieee[j] = false;
-            let trial = candidate(data, fs, ieee, best.gm_tau.clone(), best.solution.d2)?;
+            let trial = candidate(
+                data,
+                fs,
+                ieee,
+                best.gm_tau.clone(),
+                best.sine,
+                best.solution.d2,
+            )?;
             let bar = improved.as_ref().map_or(best.bic, |c| c.bic);
             if trial.bic < bar {
                 improved = Some(trial);
@@ -286,22 +478,42 @@ fn eliminate(data: &Data, fs: f64, mut best: Candidate) -> CoreResult<Candidate>
 }
 
 /// Automatic selection over 0..=`max_gm` Gauss–Markov terms and the IEEE terms
-/// in `ieee`.
+/// in `ieee`, each also with a tone when `sine`.
 pub fn select(
     data: &Data,
     fs: f64,
     ieee: [bool; IEEE_TERMS],
     max_gm: usize,
+    sine: bool,
 ) -> CoreResult<Candidate> {
     let base = fit_structure(data, fs, ieee, 0, 0.0, &[])?;
     let mut best = eliminate(data, fs, base.clone())?;
+    let mut times = vec![Vec::new()];
     let mut seed: Vec<f64> = Vec::new();
     for gm in 1..=max_gm {
         let full = fit_structure(data, fs, ieee, gm, base.solution.d2, &seed)?;
         seed = full.gm_tau.clone();
+        times.push(seed.clone());
         let reduced = eliminate(data, fs, full)?;
         if reduced.bic < best.bic {
             best = reduced;
+        }
+    }
+    if sine {
+        // The tone on its own, and with the times of the best structure
+        // without one (refined around them): two searches, not one per count.
+        let best_times = best.gm_tau.clone();
+        times.retain(|t| t.is_empty() || *t == best_times);
+        if !best_times.is_empty() && !times.contains(&best_times) {
+            times.push(best_times);
+        }
+        for gm_tau in &times {
+            if let Some(toned) = with_sine(data, fs, ieee, gm_tau, base.solution.d2, true)? {
+                let reduced = eliminate(data, fs, toned)?;
+                if reduced.bic < best.bic {
+                    best = reduced;
+                }
+            }
         }
     }
     Ok(best)

@@ -118,11 +118,16 @@ def test_goodness_of_fit_warns_only_when_the_model_misses():
         warnings.simplefilter("error", RuntimeWarning)
         model = imunoise.fit(imunoise.adev(good, FS, taus=10))
     assert float(model.coverage) > 0.95
-    # A strong 0.05 Hz tone: the Allan deviation has nulls at τ = k·20 s that
-    # no noise term can follow.
-    tone = good + 3.0 * np.sin(2 * np.pi * 0.05 * t)
+    # A 0.05 Hz tone (nulls at τ = k·20 s) is the model's sine term ...
+    tone = good + np.sin(2 * np.pi * 0.05 * t)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        followed = imunoise.fit(imunoise.adev(tone, FS, taus=20))
+    assert float(followed.coverage) > 0.95
+    # ... two are not: the model has one tone and no term follows the other's nulls.
+    two = good + 3.0 * np.sin(2 * np.pi * 0.05 * t) + 2.0 * np.sin(2 * np.pi * 0.37 * t)
     with pytest.warns(RuntimeWarning, match="follows the Allan deviation of channel 0"):
-        missed = imunoise.fit(imunoise.adev(tone, FS, taus=20))
+        missed = imunoise.fit(imunoise.adev(two, FS, taus=20))
     assert float(missed.coverage) < 0.8
     assert float(missed.discrepancy) > 0.1
 

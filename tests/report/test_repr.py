@@ -107,7 +107,7 @@ def test_reprs_say_what_matters(objects):
     assert model.startswith("NoiseModel(wls fit of adev at 40 Hz, 3 channels;")
     assert "X: " in model and "Z: " in model and "covers" in model and "GM" in model
     assert "more)" in repr(objects["6-channel model"])  # the axes beyond the budget
-    assert "terms Q N GM1" in repr(objects["prediction"])
+    assert "terms Q N B GM1 sine" in repr(objects["prediction"])  # X/Y carry an 18.6 Hz tone
     assert "gyro X Y Z, accel X Y Z, mag X Y Z" in repr(objects["description"])
     assert "bins" in repr(objects["distribution"])
     # values with an uncertainty are rounded to it (GUM), not printed to fixed digits

@@ -10,7 +10,10 @@ IEEE_TERM_NAMES: list[str]
 MAX_GAUSS_MARKOV: int
 """Most first-order Gauss–Markov terms a model may have."""
 PARAMETERS: int
-"""Slots of the covariance: Q²…R², then (q², ln τc) per Gauss–Markov term."""
+"""Slots of the covariance: Q²…R², then (q², ln τc) per Gauss–Markov term, then
+(s², ln f₀) of the tone."""
+SINE_SLOT: int
+"""Slot of the tone's variance s² (its ln f₀ follows)."""
 FLICKER_FACTOR: float
 """(2 ln 2)/π: the Allan variance of flicker rate noise per unit B²."""
 
@@ -24,6 +27,9 @@ class NoiseFit:
     @property
     def gm(self) -> npt.NDArray[np.float64]:
         """(k, 2) rows of (q², τc), one per Gauss–Markov term."""
+    @property
+    def sine(self) -> npt.NDArray[np.float64]:
+        """(k, 2) rows of (s², f₀), k ≤ 1: the tone."""
     @property
     def cov(self) -> npt.NDArray[np.float64]:
         """(PARAMETERS, PARAMETERS) covariance of (Q²…R², then q², ln τc per slot)."""
@@ -51,12 +57,18 @@ def fit_noise(
     terms: list[bool],
     gm: int = 3,
     select: bool = True,
+    sine: bool = True,
 ) -> NoiseFit:
-    """Log-space, octave-weighted fit of the noise model (IEEE terms and up to
-    ``gm`` Gauss–Markov terms) to one channel; structure chosen by BIC when
-    ``select``."""
+    """Log-space, octave-weighted fit of the noise model (IEEE terms, up to
+    ``gm`` Gauss–Markov terms and, with ``sine``, a tone) to one channel;
+    structure chosen by BIC when ``select``."""
 
 def noise_terms(
-    taus: npt.NDArray[np.float64], fs: float, ieee: list[float], gm: list[tuple[float, float]]
+    taus: npt.NDArray[np.float64],
+    fs: float,
+    ieee: list[float],
+    gm: list[tuple[float, float]],
+    sine: list[tuple[float, float]] = ...,
 ) -> npt.NDArray[np.float64]:
-    """Allan variance of each model term at ``taus``: (len(taus), 5 + len(gm))."""
+    """Allan variance of each model term at ``taus``: (len(taus), 5 + len(gm) +
+    len(sine)), ``sine`` as (s², f₀) pairs."""

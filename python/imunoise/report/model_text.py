@@ -62,6 +62,13 @@ def model_sentences(model: NoiseModel, sensor: str) -> list[str]:
                                              sensor=sensor)
             parts.append(f"Gauss–Markov bias σ = {format_number(value, value_std)} "
                          f"{b_unit.label}, τc = {format_number(tau_c, tau_std)} s")
+        for amplitude, f0 in model.sine(c):
+            amp_std = float(np.atleast_1d(model.sine_amplitude_std)[c])
+            f0_std = float(np.atleast_1d(model.sine_freq_std)[c])
+            value, value_std = units.convert(np.array([amplitude, amp_std]), "B", b_unit.name,
+                                             sensor=sensor)
+            parts.append(f"a tone of amplitude {format_number(value, value_std)} "
+                         f"{b_unit.label} at {format_number(f0, f0_std)} Hz")
         for term, unit in (("N", n_unit), ("B", b_unit)):
             parts += _readoff_agreement(model, c, term, unit, sensor)
         out.append("; ".join(parts) + ".")
