@@ -227,7 +227,8 @@ def allan_deviation(ctx: Context, doc: Doc) -> None:
 def noise_coefficients(ctx: Context, doc: Doc) -> None:
     """The fitted noise model per sensor: datasheet table and one sentence per axis."""
     doc.p("Fit of σ²(τ) = 3Q²/τ² + N²/τ + (2 ln2/π)B² + K²τ/3 + R²τ²/2 (IEEE Std 952) "
-          "plus up to three first-order Gauss–Markov bias terms, on ln σ², each octave of τ "
+          "plus up to three first-order Gauss–Markov bias terms and a tone (a sinusoid, "
+          "IEEE 952 Annex C), on ln σ², each octave of τ "
           "weighted alike, the terms chosen by BIC; standard uncertainties from the fit "
           "(docs/noise.md). Read-offs: N on the −½ line at τ = 1 s, B = σ_min/0.664.")
     for sensor, m in ctx.models.items():
@@ -414,7 +415,7 @@ def events_section(ctx: Context, doc: Doc) -> None:
             with_, without = stats.distribution(y[:, j]), stats.distribution(
                 z[:, j][np.isfinite(z[:, j])])
             kept.append(without)
-            rows.append([f"{sensor} {axis}", *(format_number(v) for v in (
+            rows.append([f"{sensor} {axis}", *(numbers.cell(v) for v in (
                 np.nanstd(y[:, j], ddof=1), np.nanstd(z[:, j], ddof=1), with_.excess_kurtosis,
                 without.excess_kurtosis, with_.ks_statistic, without.ks_statistic))])
         fig = plot.histograms(kept, title=f"{sensor} without events (short log)",
@@ -434,15 +435,16 @@ def warmup_section(ctx: Context, doc: Doc) -> None:
     w = ctx.warmup
     doc.p(f"Bias of the {'only' if ctx.one_log else 'long'} log over time "
           f"({format_duration(w.block)} means), fitted with b∞ + A·exp(−t/τ) per channel; "
-          f"a transient counts when it beats a constant bias (F-test, p < {w.alpha:g}, "
-          "corrected for correlated means) and has settled when what is left of it is below "
+          f"a transient counts when it explains the means better than the sensor's own "
+          f"stationary noise does (parametric bootstrap of its noise model, p < {w.alpha:g}) "
+          "and has settled when what is left of it is below "
           "the channel's Allan-deviation floor (docs/events.md).")
     doc.table(
         ["channel", "A", "τ", "p", "tolerance", "settled after"],
         [[r["name"],
           format_number(r["amplitude"], r["amplitude_std"]) if r["significant"] else "—",
           format_duration(r["tau"]) if r["significant"] else "—", f"{r['p_value']:.2g}",
-          format_number(r["tolerance"]),
+          numbers.cell(r["tolerance"]),
           format_duration(r["settle_time"]) if r["significant"] else
           "slow drift (τ > half the log)" if r["p_value"] < w.alpha else "no transient"]
          for r in w.rows()],
@@ -463,8 +465,10 @@ def warmup_section(ctx: Context, doc: Doc) -> None:
         verdict = ("The transient has not settled by the end of the log: `--trim auto` does "
                    "not cut it, and the long-tau analysis includes it.")
     doc.p(verdict)
-    doc.p(ctx.trim_note or ("The analysis uses the whole log (`--trim auto` would start it "
-                            "at the settle point)." if w.settle > 0 else ""))
+    note = ctx.trim_note or ("The analysis uses the whole log (`--trim auto` would start it "
+                             "at the settle point)." if 0 < w.settle_index < w.n_samples else "")
+    if note:
+        doc.p(note)
     ctx.add_figure(doc, plot.warmup(w), "warmup",
                    "Bias over time (block means), fitted transient, settle point (dotted; "
                    "before it shaded)")
