@@ -27,3 +27,12 @@ def positive_finite(value, name: str, *, unit: str | None = None) -> float:
 def sample_rate(fs, name: str = "fs") -> float:
     """A sample rate in Hz as a float: a real number, positive and finite."""
     return positive_finite(fs, name, unit="Hz")
+
+
+def integer(value, name: str, minimum: int) -> int:
+    """``value`` as an int of at least ``minimum`` (bools are not integers here)."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
+        raise TypeError(f"{name} must be an integer; got {value!r}")
+    if value < minimum:
+        raise ValueError(f"{name} must be >= {minimum}; got {value!r}")
+    return int(value)

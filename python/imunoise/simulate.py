@@ -40,14 +40,13 @@ IEEE Std 952-1997, Annex C.
 from __future__ import annotations
 
 import math
-import numbers
 from collections.abc import Sequence
 
 import numpy as np
 from scipy import fft as _fft
 
 from imunoise._deprecation import old_call_forms
-from imunoise._validate import sample_rate
+from imunoise._validate import integer, sample_rate
 
 __all__ = ["simulate", "flicker"]
 
@@ -63,14 +62,6 @@ def _check_coef(name: str, value) -> float:
     if not (math.isfinite(v) and v >= 0.0):
         raise ValueError(f"{name} must be finite and >= 0; got {value!r}")
     return v
-
-
-def _check_int(name: str, value, minimum: int) -> int:
-    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
-        raise TypeError(f"{name} must be an integer; got {value!r}")
-    if value < minimum:
-        raise ValueError(f"{name} must be >= {minimum}; got {value!r}")
-    return int(value)
 
 
 def _kw_filter(length: int, alpha: float = 1.0) -> np.ndarray:
@@ -156,8 +147,8 @@ def simulate(n_samples: int, fs: float, Q: float = 0.0, N: float = 0.0, B: float
     >>> y.shape
     (100000,)
     """
-    n = _check_int("n_samples", n_samples, 1)
-    channels = _check_int("channels", channels, 1)
+    n = integer(n_samples, "n_samples", 1)
+    channels = integer(channels, "channels", 1)
     fs = sample_rate(fs)
     Q, N, B, K, R = (_check_coef(k, v) for k, v in zip("QNBKR", (Q, N, B, K, R), strict=True))
     markov = _check_gm(gm)

@@ -70,7 +70,7 @@ from scipy import signal as _signal
 from scipy import stats as _stats
 
 from imunoise import _schema, _summary
-from imunoise._validate import positive_finite, sample_rate
+from imunoise._validate import integer, positive_finite, sample_rate
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -233,7 +233,7 @@ class Spectrum:
     def smooth(self, bins_per_decade: int = 10) -> Spectrum:
         """The spectrum averaged in logarithmic frequency bins (for plotting): each
         bin's mean density, with the EDF that averaging gains; N is unchanged."""
-        bins = _check_int("bins_per_decade", bins_per_decade, 1)
+        bins = integer(bins_per_decade, "bins_per_decade", 1)
         if self.bins_per_decade:
             raise ValueError("this spectrum is already log-binned; smooth the original")
         f, p, edf = _log_bins(self.f, _columns(self.psd), self.edf, bins,
@@ -336,7 +336,7 @@ def psd(
     fs = sample_rate(fs)
     confidence = _check_confidence(confidence)
     n = data.shape[0]
-    seg = _default_nperseg(n) if nperseg is None else _check_int("nperseg", nperseg, 16)
+    seg = _default_nperseg(n) if nperseg is None else integer(nperseg, "nperseg", 16)
     if seg > n:
         raise ValueError(f"nperseg must be <= the number of samples ({n}); got {seg}")
     user_band = None if band is None else _check_band(band, fs)
@@ -567,14 +567,6 @@ def _samples(x) -> tuple[np.ndarray, bool]:
             "pass the longest gap-free run)"
         )
     return (data[:, None], True) if data.ndim == 1 else (data, False)
-
-
-def _check_int(name: str, value, minimum: int) -> int:
-    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
-        raise TypeError(f"{name} must be an integer; got {value!r}")
-    if value < minimum:
-        raise ValueError(f"{name} must be >= {minimum}; got {value!r}")
-    return int(value)
 
 
 def _check_confidence(confidence) -> float:
