@@ -11,7 +11,8 @@
    oscillation plus broadband shaking, RMS at onset 2-6 x the record's quiet RMS
    (rates per amplitude band).
 3. Settle time on simulated 2 h logs at 40 Hz with an exponential transient,
-   tau 5-30 min, against the truth tau ln(A/tolerance) (target: within 20 %).
+   tau 5-30 min, against the truth tau ln(A/tolerance) (target: within 20 %);
+   and how often a warm-up is called on still logs without one (rate random walk).
 4. Thermal slope on simulated bias-vs-temperature data (target: within 5 %).
 Plus the time of imunoise.events against a Hampel filter with
 scipy.ndimage.median_filter (the usual peer), same run, as a ratio.
@@ -128,6 +129,21 @@ def settle(rng) -> None:
               f"max {100 * errs.max():.1f} % (10 logs)")
 
 
+def false_warmups(logs: int = 10) -> None:
+    """Stationary noise with rate random walk and flicker: how often a warm-up is called."""
+    from imunoise.simulate_log import still_log
+
+    print(f"3b. false warm-ups: {logs} simulated still VN-100 logs (5 h, 40 Hz, datasheet N, B, "
+          "K; no transient), 6 channels each")
+    called, p_small = 0, 0
+    for seed in range(logs):
+        w = imunoise.warmup(still_log(5.0, 40.0, seed=1000 + seed))
+        called += int(w.significant.sum())
+        p_small += int(np.sum(w.p_value < 0.01))
+    print(f"   transients called: {called} of {6 * logs} channels; p < 0.01: {p_small} "
+          f"(about {0.06 * logs:.1f} expected)")
+
+
 def thermal_fit(rng) -> None:
     print("4. thermal slope, 2 h at 10 Hz warming 30->40 °C, slope 2e-5 rad/s/°C")
     fs, n = 10.0, 72_000
@@ -165,6 +181,7 @@ def main() -> None:
         false_alarms(args.white, rng)
     detection(args.data, args.bursts, rng)
     settle(rng)
+    false_warmups()
     thermal_fit(rng)
     timing(rng)
 
