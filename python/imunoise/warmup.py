@@ -57,7 +57,7 @@ from scipy import optimize as _opt
 from imunoise import _summary
 from imunoise._channels import rate_channels
 from imunoise.allan import adev
-from imunoise.noise import fit
+from imunoise.noise import fit, model_variance
 from imunoise.readers.log import ImuLog
 from imunoise.simulate import simulate
 
@@ -356,18 +356,50 @@ def _null_p_values(x, fs, t, bias, duration, seed) -> np.ndarray:
     taus = taus[taus < duration / 2]  # as the significance rule: longer is drift
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # a poorly followed curve still bounds the wander
-        model = fit(adev(x[len(x) // 2:, ok], fs), warn_coverage=False)
+        half = adev(x[len(x) // 2:, ok], fs)
+        model = fit(half, warn_coverage=False)
+    k_floor = _random_walk_bound(half, model)
     rng = np.random.default_rng(seed)
     block_rate = 1.0 / (t[1] - t[0])
     for c, j in enumerate(np.flatnonzero(ok)):
         kept = np.isfinite(bias[:, j])  # blocks a gap emptied are left out of both
         observed = _explained(t[kept], bias[kept, j:j + 1], taus)[0]
-        coef = {term: float(np.ravel(model.value(term))[c]) for term in ("N", "B", "K", "R")}
+        coef = {term: _upper(model, term, c) for term in ("N", "B", "K", "R")}
+        coef["K"] = max(coef["K"], float(k_floor[c]))
         null = simulate(len(t), block_rate, channels=NULL_RECORDS, seed=rng,
                         gm=model.gauss_markov(c), **coef)
         p[j] = (1 + np.count_nonzero(_explained(t[kept], null[kept], taus) >= observed)) / (
             NULL_RECORDS + 1)
     return p
+
+
+def _random_walk_bound(result, model, min_edf: float = 5.0) -> np.ndarray:
+    """Per channel, the rate random walk K the half log cannot exclude: the one whose
+    K²τ/3 makes up what the model's other terms leave of the measured Allan variance
+    at the longest τ with at least ``min_edf`` degrees of freedom. A 2.5 h half of a
+    VN-100 log does not resolve its K (2e-6 rad/s/√s), and a null without it calls
+    its wander a transient."""
+    edf = np.reshape(result.edf, (len(result.taus), -1))
+    dev = np.reshape(result.dev, edf.shape)
+    out = np.zeros(edf.shape[1])
+    for c in range(edf.shape[1]):
+        usable = np.flatnonzero((edf[:, c] >= min_edf) & np.isfinite(dev[:, c]))
+        if usable.size:
+            i = usable[-1]
+            tau = result.taus[i : i + 1]
+            others = {t: float(np.ravel(model.value(t))[c]) for t in ("Q", "N", "B", "R")}
+            rest = dev[i, c] ** 2 - float(model_variance(tau, **others)[0])
+            out[c] = np.sqrt(3.0 / tau[0] * max(rest, 0.0))
+    return out
+
+
+def _upper(model, term: str, c: int) -> float:
+    """A coefficient of the null model at its value + 2 standard uncertainties: half a
+    log estimates the wander loosely, and a null that is too quiet calls wander a
+    transient."""
+    value = float(np.ravel(model.value(term))[c])
+    std = float(np.ravel(model.std(term))[c])
+    return value + 2 * std if value > 0 and np.isfinite(std) else value
 
 
 def _transient(amp, tau, n, fs) -> np.ndarray:
