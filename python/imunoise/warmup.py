@@ -324,18 +324,30 @@ def _tau_grid(t: np.ndarray, duration: float) -> np.ndarray:
     return np.geomspace(t[1] - t[0], 2 * duration, TAU_GRID)
 
 
+def _grid_fits(t: np.ndarray, y: np.ndarray, taus: np.ndarray) -> tuple[np.ndarray, ...]:
+    """Least-squares c + A e^{-t/τ} of each column of ``y`` (m, r) at every τ of
+    ``taus``: the projection on the centred exponential. Returns the variance each
+    explains (len(taus), r), A (len(taus), r) and the exponentials' means (len(taus),)."""
+    yc = y - y.mean(axis=0)
+    explained = np.zeros((len(taus), y.shape[1]))
+    amplitude = np.zeros_like(explained)
+    means = np.zeros(len(taus))
+    for i, tau in enumerate(taus):
+        e = np.exp(-t / tau)
+        means[i] = e.mean()
+        e = e - means[i]
+        norm = float(e @ e)
+        if norm > 0:
+            dot = e @ yc
+            explained[i], amplitude[i] = dot**2 / norm, dot / norm
+    return explained, amplitude, means
+
+
 def _explained(t: np.ndarray, y: np.ndarray, taus: np.ndarray) -> np.ndarray:
     """Share of the variance of each column of ``y`` (m, r) that the best
     c + A e^{-t/τ} over ``taus`` explains, (r,)."""
-    yc = y - y.mean(axis=0)
-    total = np.sum(yc**2, axis=0)
-    best = np.zeros(y.shape[1])
-    for tau in taus:
-        e = np.exp(-t / tau)
-        e = e - e.mean()
-        norm = float(e @ e)
-        if norm > 0:  # projection on the centred exponential: what it explains
-            best = np.maximum(best, (e @ yc) ** 2 / norm)
+    total = np.sum((y - y.mean(axis=0)) ** 2, axis=0)
+    best = _grid_fits(t, y, taus)[0].max(axis=0)
     with np.errstate(divide="ignore", invalid="ignore"):
         return np.where(total > 0, best / total, 0.0)
 
@@ -416,14 +428,11 @@ def _fit_exponential(t, y, duration):
     nan = (float(np.nanmean(y)) if y.size else np.nan, 0.0, np.inf, np.nan, np.nan)
     if y.size < MIN_BLOCKS or np.ptp(y) == 0:
         return nan
-    best = None
-    for tau in _tau_grid(t, duration):
-        design = np.column_stack([np.ones_like(t), np.exp(-t / tau)])
-        coef, *_ = np.linalg.lstsq(design, y, rcond=None)
-        rss = float(np.sum((y - design @ coef) ** 2))
-        if best is None or rss < best[0]:
-            best = (rss, coef[0], coef[1], tau)
-    _rss, c, a, tau = best
+    taus = _tau_grid(t, duration)
+    explained, amplitude, means = _grid_fits(t, y[:, None], taus)
+    i = int(np.argmax(explained[:, 0]))  # the least residual sum of squares
+    tau, a = taus[i], float(amplitude[i, 0])
+    c = float(y.mean()) - a * means[i]
     try:
         with warnings.catch_warnings(), np.errstate(over="ignore", invalid="ignore"):
             warnings.simplefilter("ignore", _opt.OptimizeWarning)  # trial τ may go negative
