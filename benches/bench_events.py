@@ -175,15 +175,22 @@ def main() -> None:
     parser.add_argument("--white", type=int, default=20_000_000)
     parser.add_argument("--bursts", type=int, default=200)
     parser.add_argument("--data", type=Path, default=DATA)
+    parser.add_argument("--only", default="12345",
+                        help="sections to run, e.g. 2 or 3b (default: all)")
     args = parser.parse_args()
     rng = np.random.default_rng(13)
-    if args.white:
+    if args.white and "1" in args.only:
         false_alarms(args.white, rng)
-    detection(args.data, args.bursts, rng)
-    settle(rng)
-    false_warmups()
-    thermal_fit(rng)
-    timing(rng)
+    if "2" in args.only:
+        detection(args.data, args.bursts, rng)
+    if "3" in args.only and "3b" not in args.only:
+        settle(rng)
+    if "3" in args.only:
+        false_warmups()
+    if "4" in args.only:
+        thermal_fit(rng)
+    if "5" in args.only:
+        timing(rng)
 
 
 if __name__ == "__main__":

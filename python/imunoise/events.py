@@ -48,7 +48,7 @@ from imunoise._channels import rate_channels
 from imunoise._validate import positive_finite
 from imunoise.readers.log import ImuLog
 
-__all__ = ["Events", "events", "FALSE_ALARM", "OVERLAP_FACTOR"]
+__all__ = ["Events", "events", "FALSE_ALARM", "OVERLAP_FACTOR", "CHANGE_POINT_DOF"]
 
 #: Default design rate of false events per sample and channel.
 FALSE_ALARM = 1e-7
@@ -56,6 +56,9 @@ FALSE_ALARM = 1e-7
 #: white noise, relative to ``n/w·p_w`` (measured: about 2.5–3.5 for w = 10–400;
 #: 4 keeps the design rate an upper bound).
 OVERLAP_FACTOR = 4.0
+#: Degrees of freedom of the Student-t likelihood that places a burst's edges
+#: (bounded influence of single samples; measured on the MTi-G record, docs/events.md).
+CHANGE_POINT_DOF = 10.0
 #: Smallest energy window, samples (fewer makes the χ² test a spike test).
 MIN_WINDOW = 4
 
@@ -300,7 +303,7 @@ def events(
         # the burst test sees z clipped at the spike threshold: one spike, however
         # large, is a spike, not a burst
         spans = _spikes(z, k_spike) + _bursts(np.clip(z, -k_spike, k_spike), w, p_window, dof)
-        per_channel.append((_join(spans, gap), z))
+        per_channel.append((_join([(a, b, kind, {j}) for a, b, kind in spans], gap), z))
     return _merge_channels(
         per_channel, names, fs, n, gap, sigma,
         k_spike=k_spike,
@@ -406,15 +409,22 @@ def _energy_law(z: np.ndarray, w: int) -> tuple[float, float]:
 
 def _change_points(seg: np.ndarray) -> tuple[int, int]:
     """The segment of ``seg`` (squared standardised samples) whose variance v > 1
-    maximises the log-likelihood ratio Σ z²(1 − 1/v) − ln v. v is first the mean
+    maximises the log-likelihood ratio Σ ℓ_i of v against 1. v is first the mean
     over all of ``seg`` (diluted by the noise around the burst), then the mean
     over the segment found; a second pass that loses the first segment (a
-    decaying burst's variance is not one number) keeps the first."""
+    decaying burst's variance is not one number) keeps the first.
+
+    ℓ_i is the Student-t (ν = :data:`CHANGE_POINT_DOF`) log-likelihood ratio of a
+    scale change, not the Gaussian z²(1 − 1/v) − ln v: one large sample adds at most
+    (ν/2)·ln v, so a few heavy-tailed samples before a burst cannot pull its start
+    forward (real gyro noise is heavy-tailed; see docs/events.md)."""
+    nu = CHANGE_POINT_DOF
     start, end = 0, len(seg)
     found = (0, 0)
     for _ in range(2):
         v = max(float(seg[start:end].mean()), 1.0 + 1e-9)
-        s = np.concatenate(([0.0], np.cumsum(seg * (1 - 1 / v) - np.log(v))))
+        ell = -0.5 * np.log(v) - (nu + 1) / 2 * (np.log1p(seg / (nu * v)) - np.log1p(seg / nu))
+        s = np.concatenate(([0.0], np.cumsum(ell)))
         new_end = int(np.argmax(s))
         new_start = int(np.argmin(s[: new_end + 1]))
         if new_end <= new_start or (found[1] and (new_end <= found[0] or new_start >= found[1])):
@@ -435,35 +445,37 @@ def _runs(flags: np.ndarray) -> list[tuple[int, int]]:
                     strict=True))
 
 
-def _join(spans: list[tuple[int, int, str]], gap: int) -> list[tuple[int, int, str]]:
-    """Spans sorted and joined when closer than ``gap`` samples; a join with a burst
-    is a burst."""
-    out: list[list] = []
-    for a, b, kind in sorted(spans):
-        if out and a - out[-1][1] <= gap:
-            last = out[-1]
-            last[1] = max(last[1], b)
-            if kind == "burst":
-                last[2] = "burst"
+def _join(spans: list[tuple], gap: int) -> list[list]:
+    """Spans ``(start, stop, kind, channels)`` joined into ``[start, stop, kind, channels]``.
+
+    Spans of one kind closer than ``gap`` samples are joined; a spike joins a burst
+    only where it overlaps it: an isolated outlier next to a burst stays a spike of
+    its own, so it neither becomes the burst's start nor swallows the burst."""
+    groups: dict[str, list[list]] = {"spike": [], "burst": []}
+    for a, b, kind, chans in sorted(spans, key=lambda span: span[:3]):
+        same = groups[kind]
+        if same and a - same[-1][1] <= gap:
+            same[-1][1] = max(same[-1][1], b)
+            same[-1][3] |= set(chans)
         else:
-            out.append([a, b, kind])
-    return [tuple(s) for s in out]
+            same.append([a, b, kind, set(chans)])
+    bursts = groups["burst"]
+    out = list(bursts)
+    starts = np.array([g[0] for g in bursts], dtype=np.int64)
+    for g in groups["spike"]:
+        k = int(np.searchsorted(starts, g[1], side="left")) - 1  # last burst starting before
+        if k >= 0 and g[0] < bursts[k][1]:
+            bursts[k][0] = min(bursts[k][0], g[0])
+            bursts[k][1] = max(bursts[k][1], g[1])
+            bursts[k][3] |= g[3]
+        else:
+            out.append(g)
+    return sorted(out, key=lambda g: (g[0], g[1]))
 
 
 def _merge_channels(per_channel, names, fs, n, gap, sigma, **thresholds) -> Events:
     """One event per overlapping group of the channels' events."""
-    tagged = sorted(
-        (a, b, kind, j) for j, (spans, _z) in enumerate(per_channel) for a, b, kind in spans
-    )
-    groups: list[list] = []
-    for a, b, kind, j in tagged:
-        if groups and a - groups[-1][1] <= gap:
-            g = groups[-1]
-            g[1] = max(g[1], b)
-            g[2] = "burst" if kind == "burst" else g[2]
-            g[3].add(j)
-        else:
-            groups.append([a, b, kind, {j}])
+    groups = _join([span for spans, _z in per_channel for span in spans], gap)
     peaks = [
         max(_peak(per_channel[j][1][a:b]) for j in chans)
         for a, b, _k, chans in groups
