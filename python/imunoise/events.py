@@ -48,7 +48,8 @@ from imunoise._channels import rate_channels
 from imunoise._validate import positive_finite
 from imunoise.readers.log import ImuLog
 
-__all__ = ["Events", "events", "FALSE_ALARM", "OVERLAP_FACTOR", "CHANGE_POINT_DOF"]
+__all__ = ["Events", "events", "FALSE_ALARM", "OVERLAP_FACTOR", "CHANGE_POINT_DOF",
+           "BURST_SCALES"]
 
 #: Default design rate of false events per sample and channel.
 FALSE_ALARM = 1e-7
@@ -56,9 +57,12 @@ FALSE_ALARM = 1e-7
 #: white noise, relative to ``n/w·p_w`` (measured: about 2.5–3.5 for w = 10–400;
 #: 4 keeps the design rate an upper bound).
 OVERLAP_FACTOR = 4.0
-#: Degrees of freedom of the Student-t likelihood that places a burst's edges
-#: (bounded influence of single samples; measured on the MTi-G record, docs/events.md).
+#: Fewest degrees of freedom of the Student-t likelihood that places a burst's
+#: edges (bounded influence of single samples; measured on the MTi-G record,
+#: docs/events.md). A record with lighter tails gets more (Gaussian in the limit).
 CHANGE_POINT_DOF = 10.0
+#: Energy windows per channel: ``window``, ``window``/2, … (``BURST_SCALES`` of them).
+BURST_SCALES = 3
 #: Smallest energy window, samples (fewer makes the χ² test a spike test).
 MIN_WINDOW = 4
 
@@ -290,22 +294,41 @@ def events(
         raise ValueError(f"data needs at least 2·window = {2 * w} samples; got {n}")
     block = max(2 * w, int(round(baseline * fs)))
     k_spike = float(_sstats.norm.isf(false_alarm / 4))
-    p_window = min(0.5, false_alarm * w / (2 * OVERLAP_FACTOR))
+    # a short burst is diluted in a long window: the energy test runs at w, w/2, w/4
+    # (false-alarm budget split between them)
+    windows = sorted({max(MIN_WINDOW, w >> i) for i in range(BURST_SCALES)}, reverse=True)
+    p_window = min(0.5, false_alarm * w / (2 * OVERLAP_FACTOR * len(windows)))
+    touch = windows[-1] // 2
     gap = int(round(merge * fs))
 
     per_channel = []
     sigma = np.empty(x.shape[1])
     for j in range(x.shape[1]):
-        z, mad_sigma = _standardise(x[:, j], block)
-        scale, dof = _energy_law(z, w)
-        z /= np.sqrt(scale)
+        r, mad_sigma = _standardise(x[:, j], block)
+        # first pass with the noise law of the whole channel, then once more with
+        # the law of its quiet part: a record with vibration of its own (the VN-100
+        # live capture, 20 % of it) otherwise sets thresholds for quiet noise from
+        # its loud stretches (ν 10.5 instead of 19.9 there)
+        quiet = np.ones(n, dtype=bool)
+        for _ in range(2):
+            scale, rho = _energy_law(np.where(quiet, r, np.nan), w)
+            z = r / np.sqrt(scale)
+            spans = _spikes(z, k_spike)
+            p_v = [min(0.5, false_alarm * v / (2 * OVERLAP_FACTOR * len(windows)))
+                   for v in windows]
+            quiet_level = _sstats.chi2.isf(p_v[-1], _dof(rho, windows[-1])) / _dof(
+                rho, windows[-1])
+            isolated = _isolated(z, k_spike, touch, quiet_level)
+            tail_dof = _tail_dof(z[quiet])
+            for v, p in zip(windows, p_v, strict=True):
+                spans += _bursts(z, v, p, _dof(rho, v), k_spike, isolated, tail_dof)
+            if not spans:
+                break
+            quiet = ~_span_mask(spans, n, pad=w)
         sigma[j] = mad_sigma * np.sqrt(scale)
-        # the burst test sees z clipped at the spike threshold: one spike, however
-        # large, is a spike, not a burst
-        spans = _spikes(z, k_spike) + _bursts(np.clip(z, -k_spike, k_spike), w, p_window, dof)
-        per_channel.append((_join([(a, b, kind, {j}) for a, b, kind in spans], gap), z))
+        per_channel.append((_join([(a, b, kind, {j}) for a, b, kind in spans], gap, touch), z))
     return _merge_channels(
-        per_channel, names, fs, n, gap, sigma,
+        per_channel, names, fs, n, gap, windows[-1] // 2, sigma,
         k_spike=k_spike,
         energy=float(_sstats.chi2.isf(p_window, w)) / w,
         window=w,
@@ -336,6 +359,33 @@ def _standardise(col: np.ndarray, block: int) -> tuple[np.ndarray, float]:
     return r / sigma, sigma
 
 
+def _isolated(z: np.ndarray, k_spike: float, half: int, level: float) -> np.ndarray:
+    """Boolean (n,): samples above the spike threshold whose ``half`` neighbours on
+    each side are quiet (mean clipped z² below ``level``, the shortest energy
+    window's threshold): outliers, not the onset of a burst."""
+    n = len(z)
+    out = np.zeros(n, dtype=bool)
+    big = np.flatnonzero(np.abs(np.nan_to_num(z)) > k_spike)
+    if not big.size or half < 1:
+        return out
+    c = np.clip(np.nan_to_num(z), -k_spike, k_spike)
+    csum = np.concatenate(([0.0], np.cumsum(c * c)))
+    lo, hi = np.maximum(big - half, 0), np.minimum(big + 1 + half, n)
+    left = (csum[big] - csum[lo]) / np.maximum(big - lo, 1)
+    right = (csum[hi] - csum[big + 1]) / np.maximum(hi - big - 1, 1)
+    out[big] = np.maximum(left, right) < level
+    return out
+
+
+def _span_mask(spans: list[tuple[int, int, str]], n: int, *, pad: int) -> np.ndarray:
+    """Boolean (n,): within ``pad`` samples of one of ``spans``."""
+    mark = np.zeros(n + 1, dtype=np.int64)
+    for a, b, _kind in spans:
+        mark[max(0, a - pad)] += 1
+        mark[min(n, b + pad)] -= 1
+    return np.cumsum(mark[:-1]) > 0
+
+
 def _nanmedian(v: np.ndarray) -> float:
     v = v[np.isfinite(v)]
     return float(np.median(v)) if v.size else float("nan")
@@ -345,12 +395,19 @@ def _spikes(z: np.ndarray, k: float) -> list[tuple[int, int, str]]:
     return [(int(i), int(i) + 1, "spike") for i in np.flatnonzero(np.abs(z) > k)]
 
 
-def _bursts(z: np.ndarray, w: int, p_window: float, dof: float) -> list[tuple[int, int, str]]:
+def _bursts(z: np.ndarray, w: int, p_window: float, dof: float, k_spike: float,
+            isolated: np.ndarray, tail_dof: float) -> list[tuple[int, int, str]]:
     """Stretches where the sliding energy exceeds its threshold, cut to the
-    maximum-likelihood segment of raised variance."""
+    maximum-likelihood segment of raised variance.
+
+    The energy sees z clipped at the spike threshold (one spike, however large, is
+    a spike, not a burst); the change points do not see ``isolated`` samples (an
+    outlier just before a burst would otherwise become its start)."""
     n = len(z)
     valid = np.isfinite(z)
-    z2 = np.where(valid, z * z, 0.0)
+    clipped = np.clip(z, -k_spike, k_spike)
+    z2 = np.where(valid, clipped * clipped, 0.0)
+    onset = np.where(valid & ~isolated, z2, np.nan)
     csum = np.concatenate(([0.0], np.cumsum(z2)))
     count = np.concatenate(([0], np.cumsum(valid)))
     energy = csum[w:] - csum[:-w]  # window j covers samples j .. j+w-1
@@ -364,15 +421,16 @@ def _bursts(z: np.ndarray, w: int, p_window: float, dof: float) -> list[tuple[in
     out = []
     for a, b in _runs(hot):  # windows a .. b-1 flagged: samples a .. b+w-2 involved
         lo, hi = max(0, a - w // 2), min(n, b - 1 + w + w // 2)
-        start, end = _change_points(z2[lo:hi])
+        start, end = _change_points(onset[lo:hi], tail_dof)
         if end > start:
             out.append((lo + start, lo + end, "burst"))
     return out
 
 
-def _energy_law(z: np.ndarray, w: int) -> tuple[float, float]:
-    """Scale s and degrees of freedom ν of the window energy of a quiet record:
-    Σ_window z² ≈ s·(w/ν)·χ²(ν) (Satterthwaite).
+def _energy_law(z: np.ndarray, w: int) -> tuple[float, np.ndarray]:
+    """Scale s and autocorrelation ρ_0 … ρ_{w−1} of a quiet record, which set the
+    law of its window energy: Σ_window z² ≈ s·(w/ν)·χ²(ν) (Satterthwaite), ν from
+    :func:`_dof`.
 
     Real sensor noise is not white: correlated samples (a sensor's own filter,
     bias wander faster than the baseline) make the window energy vary more than
@@ -395,35 +453,54 @@ def _energy_law(z: np.ndarray, w: int) -> tuple[float, float]:
     pairs = np.fft.irfft(np.abs(np.fft.rfft(valid.astype(float), size)) ** 2, size)[:w]
     rho = acf / np.maximum(pairs, 1.0) / (acf[0] / max(pairs[0], 1.0)) if acf[0] > 0 \
         else np.zeros(w)
-    k = np.arange(1, w)
-    dof = w / (1 + 2 * np.sum((1 - k / w) * rho[1:] ** 2))
+    dof = _dof(rho, w)
     full = len(z) // w
     blocks = (z[: full * w] ** 2).reshape(full, w)
     complete = valid[: full * w].reshape(full, w).all(axis=1)
     if not complete.any():
-        return 1.0, float(dof)
+        return 1.0, rho
     median = float(np.median(blocks[complete].mean(axis=1)))
     expected = float(_sstats.chi2.median(dof)) / dof
-    return (median / expected if median > 0 else 1.0), float(dof)
+    return (median / expected if median > 0 else 1.0), rho
 
 
-def _change_points(seg: np.ndarray) -> tuple[int, int]:
-    """The segment of ``seg`` (squared standardised samples) whose variance v > 1
+def _dof(rho: np.ndarray, w: int) -> float:
+    """Satterthwaite degrees of freedom of the energy of ``w`` samples with
+    autocorrelation ``rho`` (ρ_0 … ρ_{w−1} at least)."""
+    k = np.arange(1, w)
+    return float(w / (1 + 2 * np.sum((1 - k / w) * rho[1:w] ** 2)))
+
+
+def _tail_dof(z: np.ndarray) -> float:
+    """Degrees of freedom ν of the Student-t with the excess kurtosis of ``z``
+    (6/(ν − 4)), at least :data:`CHANGE_POINT_DOF`: Gaussian-like noise keeps the
+    Gaussian likelihood's precision, heavy-tailed noise gets bounded influence."""
+    z = z[np.isfinite(z)]
+    if z.size < 8:
+        return CHANGE_POINT_DOF
+    excess = float(_sstats.kurtosis(z))
+    return 1e6 if excess <= 6 / (1e6 - 4) else max(CHANGE_POINT_DOF, 4 + 6 / excess)
+
+
+def _change_points(seg: np.ndarray, nu: float) -> tuple[int, int]:
+    """The segment of ``seg`` (squared standardised samples, NaN = no say) whose variance v > 1
     maximises the log-likelihood ratio Σ ℓ_i of v against 1. v is first the mean
     over all of ``seg`` (diluted by the noise around the burst), then the mean
     over the segment found; a second pass that loses the first segment (a
     decaying burst's variance is not one number) keeps the first.
 
-    ℓ_i is the Student-t (ν = :data:`CHANGE_POINT_DOF`) log-likelihood ratio of a
+    ℓ_i is the Student-t (ν from :func:`_tail_dof`) log-likelihood ratio of a
     scale change, not the Gaussian z²(1 − 1/v) − ln v: one large sample adds at most
     (ν/2)·ln v, so a few heavy-tailed samples before a burst cannot pull its start
     forward (real gyro noise is heavy-tailed; see docs/events.md)."""
-    nu = CHANGE_POINT_DOF
     start, end = 0, len(seg)
     found = (0, 0)
     for _ in range(2):
-        v = max(float(seg[start:end].mean()), 1.0 + 1e-9)
+        inside = seg[start:end]
+        inside = inside[np.isfinite(inside)]
+        v = max(float(inside.mean()) if inside.size else 1.0, 1.0 + 1e-9)
         ell = -0.5 * np.log(v) - (nu + 1) / 2 * (np.log1p(seg / (nu * v)) - np.log1p(seg / nu))
+        ell = np.where(np.isfinite(ell), ell, 0.0)  # spikes and missing samples: no say
         s = np.concatenate(([0.0], np.cumsum(ell)))
         new_end = int(np.argmax(s))
         new_start = int(np.argmin(s[: new_end + 1]))
@@ -445,37 +522,48 @@ def _runs(flags: np.ndarray) -> list[tuple[int, int]]:
                     strict=True))
 
 
-def _join(spans: list[tuple], gap: int) -> list[list]:
+def _join(spans: list[tuple], gap: int, touch: int) -> list[list]:
     """Spans ``(start, stop, kind, channels)`` joined into ``[start, stop, kind, channels]``.
 
     Spans of one kind closer than ``gap`` samples are joined; a spike joins a burst
-    only where it overlaps it: an isolated outlier next to a burst stays a spike of
-    its own, so it neither becomes the burst's start nor swallows the burst."""
-    groups: dict[str, list[list]] = {"spike": [], "burst": []}
-    for a, b, kind, chans in sorted(spans, key=lambda span: span[:3]):
-        same = groups[kind]
-        if same and a - same[-1][1] <= gap:
-            same[-1][1] = max(same[-1][1], b)
-            same[-1][3] |= set(chans)
-        else:
-            same.append([a, b, kind, set(chans)])
-    bursts = groups["burst"]
-    out = list(bursts)
+    only where it overlaps it or is within ``touch`` samples of it (half the shortest
+    energy window, which cannot tell them apart): an isolated outlier next to a
+    burst stays a spike of its own, so it neither becomes the burst's start nor
+    swallows the burst."""
+    ordered = sorted(spans, key=lambda span: span[:3])
+    bursts = _join_kind([sp for sp in ordered if sp[2] == "burst"], gap)
     starts = np.array([g[0] for g in bursts], dtype=np.int64)
-    for g in groups["spike"]:
-        k = int(np.searchsorted(starts, g[1], side="left")) - 1  # last burst starting before
-        if k >= 0 and g[0] < bursts[k][1]:
-            bursts[k][0] = min(bursts[k][0], g[0])
-            bursts[k][1] = max(bursts[k][1], g[1])
-            bursts[k][3] |= g[3]
+    alone = []
+    for a, b, kind, chans in ordered:
+        if kind != "spike":
+            continue
+        # the last burst starting before the spike's end (+ touch)
+        k = int(np.searchsorted(starts, b + touch, side="left")) - 1
+        if k >= 0 and a < bursts[k][1] + touch:
+            bursts[k][0] = min(bursts[k][0], a)
+            bursts[k][1] = max(bursts[k][1], b)
+            bursts[k][3] |= set(chans)
         else:
-            out.append(g)
+            alone.append((a, b, kind, chans))
+    out = bursts + _join_kind(alone, gap)
     return sorted(out, key=lambda g: (g[0], g[1]))
 
 
-def _merge_channels(per_channel, names, fs, n, gap, sigma, **thresholds) -> Events:
+def _join_kind(spans: list[tuple], gap: int) -> list[list]:
+    """Sorted spans of one kind joined where closer than ``gap`` samples."""
+    out: list[list] = []
+    for a, b, kind, chans in spans:
+        if out and a - out[-1][1] <= gap:
+            out[-1][1] = max(out[-1][1], b)
+            out[-1][3] |= set(chans)
+        else:
+            out.append([a, b, kind, set(chans)])
+    return out
+
+
+def _merge_channels(per_channel, names, fs, n, gap, touch, sigma, **thresholds) -> Events:
     """One event per overlapping group of the channels' events."""
-    groups = _join([span for spans, _z in per_channel for span in spans], gap)
+    groups = _join([span for spans, _z in per_channel for span in spans], gap, touch)
     peaks = [
         max(_peak(per_channel[j][1][a:b]) for j in chans)
         for a, b, _k, chans in groups
