@@ -118,3 +118,23 @@ def test_settle_point_never_passes_the_end_of_the_log():
     assert found.significant[0]
     assert found.settle == len(x) / FS and found.settle_index == len(x)
     assert len(found.trim(x)) == 0 and not found.settled
+
+
+@pytest.mark.parametrize("seed", [11, 12])
+def test_rate_ramp_after_trimming_is_the_truth(seed):
+    """A 4 h log with a rate ramp R and a 20 min transient, no rate random walk: the
+    transient reads as a K of 9σ before trimming (and R of 1–3× the truth); after it,
+    R is within 2 standard uncertainties of the truth."""
+    fs, hours, r_true = 10.0, 4.0, 1e-7
+    n = int(hours * 3600 * fs)
+    t = np.arange(n) / fs
+    x = imunoise.simulate(n, fs, N=2e-3, R=r_true, seed=seed) + 1e-2 * np.exp(-t / 1200)
+    found = imunoise.warmup(x, fs)
+    assert found.significant[0] and 0 < found.settle < 2 * 3600
+    terms = ["N", "K", "R"]
+    before = imunoise.fit(imunoise.adev(x, fs), terms=terms, warn_coverage=False)
+    after = imunoise.fit(imunoise.adev(found.trim(x), fs), terms=terms, warn_coverage=False)
+    assert float(before.value("K")[0]) > 5 * float(before.std("K")[0])  # spurious: K = 0
+    r_after, r_std = float(after.value("R")[0]), float(after.std("R")[0])
+    assert abs(r_after - r_true) <= 2 * r_std
+    assert abs(r_after - r_true) < abs(float(before.value("R")[0]) - r_true)
