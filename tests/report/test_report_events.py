@@ -109,3 +109,49 @@ def test_cli_trim_option(tmp_path, capsys):
     assert "nothing was cut" in (tmp_path / "r" / "report.md").read_text(encoding="utf-8")
     assert main(["report", str(VN_LOG), "--trim", "always"]) == 2
     assert "--trim" in capsys.readouterr().err
+
+
+def _section(md: str, title: str) -> str:
+    return md.split(f". {title}\n")[1].split("\n## ")[0]
+
+
+def test_long_log_events_with_and_without_in_the_allan_analysis(trimmed):
+    rep, _log, md = trimmed
+    titles = sections(md)
+    assert titles.index("Events and the Allan deviation") > titles.index("Allan deviation")
+    text = _section(md, "Events and the Allan deviation")
+    (analysed,) = rep.logs
+    found = imunoise.events(analysed)
+    assert f"holds {len(found)} event" in text
+    # the "without events" column is the gap-aware ADEV of the log with them left out
+    cut = found.exclude(analysed, pad=0.2)
+    row = re.search(r"\| gyro X \| 10(?:\.0)? s \| ([^|]+) \| ([^|]+) \|", text)
+    assert row, text
+    want = imunoise.adev(cut.gyro[:, 0], FS, taus=[10.0]).dev[0]
+    assert float(row.group(2)) == pytest.approx(want, rel=0.01)
+
+
+def test_events_that_change_the_allan_deviation_are_said_to(tmp_path):
+    rng = np.random.default_rng(9)
+    n = int(40 * 60 * FS)
+    gyro = 1e-3 * rng.standard_normal((n, 3))
+    for s in range(600, n - 100, 1200):  # a 5 s, 10σ shake every 2 minutes
+        gyro[s:s + 50, 1] += 1e-2 * rng.standard_normal(50)
+    accel = 0.01 * rng.standard_normal((n, 3))
+    long = imunoise.ImuLog.from_arrays(FS, gyro=gyro, accel=accel, source="<shaken>")
+    short = imunoise.ImuLog.from_arrays(FS, gyro=gyro[:3000], accel=accel[:3000],
+                                        source="<short>")
+    rep = report.build(short, long, out_dir=tmp_path, spec=None, progress=False)
+    text = _section(rep.markdown.read_text(encoding="utf-8"), "Events and the Allan deviation")
+    assert "The long log holds 2" in text and "(20 bursts" in text
+    assert "change the Allan deviation beyond its confidence interval" in text
+    assert re.search(r"gyro Y at 1(\.0)? s", text) and "gyro X at" not in text
+
+
+def test_no_events_no_allan_events_section(tmp_path):
+    rng = np.random.default_rng(4)
+    log = imunoise.ImuLog.from_arrays(FS, gyro=rng.standard_normal((6000, 3)),
+                                      accel=rng.standard_normal((6000, 3)))
+    rep = report.build(log, out_dir=tmp_path, spec=None, progress=False)
+    assert "Events and the Allan deviation" not in sections(
+        rep.markdown.read_text(encoding="utf-8"))

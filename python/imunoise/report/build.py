@@ -120,6 +120,16 @@ class Context:
         return events(self.short)
 
     @cached_property
+    def long_events(self) -> Events | None:
+        """Events of the long log's gyro and accel, as analysed (after any trim);
+        the short log's when there is one log. None without gyro and accel."""
+        if self.one_log:
+            return self.events
+        if not any(getattr(self.long, s) is not None for s in ALLAN_SENSORS):
+            return None
+        return events(self.long)
+
+    @cached_property
     def warmup(self) -> Warmup | None:
         """Warm-up of the whole long log (before any trim); None when it is shorter
         than ``sections.WARMUP_MIN_DURATION`` or has no gyro/accel."""
@@ -178,6 +188,8 @@ SECTIONS: tuple[Section, ...] = (
             applies=lambda ctx: ctx.thermal is not None),
     Section("Allan deviation", sections.allan_deviation),
     Section("Noise coefficients", sections.noise_coefficients),
+    Section("Events and the Allan deviation", sections.long_log_events,
+            applies=lambda ctx: ctx.long_events is not None and len(ctx.long_events) > 0),
     Section("Datasheet comparison", sections.datasheet_comparison),
     Section("Power spectral density", sections.power_spectral_density,
             applies=lambda ctx: any(getattr(ctx.short, s) is not None for s in ALLAN_SENSORS)),

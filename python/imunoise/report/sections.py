@@ -38,6 +38,7 @@ __all__ = [
     "distribution_fits",
     "dynamic_allan",
     "events_section",
+    "long_log_events",
     "noise_coefficients",
     "power_spectral_density",
     "recording_summary",
@@ -427,6 +428,72 @@ def events_section(ctx: Context, doc: Doc) -> None:
               caption="Statistics and normal fits with and without the events (short log)")
     doc.p("`imunoise.events(log).exclude(log)` makes the events missing samples; the "
           "Allan statistics then skip every term that touches one (docs/gaps.md).")
+
+
+#: Padding (s) around each event of the long log when it is left out of the Allan analysis.
+EVENT_PAD = 0.2
+
+
+def _decade_taus(result) -> np.ndarray:
+    """The report grid's taus nearest to each power of ten it spans, where the
+    Allan deviation has at least 5 degrees of freedom."""
+    edf = np.reshape(result.edf, (len(result.taus), -1)).min(axis=1)
+    usable = result.taus[edf >= 5]
+    if not usable.size:
+        return usable
+    decades = 10.0 ** np.arange(np.ceil(np.log10(usable[0])), np.floor(np.log10(usable[-1])) + 1)
+    picked = [usable[np.argmin(np.abs(np.log(usable / d)))] for d in decades]
+    return np.unique(picked) if picked else usable[[0, -1]]
+
+
+def long_log_events(ctx: Context, doc: Doc) -> None:
+    """Events of the long log and what they do to its Allan deviation: with and
+    without them (as missing samples) at a few taus; which result the noise model
+    used."""
+    found, log = ctx.long_events, ctx.long
+    cut = found.exclude(log, pad=EVENT_PAD)
+    kinds = (f"{found.kind.count('burst')} bursts, {found.kind.count('spike')} spikes")
+    doc.p(f"The {'only' if ctx.one_log else 'long'} log holds {len(found)} "
+          f"event{'' if len(found) == 1 else 's'} ({kinds}, "
+          f"{100 * found.share:.3g} % of the samples; detector as in the events section). "
+          f"Left out as missing samples (±{format_duration(EVENT_PAD)}), the gap-aware Allan "
+          "statistics skip every term that touches one. The Allan deviation with and "
+          "without them:")
+    rows, changed = [], []
+    for sensor, with_ in ctx.allan.items():
+        taus = _decade_taus(with_)
+        if not taus.size:
+            continue
+        both = _allan.adev(getattr(log, sensor), log.fs, taus=taus)
+        without = _allan.adev(getattr(cut, sensor), log.fs, taus=both.taus)
+        # the taus both have (the grid's own, whole samples; gaps may cost the longest)
+        taus, a, b = np.intersect1d(both.taus, without.taus, return_indices=True)
+        dev, lo, hi = (np.reshape(v, (len(both.taus), -1))[a] for v in (
+            both.dev, both.ci_low, both.ci_high))
+        dev_out = np.reshape(without.dev, (len(without.taus), -1))[b]
+        for j, axis in enumerate(axis_names(dev.shape[1])):
+            for i, tau in enumerate(taus):
+                outside = not lo[i, j] <= dev_out[i, j] <= hi[i, j]
+                if outside:
+                    changed.append(f"{sensor} {axis} at {format_duration(tau)}")
+                rows.append([f"{sensor} {axis}", format_duration(tau),
+                             numbers.cell(dev[i, j]), numbers.cell(dev_out[i, j]),
+                             f"{dev_out[i, j] / dev[i, j]:.3g}" if dev[i, j] > 0 else "—",
+                             "yes" if outside else "no"])
+    doc.table(["channel", "τ", "ADEV", "without events", "ratio",
+               "outside the confidence interval"], rows,
+              caption=f"Allan deviation of the {'only' if ctx.one_log else 'long'} log with "
+                      "and without its events")
+    if changed:
+        doc.p(f"The events change the Allan deviation beyond its confidence interval at "
+              f"{len(changed)} of {len(rows)} points ({', '.join(changed[:6])}"
+              f"{', …' if len(changed) > 6 else ''}). The noise coefficients above are "
+              "those of the log as recorded; for the sensor's own noise, analyse "
+              "`imunoise.events(log).exclude(log)` (`imunoise.adev` skips the missing "
+              "samples).")
+    else:
+        doc.p("Leaving them out moves no point outside the confidence interval: the "
+              "Allan analysis above holds with or without them.")
 
 
 def warmup_section(ctx: Context, doc: Doc) -> None:
