@@ -53,6 +53,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy import optimize as _opt
+from scipy import stats as _stats
 
 from imunoise import _summary
 from imunoise._channels import rate_channels
@@ -71,6 +72,10 @@ BLOCKS = 300
 MIN_BLOCKS = 20
 #: Records of the sensor's stationary noise the significance test simulates.
 NULL_RECORDS = 1999
+#: Confidence of the upper limit of the Allan variance that bounds the null's
+#: rate random walk (see ``_random_walk_bound``): one-sigma. At 95 % the null is
+#: so loud that a 20-minute transient 5× the random walk's wander is missed.
+BOUND_CONFIDENCE = 0.683
 #: Correlation times of the exponential fit: this many per log, log-spaced.
 TAU_GRID = 80
 
@@ -387,10 +392,14 @@ def _null_p_values(x, fs, t, bias, duration, seed) -> np.ndarray:
 
 def _random_walk_bound(result, model, min_edf: float = 5.0) -> np.ndarray:
     """Per channel, the rate random walk K the half log cannot exclude: the one whose
-    K²τ/3 makes up what the model's other terms leave of the measured Allan variance
-    at the longest τ with at least ``min_edf`` degrees of freedom. A 2.5 h half of a
-    VN-100 log does not resolve its K (2e-6 rad/s/√s), and a null without it calls
-    its wander a transient."""
+    K²τ/3 makes up what the model's other terms leave of the upper
+    :data:`BOUND_CONFIDENCE` confidence limit of the Allan variance (χ² with the
+    estimate's degrees of freedom ν: σ²·ν/χ²_{1−c}(ν)) at the longest τ with at least
+    ``min_edf`` degrees of freedom. A 2.5 h half of a VN-100 log does not resolve its
+    K (2e-6 rad/s/√s), and a null without it calls its wander a transient; a half
+    whose random walk happened to wander little measures K = 0 at its point
+    estimate, and a null built on that called still channels warming up (p = 5e-4;
+    docs/events.md)."""
     edf = np.reshape(result.edf, (len(result.taus), -1))
     dev = np.reshape(result.dev, edf.shape)
     out = np.zeros(edf.shape[1])
@@ -400,7 +409,9 @@ def _random_walk_bound(result, model, min_edf: float = 5.0) -> np.ndarray:
             i = usable[-1]
             tau = result.taus[i : i + 1]
             others = {t: float(np.ravel(model.value(t))[c]) for t in ("Q", "N", "B", "R")}
-            rest = dev[i, c] ** 2 - float(model_variance(tau, **others)[0])
+            upper = dev[i, c] ** 2 * edf[i, c] / _stats.chi2.ppf(1 - BOUND_CONFIDENCE,
+                                                                  edf[i, c])
+            rest = upper - float(model_variance(tau, **others)[0])
             out[c] = np.sqrt(3.0 / tau[0] * max(rest, 0.0))
     return out
 

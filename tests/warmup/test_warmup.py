@@ -112,6 +112,19 @@ def test_still_vn100_noise_with_rate_random_walk_has_no_transient(seed):
     assert np.mean(found.p_value > 0.01) >= 0.5  # p-values of stationary noise are not tiny
 
 
+@pytest.mark.parametrize("seed", [1002, 1019])
+def test_a_quiet_second_half_does_not_make_the_null_too_quiet(seed):
+    """In these still logs the second half's random walk wandered so little that its
+    point estimate of K is 0 on one gyro axis; a null built on it called that axis a
+    warm-up (p = 5e-4). The null's K is the one the half cannot exclude (upper
+    confidence limit of its Allan variance)."""
+    from imunoise.simulate_log import still_log
+
+    found = imunoise.warmup(still_log(5.0, 40.0, seed=seed))
+    assert not found.significant.any()
+    assert found.p_value.min() > 0.005
+
+
 def test_settle_point_never_passes_the_end_of_the_log():
     x = transient_log(900.0, seed=7, hours=0.6, amplitude=5e-2)
     found = imunoise.warmup(x, FS, tolerance=1e-7)
