@@ -14,16 +14,24 @@ blocks, interpolated linearly, so slow bias drift is not an event):
    :math:`\hat\sigma = 1.4826\,\mathrm{MAD}(r)` (consistent for Gaussian noise
    and unmoved by the events themselves), :math:`k = \Phi^{-1}(1 - p/4)`.
 2. **Bursts** (windowed energy): :math:`S_j = \sum_{i\in W_j} z_i^2` over a
-   sliding window of ``window`` seconds (:math:`w` samples). Under white Gaussian
-   noise :math:`S_j \sim \chi^2_w`; a window is flagged when
+   sliding window of ``window`` seconds (:math:`w` samples), and of :math:`w/2` and
+   :math:`w/4` (:data:`BURST_SCALES`; a short burst is diluted in a long window).
+   Under white Gaussian noise :math:`S_j \sim \chi^2_w`; a window is flagged when
    :math:`S_j > \chi^{2}_{w}{}^{-1}(1 - p_w)`, with
-   :math:`p_w = p\,w/(2\,c)`, :math:`c =` :data:`OVERLAP_FACTOR` (overlapping windows
-   cross the threshold in clusters; the factor was measured, see below).
+   :math:`p_w = p\,w/(2\,c\,s)` for :math:`s` window sizes, :math:`c =`
+   :data:`OVERLAP_FACTOR` (overlapping windows cross the threshold in clusters;
+   the factor was measured, see below). Real noise is not white: the scale and
+   the degrees of freedom of the window energy come from the record itself
+   (Satterthwaite), from its quiet part (a second pass leaves out what the first
+   found: a record with vibration of its own would otherwise set the thresholds
+   of its quiet stretches).
    The start and end of a burst are then placed by maximum likelihood of a
-   variance change inside the flagged stretch: with :math:`v` the stretch's mean
-   :math:`z^2`, each sample adds :math:`\ell_i = z_i^2(1-1/v) - \ln v` to the
-   log-likelihood ratio, and the burst is the segment maximising
-   :math:`\sum \ell_i` (the CUSUM change-point estimate, Page 1954).
+   variance change inside the flagged stretch (the CUSUM change-point estimate,
+   Page 1954), with a Student-t likelihood (ν from the quiet noise's kurtosis,
+   at least :data:`CHANGE_POINT_DOF`) so that one heavy-tailed sample adds at most
+   :math:`(\nu/2)\ln v`, and without the isolated outliers (spike samples whose
+   neighbours are quiet), which stay spikes of their own: an outlier just before
+   a burst neither becomes its start nor swallows it.
 
 ``false_alarm`` (:math:`p`, default :data:`FALSE_ALARM`) is the design rate of
 false events per sample and channel, split evenly between the two tests.
@@ -31,9 +39,11 @@ Measured on white Gaussian noise (``benches/bench_events.py``, 2·10⁷ samples)
 see ``docs/events.md`` for the numbers; the target is at most one false event
 per 10⁶ samples at the default.
 
-Events closer than ``merge`` seconds are joined, per channel and then across
-channels. :meth:`Events.exclude` turns the events into missing samples (NaN),
-which the Allan-family statistics skip (``docs/gaps.md``).
+Events of one kind closer than ``merge`` seconds are joined, per channel and
+then across channels; a spike joins a burst only where it overlaps it or lies
+within half the shortest energy window of it. :meth:`Events.exclude` turns the
+events into missing samples (NaN), which the Allan-family statistics skip
+(``docs/gaps.md``).
 """
 
 from __future__ import annotations
