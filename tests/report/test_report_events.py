@@ -144,7 +144,7 @@ def test_events_that_change_the_allan_deviation_are_said_to(tmp_path):
     rep = report.build(short, long, out_dir=tmp_path, spec=None, progress=False)
     text = _section(rep.markdown.read_text(encoding="utf-8"), "Events and the Allan deviation")
     assert "The long log holds 2" in text and "(20 bursts" in text
-    assert "change the Allan deviation beyond its confidence interval" in text
+    assert "change the Allan deviation beyond its 68.3 % confidence interval" in text
     assert re.search(r"gyro Y at 1(\.0)? s", text) and "gyro X at" not in text
 
 

@@ -480,20 +480,21 @@ def long_log_events(ctx: Context, doc: Doc) -> None:
                              numbers.cell(dev[i, j]), numbers.cell(dev_out[i, j]),
                              f"{dev_out[i, j] / dev[i, j]:.3g}" if dev[i, j] > 0 else "—",
                              "yes" if outside else "no"])
+    level = f"{100 * next(iter(ctx.allan.values())).confidence:.3g} %"
     doc.table(["channel", "τ", "ADEV", "without events", "ratio",
-               "outside the confidence interval"], rows,
+               f"outside the {level} interval"], rows,
               caption=f"Allan deviation of the {'only' if ctx.one_log else 'long'} log with "
                       "and without its events")
     if changed:
-        doc.p(f"The events change the Allan deviation beyond its confidence interval at "
+        doc.p(f"The events change the Allan deviation beyond its {level} confidence interval at "
               f"{len(changed)} of {len(rows)} points ({', '.join(changed[:6])}"
               f"{', …' if len(changed) > 6 else ''}). The noise coefficients above are "
               "those of the log as recorded; for the sensor's own noise, analyse "
               "`imunoise.events(log).exclude(log)` (`imunoise.adev` skips the missing "
               "samples).")
     else:
-        doc.p("Leaving them out moves no point outside the confidence interval: the "
-              "Allan analysis above holds with or without them.")
+        doc.p(f"Leaving them out moves no point outside the {level} confidence interval: "
+              "the Allan analysis above holds with or without them.")
 
 
 def warmup_section(ctx: Context, doc: Doc) -> None:
