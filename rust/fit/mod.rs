@@ -112,6 +112,7 @@ pub fn fit_noise(
     let data = Data::new(taus, var, edf, fs)?;
     let chosen = if opts.select {
         let best = search::select(&data, fs, opts.ieee, opts.gm, opts.sine)?;
+        let best = search::prefer_random_walk(&data, fs, opts.ieee, opts.gm, opts.sine, best)?;
         prune_insignificant(&data, fs, best)?
     } else {
         let base = search::fit_structure(&data, fs, opts.ieee, 0, 0.0, &[])?;
