@@ -262,7 +262,10 @@ mod tests {
             for &nu in &[0.01, 0.17, 0.5] {
                 let (tone, res) = (sinusoid(m, nu), resonance(m, 1e-12, 2.0 * PI * nu));
                 // Absolute floor: the damping u = 1e-12 itself at the nulls.
-                assert!((res - tone).abs() <= 1e-8 * tone + 1e-11, "m {m}: {res} {tone}");
+                assert!(
+                    (res - tone).abs() <= 1e-8 * tone + 1e-11,
+                    "m {m}: {res} {tone}"
+                );
             }
             for &u in &[1e-6, 1e-3, 0.1, 2.0] {
                 let (gm, res) = (gauss_markov(m, u), resonance(m, u, 0.0));
