@@ -65,9 +65,11 @@ const RES_PER_DECADE: f64 = 32.0;
 /// best of these (up to [`RES_Q_MAX`]) or are the tone.
 const RES_Q: [f64; 4] = [0.7, 1.5, 3.0, 6.0];
 
-/// Bounds of the refined quality factor.
+/// Bounds of the refined quality factor. A resonance refined onto the upper
+/// bound is a line: the tone (two parameters, not three) describes it, and the
+/// resonance is dropped.
 const RES_Q_MIN: f64 = 0.5;
-const RES_Q_MAX: f64 = 100.0;
+const RES_Q_MAX: f64 = 30.0;
 
 /// Nelder–Mead tolerance (simplex size) in ln f_r and ln τr of a resonance: its curve is
 /// smooth in both (the damping blurs the phase πf_rτ that makes the tone's
@@ -632,7 +634,7 @@ pub fn with_sine(
 /// refined again at the discrepancy the fit settles on when that moved by more
 /// than a factor of two. None when the curve is too short for one or, when
 /// `gated`, the grid's best gains less than a quarter of the BIC penalty of its
-/// three parameters (the tone's gate).
+/// three parameters (the tone's gate) or it is refined onto [`RES_Q_MAX`].
 pub fn with_resonance(
     data: &Data,
     fs: f64,
@@ -672,10 +674,14 @@ pub fn with_resonance(
         let sine = sine.map(|f| s.refine_frequency(&times, f));
         candidate(data, fs, ieee, times, (sine, Some(res)), d2)
     };
+    let is_line = |c: &Candidate| {
+        c.resonance
+            .is_some_and(|(f, t)| std::f64::consts::PI * f * t >= 0.99 * RES_Q_MAX)
+    };
     let first = polish(d2, base.gm_tau.clone(), base.sine, res)?;
     let settled = first.solution.d2;
     if settled <= 2.0 * d2 && settled >= 0.5 * d2 {
-        return Ok(Some(first));
+        return Ok((!(gated && is_line(&first))).then_some(first));
     }
     let second = polish(
         settled,
@@ -683,11 +689,12 @@ pub fn with_resonance(
         first.sine,
         first.resonance.unwrap_or(res),
     )?;
-    Ok(Some(if second.solution.loss < first.solution.loss {
+    let better = if second.solution.loss < first.solution.loss {
         second
     } else {
         first
-    }))
+    };
+    Ok((!(gated && is_line(&better))).then_some(better))
 }
 
 /// Backward elimination of IEEE terms while the BIC decreases.
@@ -762,7 +769,10 @@ pub fn select(
             }
         }
     }
-    if resonance {
+    // A resonance is searched only where the best structure leaves a model
+    // discrepancy (δ > 0: the curve departs from it beyond its own scatter); on
+    // a curve it describes the search is skipped (it costs as much as the tone's).
+    if resonance && best.solution.d2 > 0.0 {
         best = add_resonance(data, fs, ieee, best, &plain, sine)?;
     }
     Ok(best)
