@@ -23,7 +23,7 @@
 //! A resonance (a damped oscillator: a sensor's filter top or a mechanical mode,
 //! `basis::resonance`) is one more column, linear in its variance for a fixed
 //! frequency f_r and damping time τr: a grid of [`RES_PER_DECADE`] frequencies
-//! per decade (the tone's range) times the quality factors [`RES_Q`]
+//! per decade from fs/[`RES_LOWEST`] to fs/2 times the quality factors [`RES_Q`]
 //! (Q = πf_rτr, the centre frequency over the half-power bandwidth), then
 //! coordinate golden-section refinement of ln f_r and ln τr, the times and the
 //! tone polished with it in place; it competes by BIC with three parameters.
@@ -56,19 +56,29 @@ const FINE_SCAN: f64 = 100.0;
 const TIME_TOL: f64 = 1e-2;
 const FREQ_TOL: f64 = 1e-7;
 
-/// Grid of candidate resonance frequencies per decade (7 % apart, a third of
+/// Grid of candidate resonance frequencies per decade (7 % apart, about half
 /// the half-power width of the sharpest grid quality factor).
 const RES_PER_DECADE: f64 = 32.0;
 
-/// Quality factors Q = πf_rτr of the resonance grid: from a band as wide as its
-/// centre frequency to a peak a sixth of it; sharper ones are refined from the
-/// best of these (up to [`RES_Q_MAX`]) or are the tone.
-const RES_Q: [f64; 4] = [0.7, 1.5, 3.0, 6.0];
+/// Lowest resonance frequency, as a fraction of fs: fs/20, a period of 20
+/// samples. What the term is for — a sensor filter's top, a mechanical mode
+/// near the sample rate — shapes the first few cluster sizes, where one tone
+/// or Gauss–Markov term cannot; slower oscillations are the tone's and the
+/// Gauss–Markov terms' (and the search costs a grid per decade).
+const RES_LOWEST: f64 = 20.0;
 
-/// Bounds of the refined quality factor. A resonance refined onto the upper
-/// bound is a line: the tone (two parameters, not three) describes it, and the
-/// resonance is dropped.
-const RES_Q_MIN: f64 = 0.5;
+/// Quality factors Q = πf_rτr of the resonance grid: from a band as wide as its
+/// centre frequency to a peak an eighth of it; sharper ones are refined from
+/// the best of these (up to [`RES_Q_MAX`]) or are the tone.
+const RES_Q: [f64; 4] = [1.0, 2.0, 4.0, 8.0];
+
+/// Bounds of the refined quality factor. Below Q = 1 the band is wider than its
+/// centre frequency and its spectrum has no peak to speak of: a low-pass
+/// shape, which the Gauss–Markov terms describe (on the ADIS16405, whose own
+/// filter is such a shape, a free Q went to 0.5 on most channels and moved the
+/// long-tau coefficients). Above Q = 30 it is a line, which the tone describes
+/// with one parameter fewer. A resonance refined onto either bound is dropped.
+const RES_Q_MIN: f64 = 1.0;
 const RES_Q_MAX: f64 = 30.0;
 
 /// Nelder–Mead tolerance (simplex size) in ln f_r and ln τr of a resonance: its curve is
@@ -132,9 +142,14 @@ pub fn frequency_grid(data: &Data, fs: f64) -> Vec<f64> {
     log_grid(data, fs, FREQ_PER_DECADE)
 }
 
-/// Candidate resonance frequencies (Hz): the tone's range at [`RES_PER_DECADE`].
+/// Candidate resonance frequencies (Hz): [`RES_PER_DECADE`] per decade from
+/// fs/[`RES_LOWEST`] (or the tone's lowest, if higher) to fs/2, and fs/2.
 pub fn resonance_grid(data: &Data, fs: f64) -> Vec<f64> {
+    let lowest = fs / RES_LOWEST;
     log_grid(data, fs, RES_PER_DECADE)
+        .into_iter()
+        .filter(|&f| f >= lowest * (1.0 - 1e-12))
+        .collect()
 }
 
 /// 10^(j/`per_decade`) Hz from [`SINE_PERIODS`] periods in the longest tau up
@@ -634,7 +649,7 @@ pub fn with_sine(
 /// refined again at the discrepancy the fit settles on when that moved by more
 /// than a factor of two. None when the curve is too short for one or, when
 /// `gated`, the grid's best gains less than a quarter of the BIC penalty of its
-/// three parameters (the tone's gate) or it is refined onto [`RES_Q_MAX`].
+/// three parameters (the tone's gate) or it is refined onto a bound of its Q.
 pub fn with_resonance(
     data: &Data,
     fs: f64,
@@ -674,14 +689,16 @@ pub fn with_resonance(
         let sine = sine.map(|f| s.refine_frequency(&times, f));
         candidate(data, fs, ieee, times, (sine, Some(res)), d2)
     };
-    let is_line = |c: &Candidate| {
-        c.resonance
-            .is_some_and(|(f, t)| std::f64::consts::PI * f * t >= 0.99 * RES_Q_MAX)
+    let on_bound = |c: &Candidate| {
+        c.resonance.is_some_and(|(f, t)| {
+            let q = std::f64::consts::PI * f * t;
+            q >= 0.99 * RES_Q_MAX || q <= 1.01 * RES_Q_MIN
+        })
     };
     let first = polish(d2, base.gm_tau.clone(), base.sine, res)?;
     let settled = first.solution.d2;
     if settled <= 2.0 * d2 && settled >= 0.5 * d2 {
-        return Ok((!(gated && is_line(&first))).then_some(first));
+        return Ok((!(gated && on_bound(&first))).then_some(first));
     }
     let second = polish(
         settled,
@@ -694,7 +711,7 @@ pub fn with_resonance(
     } else {
         first
     };
-    Ok((!(gated && is_line(&better))).then_some(better))
+    Ok((!(gated && on_bound(&better))).then_some(better))
 }
 
 /// Backward elimination of IEEE terms while the BIC decreases.
