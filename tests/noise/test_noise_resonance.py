@@ -175,3 +175,17 @@ def test_a_table_row_is_a_dash_where_an_axis_has_no_resonance(resonant):
     row = next(r for r in model.table("gyro") if r["term"] == "f_r")
     assert not row["X_supported"] and row["Y_supported"] and row["missing"] == "—"
     assert "—" in model.table_text("gyro")
+
+
+def test_bootstrap_simulates_and_refits_the_resonance():
+    t = TRUTH
+    x = imunoise.simulate(int(1800 * FS), FS, N=t["N"], seed=9,
+                          resonance=(t["sigma"], t["f_r"], t["tau_r"]))
+    model = _fit(imunoise.adev(x, FS, taus=10), uncertainty="bootstrap", replicates=6, seed=2)
+    assert len(model.resonance(0)) == 1
+    sigma, f_r, tau_r = model.resonance(0)[0]
+    stds = [float(a) for a in (model.resonance_sigma_std, model.resonance_freq_std,
+                               model.resonance_tau_std)]
+    # The replicates' spread is small next to each value yet not zero.
+    for value, std in zip((sigma, f_r, tau_r), stds, strict=True):
+        assert 0 < std < 0.2 * value
