@@ -795,10 +795,11 @@ pub fn select(
     Ok(best)
 }
 
-/// The best of `best`, `best` with a resonance, and, when `best` has a tone,
-/// `plain` (the best structure without one) with a resonance and then a tone
-/// searched again on top (when `sine`): the tone may have taken the band the
-/// resonance describes better, leaving the line next to it.
+/// The best of `best`, `best` with a resonance, and, when `best` has a tone in
+/// the resonance's range (≥ fs/[`RES_LOWEST`]), `plain` (the best structure
+/// without one) with a resonance and then a tone searched again on top (when
+/// `sine`): the tone may have taken the band the resonance describes better,
+/// leaving the line next to it. A slower tone cannot have, and is kept.
 fn add_resonance(
     data: &Data,
     fs: f64,
@@ -809,7 +810,7 @@ fn add_resonance(
 ) -> CoreResult<Candidate> {
     let d2 = best.solution.d2;
     let mut bases = vec![best.clone()];
-    if best.sine.is_some() {
+    if best.sine.is_some_and(|f| f >= fs / RES_LOWEST) {
         bases.push(plain.clone());
     }
     for base in &bases {
