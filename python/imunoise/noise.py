@@ -18,7 +18,7 @@ also has up to three first-order Gauss–Markov (exponentially correlated) bias
 terms, each with a standard deviation σ and a correlation time τc, whose Allan
 variance is the discrete AR1 form of IEEE 952 Annex C (slope +½ for τ ≪ τc, a
 peak near 1.9 τc, slope −½ for τ ≫ τc), and at most one tone A·sin(2πf₀t + ϕ)
-(a resonance, dither or ripple), IEEE 952 Annex C's sinusoidal term
+(a line: dither, ripple, a sharp mode), IEEE 952 Annex C's sinusoidal term
 A²·sin⁴(πf₀τ)/(πf₀τ)² in its sampled form 2·(A²/2)·sin⁴(πνm)/(m² sin²πν),
 ν = f₀/fs, m = τ·fs, whose frequency is searched like the correlation times,
 and at most one resonance: a damped oscillator (second-order Gauss–Markov

@@ -20,12 +20,21 @@ import matplotlib
 import numpy as np
 import pytest
 from imunoise import export, report
-from imunoise.noise import _terms, resonance_white_density
+from imunoise._core import fit as core_fit
+from imunoise.noise import resonance_white_density
 
 matplotlib.use("Agg")
 
 FS = 100.0
+NO_IEEE = [0.0] * 5
 TRUTH = {"N": 1e-3, "K": 2e-5, "sigma": 2e-2, "f_r": 30.0, "tau_r": 0.05}
+
+
+def _curve(taus, *, tone=(), resonance=()):
+    """Allan variance of one tone (s², f0) or resonance (σ², f_r, τr) alone, from the
+    Rust closed forms."""
+    t = np.ascontiguousarray(taus, dtype=float)
+    return core_fit.noise_terms(t, FS, NO_IEEE, [], list(tone), list(resonance))[:, -1]
 
 
 def _fit(result, **kwargs):
@@ -50,19 +59,19 @@ def test_simulated_resonance_has_the_closed_form_allan_variance(f_r, tau_r):
     x = imunoise.simulate(400_000, FS, resonance=(sigma, f_r, tau_r), seed=1)
     assert np.std(x) == pytest.approx(sigma, rel=0.05)
     r = imunoise.adev(x, FS, taus=np.array([0.01, 0.02, 0.05, 0.1, 0.3, 1.0, 3.0]))
-    want = _terms(r.taus, FS, [0.0] * 5, resonance=[(sigma, f_r, tau_r)])[:, -1]
+    want = _curve(r.taus, resonance=[(sigma**2, f_r, tau_r)])
     # Within four standard errors of each estimate (σ̂²'s relative sd is √(2/edf)).
     np.testing.assert_array_less(np.abs(r.var / want - 1), 4 * np.sqrt(2 / r.edf) + 0.01)
 
 
 def test_resonance_limits_are_the_tone_and_white_noise():
     taus = np.array([0.01, 0.05, 0.2, 1.0])
-    tone = _terms(taus, FS, [0.0] * 5, tone=[(math.sqrt(2), 7.3)])[:, -1]
-    slow = _terms(taus, FS, [0.0] * 5, resonance=[(1.0, 7.3, 1e9)])[:, -1]
+    tone = _curve(taus, tone=[(1.0, 7.3)])
+    slow = _curve(taus, resonance=[(1.0, 7.3, 1e9)])
     np.testing.assert_allclose(slow, tone, rtol=1e-6)
     # τ ≫ τr: white noise of the spectrum at zero frequency, σ²(τ) = N²/τ.
     n2 = resonance_white_density(1.0, 7.3, 0.05, FS)
-    far = _terms(np.array([100.0]), FS, [0.0] * 5, resonance=[(1.0, 7.3, 0.05)])[0, -1]
+    far = _curve(np.array([100.0]), resonance=[(1.0, 7.3, 0.05)])[0]
     assert far == pytest.approx(n2 / 100.0, rel=1e-2)
 
 
