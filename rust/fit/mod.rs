@@ -534,7 +534,7 @@ mod tests {
         // rate random walk noise: the VN-100 gyro's pattern at 100 Hz.
         let ieee = [0.0, 1e-6, 0.0, 1e-10, 0.0];
         let tone = [(2e-5, 10.0)];
-        let res = [(4e-5, 30.0, 0.02)];
+        let res = [(4e-4, 30.0, 0.02)];
         for per_decade in [10.0, 20.0] {
             let taus = grid(per_decade, 0.01, 1000.0);
             let var: Vec<f64> = terms(&taus, FS, &ieee, &[], (&tone, &res))
