@@ -91,7 +91,8 @@ def structure(model):
     terms = [t for t in imunoise.noise.TERMS if bool(model.supported[t])]
     gm = [f"GM({tc:.3g} s)" for _, tc in model.gauss_markov()]
     tone = [f"sine({f0:.3g} Hz)" for _, f0 in model.sine()]
-    return "+".join(terms + gm + tone)
+    res = [f"res({f:.3g} Hz, Q {math.pi * f * tr:.2g})" for _, f, tr in model.resonance()]
+    return "+".join(terms + gm + tone + res)
 
 
 def main() -> int:

@@ -45,7 +45,7 @@ from pathlib import Path
 import numpy as np
 
 from imunoise import units as _units
-from imunoise.noise import gm_white_density
+from imunoise.noise import gm_white_density, resonance_white_density
 
 __all__ = [
     "ekf_dict",
@@ -225,6 +225,10 @@ def _ekf_axes(model, sensor: str, input_unit, min_samples: float) -> dict:
     names = ["x", "y", "z"] if model.channels == 3 else [f"ch{i}" for i in range(model.channels)]
     for c, name in enumerate(names):
         white2 = float(model.value("N")[c]) ** 2
+        # A resonance (like a tone) is no bias state; what it adds to the white
+        # floor (its spectrum at zero frequency) is measurement noise.
+        for sigma, f_r, tau_r in model.resonance(c):
+            white2 += resonance_white_density(sigma, f_r, tau_r, model.fs)
         states = []
         for sigma, tau_c in model.gauss_markov(c):
             if tau_c * model.fs < min_samples:

@@ -18,9 +18,14 @@ also has up to three first-order Gauss–Markov (exponentially correlated) bias
 terms, each with a standard deviation σ and a correlation time τc, whose Allan
 variance is the discrete AR1 form of IEEE 952 Annex C (slope +½ for τ ≪ τc, a
 peak near 1.9 τc, slope −½ for τ ≫ τc), and at most one tone A·sin(2πf₀t + ϕ)
-(a resonance, dither or ripple), IEEE 952 Annex C's sinusoidal term
+(a line: dither, ripple, a sharp mode), IEEE 952 Annex C's sinusoidal term
 A²·sin⁴(πf₀τ)/(πf₀τ)² in its sampled form 2·(A²/2)·sin⁴(πνm)/(m² sin²πν),
-ν = f₀/fs, m = τ·fs, whose frequency is searched like the correlation times.
+ν = f₀/fs, m = τ·fs, whose frequency is searched like the correlation times,
+and at most one resonance: a damped oscillator (second-order Gauss–Markov
+process) of standard deviation σ, centre frequency f_r and damping time τr,
+autocovariance σ²ρ^|h|·cos(θh) with ρ = exp(−1/(fs·τr)), θ = 2πf_r/fs (a
+sensor's filter top or a mechanical mode: a band, not a line), whose Allan
+variance is the real part of the AR1 form continued to z = ρe^(iθ).
 
 :func:`fit` offers two estimators:
 
@@ -113,6 +118,8 @@ _PARAMS: int = _core_fit.PARAMETERS
 then (A²/2, ln f0) of the tone."""
 _SINE: int = _core_fit.SINE_SLOT
 """Slot of the tone's variance A²/2 in the covariance (its ln f0 follows)."""
+_RES: int = _core_fit.RESONANCE_SLOT
+"""Slot of the resonance's variance σ² in the covariance (ln f_r, ln τr follow)."""
 
 
 def gm_white_density(sigma: float, tau_c: float, fs: float) -> float:
@@ -123,22 +130,35 @@ def gm_white_density(sigma: float, tau_c: float, fs: float) -> float:
     return sigma**2 * (1 + phi) / ((1 - phi) * fs)
 
 
+def resonance_white_density(sigma: float, f_r: float, tau_r: float, fs: float) -> float:
+    """N² (rate²·s) that a sampled resonance of standard deviation ``sigma``,
+    frequency ``f_r`` and damping time ``tau_r`` contributes at τ ≫ τr:
+    σ²·Re[(1+z)/(1−z)]/fs, z = exp(−1/(fs·τr) + 2πi·f_r/fs), the −½ asymptote of
+    its Allan variance (its spectrum at zero frequency)."""
+    z = complex(math.exp(-1.0 / (fs * tau_r)), 0.0) * complex(
+        math.cos(2 * math.pi * f_r / fs), math.sin(2 * math.pi * f_r / fs))
+    return sigma**2 * ((1 + z) / (1 - z)).real / fs
+
+
 def _is_log_time(slot: int) -> bool:
-    return slot >= 5 and (slot - 5) % 2 == 1
+    """Whether covariance slot ``slot`` holds a logarithm (ln τc, ln f0, ln f_r, ln τr)."""
+    return slot > _RES or (5 <= slot < _RES and (slot - 5) % 2 == 1)
 
 
 _CLOSE = 0.05
 """A model within this relative distance of the measured deviation follows it."""
 
 
-def _terms(taus, fs: float, coef, markov=(), tone=()) -> np.ndarray:
+def _terms(taus, fs: float, coef, markov=(), tone=(), resonance=()) -> np.ndarray:
     """Allan variance of each model term at ``taus``: (len(taus), 5 + len(markov) +
-    len(tone)), from the one implementation of the model (Rust); ``coef`` holds Q…R,
-    ``markov`` (sigma, tau_c) pairs, ``tone`` (amplitude, f0) pairs."""
+    len(tone) + len(resonance)), from the one implementation of the model (Rust);
+    ``coef`` holds Q…R, ``markov`` (sigma, tau_c) pairs, ``tone`` (amplitude, f0)
+    pairs, ``resonance`` (sigma, f_r, tau_r) triples."""
     t = np.ascontiguousarray(np.atleast_1d(np.asarray(taus, dtype=float)))
     return _core_fit.noise_terms(t, float(fs), [float(c) ** 2 for c in coef],
                              [(s * s, tc) for s, tc in markov],
-                             [(a * a / 2, f0) for a, f0 in tone])
+                             [(a * a / 2, f0) for a, f0 in tone],
+                             [(s * s, f, tr) for s, f, tr in resonance])
 
 
 def model_variance(taus, Q=0.0, N=0.0, B=0.0, K=0.0, R=0.0) -> np.ndarray:
@@ -207,6 +227,15 @@ class NoiseModel:
         or (channels,); NaN where a channel has none.
     sine_amplitude_std, sine_freq_std : ndarray
         Their standard uncertainties.
+    resonance_sigma, resonance_freq, resonance_tau : ndarray
+        A damped oscillator (second-order Gauss–Markov process, autocovariance
+        σ²·ρ^|h|·cos(2πf_r h/fs), ρ = exp(−1/(fs·τr))): standard deviation
+        (rate), centre frequency f_r (Hz) and damping time τr (s; the quality
+        factor is π·f_r·τr), shape () or (channels,); NaN where a channel has
+        none.
+    resonance_sigma_std, resonance_freq_std, resonance_tau_std : ndarray
+        Their standard uncertainties (the frequency's is NaN when it sits on the
+        fs/2 bound of the search).
     supported : dict[str, ndarray of bool]
         Whether each IEEE term is in the model (``False``: the value is 0 and
         means "not resolved", not "absent").
@@ -241,8 +270,9 @@ class NoiseModel:
         no such part; ``"B"`` also has ``low``/``high`` (95 % interval).
     cov : ndarray
         ``"wls"``: covariance of (Q², N², B², K², R², then σ², ln τc of each
-        Gauss–Markov slot, then A²/2, ln f0 of the tone), shape (13, 13) or
-        (channels, 13, 13); NaN for ``"slopes"``.
+        Gauss–Markov slot, then A²/2, ln f0 of the tone, then σ², ln f_r, ln τr
+        of the resonance), shape (16, 16) or (channels, 16, 16); NaN for
+        ``"slopes"``.
     """
 
     Q: np.ndarray
@@ -263,6 +293,12 @@ class NoiseModel:
     sine_freq: np.ndarray
     sine_amplitude_std: np.ndarray
     sine_freq_std: np.ndarray
+    resonance_sigma: np.ndarray
+    resonance_freq: np.ndarray
+    resonance_tau: np.ndarray
+    resonance_sigma_std: np.ndarray
+    resonance_freq_std: np.ndarray
+    resonance_tau_std: np.ndarray
     supported: dict[str, np.ndarray]
     tau_range: dict[str, np.ndarray]
     method: str
@@ -310,29 +346,38 @@ class NoiseModel:
         f0 = float(np.atleast_1d(self.sine_freq)[channel])
         return [(amp, f0)] if np.isfinite(amp) else []
 
+    def resonance(self, channel: int = 0) -> list[tuple[float, float, float]]:
+        """The (sigma, f_r, tau_r) of the resonance of ``channel``: one triple, or none."""
+        sigma, f_r, tau_r = (float(np.atleast_1d(a)[channel]) for a in
+                             (self.resonance_sigma, self.resonance_freq, self.resonance_tau))
+        return [(sigma, f_r, tau_r)] if np.isfinite(sigma) else []
+
     # -- curves -------------------------------------------------------------
     def predict(self, taus=None) -> Prediction:
         """Model Allan deviation at ``taus`` (default: the fitted taus).
 
         Returns the total curve σ(τ) and each term's own curve, e.g.
         ``terms["N"] = N/√τ``, ``terms["GM1"]`` for the first Gauss–Markov term,
-        ``terms["sine"]`` for the tone (when a channel has one).
+        ``terms["sine"]`` for the tone and ``terms["resonance"]`` for the
+        resonance (when a channel has one).
         """
         t = self.taus if taus is None else np.asarray(taus, dtype=float)
         if t.ndim != 1 or t.size == 0 or not np.all(np.isfinite(t)) or np.any(t <= 0):
             raise ValueError(f"taus must be a non-empty 1-D array of finite values > 0; got {t!r}")
         gm_names = [f"GM{k + 1}" for k in range(GM_MAX)]
-        names = [*TERMS, *gm_names, "sine"]
+        names = [*TERMS, *gm_names, "sine", "resonance"]
         parts = np.zeros((t.size, len(names), self.channels))
         for c in range(self.channels):
-            markov, tone = self.gauss_markov(c), self.sine(c)
-            var = _terms(t, self.fs, [self.value(k)[c] for k in TERMS], markov, tone)
-            cols = [*range(len(TERMS) + len(markov)), *([names.index("sine")] if tone else [])]
+            markov, tone, osc = self.gauss_markov(c), self.sine(c), self.resonance(c)
+            var = _terms(t, self.fs, [self.value(k)[c] for k in TERMS], markov, tone, osc)
+            cols = [*range(len(TERMS) + len(markov)), *([names.index("sine")] if tone else []),
+                    *([names.index("resonance")] if osc else [])]
             parts[:, cols, c] = var
         total = np.sqrt(parts.sum(axis=1))
         channels = range(self.channels)
         used = [*TERMS, *gm_names[: max(len(self.gauss_markov(c)) for c in channels)],
-                *(["sine"] if any(self.sine(c) for c in channels) else [])]
+                *(["sine"] if any(self.sine(c) for c in channels) else []),
+                *(["resonance"] if any(self.resonance(c) for c in channels) else [])]
         terms = {k: np.sqrt(parts[:, names.index(k), :]) for k in used}
         if self.one_channel:
             total = total[:, 0]
@@ -344,7 +389,9 @@ class NoiseModel:
 
         ``"N"``: the white-noise density of the model, N together with every
         Gauss–Markov term faster than 1 s (white at the τ = 1 s read-off:
-        σ²(1+φ)/((1−φ)·fs)); what a filter's white-noise input should be.
+        σ²(1+φ)/((1−φ)·fs)) and a resonance damped faster than 1 s (its
+        spectrum at zero frequency, :func:`resonance_white_density`); what a
+        filter's white-noise input should be.
         ``"K"``: K together with every slower Gauss–Markov term's short-τ
         random-walk rate √(2σ²/τc) (its +½ slope; a random walk that bounds
         the bias over times shorter than τc). ``"B"``: the minimum of the model's
@@ -388,23 +435,27 @@ class NoiseModel:
 
     def _parameters(self, channel: int) -> np.ndarray:
         """(Q², N², B², K², R², then σ², ln τc per Gauss–Markov slot, then A²/2,
-        ln f0 of the tone) of a channel."""
+        ln f0 of the tone, then σ², ln f_r, ln τr of the resonance) of a channel."""
         p = np.zeros(_PARAMS)
         p[:5] = [float(self.value(t)[channel]) ** 2 for t in TERMS]
         for k, (sigma, tau_c) in enumerate(self.gauss_markov(channel)):
             p[5 + 2 * k], p[6 + 2 * k] = sigma**2, math.log(tau_c)
         for amplitude, f0 in self.sine(channel):
             p[_SINE], p[_SINE + 1] = amplitude**2 / 2, math.log(f0)
+        for sigma, f_r, tau_r in self.resonance(channel):
+            p[_RES], p[_RES + 1], p[_RES + 2] = sigma**2, math.log(f_r), math.log(tau_r)
         return p
 
     def _equivalent_of(self, term: str, p: np.ndarray) -> float:
         gm = [(p[5 + 2 * k], math.exp(p[6 + 2 * k])) for k in range(GM_MAX) if p[5 + 2 * k] > 0]
         if term == "B":
-            # The tone is part of the curve whose floor B is read from; it is
-            # neither white nor a walk, so N and K leave it out.
+            # The tone and the resonance are part of the curve whose floor B is
+            # read from; they are neither white nor a walk, so N and K leave them out.
             tone = [(p[_SINE], math.exp(p[_SINE + 1]))] if p[_SINE] > 0 else []
+            osc = ([(p[_RES], math.exp(p[_RES + 1]), math.exp(p[_RES + 2]))]
+                   if p[_RES] > 0 else [])
             grid = np.geomspace(self.taus[0], self.taus[-1], 200)
-            dev = np.sqrt(_core_fit.noise_terms(grid, self.fs, list(p[:5]), gm, tone).sum(
+            dev = np.sqrt(_core_fit.noise_terms(grid, self.fs, list(p[:5]), gm, tone, osc).sum(
                 axis=1))
             i = int(np.argmin(dev))
             # A minimum at the longest tau is a floor only where the curve has
@@ -414,6 +465,9 @@ class NoiseModel:
                 return 0.0
             return float(dev[i] / FLICKER)
         total = p[1] if term == "N" else p[3]
+        if term == "N" and p[_RES] > 0 and p[_RES + 2] <= 0.0:  # τr ≤ 1 s
+            total += resonance_white_density(1.0, math.exp(p[_RES + 1]),
+                                             math.exp(p[_RES + 2]), self.fs) * p[_RES]
         for q2, tau_c in gm:
             if term == "N" and tau_c <= 1.0:
                 total += q2 * gm_white_density(1.0, tau_c, self.fs)
@@ -436,6 +490,8 @@ class NoiseModel:
                  if np.atleast_1d(self.supported[t])[channel]]
         gm = len(self.gauss_markov(channel))
         tone = "".join(f", tone {_summary.number(f0)} Hz" for _, f0 in self.sine(channel))
+        tone += "".join(f", resonance {_summary.number(f)} Hz"
+                        for _, f, _ in self.resonance(channel))
         return (" ".join(terms) or "no term resolved") + (f", {gm} GM" if gm else "") + tone + (
             f", covers {100 * float(np.atleast_1d(self.coverage)[channel]):.3g} %")
 
@@ -469,11 +525,14 @@ class NoiseModel:
                                  for sg, tc in self.gauss_markov(c)) or "—")
             row.append(", ".join(f"A {_summary.number(a)}, f0 {_summary.number(f0)} Hz"
                                  for a, f0 in self.sine(c)) or "—")
+            row.append(", ".join(f"σ {_summary.number(sg)}, f_r {_summary.number(f)} Hz, "
+                                 f"τr {_summary.number(tr)} s"
+                                 for sg, f, tr in self.resonance(c)) or "—")
             row.append(f"{100 * float(np.atleast_1d(self.coverage)[c]):.3g} %")
             rows.append(row)
         return _summary.html_table(
             ["axis", *(f"{t} [{units[t]}]" for t in TERMS), "Gauss–Markov", "tone",
-             "coverage"],
+             "resonance", "coverage"],
             rows, caption=f"NoiseModel: {self._title()}, {_summary.tau_span(self.taus)}")
 
     # -- units and tables ---------------------------------------------------
@@ -526,9 +585,14 @@ class NoiseModel:
     def table(self, sensor: str = "gyro", *, units: dict[str, str] | None = None,
               input_unit: str | None = None, axes: Sequence[str] | None = None,
               terms: Sequence[str] = ("N", "B", "K", "Q", "R")) -> list[dict]:
-        """Per-axis table in datasheet units: one row per coefficient.
+        """Per-axis table in datasheet units: one row per coefficient, then the
+        model's other terms where any axis has them (``σ1``, ``τc1``, … per
+        Gauss–Markov term, ``A``, ``f0`` of the tone, ``σr``, ``f_r``, ``τr`` of
+        the resonance; σ and A in the unit of B, times in s, frequencies in Hz).
 
-        Each row is a dict with ``term``, ``quantity``, ``unit``, ``label`` and,
+        Each row is a dict with ``term``, ``quantity``, ``unit``, ``label``,
+        ``missing`` (the text of an axis without the value: ``not resolved`` for
+        a coefficient, ``—`` for a term the axis's model does not have) and,
         per axis name (default X, Y, Z…), the value, ``<axis>_std`` and
         ``<axis>_supported``. Render it with :func:`format_table`.
         """
@@ -543,6 +607,7 @@ class NoiseModel:
                 "quantity": _SENSOR_NAMES[sensor].get(term, _NAMES[term]),
                 "unit": c["unit"],
                 "label": c["label"],
+                "missing": _numbers.NOT_RESOLVED,
             }
             vals = np.atleast_1d(c["value"])
             stds = np.atleast_1d(c["std"])
@@ -552,7 +617,52 @@ class NoiseModel:
                 row[ax + "_std"] = float(stds[i])
                 row[ax + "_supported"] = bool(sup[i])
             rows.append(row)
+        rate = _units.unit_info("B", (units or {}).get("B"), sensor)
+
+        def to_rate(v):
+            return _units.convert(v, "B", rate.name, sensor=sensor, input_unit=input_unit)
+
+        for term, quantity, unit, values, stds in self._other_terms():
+            rate_valued = unit is None
+            row = {"term": term, "quantity": quantity, "missing": "—",
+                   "unit": rate.name if rate_valued else unit,
+                   "label": rate.label if rate_valued else unit}
+            for i, ax in enumerate(axes):
+                v, e = float(values[i]), float(stds[i])
+                row[ax] = float(to_rate(v)) if rate_valued and np.isfinite(v) else v
+                row[ax + "_std"] = float(to_rate(e)) if rate_valued and np.isfinite(e) else e
+                row[ax + "_supported"] = bool(np.isfinite(v))
+            rows.append(row)
         return rows
+
+    def _other_terms(self) -> list[tuple[str, str, str | None, np.ndarray, np.ndarray]]:
+        """(term, quantity, unit — None for a rate —, values, stds per channel) of
+        each row of the model's non-IEEE terms that any axis has."""
+        out = []
+        sig = np.reshape(self.gm_sigma, (self.channels, GM_MAX))
+        sig_std = np.reshape(self.gm_sigma_std, (self.channels, GM_MAX))
+        tau = np.reshape(self.gm_tau, (self.channels, GM_MAX))
+        tau_std = np.reshape(self.gm_tau_std, (self.channels, GM_MAX))
+        for k in range(GM_MAX):
+            if np.isfinite(sig[:, k]).any():
+                out.append((f"σ{k + 1}", "Gauss–Markov bias", None, sig[:, k],
+                            sig_std[:, k]))
+                out.append((f"τc{k + 1}", "Gauss–Markov correlation time", "s", tau[:, k],
+                            tau_std[:, k]))
+        one = np.atleast_1d
+        if np.isfinite(one(self.sine_amplitude)).any():
+            out.append(("A", "tone amplitude", None, one(self.sine_amplitude),
+                        one(self.sine_amplitude_std)))
+            out.append(("f0", "tone frequency", "Hz", one(self.sine_freq),
+                        one(self.sine_freq_std)))
+        if np.isfinite(one(self.resonance_sigma)).any():
+            out.append(("σr", "resonance standard deviation", None, one(self.resonance_sigma),
+                        one(self.resonance_sigma_std)))
+            out.append(("f_r", "resonance frequency", "Hz", one(self.resonance_freq),
+                        one(self.resonance_freq_std)))
+            out.append(("τr", "resonance damping time", "s", one(self.resonance_tau),
+                        one(self.resonance_tau_std)))
+        return out
 
     def table_text(self, sensor: str = "gyro", **kwargs) -> str:
         """Text rendering of :meth:`table`."""
@@ -609,6 +719,10 @@ class NoiseModel:
             [{"amplitude": a, "frequency": f0} for a, f0 in self.sine(c)]
             for c in range(self.channels)
         ]
+        d["resonance"] = [
+            [{"sigma": sg, "frequency": f, "tau_r": tr} for sg, f, tr in self.resonance(c)]
+            for c in range(self.channels)
+        ]
         d["coverage"] = np.atleast_1d(self.coverage).tolist()
         d["discrepancy"] = np.atleast_1d(self.discrepancy).tolist()
         d["readoff"] = {
@@ -623,12 +737,13 @@ def format_table(rows: list[dict], axes: Sequence[str]) -> str:
     """Render :meth:`NoiseModel.table` rows as fixed-width text.
 
     Terms the data do not resolve print as ``not resolved`` (the report's and
-    ``imunoise fit``'s wording too); values carry ``± std``, rounded to it
+    ``imunoise fit``'s wording too), a term an axis's model does not have as
+    ``—``; values carry ``± std``, rounded to it
     (:func:`imunoise.numbers.format_value`).
     """
     def cell(row, ax):
         if not row[ax + "_supported"]:
-            return _numbers.NOT_RESOLVED
+            return row.get("missing", _numbers.NOT_RESOLVED)
         return _numbers.format_value(row[ax], row[ax + "_std"])
 
     header = ["coefficient", "unit", *axes]
@@ -729,20 +844,22 @@ def _edf_cap(result, taus):
     return np.where(np.isfinite(cap) & (cap > 1.0), cap, 1.0)
 
 
-def _parse_terms(terms) -> tuple[np.ndarray, int, bool, bool]:
-    """``terms`` → (IEEE mask, Gauss–Markov count, tone, select by BIC)."""
+def _parse_terms(terms) -> tuple[np.ndarray, int, tuple[bool, bool], bool]:
+    """``terms`` → (IEEE mask, Gauss–Markov count, (tone, resonance), select by BIC)."""
     if isinstance(terms, str) and terms == "auto":
-        return np.ones(len(TERMS), dtype=bool), GM_MAX, True, True
+        return np.ones(len(TERMS), dtype=bool), GM_MAX, (True, True), True
     names = tuple(terms) if not isinstance(terms, str) else tuple(terms)
-    allowed = (*TERMS, "GM", "sine")
+    allowed = (*TERMS, "GM", "sine", "resonance")
     bad = [t for t in names if t not in allowed]
     gm = names.count("GM")
-    if bad or not names or gm > GM_MAX or names.count("sine") > 1:
+    if (bad or not names or gm > GM_MAX or names.count("sine") > 1
+            or names.count("resonance") > 1):
         raise ValueError(
             f"terms must be 'auto' or a non-empty sequence of {allowed} with 'GM' at most "
-            f"{GM_MAX} times and 'sine' at most once; got {terms!r}"
+            f"{GM_MAX} times, 'sine' at most once and 'resonance' at most once; got {terms!r}"
         )
-    return np.array([t in names for t in TERMS]), gm, "sine" in names, False
+    mask = np.array([t in names for t in TERMS])
+    return mask, gm, ("sine" in names, "resonance" in names), False
 
 
 @old_call_forms(keyword_only=("method", "terms", "tau_range"))
@@ -760,12 +877,13 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
     method : {"wls", "slopes"}
         Log-space weighted least squares (default) or the IEEE 952 / MATLAB
         slope read-off (see the module docstring).
-    terms : "auto" or sequence of {"Q", "N", "B", "K", "R", "GM", "sine"}
-        ``"auto"`` (default): the IEEE terms, up to three Gauss–Markov terms
-        and a tone, the structure with the lowest BIC (the fewest terms that
-        describe the curve). A sequence fits exactly those terms (``"GM"`` up to
-        three times for Gauss–Markov terms, ``"sine"`` once for a tone); a term
-        the data push below zero is still 0.
+    terms : "auto" or sequence of {"Q", "N", "B", "K", "R", "GM", "sine", "resonance"}
+        ``"auto"`` (default): the IEEE terms, up to three Gauss–Markov terms,
+        a tone and a resonance, the structure with the lowest BIC (the fewest
+        terms that describe the curve). A sequence fits exactly those terms
+        (``"GM"`` up to three times for Gauss–Markov terms, ``"sine"`` once for
+        a tone, ``"resonance"`` once for a damped oscillator); a term the data
+        push below zero is still 0.
     tau_range : (float, float), optional
         Only use taus in [min, max] seconds.
     uncertainty : {"independent", "bootstrap"}
@@ -815,7 +933,7 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
             raise TypeError(f"replicates must be an integer; got {replicates!r}")
         if replicates < 5:
             raise ValueError(f"replicates must be >= 5; got {replicates}")
-    mask, gm_count, tone, select = _parse_terms(terms)
+    mask, gm_count, oscillators, select = _parse_terms(terms)
     taus, var, edf, one = _extract(result, tau_range)
     dev_all, edf_raw = _measured(result, taus)
     channels = var.shape[1]
@@ -827,6 +945,8 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
     gm_std = np.full((channels, GM_MAX, 2), np.nan)
     sine = np.full((channels, 2), np.nan)  # amplitude, f0
     sine_std = np.full((channels, 2), np.nan)
+    osc = np.full((channels, 3), np.nan)  # sigma, f_r, tau_r
+    osc_std = np.full((channels, 3), np.nan)
     stats = np.full((channels, 3), np.nan)  # discrepancy, chi2, n_eff
     cov = np.full((channels, _PARAMS, _PARAMS), np.nan)
     usable = []
@@ -847,17 +967,18 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
         def fit_channel(c):
             ok = usable[c]
             return _fit_wls(taus[ok], var[ok, c], edf[ok, c], float(result.fs), mask,
-                            gm_count, tone, select)
+                            gm_count, oscillators, select)
 
         with ThreadPoolExecutor(max_workers=min(channels, os.cpu_count() or 1)) as pool:
             fits = list(pool.map(fit_channel, range(channels)))
         for c, out in enumerate(fits):
-            coef[c], std[c], sup[c], gm[c], gm_std[c], sine[c], sine_std[c], stats[c], \
-                cov[c] = out
+            coef[c], std[c], sup[c], gm[c], gm_std[c], sine[c], sine_std[c], osc[c], \
+                osc_std[c], stats[c], cov[c] = out
             markov = [(a, b) for a, b in gm[c] if np.isfinite(a)]
             tones = [tuple(sine[c])] if np.isfinite(sine[c, 0]) else []
-            rng[c] = _support_range(_terms(taus[usable[c]], result.fs, coef[c], markov, tones),
-                                    taus[usable[c]], sup[c])
+            oscs = [tuple(osc[c])] if np.isfinite(osc[c, 0]) else []
+            parts = _terms(taus[usable[c]], result.fs, coef[c], markov, tones, oscs)
+            rng[c] = _support_range(parts, taus[usable[c]], sup[c])
     else:
         for c in range(channels):
             ok = usable[c]
@@ -868,12 +989,15 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
             kept = [t for t, keep in zip(TERMS, sup[c], strict=True) if keep]
             markov = [(float(a), float(b)) for a, b in gm[c] if np.isfinite(a)]
             tones = [(float(sine[c, 0]), float(sine[c, 1]))] if np.isfinite(sine[c, 0]) else []
-            if not kept and not markov and not tones:
+            oscs = [tuple(map(float, osc[c]))] if np.isfinite(osc[c, 0]) else []
+            if not kept and not markov and not tones and not oscs:
                 continue
             options = dict(method=method, terms=[*kept, *["GM"] * len(markov),
-                                                 *["sine"] * len(tones)], tau_range=tau_range)
-            std[c], gm_std[c], sine_std[c] = _bootstrap_std(
-                result, coef[c], markov, tones, int(replicates), generator, options)
+                                                 *["sine"] * len(tones),
+                                                 *["resonance"] * len(oscs)],
+                           tau_range=tau_range)
+            std[c], gm_std[c], sine_std[c], osc_std[c] = _bootstrap_std(
+                result, coef[c], markov, (tones, oscs), int(replicates), generator, options)
     std[~sup] = np.nan
 
     def shaped(a):
@@ -894,6 +1018,12 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
         sine_freq=shaped(sine[:, 1]),
         sine_amplitude_std=shaped(sine_std[:, 0]),
         sine_freq_std=shaped(sine_std[:, 1]),
+        resonance_sigma=shaped(osc[:, 0]),
+        resonance_freq=shaped(osc[:, 1]),
+        resonance_tau=shaped(osc[:, 2]),
+        resonance_sigma_std=shaped(osc_std[:, 0]),
+        resonance_freq_std=shaped(osc_std[:, 1]),
+        resonance_tau_std=shaped(osc_std[:, 2]),
         supported={k: shaped(sup[:, i]) for i, k in enumerate(TERMS)},
         tau_range={k: shaped(rng[:, i, :]) for i, k in enumerate(TERMS)},
         method=method,
@@ -1005,16 +1135,18 @@ def _record_length(result) -> int:
     return n0 + 2 * m0 - 1 if overlapping else (n0 + 1) * m0
 
 
-def _bootstrap_std(result, coef, markov, tones, replicates, rng, options):
-    """Standard deviation of each coefficient (and Gauss–Markov σ, τc, and tone A,
-    f0) over fits to records simulated from the model with the length, rate and
-    taus of ``result``."""
+def _bootstrap_std(result, coef, markov, oscillators, replicates, rng, options):
+    """Standard deviation of each coefficient (and Gauss–Markov σ, τc, tone A, f0
+    and resonance σ, f_r, τr) over fits to records simulated from the model with
+    the length, rate and taus of ``result``; ``oscillators`` is (tones, resonances)."""
     from imunoise.allan import adev
     from imunoise.simulate import simulate
 
+    tones, oscs = oscillators
     n = _record_length(result)
     sims = simulate(n, result.fs, *coef, channels=replicates, seed=rng, gm=markov,
-                    sinusoid=tones[0] if tones else None)
+                    sinusoid=tones[0] if tones else None,
+                    resonance=oscs[0] if oscs else None)
     again = adev(sims, result.fs, taus=np.asarray(result.taus), overlapping=result.overlapping,
                  confidence=result.confidence)
     with warnings.catch_warnings():
@@ -1025,10 +1157,12 @@ def _bootstrap_std(result, coef, markov, tones, replicates, rng, options):
                    np.reshape(refit.gm_tau, (-1, GM_MAX))], axis=-1)
     tone = np.stack([np.atleast_1d(refit.sine_amplitude), np.atleast_1d(refit.sine_freq)],
                     axis=-1)
+    osc = np.stack([np.atleast_1d(a) for a in (refit.resonance_sigma, refit.resonance_freq,
+                                               refit.resonance_tau)], axis=-1)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN: no tone
         return (values.std(axis=0, ddof=1), np.nanstd(gm, axis=0, ddof=1),
-                np.nanstd(tone, axis=0, ddof=1))
+                np.nanstd(tone, axis=0, ddof=1), np.nanstd(osc, axis=0, ddof=1))
 
 
 def _readonly(a):
@@ -1037,11 +1171,12 @@ def _readonly(a):
     return out
 
 
-def _fit_wls(t, v, e, fs, mask, gm_count, tone, select):
+def _fit_wls(t, v, e, fs, mask, gm_count, oscillators, select):
+    tone, resonance = oscillators
     try:
         r = _core_fit.fit_noise(
             np.ascontiguousarray(t), np.ascontiguousarray(v), np.ascontiguousarray(e), fs,
-            [bool(m) for m in mask], gm_count, select, tone,
+            [bool(m) for m in mask], gm_count, select, tone, resonance,
         )
     except ValueError as exc:
         raise ValueError(f"cannot fit the noise model to result: {exc}") from None
@@ -1068,8 +1203,18 @@ def _fit_wls(t, v, e, fs, mask, gm_count, tone, select):
         sine[:] = amplitude, f0
         sine_std[:] = (math.sqrt(max(cov[_SINE, _SINE], 0.0)) / amplitude,
                        f0 * math.sqrt(max(cov[_SINE + 1, _SINE + 1], 0.0)))
+    osc = np.full(3, np.nan)
+    osc_std = np.full(3, np.nan)
+    for r2, f_r, tau_r in r.resonance:
+        # u(σ) = u(σ²)/(2σ); f_r, τr from their logarithms (NaN: f_r on the fs/2 bound).
+        sigma = math.sqrt(r2)
+        osc[:] = sigma, f_r, tau_r
+        osc_std[:] = (math.sqrt(max(cov[_RES, _RES], 0.0)) / (2 * sigma),
+                      f_r * math.sqrt(cov[_RES + 1, _RES + 1]) if np.isfinite(
+                          cov[_RES + 1, _RES + 1]) else np.nan,
+                      tau_r * math.sqrt(max(cov[_RES + 2, _RES + 2], 0.0)))
     return (np.where(supported, coef, 0.0), std, supported, markov, markov_std, sine, sine_std,
-            (delta, chi2, n_eff), cov)
+            osc, osc_std, (delta, chi2, n_eff), cov)
 
 
 def _support_range(parts, t, sup, min_share=0.25):

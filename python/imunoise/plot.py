@@ -447,6 +447,9 @@ def allan(
                     # Zeros at whole periods: masked on the log axis.
                     tone = np.where(curves["sine"] > 0, curves["sine"], np.nan)
                     ax.plot(grid, tone, color="tab:olive", linewidth=0.9, label="tone")
+                if "resonance" in curves and np.any(curves["resonance"] > 0):
+                    band = np.where(curves["resonance"] > 0, curves["resonance"], np.nan)
+                    ax.plot(grid, band, color="tab:cyan", linewidth=0.9, label="resonance")
                 if marks.get("N", 0.0) > 0:
                     ax.plot([1.0], [marks["N"]], marker="s", color="crimson", ms=5,
                             linestyle="none", label="N at τ=1 s")

@@ -108,7 +108,8 @@ def flicker(n_samples: int, scale: float, rng: np.random.Generator, *,
 def simulate(n_samples: int, fs: float, Q: float = 0.0, N: float = 0.0, B: float = 0.0,
              K: float = 0.0, R: float = 0.0, *, channels: int = 1, seed=None,
              gm: Sequence[tuple[float, float]] = (),
-             sinusoid: tuple[float, float] | None = None) -> np.ndarray:
+             sinusoid: tuple[float, float] | None = None,
+             resonance: tuple[float, float, float] | None = None) -> np.ndarray:
     """Rate noise with the given IEEE 952 coefficients.
 
     Parameters
@@ -133,6 +134,13 @@ def simulate(n_samples: int, fs: float, Q: float = 0.0, N: float = 0.0, B: float
         A tone A·sin(2π·f0·t + ϕ) of peak amplitude A (rate) and frequency f0
         (Hz), a random phase ϕ per channel: IEEE 952 Annex C's sinusoidal term,
         Allan variance A²·sin⁴(πf0τ)/(πf0τ)².
+    resonance : (sigma, f_r, tau_r), optional
+        A damped oscillator (second-order Gauss–Markov process): the real part
+        of the complex AR1 z[t] = ρe^(iθ)·z[t−1] + w[t], ρ = exp(−1/(fs·tau_r)),
+        θ = 2π·f_r/fs, started stationary, so that its autocovariance is
+        sigma²·ρ^|h|·cos(θh): standard deviation ``sigma`` (rate), centre
+        frequency ``f_r`` (Hz, at most fs/2) and damping time ``tau_r`` (s) —
+        the process of the ``"resonance"`` term of :func:`imunoise.fit`.
 
     Returns
     -------
@@ -153,6 +161,7 @@ def simulate(n_samples: int, fs: float, Q: float = 0.0, N: float = 0.0, B: float
     Q, N, B, K, R = (_check_coef(k, v) for k, v in zip("QNBKR", (Q, N, B, K, R), strict=True))
     markov = _check_gm(gm)
     tone = _check_sinusoid(sinusoid)
+    oscillator = _check_resonance(resonance, fs)
     rng = np.random.default_rng(seed)
     out = np.zeros((n, channels))
     sqfs = math.sqrt(fs)
@@ -187,6 +196,8 @@ def simulate(n_samples: int, fs: float, Q: float = 0.0, N: float = 0.0, B: float
             amplitude, f0 = tone
             phase = rng.uniform(0.0, 2 * math.pi)
             col += amplitude * np.sin(2 * math.pi * f0 / fs * np.arange(n) + phase)
+        if oscillator is not None and oscillator[0] > 0:
+            col += damped_oscillator(n, fs, *oscillator, rng)
     return out[:, 0].copy() if channels == 1 else out
 
 
@@ -203,6 +214,37 @@ def _check_sinusoid(sinusoid) -> tuple[float, float] | None:
     if not (math.isfinite(f0) and f0 > 0):
         raise ValueError(f"sinusoid f0 must be finite and > 0 Hz; got {f0!r}")
     return amplitude, f0
+
+
+def _check_resonance(resonance, fs: float) -> tuple[float, float, float] | None:
+    if resonance is None:
+        return None
+    try:
+        sigma, f_r, tau_r = (float(v) for v in resonance)
+    except (TypeError, ValueError):
+        raise TypeError(f"resonance must be a (sigma, f_r, tau_r) triple or None; got "
+                        f"{resonance!r}") from None
+    if not (math.isfinite(sigma) and sigma >= 0):
+        raise ValueError(f"resonance sigma must be finite and >= 0; got {sigma!r}")
+    if not (math.isfinite(f_r) and 0 < f_r <= fs / 2):
+        raise ValueError(f"resonance f_r must be in (0, fs/2 = {fs / 2:g}] Hz; got {f_r!r}")
+    if not (math.isfinite(tau_r) and tau_r > 0):
+        raise ValueError(f"resonance tau_r must be finite and > 0 s; got {tau_r!r}")
+    return sigma, f_r, tau_r
+
+
+def damped_oscillator(n: int, fs: float, sigma: float, f_r: float, tau_r: float,
+                      rng: np.random.Generator) -> np.ndarray:
+    """Stationary damped oscillator: Re z of z[t] = ρe^(iθ)·z[t−1] + w[t] with
+    autocovariance sigma²·ρ^|h|·cos(θh) (E|z|² = 2 sigma²)."""
+    from scipy.signal import lfilter
+
+    pole = math.exp(-1.0 / (fs * tau_r)) * complex(math.cos(2 * math.pi * f_r / fs),
+                                                   math.sin(2 * math.pi * f_r / fs))
+    scale = sigma * math.sqrt(-math.expm1(-2.0 / (fs * tau_r)))  # σ·√(1 − ρ²) per part
+    w = (rng.standard_normal(n) + 1j * rng.standard_normal(n)) * scale
+    w[0] = (rng.standard_normal() + 1j * rng.standard_normal()) * sigma
+    return lfilter([1.0], [1.0, -pole], w).real
 
 
 def _check_gm(gm) -> list[tuple[float, float]]:

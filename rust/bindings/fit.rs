@@ -10,7 +10,8 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
 use crate::fit::{
-    self, Options, FLICKER_FACTOR, IEEE_TERMS, IEEE_TERM_NAMES, MAX_GM, PARAMETERS, SINE_SLOT,
+    self, Options, FLICKER_FACTOR, IEEE_TERMS, IEEE_TERM_NAMES, MAX_GM, PARAMETERS, RESONANCE_SLOT,
+    SINE_SLOT,
 };
 
 /// The fit of one channel, as `_core.fit.NoiseFit`.
@@ -22,8 +23,10 @@ struct PyNoiseFit {
     gm: Py<PyArray2<f64>>,
     /// (k, 2) rows of (s², f₀), k ≤ 1: the tone.
     sine: Py<PyArray2<f64>>,
+    /// (k, 3) rows of (r², f_r, τr), k ≤ 1: the resonance.
+    resonance: Py<PyArray2<f64>>,
     /// PARAMETERS × PARAMETERS covariance of (Q²…R², then q², ln τc per slot,
-    /// then s², ln f₀).
+    /// then s², ln f₀, then r², ln f_r, ln τr; NaN variance of ln f_r at fs/2).
     cov: Py<PyArray2<f64>>,
     /// δ, the relative model discrepancy.
     discrepancy: f64,
@@ -55,10 +58,10 @@ fn to_matrix(rows: Vec<Vec<f64>>, cols: usize) -> PyResult<Array2<f64>> {
         .map_err(|e| PyValueError::new_err(e.to_string()))
 }
 
-/// fit_noise(taus, var, edf, fs, terms, gm, select, sine) -> NoiseFit
+/// fit_noise(taus, var, edf, fs, terms, gm, select, sine, resonance) -> NoiseFit
 #[pyfunction]
 #[allow(clippy::too_many_arguments)] // mirrors the Python keyword arguments
-#[pyo3(signature = (taus, var, edf, fs, terms, gm=3, select=true, sine=true))]
+#[pyo3(signature = (taus, var, edf, fs, terms, gm=3, select=true, sine=true, resonance=true))]
 fn fit_noise<'py>(
     py: Python<'py>,
     taus: PyReadonlyArray1<'py, f64>,
@@ -69,11 +72,13 @@ fn fit_noise<'py>(
     gm: usize,
     select: bool,
     sine: bool,
+    resonance: bool,
 ) -> PyResult<PyNoiseFit> {
     let opts = Options {
         ieee: ieee_flags(&terms)?,
         gm,
         sine,
+        resonance,
         select,
     };
     let taus = taus.as_array().to_vec();
@@ -82,10 +87,12 @@ fn fit_noise<'py>(
     let r = py.detach(|| fit::fit_noise(&taus, &var, &edf, fs, &opts))?;
     let gm_rows: Vec<Vec<f64>> = r.gm.iter().map(|&(q2, tc)| vec![q2, tc]).collect();
     let sine_rows: Vec<Vec<f64>> = r.sine.iter().map(|&(s2, f0)| vec![s2, f0]).collect();
+    let res_rows: Vec<Vec<f64>> = r.resonance.iter().map(|&(a, f, t)| vec![a, f, t]).collect();
     Ok(PyNoiseFit {
         ieee: r.ieee.to_vec().into_pyarray(py).unbind(),
         gm: to_matrix(gm_rows, 2)?.into_pyarray(py).unbind(),
         sine: to_matrix(sine_rows, 2)?.into_pyarray(py).unbind(),
+        resonance: to_matrix(res_rows, 3)?.into_pyarray(py).unbind(),
         cov: to_matrix(r.cov, PARAMETERS)?.into_pyarray(py).unbind(),
         discrepancy: r.discrepancy,
         chi2: r.chi2,
@@ -95,10 +102,10 @@ fn fit_noise<'py>(
     })
 }
 
-/// noise_terms(taus, fs, ieee, gm, sine) -> (len(taus), 5 + k + j) Allan variance of
-/// each term
+/// noise_terms(taus, fs, ieee, gm, sine, resonance) -> (len(taus), 5 + k + j + l) Allan
+/// variance of each term
 #[pyfunction]
-#[pyo3(signature = (taus, fs, ieee, gm, sine=Vec::new()))]
+#[pyo3(signature = (taus, fs, ieee, gm, sine=Vec::new(), resonance=Vec::new()))]
 fn noise_terms<'py>(
     py: Python<'py>,
     taus: PyReadonlyArray1<'py, f64>,
@@ -106,6 +113,7 @@ fn noise_terms<'py>(
     ieee: Vec<f64>,
     gm: Vec<(f64, f64)>,
     sine: Vec<(f64, f64)>,
+    resonance: Vec<(f64, f64, f64)>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     if ieee.len() != IEEE_TERMS {
         return Err(PyValueError::new_err(format!(
@@ -125,9 +133,17 @@ fn noise_terms<'py>(
             "sine frequencies must be finite and > 0 Hz; got {f0}"
         )));
     }
-    let cols = IEEE_TERMS + gm.len() + sine.len();
+    if let Some(&(_, f, t)) = resonance
+        .iter()
+        .find(|r| !(r.1.is_finite() && r.1 > 0.0 && r.2.is_finite() && r.2 > 0.0))
+    {
+        return Err(PyValueError::new_err(format!(
+            "resonance frequency and damping time must be finite and > 0; got {f} Hz, {t} s"
+        )));
+    }
+    let cols = IEEE_TERMS + gm.len() + sine.len() + resonance.len();
     let taus = taus.as_array().to_vec();
-    let rows = fit::terms(&taus, fs, &coef, &gm, &sine);
+    let rows = fit::terms(&taus, fs, &coef, &gm, (&sine, &resonance));
     Ok(to_matrix(rows, cols)?.into_pyarray(py))
 }
 
@@ -136,6 +152,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("MAX_GAUSS_MARKOV", MAX_GM)?;
     m.add("PARAMETERS", PARAMETERS)?;
     m.add("SINE_SLOT", SINE_SLOT)?;
+    m.add("RESONANCE_SLOT", RESONANCE_SLOT)?;
     m.add("FLICKER_FACTOR", FLICKER_FACTOR)?;
     m.add_class::<PyNoiseFit>()?;
     m.add_function(wrap_pyfunction!(fit_noise, m)?)?;

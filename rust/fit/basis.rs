@@ -17,6 +17,8 @@
 //! O((mu)³); there it is summed as its Taylor series in u, whose k-th term is
 //! (−1)ᵏ/k!·[−m(2u)ᵏ − 3uᵏ + 4((m+1)u)ᵏ − ((2m+1)u)ᵏ] (the terms k ≤ 2 vanish).
 
+use rustfft::num_complex::Complex64;
+
 /// Number of IEEE 952 terms: Q, N, B, K, R.
 pub const IEEE_TERMS: usize = 5;
 
@@ -89,6 +91,75 @@ pub fn sinusoid(m: f64, nu: f64) -> f64 {
     2.0 * s.powi(4) / (d * d)
 }
 
+/// Allan variance at cluster size `m` of a unit-variance damped oscillator (a
+/// resonance, second-order Gauss–Markov process) with autocovariance
+/// γ(h) = ρʰ cos θh, ρ = e^(−u) (u = τ₀/τr), θ = 2πf_r/fs.
+///
+/// σ²(m) is a sum over lags linear in γ with real coefficients, and
+/// γ(h) = Re zʰ with z = ρe^(iθ) = e^(−w), w = u − iθ; so σ²(m) is the real part
+/// of the first-order form [`gauss_markov`] continued to the complex rate w:
+///
+/// ```text
+/// σ²(m) = Re [m(1 − z²) − z(1 − zᵐ)(3 − zᵐ)] / (m² (1 − z)²)
+/// ```
+///
+/// The same cancellation as for the real AR1 appears when |m·w| is small (a
+/// slow, barely oscillating resonance): there the numerator is summed as the
+/// same Taylor series, whose terms carry w^k = |w|^k e^(ik arg w). It tends to
+/// [`sinusoid`] as u → 0, to [`gauss_markov`] as θ → 0, and θ = π is the AR1
+/// with φ = −ρ (a band peaked at fs/2).
+pub fn resonance(m: f64, u: f64, theta: f64) -> f64 {
+    let w = Complex64::new(u, -theta);
+    let r = w.norm();
+    let d = -expm1(-w); // 1 − z
+    let numerator = if m * r < 0.5 {
+        let phase = Complex64::from_polar(1.0, w.arg());
+        let mut sum = Complex64::new(0.0, 0.0);
+        let mut turn = Complex64::new(1.0, 0.0);
+        let (mut p2, mut p1, mut pm1, mut p2m1) = (1.0, 1.0, 1.0, 1.0);
+        let mut fact = 1.0;
+        for k in 1..=40 {
+            p2 *= 2.0 * r;
+            p1 *= r;
+            pm1 *= (m + 1.0) * r;
+            p2m1 *= (2.0 * m + 1.0) * r;
+            fact *= k as f64;
+            turn *= phase;
+            if k < 3 {
+                continue;
+            }
+            let c = -m * p2 - 3.0 * p1 + 4.0 * pm1 - p2m1;
+            let sign = if k % 2 == 0 { 1.0 } else { -1.0 };
+            let term = turn * (sign * c / fact);
+            sum += term;
+            if term.norm() <= 1e-17 * sum.norm() {
+                break;
+            }
+        }
+        sum
+    } else {
+        let z = (-w).exp();
+        let e = -expm1(-w * m); // 1 − zᵐ
+        d * (2.0 - d) * m - z * e * (2.0 + e)
+    };
+    (numerator / (d * d * (m * m))).re.max(0.0)
+}
+
+/// e^w − 1 without the cancellation of e^w − 1 for small |w|.
+fn expm1(w: Complex64) -> Complex64 {
+    let half = (0.5 * w.im).sin();
+    Complex64::new(
+        w.re.exp_m1() * w.im.cos() - 2.0 * half * half,
+        w.re.exp() * w.im.sin(),
+    )
+}
+
+/// (u, θ) of a resonance of frequency `f_r` (Hz) and damping time `tau_r` (s)
+/// at rate `fs`: u = 1/(fs·τr), θ = 2πf_r/fs.
+pub fn resonance_rates(f_r: f64, tau_r: f64, fs: f64) -> (f64, f64) {
+    (1.0 / (fs * tau_r), 2.0 * std::f64::consts::PI * f_r / fs)
+}
+
 /// u = τ₀/τc of a Gauss–Markov term of correlation time `tau_c` at rate `fs`.
 pub fn gm_rate(tau_c: f64, fs: f64) -> f64 {
     1.0 / (fs * tau_c)
@@ -97,6 +168,7 @@ pub fn gm_rate(tau_c: f64, fs: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::f64::consts::PI;
 
     /// σ²(m) from the autocovariance γ(h) = φʰ, summed directly (DESIGN.md).
     fn direct(m: usize, phi: f64) -> f64 {
@@ -162,6 +234,57 @@ mod tests {
         // Zero at whole periods: a tone at fs/5 vanishes at m = 5, 10, …
         for m in [5.0, 10.0, 55.0] {
             assert!(sinusoid(m, 0.2) < 1e-25, "m {m}");
+        }
+    }
+
+    #[test]
+    fn resonance_matches_the_autocovariance_sum() {
+        let two_pi = 2.0 * std::f64::consts::PI;
+        for &rho in &[0.2f64, 0.5, 0.9, 0.99, 0.999, 0.99999] {
+            for &nu in &[1e-5, 1e-3, 0.013, 0.1, 0.25, 0.37, 0.5] {
+                let (u, theta) = (-rho.ln(), two_pi * nu);
+                let g = |h: usize| rho.powi(h as i32) * (theta * h as f64).cos();
+                for &m in &[1usize, 2, 3, 5, 7, 10, 64, 300, 2000] {
+                    let want = direct_from(m, g);
+                    let got = resonance(m as f64, u, theta);
+                    assert!(
+                        (got - want).abs() <= 1e-9 * want.abs() + 1e-13,
+                        "rho {rho} nu {nu} m {m}: {got} vs {want}"
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn resonance_tends_to_the_tone_and_to_gauss_markov() {
+        for &m in &[1.0, 3.0, 10.0, 57.0, 400.0, 1e4] {
+            for &nu in &[0.01, 0.17, 0.5] {
+                let (tone, res) = (sinusoid(m, nu), resonance(m, 1e-12, 2.0 * PI * nu));
+                // Absolute floor: the damping u = 1e-12 itself at the nulls.
+                assert!(
+                    (res - tone).abs() <= 1e-8 * tone + 1e-11,
+                    "m {m}: {res} {tone}"
+                );
+            }
+            for &u in &[1e-6, 1e-3, 0.1, 2.0] {
+                let (gm, res) = (gauss_markov(m, u), resonance(m, u, 0.0));
+                assert!((res / gm - 1.0).abs() < 1e-10, "m {m} u {u}: {res} {gm}");
+            }
+        }
+        // θ = π: the AR1 with φ = −ρ, whose sum over lags alternates.
+        let rho: f64 = 0.6;
+        let want = direct_from(5, |h| (-rho).powi(h as i32));
+        assert!((resonance(5.0, -rho.ln(), PI) / want - 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn resonance_is_continuous_across_the_series_switch() {
+        for &(u, theta) in &[(1e-6, 1e-6), (1e-3, 2e-3), (0.05, 0.1)] {
+            let m = 0.5 / f64::hypot(u, theta);
+            let lo = resonance(m * (1.0 - 1e-9), u, theta);
+            let hi = resonance(m * (1.0 + 1e-9), u, theta);
+            assert!((lo / hi - 1.0).abs() < 1e-7, "u {u}: {lo} {hi}");
         }
     }
 

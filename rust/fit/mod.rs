@@ -2,14 +2,15 @@
 //!
 //! ```text
 //! σ²(τ) = 3Q²/τ² + N²/τ + (2 ln2/π)·B² + K²τ/3 + R²τ²/2 + Σₖ qₖ²·g(τ; τcₖ)
-//!         + s²·h(τ; f₀)
+//!         + s²·h(τ; f₀) + r²·o(τ; f_r, τr)
 //! ```
 //!
 //! the IEEE Std 952 / 1293 terms plus up to [`MAX_GM`] = 3 first-order
 //! Gauss–Markov bias terms of variance qₖ² and correlation time τcₖ (three: a
 //! MEMS sensor's own filter, a bump of correlated bias, and slow wander), and
 //! at most one sinusoid (tone) of variance s² (amplitude √2·s) and frequency f₀
-//! (`basis`). The estimator
+//! and at most one resonance (damped oscillator, second-order Gauss–Markov) of
+//! variance r², frequency f_r and damping time τr (`basis`). The estimator
 //! (`estimate`) is a weighted least-squares fit of ln σ̂² with weights from the
 //! EDF, the share of an octave each tau stands for, and a model-discrepancy
 //! variance fitted by maximum likelihood; the structure (`search`) is chosen by
@@ -41,9 +42,17 @@ pub const MAX_GM: usize = 3;
 /// First slot of the tone in the parameter covariance: s², then ln f₀.
 pub const SINE_SLOT: usize = IEEE_TERMS + 2 * MAX_GM;
 
+/// First slot of the resonance in the parameter covariance: r², ln f_r, ln τr.
+pub const RESONANCE_SLOT: usize = SINE_SLOT + 2;
+
 /// Slots of the parameter covariance: Q², N², B², K², R², then (q², ln τc) per
-/// Gauss–Markov term, then (s², ln f₀) of the tone.
-pub const PARAMETERS: usize = SINE_SLOT + 2;
+/// Gauss–Markov term, then (s², ln f₀) of the tone, then (r², ln f_r, ln τr) of
+/// the resonance.
+pub const PARAMETERS: usize = RESONANCE_SLOT + 3;
+
+/// The tone (s², f₀) and resonance (r², f_r, τr) terms of a model, at most one
+/// each.
+pub type Oscillators<'a> = (&'a [(f64, f64)], &'a [(f64, f64, f64)]);
 
 /// What [`fit_noise`] may use.
 #[derive(Debug, Clone, Copy)]
@@ -54,6 +63,8 @@ pub struct Options {
     pub gm: usize,
     /// A tone: may enter (`select`) or is fitted (not `select`).
     pub sine: bool,
+    /// A resonance: may enter (`select`) or is fitted (not `select`).
+    pub resonance: bool,
     /// Choose the structure by BIC (`true`), or fit exactly the terms given.
     pub select: bool,
 }
@@ -64,6 +75,7 @@ impl Default for Options {
             ieee: [true; IEEE_TERMS],
             gm: MAX_GM,
             sine: true,
+            resonance: true,
             select: true,
         }
     }
@@ -79,6 +91,9 @@ pub struct NoiseFit {
     pub gm: Vec<(f64, f64)>,
     /// Variance s² and frequency f₀ (Hz) of the tone, if the model has one.
     pub sine: Vec<(f64, f64)>,
+    /// Variance r², frequency f_r (Hz) and damping time τr (s) of the
+    /// resonance, if the model has one.
+    pub resonance: Vec<(f64, f64, f64)>,
     /// Covariance over [`PARAMETERS`] slots (0 for parameters not in the model).
     pub cov: Vec<Vec<f64>>,
     /// Model discrepancy δ: relative standard deviation of the Allan variance
@@ -111,8 +126,9 @@ pub fn fit_noise(
     }
     let data = Data::new(taus, var, edf, fs)?;
     let chosen = if opts.select {
-        let best = search::select(&data, fs, opts.ieee, opts.gm, opts.sine)?;
-        let best = search::prefer_random_walk(&data, fs, opts.ieee, opts.gm, opts.sine, best)?;
+        let kinds = (opts.sine, opts.resonance);
+        let best = search::select(&data, fs, opts.ieee, opts.gm, kinds)?;
+        let best = search::prefer_random_walk(&data, fs, opts.ieee, opts.gm, kinds, best)?;
         prune_insignificant(&data, fs, best)?
     } else {
         let base = search::fit_structure(&data, fs, opts.ieee, 0, 0.0, &[])?;
@@ -121,18 +137,24 @@ pub fn fit_noise(
         } else {
             search::fit_structure(&data, fs, opts.ieee, opts.gm, base.solution.d2, &[])?
         };
-        if opts.sine {
+        let toned = if opts.sine {
             search::with_sine(
                 &data,
                 fs,
                 opts.ieee,
-                &fixed.gm_tau,
+                (&fixed.gm_tau, None),
                 fixed.solution.d2,
                 false,
             )?
             .unwrap_or(fixed)
         } else {
             fixed
+        };
+        if opts.resonance {
+            let d2 = toned.solution.d2;
+            search::with_resonance(&data, fs, opts.ieee, &toned, d2, false)?.unwrap_or(toned)
+        } else {
+            toned
         }
     };
     Ok(summarise(&data, fs, &chosen))
@@ -153,7 +175,8 @@ const PRUNE_PENALTIES: f64 = 2.0;
 /// long-tau estimates (they are less independent than an octave each), this
 /// keeps only terms the data constrain. Gauss–Markov terms are tried before
 /// IEEE terms (where a fast one looks white or a slow one like a walk, the
-/// datasheet term is kept), each group by increasing z; a tone before either.
+/// datasheet term is kept), each group by increasing z; a tone or a resonance
+/// before either.
 /// The last term stays.
 fn prune_insignificant(data: &Data, fs: f64, mut best: Candidate) -> CoreResult<Candidate> {
     // The allowance is cumulative against the selected fit: each removal raises
@@ -164,7 +187,10 @@ fn prune_insignificant(data: &Data, fs: f64, mut best: Candidate) -> CoreResult<
     let mut removed = 0.0;
     'outer: loop {
         let fit = summarise(data, fs, &best);
-        let active = fit.ieee.iter().filter(|v| **v > 0.0).count() + fit.gm.len() + fit.sine.len();
+        let active = fit.ieee.iter().filter(|v| **v > 0.0).count()
+            + fit.gm.len()
+            + fit.sine.len()
+            + fit.resonance.len();
         if active <= 1 {
             return Ok(best);
         }
@@ -184,22 +210,27 @@ fn prune_insignificant(data: &Data, fs: f64, mut best: Candidate) -> CoreResult<
             .filter(|&j| fit.ieee[j] > 0.0)
             .map(|j| (j, fit.ieee[j]))
             .collect();
-        let sine_slots = fit.sine.iter().map(|s| (SINE_SLOT, s.0)).collect();
-        let mut order = weak(sine_slots);
+        let sine_slots = fit.sine.iter().map(|s| (SINE_SLOT, s.0));
+        let res_slots = fit.resonance.iter().map(|r| (RESONANCE_SLOT, r.0));
+        let mut order = weak(sine_slots.chain(res_slots).collect());
         order.extend(weak(gm_slots));
         order.extend(weak(ieee_slots));
         for (slot, _) in order {
             let mut ieee = best.ieee;
             let mut times: Vec<f64> = fit.gm.iter().map(|g| g.1).collect();
             let mut sine = fit.sine.first().map(|s| s.1);
+            let mut resonance = fit.resonance.first().map(|r| (r.1, r.2));
             if slot < IEEE_TERMS {
                 ieee[slot] = false;
             } else if slot == SINE_SLOT {
                 sine = None;
+            } else if slot == RESONANCE_SLOT {
+                resonance = None;
             } else {
                 times.remove((slot - IEEE_TERMS) / 2);
             }
-            if let Ok(next) = search::candidate(data, fs, ieee, times, sine, best.solution.d2) {
+            let extras = (sine, resonance);
+            if let Ok(next) = search::candidate(data, fs, ieee, times, extras, best.solution.d2) {
                 if next.solution.loss - selected < allowance * (removed + 1.0) {
                     best = next;
                     removed += 1.0;
@@ -228,31 +259,39 @@ fn summarise(data: &Data, fs: f64, c: &Candidate) -> NoiseFit {
         .filter(|s| s.0 > 0.0)
         .into_iter()
         .collect();
+    let res_column = IEEE_TERMS + c.gm_tau.len() + usize::from(c.sine.is_some());
+    let resonance: Vec<(f64, f64, f64)> = c
+        .resonance
+        .map(|(f, t)| (theta[res_column], f, t))
+        .filter(|r| r.0 > 0.0)
+        .into_iter()
+        .collect();
     let chi2 = (0..data.len())
         .map(|i| data.omega[i] * (data.y[i] - c.solution.model[i].ln()).powi(2) / data.v[i])
         .sum();
     NoiseFit {
-        cov: covariance(data, fs, &ieee, &gm, &sine, c.solution.d2),
+        cov: covariance(data, fs, &ieee, &gm, (&sine, &resonance), c.solution.d2),
         ieee,
         gm,
         sine,
+        resonance,
         discrepancy: c.solution.d2.sqrt(),
         chi2,
         n_eff: data.n_eff(),
-        parameters: search::parameters(theta),
+        parameters: search::parameters(theta, c.resonance.is_some()),
         bic: c.bic,
     }
 }
 
 /// Model Allan variance of every term at `taus`: row i holds the five IEEE
 /// terms, then one value per Gauss–Markov term (q², τc), then one per tone
-/// (s², f₀).
+/// (s², f₀), then one per resonance (r², f_r, τr).
 pub fn terms(
     taus: &[f64],
     fs: f64,
     ieee: &[f64; IEEE_TERMS],
     gm: &[(f64, f64)],
-    sine: &[(f64, f64)],
+    (sine, resonance): Oscillators,
 ) -> Vec<Vec<f64>> {
     taus.iter()
         .map(|&t| {
@@ -266,6 +305,10 @@ pub fn terms(
                 sine.iter()
                     .map(|&(s2, f0)| s2 * basis::sinusoid(t * fs, f0 / fs)),
             );
+            row.extend(resonance.iter().map(|&(r2, f, tr)| {
+                let (u, theta) = basis::resonance_rates(f, tr, fs);
+                r2 * basis::resonance(t * fs, u, theta)
+            }));
             row
         })
         .collect()
@@ -277,7 +320,7 @@ fn covariance(
     fs: f64,
     ieee: &[f64; IEEE_TERMS],
     gm: &[(f64, f64)],
-    sine: &[(f64, f64)],
+    (sine, resonance): Oscillators,
     d2: f64,
 ) -> Vec<Vec<f64>> {
     // Parameter slots in use and, per tau, ∂M/∂p.
@@ -290,6 +333,19 @@ fn covariance(
         slots.push(SINE_SLOT);
         slots.push(SINE_SLOT + 1);
     }
+    // A resonance at fs/2 sits on the bound of its frequency, where the sampled
+    // curve is even in f_r − fs/2 (∂/∂f_r = 0): the frequency is then not a
+    // free parameter and its variance is NaN (set below).
+    let at_nyquist = resonance
+        .first()
+        .is_some_and(|r| r.1 >= 0.5 * fs * (1.0 - 1e-9));
+    if !resonance.is_empty() {
+        slots.push(RESONANCE_SLOT);
+        if !at_nyquist {
+            slots.push(RESONANCE_SLOT + 1);
+        }
+        slots.push(RESONANCE_SLOT + 2);
+    }
     let h: f64 = 1e-4;
     let rows: Vec<(f64, Vec<f64>)> = (0..data.len())
         .map(|i| {
@@ -298,14 +354,30 @@ fn covariance(
             let gmv =
                 |q2: f64, tc: f64| q2 * basis::gauss_markov(data.m[i], basis::gm_rate(tc, fs));
             let tone = |s2: f64, f0: f64| s2 * basis::sinusoid(data.m[i], f0 / fs);
+            let osc = |r2: f64, f: f64, tr: f64| {
+                let (u, theta) = basis::resonance_rates(f, tr, fs);
+                r2 * basis::resonance(data.m[i], u, theta)
+            };
             let model: f64 = (0..IEEE_TERMS).map(|j| b[j] * ieee[j]).sum::<f64>()
                 + gm.iter().map(|&(q2, tc)| gmv(q2, tc)).sum::<f64>()
-                + sine.iter().map(|&(s2, f0)| tone(s2, f0)).sum::<f64>();
+                + sine.iter().map(|&(s2, f0)| tone(s2, f0)).sum::<f64>()
+                + resonance
+                    .iter()
+                    .map(|&(r2, f, tr)| osc(r2, f, tr))
+                    .sum::<f64>();
             let grad = slots
                 .iter()
                 .map(|&s| {
                     if s < IEEE_TERMS {
                         b[s]
+                    } else if s >= RESONANCE_SLOT {
+                        let (r2, f, tr) = resonance[0];
+                        let (e, ie) = (h.exp(), (-h).exp());
+                        match s - RESONANCE_SLOT {
+                            0 => osc(1.0, f, tr),
+                            1 => (osc(r2, f * e, tr) - osc(r2, f * ie, tr)) / (2.0 * h),
+                            _ => (osc(r2, f, tr * e) - osc(r2, f, tr * ie)) / (2.0 * h),
+                        }
                     } else if s == SINE_SLOT {
                         tone(1.0, sine[0].1)
                     } else if s == SINE_SLOT + 1 {
@@ -348,6 +420,9 @@ fn covariance(
             }
         }
     }
+    if at_nyquist {
+        cov[RESONANCE_SLOT + 1][RESONANCE_SLOT + 1] = f64::NAN;
+    }
     cov
 }
 
@@ -370,7 +445,7 @@ mod tests {
     }
 
     fn curve(taus: &[f64], ieee: &[f64; 5], gm: &[(f64, f64)]) -> Vec<f64> {
-        terms(taus, FS, ieee, gm, &[])
+        terms(taus, FS, ieee, gm, (&[], &[]))
             .iter()
             .map(|r| r.iter().sum())
             .collect()
@@ -395,6 +470,7 @@ mod tests {
         let fit = fit_exact(&taus, &var);
         assert!(fit.gm.is_empty(), "{:?}", fit.gm);
         assert!(fit.sine.is_empty(), "{:?}", fit.sine);
+        assert!(fit.resonance.is_empty(), "{:?}", fit.resonance);
         for j in [1, 2, 3] {
             assert!(
                 (fit.ieee[j] / truth[j] - 1.0).abs() < 1e-3,
@@ -417,6 +493,7 @@ mod tests {
             let fit = fit_exact(&taus, &var);
             assert_eq!(fit.gm.len(), 2, "{per_decade}: {fit:?}");
             assert!(fit.sine.is_empty(), "{per_decade}: {fit:?}");
+            assert!(fit.resonance.is_empty(), "{per_decade}: {fit:?}");
             for (got, want) in fit.gm.iter().zip(truth_gm) {
                 assert!(
                     (got.0 / want.0 - 1.0).abs() < 0.01,
@@ -437,7 +514,7 @@ mod tests {
         let tone = [(2e-5, 17.0)];
         for per_decade in [5.0, 10.0, 20.0, 50.0] {
             let taus = grid(per_decade, 0.01, 1000.0);
-            let var: Vec<f64> = terms(&taus, FS, &ieee, &[], &tone)
+            let var: Vec<f64> = terms(&taus, FS, &ieee, &[], (&tone, &[]))
                 .iter()
                 .map(|r| r.iter().sum())
                 .collect();
@@ -450,6 +527,33 @@ mod tests {
             assert!((fit.ieee[1] / ieee[1] - 1.0).abs() < 0.01);
             let u = fit.cov[SINE_SLOT][SINE_SLOT].sqrt();
             assert!(u.is_finite() && u < s2, "{per_decade}: {u}");
+        }
+    }
+
+    #[test]
+    fn a_resonance_is_recovered_next_to_a_tone() {
+        // A 10 Hz line and a band at 30 Hz (Q = π·30·0.02 ≈ 1.9), on white and
+        // rate random walk noise: the VN-100 gyro's pattern at 100 Hz.
+        let ieee = [0.0, 1e-6, 0.0, 1e-10, 0.0];
+        let tone = [(2e-5, 10.0)];
+        let res = [(4e-4, 30.0, 0.02)];
+        for per_decade in [10.0, 20.0] {
+            let taus = grid(per_decade, 0.01, 1000.0);
+            let var: Vec<f64> = terms(&taus, FS, &ieee, &[], (&tone, &res))
+                .iter()
+                .map(|r| r.iter().sum())
+                .collect();
+            let fit = fit_exact(&taus, &var);
+            assert_eq!(fit.resonance.len(), 1, "{per_decade}: {fit:?}");
+            assert_eq!(fit.sine.len(), 1, "{per_decade}: {fit:?}");
+            let (r2, f, tr) = fit.resonance[0];
+            assert!((r2 / res[0].0 - 1.0).abs() < 0.02, "{per_decade}: {fit:?}");
+            assert!((f / res[0].1 - 1.0).abs() < 0.01, "{per_decade}: {f}");
+            assert!((tr / res[0].2 - 1.0).abs() < 0.02, "{per_decade}: {tr}");
+            assert!((fit.sine[0].1 / tone[0].1 - 1.0).abs() < 1e-3);
+            for s in RESONANCE_SLOT..RESONANCE_SLOT + 3 {
+                assert!(fit.cov[s][s].is_finite() && fit.cov[s][s] > 0.0, "{s}");
+            }
         }
     }
 
@@ -484,6 +588,7 @@ mod tests {
             select: false,
             gm: 0,
             sine: false,
+            resonance: false,
             ieee: [false, true, true, true, false],
         };
         let lo = fit_noise(&taus, &var, &edf_white(&taus, 1e4), FS, &opts).unwrap();

@@ -181,6 +181,26 @@ def test_fit_prints_datasheet_table(capsys, read):
     assert format_value(want["X"], want["X_std"]) in n_row  # rounded to its uncertainty
 
 
+def test_fit_table_lists_the_gauss_markov_and_tone_terms(capsys, read):
+    from imunoise import report
+    from imunoise.cli import bundled_log
+
+    code, out, err = _run(["fit", str(bundled_log()), "--sensor", "gyro", "--fs", "40"], capsys)
+    assert code == 0, err
+    log = read(bundled_log(), fs=40.0)
+    model = imunoise.fit(imunoise.adev(log.gyro, log.fs, taus=report.TAUS_PER_DECADE))
+    # The bundled gyro's model: a tone on X and Y (the 18 Hz line), a GM term on Z.
+    others = [r for r in model.table("gyro") if r["term"] not in "QNBKR"]
+    assert {r["term"] for r in others} >= {"σ1", "τc1", "A", "f0"}
+    lines = out.splitlines()
+    for row in others:
+        line = next(ln for ln in lines if f" {row['term']} " in f" {ln} ")
+        for axis in "XYZ":
+            if row[f"{axis}_supported"]:
+                assert format_value(row[axis], row[f"{axis}_std"]) in line, (row, line)
+        assert "—" in line  # the axes whose model has no such term
+
+
 def test_fit_with_bootstrap_uncertainties(capsys, read):
     from imunoise import report
     from imunoise.cli import bundled_log

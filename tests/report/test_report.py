@@ -183,7 +183,7 @@ def test_model_files_and_tables_match_fit(built):
             assert got[1] == want["term"]
             for j, axis in enumerate("XYZ"):
                 if not want[f"{axis}_supported"]:
-                    assert got[3 + j] == "not resolved"
+                    assert got[3 + j] == want["missing"]
                     continue
                 value, std = _value_std(got[3 + j])
                 # GUM rounding: two significant digits of the std, the value to the same place

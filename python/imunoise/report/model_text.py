@@ -4,6 +4,8 @@ prints the same table and sentences."""
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from imunoise import datasheet, units
@@ -22,8 +24,9 @@ def datasheet_rows(model: NoiseModel, sensor: str) -> tuple[list[str], list[list
     """Noise coefficients per axis in datasheet units, as text.
 
     Returns the header (``quantity, term, unit``, then one column per axis) and
-    one row per term of :meth:`NoiseModel.table`; a cell is ``value ± std`` or
-    ``not resolved`` where the data do not resolve the term.
+    one row per term of :meth:`NoiseModel.table`; a cell is ``value ± std``,
+    ``not resolved`` where the data do not resolve the coefficient, or ``—``
+    where the axis's model has no such term.
     """
     axes = axis_names(model.channels)
     out = []
@@ -31,7 +34,7 @@ def datasheet_rows(model: NoiseModel, sensor: str) -> tuple[list[str], list[list
         cells = [r["quantity"], r["term"], r["unit"]]
         for a in axes:
             if not r[f"{a}_supported"]:
-                cells.append("not resolved")
+                cells.append(r["missing"])
             else:
                 cells.append(format_number(r[a], r[f"{a}_std"]))
         out.append(cells)
@@ -49,7 +52,9 @@ def model_sentences(model: NoiseModel, sensor: str) -> list[str]:
     for c, axis in enumerate(axis_names(model.channels)):
         terms = [t for t in ("N", "B", "K", "Q", "R") if np.atleast_1d(model.supported[t])[c]]
         gm = model.gauss_markov(c)
-        parts = [f"{axis}: {' + '.join(terms + [f'{len(gm)} Gauss–Markov'] * bool(gm))}"]
+        others = ([f"{len(gm)} Gauss–Markov"] * bool(gm) + ["tone"] * bool(model.sine(c))
+                  + ["resonance"] * bool(model.resonance(c)))
+        parts = [f"{axis}: {' + '.join(terms + others)}"]
         cover = float(np.atleast_1d(model.coverage)[c])
         delta = float(np.atleast_1d(model.discrepancy)[c])
         parts.append(f"follows {cover:.0%} of the taus (inside the 95 % interval or within 5 %)"
@@ -69,6 +74,16 @@ def model_sentences(model: NoiseModel, sensor: str) -> list[str]:
                                              sensor=sensor)
             parts.append(f"a tone of amplitude {format_number(value, value_std)} "
                          f"{b_unit.label} at {format_number(f0, f0_std)} Hz")
+        for sigma, f_r, tau_r in model.resonance(c):
+            stds = [float(np.atleast_1d(a)[c]) for a in (
+                model.resonance_sigma_std, model.resonance_freq_std, model.resonance_tau_std)]
+            value, value_std = units.convert(np.array([sigma, stds[0]]), "B", b_unit.name,
+                                             sensor=sensor)
+            parts.append(f"a resonance (damped oscillation, a band rather than a line) of "
+                         f"σ = {format_number(value, value_std)} {b_unit.label} at "
+                         f"{format_number(f_r, stds[1])} Hz, damping time "
+                         f"{format_number(tau_r, stds[2])} s (quality factor "
+                         f"{math.pi * f_r * tau_r:.2g})")
         for term, unit in (("N", n_unit), ("B", b_unit)):
             parts += _readoff_agreement(model, c, term, unit, sensor)
         out.append("; ".join(parts) + ".")
