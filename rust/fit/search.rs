@@ -889,7 +889,10 @@ pub fn prefer_random_walk(
     }
     let mut without = ieee;
     without[RAMP] = false;
-    let alternative = select(data, fs, without, max_gm, kinds)?;
+    // Without the ramp no structure may describe the curve at all: keep it then.
+    let Ok(alternative) = select(data, fs, without, max_gm, kinds) else {
+        return Ok(best);
+    };
     Ok(if alternative.bic < best.bic + RAMP_EVIDENCE {
         alternative
     } else {
