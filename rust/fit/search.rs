@@ -271,10 +271,15 @@ fn nelder_mead(
         .map_or(start[0], |p| p.0)
 }
 
-/// Candidate correlation times: 10^(j/6) s from half a sample (φ = e⁻² ≈ 0.14;
-/// faster is white noise to any cluster size) to three times the longest tau.
+/// Shortest correlation time, in samples: φ = e⁻² ≈ 0.14 at half a sample;
+/// a faster Gauss–Markov term is white noise to any cluster size, and would
+/// take N's place for a percent of shape at the first taus.
+const FASTEST: f64 = 0.5;
+
+/// Candidate correlation times: 10^(j/6) s from [`FASTEST`] samples to three
+/// times the longest tau.
 pub fn time_grid(data: &Data, fs: f64) -> Vec<f64> {
-    let lo = (0.5 / fs).log10();
+    let lo = (FASTEST / fs).log10();
     let hi = (3.0 * data.taus[data.len() - 1]).log10();
     let (a, b) = (
         (lo * PER_DECADE).ceil() as i64,
@@ -340,7 +345,8 @@ impl Searcher<'_> {
     fn polish(&self, times: &mut [f64], span: f64) {
         for _round in 0..2 {
             for which in 0..times.len() {
-                let mut lo = times[which] / span;
+                // The refinement stays within the grid's range too.
+                let mut lo = (times[which] / span).max(FASTEST / self.fs);
                 let mut hi = times[which] * span;
                 // Two terms closer than a factor of 2 in τc are one term.
                 if which > 0 {
