@@ -554,7 +554,10 @@ def _change_points(seg: np.ndarray, nu: float) -> tuple[int, int]:
     maximises the log-likelihood ratio Σ ℓ_i of v against 1. v is first the mean
     over all of ``seg`` (diluted by the noise around the burst), then the mean
     over the segment found; a second pass that loses the first segment (a
-    decaying burst's variance is not one number) keeps the first.
+    decaying burst's variance is not one number) keeps the first. The start is then
+    placed once more with the variance of the segment's first quarter (at least 4
+    samples): a decaying burst is loudest at its onset, and with its mean variance
+    the slightly raised noise just before it would join it.
 
     ℓ_i is the Student-t (ν from :func:`_tail_dof`) log-likelihood ratio of a
     scale change, not the Gaussian z²(1 − 1/v) − ln v: one large sample adds at most
