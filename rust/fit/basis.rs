@@ -44,26 +44,7 @@ pub fn gauss_markov(m: f64, u: f64) -> f64 {
     let x = m * u;
     let d = -(-u).exp_m1(); // 1 − φ
     let numerator = if x < 0.5 {
-        let mut sum = 0.0;
-        let (mut p2, mut p1, mut pm1, mut p2m1) = (1.0, 1.0, 1.0, 1.0);
-        let mut fact = 1.0;
-        for k in 1..=40 {
-            p2 *= 2.0 * u;
-            p1 *= u;
-            pm1 *= (m + 1.0) * u;
-            p2m1 *= (2.0 * m + 1.0) * u;
-            fact *= k as f64;
-            if k < 3 {
-                continue;
-            }
-            let c = -m * p2 - 3.0 * p1 + 4.0 * pm1 - p2m1;
-            let term = if k % 2 == 0 { c / fact } else { -c / fact };
-            sum += term;
-            if term.abs() <= 1e-17 * sum.abs() {
-                break;
-            }
-        }
-        sum
+        cancelling_numerator(m, u, Complex64::new(1.0, 0.0)).re
     } else {
         let phi = (-u).exp();
         let e = -(-x).exp_m1(); // 1 − φᵐ
@@ -113,36 +94,43 @@ pub fn resonance(m: f64, u: f64, theta: f64) -> f64 {
     let r = w.norm();
     let d = -expm1(-w); // 1 − z
     let numerator = if m * r < 0.5 {
-        let phase = Complex64::from_polar(1.0, w.arg());
-        let mut sum = Complex64::new(0.0, 0.0);
-        let mut turn = Complex64::new(1.0, 0.0);
-        let (mut p2, mut p1, mut pm1, mut p2m1) = (1.0, 1.0, 1.0, 1.0);
-        let mut fact = 1.0;
-        for k in 1..=40 {
-            p2 *= 2.0 * r;
-            p1 *= r;
-            pm1 *= (m + 1.0) * r;
-            p2m1 *= (2.0 * m + 1.0) * r;
-            fact *= k as f64;
-            turn *= phase;
-            if k < 3 {
-                continue;
-            }
-            let c = -m * p2 - 3.0 * p1 + 4.0 * pm1 - p2m1;
-            let sign = if k % 2 == 0 { 1.0 } else { -1.0 };
-            let term = turn * (sign * c / fact);
-            sum += term;
-            if term.norm() <= 1e-17 * sum.norm() {
-                break;
-            }
-        }
-        sum
+        cancelling_numerator(m, r, Complex64::from_polar(1.0, w.arg()))
     } else {
         let z = (-w).exp();
         let e = -expm1(-w * m); // 1 − zᵐ
         d * (2.0 - d) * m - z * e * (2.0 + e)
     };
     (numerator / (d * d * (m * m))).re.max(0.0)
+}
+
+/// The numerator m(1 − z²) − z(1 − zᵐ)(3 − zᵐ) of the Gauss–Markov form at
+/// z = e^(−w), w = r·e^(iα) (`phase` = e^(iα); 1 for the real AR1), where it
+/// cancels to O((m|w|)³): summed as its Taylor series, whose k-th term is
+/// (−1)ᵏ/k!·[−m·2ᵏ − 3 + 4(m+1)ᵏ − (2m+1)ᵏ]·rᵏ·e^(ikα) (the terms k ≤ 2 vanish).
+fn cancelling_numerator(m: f64, r: f64, phase: Complex64) -> Complex64 {
+    let mut sum = Complex64::new(0.0, 0.0);
+    let mut turn = Complex64::new(1.0, 0.0);
+    let (mut p2, mut p1, mut pm1, mut p2m1) = (1.0, 1.0, 1.0, 1.0);
+    let mut fact = 1.0;
+    for k in 1..=40 {
+        p2 *= 2.0 * r;
+        p1 *= r;
+        pm1 *= (m + 1.0) * r;
+        p2m1 *= (2.0 * m + 1.0) * r;
+        fact *= k as f64;
+        turn *= phase;
+        if k < 3 {
+            continue;
+        }
+        let c = -m * p2 - 3.0 * p1 + 4.0 * pm1 - p2m1;
+        let sign = if k % 2 == 0 { 1.0 } else { -1.0 };
+        let term = turn * (sign * c / fact);
+        sum += term;
+        if term.norm() <= 1e-17 * sum.norm() {
+            break;
+        }
+    }
+    sum
 }
 
 /// e^w − 1 without the cancellation of e^w − 1 for small |w|.
