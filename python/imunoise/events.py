@@ -314,6 +314,7 @@ def events(
     # (false-alarm budget split between them)
     windows = sorted({max(MIN_WINDOW, w >> i) for i in range(BURST_SCALES)}, reverse=True)
     p_window = min(0.5, false_alarm * w / (2 * OVERLAP_FACTOR * len(windows)))
+    p_v = [min(0.5, false_alarm * v / (2 * OVERLAP_FACTOR * len(windows))) for v in windows]
     touch = windows[-1] // 2
     gap = int(round(merge * fs))
 
@@ -338,8 +339,6 @@ def events(
             scale, rho = _energy_law(np.where(quiet, r, np.nan), w)
             z = r / np.sqrt(scale)
             spans = _spikes(z, k_spike)
-            p_v = [min(0.5, false_alarm * v / (2 * OVERLAP_FACTOR * len(windows)))
-                   for v in windows]
             quiet_level = _sstats.chi2.isf(p_v[-1], _dof(rho, windows[-1])) / _dof(
                 rho, windows[-1])
             isolated = _isolated(z, k_spike, touch, quiet_level)
@@ -568,10 +567,7 @@ def _change_points(seg: np.ndarray, nu: float) -> tuple[int, int]:
     for _ in range(2):
         inside = seg[start:end]
         inside = inside[np.isfinite(inside)]
-        v = max(float(inside.mean()) if inside.size else 1.0, 1.0 + 1e-9)
-        ell = -0.5 * np.log(v) - (nu + 1) / 2 * (np.log1p(seg / (nu * v)) - np.log1p(seg / nu))
-        ell = np.where(np.isfinite(ell), ell, 0.0)  # spikes and missing samples: no say
-        s = np.concatenate(([0.0], np.cumsum(ell)))
+        s = _cumulative_log_ratio(seg, inside, nu)
         new_end = int(np.argmax(s))
         new_start = int(np.argmin(s[: new_end + 1]))
         if new_end <= new_start or (found[1] and (new_end <= found[0] or new_start >= found[1])):
@@ -583,14 +579,19 @@ def _change_points(seg: np.ndarray, nu: float) -> tuple[int, int]:
         # mean variance lets the raised noise just before it in
         head = min(end, start + max(4, (end - start) // 4))
         inside = seg[start:head]
-        inside = inside[np.isfinite(inside)]
-        v = max(float(inside.mean()) if inside.size else 1.0, 1.0 + 1e-9)
-        ell = -0.5 * np.log(v) - (nu + 1) / 2 * (np.log1p(seg[:head] / (nu * v))
-                                                 - np.log1p(seg[:head] / nu))
-        ell = np.where(np.isfinite(ell), ell, 0.0)
-        s = np.concatenate(([0.0], np.cumsum(ell)))
+        s = _cumulative_log_ratio(seg[:head], inside[np.isfinite(inside)], nu)
         found = (int(np.argmin(s)), end)
     return found
+
+
+def _cumulative_log_ratio(seg: np.ndarray, inside: np.ndarray, nu: float) -> np.ndarray:
+    """0, ℓ_0, ℓ_0 + ℓ_1, …: the running Student-t log-likelihood ratio of the scale
+    v = mean(``inside``) (at least 1) against 1 over ``seg``; NaN samples (spikes,
+    missing) have no say."""
+    v = max(float(inside.mean()) if inside.size else 1.0, 1.0 + 1e-9)
+    ell = -0.5 * np.log(v) - (nu + 1) / 2 * (np.log1p(seg / (nu * v)) - np.log1p(seg / nu))
+    ell = np.where(np.isfinite(ell), ell, 0.0)
+    return np.concatenate(([0.0], np.cumsum(ell)))
 
 
 def _peak(z: np.ndarray) -> float:
