@@ -29,3 +29,9 @@ class StandInResult:
 def allan(x, fs):
     """Overlapping ADEV at octave taus."""
     return imunoise.adev(x, fs, taus="octave", overlapping=True)
+
+
+def quiet_fit(result, **kwargs):
+    """``imunoise.fit`` without the coverage warning (the curves these tests fit
+    are meant to be hard)."""
+    return imunoise.fit(result, warn_coverage=False, **kwargs)

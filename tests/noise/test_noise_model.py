@@ -15,16 +15,11 @@ from pathlib import Path
 import imunoise
 import numpy as np
 import pytest
+from helpers.noise_fit import quiet_fit
 from imunoise import export
 
 FS = 50.0
 REAL_LOG = Path(imunoise.__file__).parent / "data" / "vn100_stationary_5min.txt"
-
-
-def _quiet_fit(result, **kwargs):
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", RuntimeWarning)
-        return imunoise.fit(result, **kwargs)
 
 
 @pytest.fixture(scope="module")
@@ -85,7 +80,7 @@ def test_rate_random_walk_wins_a_tie_with_a_rate_ramp():
         x = imunoise.simulate(int(5 * 3600 * 40), 40.0, channels=3, seed=seed,
                               N=0.0035 * deg, K=20 * deg / 3600 / 60,
                               gm=[(10 * deg / 3600, 60.0)])
-        model = _quiet_fit(imunoise.adev(x, 40.0, taus=10))
+        model = quiet_fit(imunoise.adev(x, 40.0, taus=10))
         ramps += int(np.sum(model.supported["R"]))
     assert ramps <= 1
 
@@ -93,7 +88,7 @@ def test_rate_random_walk_wins_a_tie_with_a_rate_ramp():
 def test_a_real_rate_ramp_is_kept():
     x = imunoise.simulate(int(3 * 3600 * 40), 40.0, channels=2, seed=5, N=1e-3, K=1e-6,
                           R=2e-7)
-    model = _quiet_fit(imunoise.adev(x, 40.0, taus=10))
+    model = quiet_fit(imunoise.adev(x, 40.0, taus=10))
     assert np.all(model.supported["R"])
     assert model.R == pytest.approx(2e-7, rel=0.2)
 
@@ -103,7 +98,7 @@ def test_coefficients_do_not_depend_on_the_tau_grid(seed):
     """Octave, 5, 10, 20 and 50 taus per decade: N, B, K within two standard
     uncertainties wherever every grid's model has the term."""
     x = imunoise.simulate(int(2 * 3600 * FS), FS, N=1e-3, B=2e-4, K=1e-5, seed=seed)
-    fits = {g: _quiet_fit(imunoise.adev(x, FS, taus=g)) for g in ("octave", 5, 10, 20, 50)}
+    fits = {g: quiet_fit(imunoise.adev(x, FS, taus=g)) for g in ("octave", 5, 10, 20, 50)}
     assert all(bool(m.supported["N"]) for m in fits.values())
     for term in ("N", "B", "K"):
         vals = np.array([float(m.value(term)[0]) for m in fits.values()])
@@ -125,7 +120,7 @@ def test_real_vn100_log_is_followed_on_every_grid():
     log = imunoise.read(REAL_LOG)
     n_eq = []
     for grid in ("octave", 5, 10, 20, 50):
-        model = _quiet_fit(imunoise.adev(log.gyro, log.fs, taus=grid))
+        model = quiet_fit(imunoise.adev(log.gyro, log.fs, taus=grid))
         assert np.all(model.coverage >= 0.8), (grid, model.coverage)
         n_eq.append(model.equivalent("N"))
     n_eq = np.array(n_eq)

@@ -12,13 +12,13 @@ from __future__ import annotations
 
 import json
 import math
-import warnings
 
 import imunoise
 import imunoise.plot
 import matplotlib
 import numpy as np
 import pytest
+from helpers.noise_fit import quiet_fit
 from imunoise import export, report
 from imunoise._core import fit as core_fit
 from imunoise.noise import resonance_white_density
@@ -35,12 +35,6 @@ def _curve(taus, *, tone=(), resonance=()):
     Rust closed forms."""
     t = np.ascontiguousarray(taus, dtype=float)
     return core_fit.noise_terms(t, FS, NO_IEEE, [], list(tone), list(resonance))[:, -1]
-
-
-def _fit(result, **kwargs):
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", RuntimeWarning)
-        return imunoise.fit(result, **kwargs)
 
 
 @pytest.fixture(scope="module")
@@ -87,7 +81,7 @@ def test_simulate_rejects_a_bad_resonance():
 
 
 def test_resonance_is_selected_and_recovered(resonant):
-    model = _fit(resonant)
+    model = quiet_fit(resonant)
     for c in range(2):
         assert len(model.resonance(c)) == 1, model
         sigma, f_r, tau_r = model.resonance(c)[0]
@@ -108,8 +102,8 @@ def test_resonance_is_selected_and_recovered(resonant):
 
 
 def test_without_the_resonance_the_model_misses_the_curve(resonant):
-    plain = _fit(resonant, terms=["N", "K", "GM", "sine"])
-    with_it = _fit(resonant, terms=["N", "K", "resonance"])
+    plain = quiet_fit(resonant, terms=["N", "K", "GM", "sine"])
+    with_it = quiet_fit(resonant, terms=["N", "K", "resonance"])
     assert np.all(with_it.discrepancy < plain.discrepancy)
     assert np.all(with_it.coverage >= plain.coverage)
 
@@ -119,7 +113,7 @@ def test_clean_five_term_data_selects_no_resonance(seed):
     x = imunoise.simulate(int(2 * 3600 * FS), FS, N=1e-3, B=3e-5, K=2e-6, channels=3,
                           seed=seed)
     for grid in ("octave", 10, 20):
-        model = _fit(imunoise.adev(x, FS, taus=grid))
+        model = quiet_fit(imunoise.adev(x, FS, taus=grid))
         assert all(model.resonance(c) == [] for c in range(3)), (grid, model)
         assert np.all(np.isnan(model.resonance_sigma))
 
@@ -127,14 +121,14 @@ def test_clean_five_term_data_selects_no_resonance(seed):
 def test_gauss_markov_and_tone_data_select_no_resonance():
     x = imunoise.simulate(int(2 * 3600 * FS), FS, N=2e-3, channels=2, seed=21,
                           gm=[(4e-3, 20.0)], sinusoid=(2e-2, 7.3))
-    model = _fit(imunoise.adev(x, FS, taus=20))
+    model = quiet_fit(imunoise.adev(x, FS, taus=20))
     for c in range(2):
         assert model.resonance(c) == []
         assert len(model.sine(c)) == 1 and len(model.gauss_markov(c)) == 1
 
 
 def test_resonance_in_prediction_table_dict_repr_plot_and_report(resonant):
-    model = _fit(resonant)
+    model = quiet_fit(resonant)
     p = model.predict(resonant.taus)
     assert "resonance" in p.terms
     total = sum(v**2 for v in p.terms.values())
@@ -157,7 +151,7 @@ def test_resonance_in_prediction_table_dict_repr_plot_and_report(resonant):
 
 
 def test_the_ekf_export_folds_the_resonance_into_the_white_noise(resonant):
-    model = _fit(resonant)
+    model = quiet_fit(resonant)
     axes = export.ekf_dict(gyro=model)["gyroscope"]["axes"]
     for c, name in enumerate(["ch0", "ch1"]):
         sigma, f_r, tau_r = model.resonance(c)[0]
@@ -170,7 +164,7 @@ def test_the_ekf_export_folds_the_resonance_into_the_white_noise(resonant):
 def test_explicit_resonance_terms_are_checked(resonant):
     with pytest.raises(ValueError, match="'resonance' at most once"):
         imunoise.fit(resonant, terms=["N", "resonance", "resonance"])
-    only = _fit(resonant, terms=["N", "resonance"])
+    only = quiet_fit(resonant, terms=["N", "resonance"])
     assert all(len(only.resonance(c)) == 1 for c in range(2))
     assert not np.any(only.supported["K"])
 
@@ -179,7 +173,7 @@ def test_a_table_row_is_a_dash_where_an_axis_has_no_resonance(resonant):
     x = np.column_stack([np.asarray(imunoise.simulate(int(3600 * FS), FS, N=1e-3, seed=2)),
                          imunoise.simulate(int(3600 * FS), FS, N=1e-3, seed=3,
                                            resonance=(2e-2, 30.0, 0.05))])
-    model = _fit(imunoise.adev(x, FS, taus=20))
+    model = quiet_fit(imunoise.adev(x, FS, taus=20))
     assert model.resonance(0) == [] and len(model.resonance(1)) == 1
     row = next(r for r in model.table("gyro") if r["term"] == "f_r")
     assert not row["X_supported"] and row["Y_supported"] and row["missing"] == "—"
@@ -190,7 +184,7 @@ def test_bootstrap_simulates_and_refits_the_resonance():
     t = TRUTH
     x = imunoise.simulate(int(1800 * FS), FS, N=t["N"], seed=9,
                           resonance=(t["sigma"], t["f_r"], t["tau_r"]))
-    model = _fit(imunoise.adev(x, FS, taus=10), uncertainty="bootstrap", replicates=6, seed=2)
+    model = quiet_fit(imunoise.adev(x, FS, taus=10), uncertainty="bootstrap", replicates=6, seed=2)
     assert len(model.resonance(0)) == 1
     sigma, f_r, tau_r = model.resonance(0)[0]
     stds = [float(a) for a in (model.resonance_sigma_std, model.resonance_freq_std,

@@ -10,23 +10,17 @@ from __future__ import annotations
 
 import json
 import math
-import warnings
 
 import imunoise
 import imunoise.plot
 import matplotlib
 import numpy as np
 import pytest
+from helpers.noise_fit import quiet_fit
 
 matplotlib.use("Agg")
 
 FS = 100.0
-
-
-def _fit(result, **kwargs):
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", RuntimeWarning)
-        return imunoise.fit(result, **kwargs)
 
 
 @pytest.fixture(scope="module")
@@ -59,7 +53,7 @@ def test_simulate_rejects_a_bad_tone():
 
 def test_tone_is_selected_and_recovered(toned):
     truth, r = toned
-    model = _fit(r)
+    model = quiet_fit(r)
     for c in range(2):
         tone = model.sine(c)
         assert len(tone) == 1, model
@@ -74,8 +68,8 @@ def test_tone_is_selected_and_recovered(toned):
 
 def test_without_the_tone_the_model_misses_the_curve(toned):
     _, r = toned
-    plain = _fit(r, terms=["N", "K", "GM", "GM"])
-    toned_fit = _fit(r, terms=["N", "K", "sine"])
+    plain = quiet_fit(r, terms=["N", "K", "GM", "GM"])
+    toned_fit = quiet_fit(r, terms=["N", "K", "sine"])
     assert np.all(toned_fit.coverage > plain.coverage)
     assert np.all(toned_fit.discrepancy < plain.discrepancy)
 
@@ -85,7 +79,7 @@ def test_clean_five_term_data_selects_no_tone(seed):
     x = imunoise.simulate(int(2 * 3600 * FS), FS, N=1e-3, B=3e-5, K=2e-6, channels=3,
                           seed=seed)
     for grid in ("octave", 10, 20):
-        model = _fit(imunoise.adev(x, FS, taus=grid))
+        model = quiet_fit(imunoise.adev(x, FS, taus=grid))
         assert all(model.sine(c) == [] for c in range(3)), (grid, model)
         assert np.all(np.isnan(model.sine_amplitude))
 
@@ -93,7 +87,7 @@ def test_clean_five_term_data_selects_no_tone(seed):
 def test_gauss_markov_data_selects_no_tone():
     x = imunoise.simulate(int(2 * 3600 * FS), FS, N=2e-3, channels=2, seed=21,
                           gm=[(4e-3, 20.0)])
-    model = _fit(imunoise.adev(x, FS, taus=20))
+    model = quiet_fit(imunoise.adev(x, FS, taus=20))
     for c in range(2):
         assert model.sine(c) == []
         assert len(model.gauss_markov(c)) == 1
@@ -101,7 +95,7 @@ def test_gauss_markov_data_selects_no_tone():
 
 def test_tone_in_prediction_dict_repr_and_plot(toned):
     truth, r = toned
-    model = _fit(r)
+    model = quiet_fit(r)
     p = model.predict(r.taus)
     assert "sine" in p.terms
     x_ = np.pi * model.sine(0)[0][1] * r.taus
@@ -125,7 +119,7 @@ def test_explicit_sine_terms_are_checked(toned):
     _, r = toned
     with pytest.raises(ValueError, match="'sine' at most once"):
         imunoise.fit(r, terms=["N", "sine", "sine"])
-    only = _fit(r, terms=["N", "sine"])
+    only = quiet_fit(r, terms=["N", "sine"])
     assert all(len(only.sine(c)) == 1 for c in range(2))
     assert not np.any(only.supported["K"])
 
@@ -133,7 +127,7 @@ def test_explicit_sine_terms_are_checked(toned):
 def test_bootstrap_simulates_and_refits_the_tone():
     x = imunoise.simulate(int(1800 * FS), FS, N=1e-3, seed=9, sinusoid=(4e-3, 7.3))
     r = imunoise.adev(x, FS, taus=10)
-    model = _fit(r, uncertainty="bootstrap", replicates=6, seed=2)
+    model = quiet_fit(r, uncertainty="bootstrap", replicates=6, seed=2)
     assert model.sine(0) != []
     amp_std, f_std = float(model.sine_amplitude_std), float(model.sine_freq_std)
     # The replicates' spread is small next to the tone yet not zero.

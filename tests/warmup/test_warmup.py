@@ -55,6 +55,15 @@ def test_constant_channel_never_needs_to_settle():
     assert found.settle == 0 and found.tolerance[0] == np.inf
 
 
+def _fits_around_trimming(x, fs):
+    """The warm-up found in ``x`` and the N + K + R models fitted before and after
+    trimming it."""
+    found = imunoise.warmup(x, fs)
+    fits = [imunoise.fit(imunoise.adev(y, fs), terms=["N", "K", "R"], warn_coverage=False)
+            for y in (x, found.trim(x))]
+    return found, *fits
+
+
 @pytest.mark.parametrize("seed", [11, 12])
 def test_rate_random_walk_after_trimming_is_the_truth(seed):
     """A 4 h log with rate random walk K and a 20 min transient: the transient reads
@@ -63,11 +72,8 @@ def test_rate_random_walk_after_trimming_is_the_truth(seed):
     n = int(hours * 3600 * fs)
     t = np.arange(n) / fs
     x = imunoise.simulate(n, fs, N=2e-3, K=k_true, seed=seed) + 3e-3 * np.exp(-t / 1200)
-    found = imunoise.warmup(x, fs)
+    found, before, after = _fits_around_trimming(x, fs)
     assert found.significant[0] and 0 < found.settle < 3 * 3600
-    terms = ["N", "K", "R"]
-    before = imunoise.fit(imunoise.adev(x, fs), terms=terms, warn_coverage=False)
-    after = imunoise.fit(imunoise.adev(found.trim(x), fs), terms=terms, warn_coverage=False)
     k_before, k_before_std = float(before.value("K")[0]), float(before.std("K")[0])
     assert k_before - k_true > 2 * k_before_std
     k_after, k_std = float(after.value("K")[0]), float(after.std("K")[0])
@@ -145,11 +151,8 @@ def test_rate_ramp_after_trimming_is_the_truth(seed):
     n = int(hours * 3600 * fs)
     t = np.arange(n) / fs
     x = imunoise.simulate(n, fs, N=2e-3, R=r_true, seed=seed) + 1e-2 * np.exp(-t / 1200)
-    found = imunoise.warmup(x, fs)
+    found, before, after = _fits_around_trimming(x, fs)
     assert found.significant[0] and 0 < found.settle < 2 * 3600
-    terms = ["N", "K", "R"]
-    before = imunoise.fit(imunoise.adev(x, fs), terms=terms, warn_coverage=False)
-    after = imunoise.fit(imunoise.adev(found.trim(x), fs), terms=terms, warn_coverage=False)
     assert float(before.value("K")[0]) > 5 * float(before.std("K")[0])  # spurious: K = 0
     r_after, r_std = float(after.value("R")[0]), float(after.std("R")[0])
     assert abs(r_after - r_true) <= 2 * r_std
