@@ -554,9 +554,10 @@ def _change_points(seg: np.ndarray, nu: float) -> tuple[int, int]:
     over all of ``seg`` (diluted by the noise around the burst), then the mean
     over the segment found; a second pass that loses the first segment (a
     decaying burst's variance is not one number) keeps the first. The start is then
-    placed once more with the variance of the segment's first quarter (at least 4
-    samples): a decaying burst is loudest at its onset, and with its mean variance
-    the slightly raised noise just before it would join it.
+    placed once more, no later than the segment's loudest quarter (at least 4
+    samples) and with that quarter's variance: with a diluted variance the slightly
+    raised noise just before a burst would join it. A burst that swells slowly
+    starts about where its variance has tripled.
 
     ℓ_i is the Student-t (ν from :func:`_tail_dof`) log-likelihood ratio of a
     scale change, not the Gaussian z²(1 − 1/v) − ln v: one large sample adds at most
@@ -575,13 +576,27 @@ def _change_points(seg: np.ndarray, nu: float) -> tuple[int, int]:
         start, end = found = (new_start, new_end)
     start, end = found
     if end > start:
-        # the onset: a decaying burst is loudest where it starts, and the segment's
-        # mean variance lets the raised noise just before it in
-        head = min(end, start + max(4, (end - start) // 4))
-        inside = seg[start:head]
-        s = _cumulative_log_ratio(seg[:head], inside[np.isfinite(inside)], nu)
-        found = (int(np.argmin(s)), end)
+        # the onset, placed with the variance of the segment's loudest quarter: the
+        # segment's mean variance (or its first quarter's, when the segment already
+        # begins early) is diluted, and raised noise just before the burst then joins it
+        length = max(4, (end - start) // 4)
+        loudest = start + _loudest_window(seg[start:end], length)
+        inside = seg[loudest:loudest + length]
+        s = _cumulative_log_ratio(seg[:loudest + length], inside[np.isfinite(inside)], nu)
+        found = (int(np.argmin(s[: loudest + 1])), end)
     return found
+
+
+def _loudest_window(seg: np.ndarray, length: int) -> int:
+    """Start of the ``length``-sample window of ``seg`` with the largest mean (NaN =
+    no say); 0 if ``seg`` is not longer than ``length``."""
+    if len(seg) <= length:
+        return 0
+    valid = np.isfinite(seg)
+    total = np.concatenate(([0.0], np.cumsum(np.where(valid, seg, 0.0))))
+    count = np.concatenate(([0], np.cumsum(valid)))
+    mean = (total[length:] - total[:-length]) / np.maximum(count[length:] - count[:-length], 1)
+    return int(np.argmax(mean))
 
 
 def _cumulative_log_ratio(seg: np.ndarray, inside: np.ndarray, nu: float) -> np.ndarray:
