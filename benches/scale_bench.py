@@ -52,7 +52,7 @@ print(json.dumps(out))
 
 def generate(path: Path, size: int) -> tuple[int, float]:
     import imunoise
-    from imunoise.simulate_log import still_log
+    from imunoise._simulate_log import still_log
 
     t = time.perf_counter()
     seed = 0

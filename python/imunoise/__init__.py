@@ -7,6 +7,11 @@ plots and reports. Start with ``imunoise.adev(x, fs)``.
 
 from imunoise import export, units
 from imunoise._core import __version__
+from imunoise._events import Events, events
+from imunoise._simulate import simulate
+from imunoise._simulate_log import simulate_log
+from imunoise._thermal import Thermal, thermal
+from imunoise._warmup import Warmup, warmup
 from imunoise.allan import (
     AllanResult,
     adev,
@@ -24,17 +29,12 @@ from imunoise.allan import (
 from imunoise.datasheet import compare
 from imunoise.dynamic import DynamicAllan, dynamic_adev
 from imunoise.errors import ParseError
-from imunoise.events import Events, events
 from imunoise.noise import NoiseModel, fit
 from imunoise.readers import Gaps, ImuLog, ParseIssues
 from imunoise.readers.read import read
 from imunoise.scale import batch
-from imunoise.simulate import simulate
-from imunoise.simulate_log import simulate_log
 from imunoise.spectrum import Spectrum, psd
 from imunoise.stats import describe, distribution
-from imunoise.thermal import Thermal, thermal
-from imunoise.warmup import Warmup, warmup
 from imunoise.writers.vn import write_vn_ascii, write_vn_binary
 
 __all__ = [

@@ -545,7 +545,7 @@ def _cmd_batch(args) -> int:
 
 
 def _cmd_simulate(args) -> int:
-    from imunoise.simulate_log import simulate_log
+    from imunoise._simulate_log import simulate_log
 
     out = simulate_log(args.output, args.hours, args.fs, format=args.format, seed=args.seed)
     print(f"wrote {args.hours:g} h at {args.fs:g} Hz ({args.format}) to {out}")
@@ -561,7 +561,7 @@ def bundled_log() -> Path:
 
 def _cmd_demo(args) -> int:
     from imunoise import report
-    from imunoise.simulate_log import still_log
+    from imunoise._simulate_log import still_log
 
     short = bundled_log()
     long = still_log(args.hours, 40.0, spec="vn100", seed=args.seed)
@@ -573,7 +573,7 @@ def _cmd_demo(args) -> int:
 
 
 def _cmd_events(args) -> int:
-    from imunoise import events
+    from imunoise._events import events
 
     log = _read(args)
     found = events(log, false_alarm=args.false_alarm)
@@ -586,7 +586,8 @@ def _cmd_events(args) -> int:
 
 
 def _cmd_thermal(args) -> int:
-    from imunoise import thermal, warmup
+    from imunoise._thermal import thermal
+    from imunoise._warmup import warmup
     from imunoise.numbers import format_value
 
     log = _read(args)

@@ -155,7 +155,9 @@ def _terms(taus, fs: float, coef, markov=(), tone=(), resonance=()) -> np.ndarra
     ``coef`` holds Q…R, ``markov`` (sigma, tau_c) pairs, ``tone`` (amplitude, f0)
     pairs, ``resonance`` (sigma, f_r, tau_r) triples."""
     t = np.ascontiguousarray(np.atleast_1d(np.asarray(taus, dtype=float)))
-    return _core_fit.noise_terms(t, float(fs), [float(c) ** 2 for c in coef],
+    with np.errstate(over="ignore"):  # a coefficient near 1e154 squares to inf, not an error
+        squares = np.square(np.asarray(coef, dtype=float)).tolist()
+    return _core_fit.noise_terms(t, float(fs), squares,
                              [(s * s, tc) for s, tc in markov],
                              [(a * a / 2, f0) for a, f0 in tone],
                              [(s * s, f, tr) for s, f, tr in resonance])
@@ -1139,8 +1141,8 @@ def _bootstrap_std(result, coef, markov, oscillators, replicates, rng, options):
     """Standard deviation of each coefficient (and Gauss–Markov σ, τc, tone A, f0
     and resonance σ, f_r, τr) over fits to records simulated from the model with
     the length, rate and taus of ``result``; ``oscillators`` is (tones, resonances)."""
+    from imunoise._simulate import simulate
     from imunoise.allan import adev
-    from imunoise.simulate import simulate
 
     tones, oscs = oscillators
     n = _record_length(result)

@@ -7,7 +7,7 @@ from importlib import resources
 import imunoise
 import numpy as np
 import pytest
-from imunoise.events import FALSE_ALARM, Events
+from imunoise._events import FALSE_ALARM, Events
 
 FS = 100.0
 LOG = resources.files("imunoise") / "data" / "vn100_stationary_5min.txt"

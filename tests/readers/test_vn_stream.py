@@ -6,8 +6,8 @@ import imunoise
 import numpy as np
 import pytest
 from imunoise._core import vn as _core_vn
+from imunoise._simulate_log import still_log
 from imunoise.errors import ParseError
-from imunoise.simulate_log import still_log
 
 
 def _damaged() -> bytes:

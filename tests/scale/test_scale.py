@@ -11,9 +11,9 @@ import imunoise
 import numpy as np
 import pytest
 from imunoise import scale
+from imunoise._simulate_log import still_log
 from imunoise.cli import main
 from imunoise.scale.convert import _Steps
-from imunoise.simulate_log import still_log
 
 FS = 40.0
 

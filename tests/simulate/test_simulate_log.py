@@ -3,8 +3,8 @@
 import imunoise
 import numpy as np
 import pytest
+from imunoise._simulate_log import flicker_for_floor, noise_of_spec, simulate_log, still_log
 from imunoise.noise import FLICKER, model_variance
-from imunoise.simulate_log import flicker_for_floor, noise_of_spec, simulate_log, still_log
 
 
 def _floor(terms):

@@ -18,16 +18,16 @@ import numpy as np
 from imunoise import _schema, export, noise, plot, stats
 from imunoise import allan as _allan
 from imunoise._core import __version__
+from imunoise._events import Events, events
 from imunoise._progress import Progress
 from imunoise._schema import ALLAN_SENSORS, ATTITUDE_NAMES, SAMPLE_SENSORS, sensor_label
-from imunoise.events import Events, events
+from imunoise._thermal import Thermal, thermal
+from imunoise._warmup import Warmup, warmup
 from imunoise.readers.log import ImuLog
 from imunoise.report import sections
 from imunoise.report.document import Doc
 from imunoise.report.formatting import format_duration
 from imunoise.report.inputs import read_log
-from imunoise.thermal import Thermal, thermal
-from imunoise.warmup import Warmup, warmup
 
 __all__ = ["SECTIONS", "TAUS_PER_DECADE", "TITLE", "Context", "Report", "Section", "build"]
 

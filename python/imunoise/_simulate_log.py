@@ -23,11 +23,11 @@ import numpy as np
 
 from imunoise import _schema
 from imunoise._deprecation import old_call_forms
+from imunoise._simulate import simulate
 from imunoise._validate import positive_finite, sample_rate
 from imunoise.datasheet import load_spec
 from imunoise.noise import FLICKER, model_variance
 from imunoise.readers.log import ImuLog
-from imunoise.simulate import simulate
 from imunoise.units import convert_back
 from imunoise.writers.vn import write_vn_ascii, write_vn_binary
 

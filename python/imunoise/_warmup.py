@@ -57,10 +57,10 @@ from scipy import stats as _stats
 
 from imunoise import _summary
 from imunoise._channels import rate_channels
+from imunoise._simulate import simulate
 from imunoise.allan import adev
 from imunoise.noise import fit, model_variance
 from imunoise.readers.log import ImuLog
-from imunoise.simulate import simulate
 
 __all__ = ["Warmup", "warmup", "ALPHA"]
 
