@@ -5,6 +5,8 @@ from __future__ import annotations
 import math
 import numbers
 
+import numpy as np
+
 
 def positive_finite(value, name: str, *, unit: str | None = None) -> float:
     """``value`` as a float, or ``TypeError``/``ValueError`` naming ``name``.
@@ -36,3 +38,41 @@ def integer(value, name: str, minimum: int) -> int:
     if value < minimum:
         raise ValueError(f"{name} must be >= {minimum}; got {value!r}")
     return int(value)
+
+
+def samples(x, name: str = "x") -> tuple[np.ndarray, bool]:
+    """float64 ``(n, channels)`` view or copy of samples ``x`` (NaN = missing), and
+    whether ``x`` was 1-D."""
+    arr = x if isinstance(x, np.ndarray) else np.asarray(x)
+    if arr.dtype.kind not in "iuf":
+        raise TypeError(f"{name} must be an array of real numbers; got dtype {arr.dtype}")
+    if arr.ndim not in (1, 2):
+        raise ValueError(
+            f"{name} must be 1-D (n,) or 2-D (n, channels); got {arr.ndim}-D shape {arr.shape}"
+        )
+    if arr.shape[0] == 0:
+        raise ValueError(f"{name} must not be empty; got 0 samples")
+    if arr.ndim == 2 and arr.shape[1] == 0:
+        raise ValueError(f"{name} must have at least one channel; got shape {arr.shape}")
+    data = arr.astype(np.float64, copy=False)
+    return (data[:, None], True) if data.ndim == 1 else (data, False)
+
+
+def no_infinity(data: np.ndarray, name: str = "x") -> None:
+    """``ValueError`` naming the first ±inf sample of ``data`` (NaN, a missing sample,
+    is allowed)."""
+    bad = np.isinf(data)
+    if bad.any():
+        first = np.argwhere(bad)[0]
+        raise ValueError(f"{name} must be finite or NaN (a missing sample); sample "
+                         f"{int(first[0])} is {data[tuple(first)]}")
+
+
+def confidence_level(value) -> float:
+    """A two-sided confidence level in (0, 1) as a float."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise TypeError(f"confidence must be a number in (0, 1); got {value!r}")
+    level = float(value)
+    if not 0.0 < level < 1.0:
+        raise ValueError(f"confidence must be in (0, 1); got {value!r}")
+    return level

@@ -74,7 +74,6 @@ autocorrelation", Proc. 18th EFTF (2004).
 
 from __future__ import annotations
 
-import numbers
 import warnings
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
@@ -87,6 +86,7 @@ from scipy import stats as _stats
 
 from imunoise import _schema, _summary
 from imunoise._core import allan as _core_allan
+from imunoise._validate import confidence_level, sample_rate, samples
 from imunoise.taus import averaging_factors, keep_estimable
 
 if TYPE_CHECKING:
@@ -639,8 +639,8 @@ def _deviation(
     spec = _REGISTRY[kind]
     statistic = spec.non_overlapping if not overlapping and spec.non_overlapping else spec.statistic
     data, one_d, missing = _gapped_samples(x, gaps, kind, statistic in _SKIPS_GAPS)
-    fs = _check_fs(fs)
-    confidence = _check_confidence(confidence)
+    fs = sample_rate(fs)
+    confidence = confidence_level(confidence)
     _check_bool("bias_correction", bias_correction)
     n = data.shape[0]
     m, user_given = averaging_factors(taus, fs, n)
@@ -769,8 +769,8 @@ def _theo_input(x, fs, confidence, gaps, kind: str):
     """The checked samples, fs and confidence of a Thêo statistic (no gap skipping;
     a record long enough for ThêoBR)."""
     data, one_d, missing = _gapped_samples(x, gaps, kind, False, stacklevel=4)
-    fs = _check_fs(fs)
-    confidence = _check_confidence(confidence)
+    fs = sample_rate(fs)
+    confidence = confidence_level(confidence)
     _check_theo_length(kind, data.shape[0])
     return data, one_d, missing, fs, confidence
 
@@ -840,7 +840,7 @@ def _gapped_samples(x, gaps, kind: str, skips: bool, stacklevel: int = 4):
     """float64 (n, channels) samples ready for the core, whether x was 1-D, and the
     missing samples per channel (None when the core counts them: ``gaps="skip"``
     for a statistic that skips gaps, without a scan here)."""
-    data, one_d = _as_samples(x)
+    data, one_d = samples(x)
     if not isinstance(gaps, str) or gaps not in GAPS:
         error = ValueError if isinstance(gaps, str) else TypeError
         raise error(f"gaps must be one of 'skip', 'longest', 'splice'; got {gaps!r}")
@@ -884,43 +884,6 @@ def _gapped_samples(x, gaps, kind: str, skips: bool, stacklevel: int = 4):
         stacklevel=stacklevel,
     )
     return data[~bad], one_d, missing
-
-
-def _as_samples(x) -> tuple[np.ndarray, bool]:
-    """float64 (n, channels) view or copy of x, and whether x was 1-D."""
-    arr = x if isinstance(x, np.ndarray) else np.asarray(x)
-    if arr.dtype.kind not in "iuf":
-        raise TypeError(f"x must be an array of real numbers; got dtype {arr.dtype}")
-    if arr.ndim not in (1, 2):
-        raise ValueError(
-            f"x must be 1-D (n,) or 2-D (n, channels); got {arr.ndim}-D shape {arr.shape}"
-        )
-    if arr.shape[0] == 0:
-        raise ValueError("x must not be empty; got 0 samples")
-    if arr.ndim == 2 and arr.shape[1] == 0:
-        raise ValueError(f"x must have at least one channel; got shape {arr.shape}")
-    data = arr.astype(np.float64, copy=False)
-    if data.ndim == 1:
-        return data[:, None], True
-    return data, False
-
-
-def _check_fs(fs) -> float:
-    if isinstance(fs, bool) or not isinstance(fs, numbers.Real):
-        raise TypeError(f"fs must be a real number of Hz; got {type(fs).__name__} {fs!r}")
-    fs = float(fs)
-    if not (np.isfinite(fs) and fs > 0):
-        raise ValueError(f"fs must be positive and finite (Hz); got {fs!r}")
-    return fs
-
-
-def _check_confidence(confidence) -> float:
-    if isinstance(confidence, bool) or not isinstance(confidence, numbers.Real):
-        raise TypeError(f"confidence must be a number in (0, 1); got {confidence!r}")
-    confidence = float(confidence)
-    if not 0.0 < confidence < 1.0:
-        raise ValueError(f"confidence must be in (0, 1); got {confidence!r}")
-    return confidence
 
 
 def _check_bool(name, value) -> None:

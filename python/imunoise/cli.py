@@ -400,18 +400,14 @@ def _cmd_psd(args) -> int:
     from imunoise.numbers import format_value
 
     log, y = _sensor_samples(args)
-    rows_ok = ~np.isnan(y).any(axis=1)
-    if not rows_ok.all():  # a spectrum needs an unbroken record
-        edges = np.diff(np.r_[0, rows_ok.astype(np.int8), 0])
-        starts, ends = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
-        i = int(np.argmax(ends - starts))
-        y = y[starts[i]:ends[i]]
-        print(f"imunoise: note: missing samples; the spectrum uses the longest gap-free run, "
-              f"{len(y)} samples", file=sys.stderr)
     if args.bins < 1:
         _fail(f"--bins must be >= 1; got {args.bins}")
     band = tuple(args.band) if args.band else None
     s = spectrum.psd(y, log.fs, nperseg=args.nperseg, band=band)
+    if s.segments_skipped:
+        print(f"imunoise: note: missing samples; {s.segments_skipped} of "
+              f"{s.segments + s.segments_skipped} Welch segments hold one and are left out",
+              file=sys.stderr)
     unit = CHANNELS[args.sensor][1]
     names = axis_names(s.channels)
     print(f"# one-sided PSD of {args.sensor} [({unit})^2/Hz], {s.n_samples} samples at "

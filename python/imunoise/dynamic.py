@@ -67,7 +67,7 @@ from scipy import stats as _stats
 
 from imunoise import _schema, _summary
 from imunoise._core import allan as _core_allan
-from imunoise._validate import positive_finite, sample_rate
+from imunoise._validate import no_infinity, positive_finite, sample_rate, samples
 from imunoise.allan import ONE_SIGMA, AllanResult, adev, chi2_interval
 from imunoise.taus import averaging_factors
 
@@ -305,7 +305,8 @@ def dynamic_adev(
     >>> d.dev.shape[0], d.dev.shape[2]
     (26, 3)
     """
-    data, one_d = _samples(x)
+    data, one_d = samples(x)
+    no_infinity(data)
     fs = sample_rate(fs)
     n = data.shape[0]
     width = n // 10 if window is None else _samples_of("window", window, fs)
@@ -490,20 +491,6 @@ def _chi2_score(ratio, edf):
 
 
 # -- arguments ------------------------------------------------------------------------
-
-
-def _samples(x) -> tuple[np.ndarray, bool]:
-    arr = x if isinstance(x, np.ndarray) else np.asarray(x)
-    if arr.dtype.kind not in "iuf":
-        raise TypeError(f"x must be an array of real numbers; got dtype {arr.dtype}")
-    if arr.ndim not in (1, 2) or arr.shape[0] == 0 or (arr.ndim == 2 and arr.shape[1] == 0):
-        raise ValueError(
-            f"x must be 1-D (n,) or 2-D (n, channels) and not empty; got shape {arr.shape}"
-        )
-    data = arr.astype(np.float64, copy=False)
-    if np.any(np.isinf(data)):
-        raise ValueError("x must be finite or NaN (a missing sample); it holds ±inf")
-    return (data[:, None], True) if data.ndim == 1 else (data, False)
 
 
 def _samples_of(name: str, seconds, fs: float) -> int:

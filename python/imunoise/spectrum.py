@@ -57,7 +57,6 @@ IEEE Std 952-1997, Annex C. W. J. Riley, NIST SP 1065 (2008), Table 3.
 from __future__ import annotations
 
 import math
-import numbers
 from collections.abc import Mapping
 from dataclasses import dataclass, replace
 from types import MappingProxyType
@@ -70,7 +69,14 @@ from scipy import signal as _signal
 from scipy import stats as _stats
 
 from imunoise import _schema, _summary
-from imunoise._validate import integer, positive_finite, sample_rate
+from imunoise._validate import (
+    confidence_level,
+    integer,
+    no_infinity,
+    positive_finite,
+    sample_rate,
+    samples,
+)
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -177,6 +183,12 @@ class Spectrum:
         Samples of the record.
     confidence : float
         Two-sided level of ``ci_low``/``ci_high``.
+    segments : int
+        Welch segments averaged.
+    segments_skipped : int
+        Segments left out because they hold a missing (NaN) sample: a record with
+        gaps (or with :meth:`imunoise.Events.exclude`'s events) is analysed in the
+        unbroken segments between them.
     bins_per_decade : int
         0 for Welch's linear grid, else the log binning of :meth:`smooth`.
     """
@@ -198,6 +210,8 @@ class Spectrum:
     nperseg: int
     n_samples: int
     confidence: float
+    segments: int = 0
+    segments_skipped: int = 0
     bins_per_decade: int = 0
 
     def __post_init__(self) -> None:
@@ -258,7 +272,8 @@ class Spectrum:
             f"fs {_summary.number(self.fs)} Hz",
             f"{self.n_samples} samples = {_summary.duration(self.n_samples / self.fs)}",
             f"N {read} ± {std} /√Hz",
-        ]
+        ] + ([f"{self.segments_skipped} of {self.segments + self.segments_skipped} "
+              "segments left out (missing samples)"] if self.segments_skipped else [])
 
     def __repr__(self) -> str:
         return _summary.lines("Spectrum(one-sided PSD", self._facts(), sep=", ")
@@ -301,13 +316,14 @@ def psd(
     Parameters
     ----------
     x : array_like, shape (n,) or (n, channels)
-        Rate samples, finite (no NaN: a spectrum needs an unbroken record; pass the
-        longest gap-free run).
+        Rate samples; NaN = missing. Segments holding a missing sample (in any
+        channel) are left out of the average (``Spectrum.segments_skipped``).
     fs : float
         Sample rate, Hz.
     nperseg : int, optional
         Samples per Welch segment (Hann window, 50 % overlap). Default: the largest
-        power of two ≤ n/8 (about 15 segments), at least 16 and at most n.
+        power of two ≤ n/8 (about 15 segments), at least 16 and at most n; for a
+        record with gaps, also at most the longest unbroken stretch.
     confidence : float, optional
         Two-sided level of the band (default one sigma, 68.3 %).
     band : (f_low, f_high), optional
@@ -332,18 +348,35 @@ def psd(
     >>> bool(abs(s.N / 1e-3 - 1) < 0.02)
     True
     """
-    data, one_d = _samples(x)
+    data, one_d = samples(x)
+    no_infinity(data)
     fs = sample_rate(fs)
-    confidence = _check_confidence(confidence)
+    confidence = confidence_level(confidence)
     n = data.shape[0]
-    seg = _default_nperseg(n) if nperseg is None else integer(nperseg, "nperseg", 16)
+    if n < 16:
+        raise ValueError(f"x must have at least 16 samples for a spectrum; got {n}")
+    present = ~np.isnan(data).any(axis=1)
+    longest = _longest_run(present)
+    if nperseg is None:
+        seg = _default_nperseg(n)
+        if longest >= 16:  # a record with gaps: segments that fit between them
+            seg = min(seg, 1 << int(math.floor(math.log2(longest))))
+    else:
+        seg = integer(nperseg, "nperseg", 16)
     if seg > n:
         raise ValueError(f"nperseg must be <= the number of samples ({n}); got {seg}")
+    starts = _segment_starts(present, seg)
+    if not starts.size:
+        raise ValueError(
+            f"x has no stretch of nperseg = {seg} samples without a missing (NaN) sample "
+            f"(the longest is {longest}); pass nperseg <= {longest}"
+            if longest >= 16 else
+            f"x has no stretch of 16 samples without a missing (NaN) sample (the longest is "
+            f"{longest}): a spectrum needs unbroken stretches"
+        )
     user_band = None if band is None else _check_band(band, fs)
-    f, p = _signal.welch(data, fs=fs, window="hann", nperseg=seg, noverlap=seg // 2,
-                         detrend="constant", scaling="density", axis=0)
-    f, p = f[1:], p[1:]
-    edf = np.full(f.shape, _welch_edf(n, seg))
+    f, p = _welch(data, fs, seg, starts)
+    edf = np.full(f.shape, _welch_edf(seg, starts))
     if seg % 2 == 0:
         edf[-1] /= 2  # the Nyquist value is real: one χ² degree of freedom per segment
     low, high = _chi2_band(p, edf, confidence)
@@ -362,7 +395,8 @@ def psd(
         white=np.asarray(scalar(h[:, 0])), flicker=np.asarray(scalar(h[:, 1])),
         walk=np.asarray(scalar(h[:, 2])), band=np.asarray(scalar(bands)),
         band_auto=user_band is None, lines=tuple(lines), fs=fs, nperseg=seg, n_samples=n,
-        confidence=confidence,
+        confidence=confidence, segments=int(starts.size),
+        segments_skipped=int(1 + (n - seg) // (seg - seg // 2) - starts.size),
     )
 
 
@@ -428,10 +462,40 @@ def _default_nperseg(n: int) -> int:
     return min(n, max(16, 1 << max(int(math.floor(math.log2(max(n, 1) / 8))), 0)))
 
 
-def _welch_edf(n: int, seg: int) -> float:
-    """Percival & Walden eq. 292b for Hann segments overlapping by half."""
+def _segment_starts(present: np.ndarray, seg: int) -> np.ndarray:
+    """Starts of Welch's segments (``seg`` samples, overlapping by half) that hold no
+    missing sample; ``present`` (n,) is False where a row misses one."""
+    n = len(present)
     step = seg - seg // 2
-    k = 1 + (n - seg) // step
+    starts = np.arange(0, n - seg + 1, step)
+    missing = np.concatenate(([0], np.cumsum(~present)))
+    return starts[missing[starts + seg] == missing[starts]]
+
+
+def _welch(data: np.ndarray, fs: float, seg: int, starts: np.ndarray):
+    """Frequencies (0 excluded) and the mean Hann periodogram (F, channels) of the
+    segments of ``data`` starting at ``starts``, each with its mean removed:
+    ``scipy.signal.welch`` where no segment is left out."""
+    step = seg - seg // 2
+    if starts.size == 1 + (len(data) - seg) // step:
+        f, p = _signal.welch(data, fs=fs, window="hann", nperseg=seg, noverlap=seg // 2,
+                             detrend="constant", scaling="density", axis=0)
+        return f[1:], p[1:]
+    p = 0.0
+    for chunk in np.array_split(starts, max(1, starts.size * seg // (1 << 22))):
+        pieces = np.lib.stride_tricks.sliding_window_view(data, seg, axis=0)[chunk]
+        f, q = _signal.welch(pieces, fs=fs, window="hann", nperseg=seg, noverlap=0,
+                             detrend="constant", scaling="density", axis=-1)
+        p = p + q.sum(axis=0).T
+    return f[1:], (p / starts.size)[1:]
+
+
+def _welch_edf(seg: int, starts: np.ndarray) -> float:
+    """Percival & Walden eq. 292b for Hann segments overlapping by half: 2K/(1 +
+    2Σ_j (pairs_j/K) ρ_j²) over the K segments at ``starts``, pairs_j of them j steps
+    apart (K − j for an unbroken record, the equation's 1 − j/K)."""
+    step = seg - seg // 2
+    k = starts.size
     w = _signal.get_window("hann", seg)
     norm = np.sum(w * w)
     total = 0.0
@@ -440,8 +504,16 @@ def _welch_edf(n: int, seg: int) -> float:
         if shift >= seg:
             break
         rho = np.sum(w[:-shift] * w[shift:]) / norm
-        total += (1 - j / k) * rho * rho
+        pairs = np.count_nonzero(np.isin(starts + shift, starts))
+        total += pairs / k * rho * rho
     return 2.0 * k / (1.0 + 2.0 * total)
+
+
+def _longest_run(present: np.ndarray) -> int:
+    """Length of the longest run of True in ``present``."""
+    edges = np.diff(np.concatenate(([0], present.astype(np.int8), [0])))
+    runs = np.flatnonzero(edges == -1) - np.flatnonzero(edges == 1)
+    return int(runs.max()) if runs.size else 0
 
 
 def _window_bin_correlation(seg: int) -> np.ndarray:
@@ -545,37 +617,6 @@ def _fit_levels(f, p, edf, columns: int):
 
 
 # -- arguments -------------------------------------------------------------------------
-
-
-def _samples(x) -> tuple[np.ndarray, bool]:
-    arr = x if isinstance(x, np.ndarray) else np.asarray(x)
-    if arr.dtype.kind not in "iuf":
-        raise TypeError(f"x must be an array of real numbers; got dtype {arr.dtype}")
-    if arr.ndim not in (1, 2):
-        raise ValueError(
-            f"x must be 1-D (n,) or 2-D (n, channels); got {arr.ndim}-D shape {arr.shape}"
-        )
-    if arr.shape[0] < 16:
-        raise ValueError(f"x must have at least 16 samples for a spectrum; got {arr.shape[0]}")
-    if arr.ndim == 2 and arr.shape[1] == 0:
-        raise ValueError(f"x must have at least one channel; got shape {arr.shape}")
-    data = arr.astype(np.float64, copy=False)
-    if not np.all(np.isfinite(data)):
-        k = int(np.argwhere(~np.isfinite(data))[0][0])
-        raise ValueError(
-            f"x must be finite; sample {k} is not (a spectrum needs an unbroken record: "
-            "pass the longest gap-free run)"
-        )
-    return (data[:, None], True) if data.ndim == 1 else (data, False)
-
-
-def _check_confidence(confidence) -> float:
-    if isinstance(confidence, bool) or not isinstance(confidence, numbers.Real):
-        raise TypeError(f"confidence must be a number in (0, 1); got {confidence!r}")
-    confidence = float(confidence)
-    if not 0.0 < confidence < 1.0:
-        raise ValueError(f"confidence must be in (0, 1); got {confidence!r}")
-    return confidence
 
 
 def _check_band(band, fs: float) -> tuple[float, float]:

@@ -275,6 +275,18 @@ def test_psd_command(tmp_path, capsys):
     assert code == 0 and "white band 1-5 Hz, given" in out
 
 
+def test_psd_command_leaves_out_segments_with_a_missing_sample(tmp_path, capsys):
+    from imunoise.cli import bundled_log
+
+    lines = bundled_log().read_text().splitlines(keepends=True)
+    lines[5000] = lines[5000][:20] + "X" + lines[5000][21:]  # checksum fails: one gap
+    path = tmp_path / "gap.txt"
+    path.write_text("".join(lines))
+    code, out, err = _run(["psd", str(path), "--fs", "40"], capsys)
+    assert code == 0 and "# N X = " in out
+    assert "2 of " in err and "Welch segments hold one and are left out" in err
+
+
 def test_dadev_command(tmp_path, capsys):
     from imunoise.cli import bundled_log
 

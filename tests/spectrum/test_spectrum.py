@@ -70,6 +70,61 @@ def test_confidence_band_covers_the_true_level():
     assert inside.mean() > 0.75
 
 
+def test_gaps_leave_out_the_segments_that_hold_them():
+    y = imunoise.simulate(2**17, FS, N=1e-3, B=1e-4, channels=2, seed=8)
+    gapped = y.copy()
+    gapped[30_000:30_050] = np.nan  # a gap in both channels
+    gapped[90_000, 1] = np.nan  # one channel: the row counts as missing for both
+    s = imunoise.psd(gapped, FS, nperseg=4096)
+    step = 2048
+    starts = [a for a in range(0, len(y) - 4096 + 1, step)
+              if np.isfinite(gapped[a:a + 4096]).all()]
+    assert s.segments == len(starts) and s.segments_skipped == 63 - len(starts) == 4
+    # the oracle: scipy's periodogram of each gap-free segment, averaged
+    p = np.mean([signal.welch(y[a:a + 4096], fs=FS, nperseg=4096, window="hann",
+                              axis=0)[1] for a in starts], axis=0)
+    np.testing.assert_allclose(s.psd, p[1:], rtol=1e-12)
+    whole = imunoise.psd(y, FS, nperseg=4096)
+    assert s.edf[0] < whole.edf[0] and np.all(abs(s.N - whole.N) < 3 * whole.N_std)
+    assert "4 of 63 segments left out" in repr(s)
+
+
+def test_welch_edf_counts_only_the_overlaps_that_remain():
+    # P&W 292b for an unbroken record; segments with no neighbour are independent: 2K
+    w = signal.get_window("hann", 64)
+    rho = np.sum(w[:-32] * w[32:]) / np.sum(w * w)
+    unbroken = spectrum._welch_edf(64, np.arange(10) * 32)
+    assert unbroken == pytest.approx(20 / (1 + 2 * 0.9 * rho**2))
+    assert spectrum._welch_edf(64, np.arange(10) * 96) == pytest.approx(20.0)
+
+
+def test_gapped_spectrum_scatter_matches_its_edf():
+    # the values' scatter about the true level is what the EDF says: var(S/h0) = 2/ν
+    y = imunoise.simulate(2**18, FS, N=1e-3, seed=9)
+    y[np.arange(300, len(y), 2_000)] = np.nan  # a missing sample every 2000: a quarter of
+    # the segments are left out, and the overlaps of their neighbours with them
+    s = imunoise.psd(y, FS, nperseg=512)
+    ratio = s.psd[5:-5] / 2e-6
+    assert s.segments_skipped > 0.15 * (s.segments + s.segments_skipped)
+    assert np.var(ratio) == pytest.approx(2 / s.edf[5], rel=0.1)
+
+
+def test_events_excluded_as_missing_keep_n():
+    # a record with bursts: their excluded samples leave the white level as it was
+    fs = 40.0
+    rng = np.random.default_rng(5)
+    y = 1e-3 * rng.standard_normal(200_000)
+    clean = imunoise.psd(y, fs)
+    for start in range(10_000, 190_000, 20_000):
+        y[start:start + 80] += 1e-2 * rng.standard_normal(80)
+    found = imunoise.events(y, fs)
+    assert len(found) == 9
+    loud = imunoise.psd(y, fs)
+    quiet = imunoise.psd(found.exclude(y), fs)
+    assert loud.N > 1.05 * clean.N
+    assert abs(quiet.N - clean.N) < 3 * clean.N_std and quiet.segments_skipped >= 9
+
+
 @pytest.mark.parametrize("term", ["N", "B", "K"])
 def test_power_laws_match_sp1065_integral(term):
     # σ²(τ) = 2∫ S_y(f) sin⁴(πfτ)/(πfτ)² df (SP 1065 eq. 65) of each term's one-sided PSD
@@ -164,7 +219,10 @@ def test_repr_and_html():
 
 @pytest.mark.parametrize("kwargs, message", [
     ({"x": [1.0] * 8}, "at least 16"),
-    ({"x": np.r_[np.ones(100), np.nan]}, "finite"),
+    ({"x": np.r_[np.ones(100), np.inf]}, "finite or NaN"),
+    ({"x": np.where(np.arange(200) % 10 == 0, np.nan, 1.0)}, "no stretch of 16 samples"),
+    ({"x": np.r_[np.ones(600), np.nan, np.ones(600)], "nperseg": 1024},
+     r"no stretch of nperseg = 1024 .*\(the longest is 600\); pass nperseg <= 600"),
     ({"fs": -1.0}, "fs must be positive"),
     ({"nperseg": 10**6}, "nperseg must be <="),
     ({"nperseg": 4}, "nperseg must be >= 16"),

@@ -257,17 +257,6 @@ N_AGREEMENT = 0.05
 DYNAMIC_MIN_SECONDS = 600.0
 
 
-def _longest_run(y: np.ndarray) -> np.ndarray:
-    """The longest stretch of rows without a missing sample."""
-    ok = ~np.isnan(y).any(axis=1)
-    edges = np.diff(np.r_[0, ok.astype(np.int8), 0])
-    starts, ends = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
-    if not starts.size:
-        return y[:0]
-    i = int(np.argmax(ends - starts))
-    return y[starts[i]:ends[i]]
-
-
 def _n_remark(s, j: int, ratio: float) -> str:
     """Why the PSD's N and the ADEV fit's N differ by more than :data:`N_AGREEMENT`."""
     if not np.isfinite(ratio):
@@ -309,10 +298,12 @@ def power_spectral_density(ctx: Context, doc: Doc) -> None:
         y = getattr(ctx.short, sensor)
         if y is None:
             continue
-        y = _longest_run(y)
-        if len(y) < 256:
+        if np.count_nonzero(~np.isnan(y).any(axis=1)) < 256:
             continue
-        s = spectrum.psd(y, ctx.short.fs)
+        try:  # segments with a missing sample are left out
+            s = spectrum.psd(y, ctx.short.fs)
+        except ValueError:  # no unbroken stretch of 16 samples
+            continue
         model = ctx.models.get(sensor) if ctx.one_log else noise.fit(
             _allan.adev(y, ctx.short.fs, taus=ctx.taus_per_decade), warn_coverage=False)
         unit = CHANNELS[sensor][1]
@@ -334,7 +325,10 @@ def power_spectral_density(ctx: Context, doc: Doc) -> None:
                          _n_remark(s, j, ratio)])
         doc.table(["axis", f"N PSD [{unit}/√Hz]", "white band [Hz]", "N ADEV fit",
                    "PSD/ADEV", "remark"], rows,
-                  caption=f"{sensor}: noise density from the spectrum and from the Allan fit")
+                  caption=f"{sensor}: noise density from the spectrum and from the Allan fit"
+                  + (f" ({s.segments_skipped} of {s.segments + s.segments_skipped} Welch "
+                     "segments hold a missing sample and are left out)"
+                     if s.segments_skipped else ""))
 
 
 def dynamic_allan(ctx: Context, doc: Doc) -> None:
