@@ -94,6 +94,9 @@ __all__ = [
     "term_psd",
 ]
 
+#: Share of a gapped record's present samples its default Welch segments must cover.
+_GAPPED_COVERAGE = 0.5
+
 #: One-sigma confidence, erf(1/√2).
 _ONE_SIGMA = 0.6826894921370859
 
@@ -323,7 +326,8 @@ def psd(
     nperseg : int, optional
         Samples per Welch segment (Hann window, 50 % overlap). Default: the largest
         power of two ≤ n/8 (about 15 segments), at least 16 and at most n; for a
-        record with gaps, also at most the longest unbroken stretch.
+        record with gaps, the longest such power of two whose gap-free segments
+        hold at least half of the present samples.
     confidence : float, optional
         Two-sided level of the band (default one sigma, 68.3 %).
     band : (f_low, f_high), optional
@@ -359,8 +363,8 @@ def psd(
     longest = _longest_run(present)
     if nperseg is None:
         seg = _default_nperseg(n)
-        if longest >= 16:  # a record with gaps: segments that fit between them
-            seg = min(seg, 1 << int(math.floor(math.log2(longest))))
+        if not present.all():
+            seg = _gapped_nperseg(present, seg)
     else:
         seg = integer(nperseg, "nperseg", 16)
     if seg > n:
@@ -507,6 +511,18 @@ def _welch_edf(seg: int, starts: np.ndarray) -> float:
         pairs = np.count_nonzero(np.isin(starts + shift, starts))
         total += pairs / k * rho * rho
     return 2.0 * k / (1.0 + 2.0 * total)
+
+
+def _gapped_nperseg(present: np.ndarray, seg: int) -> int:
+    """The longest power-of-two segment, at most ``seg``, whose gap-free Welch
+    segments hold at least :data:`_GAPPED_COVERAGE` of the present samples (16 if
+    none does): long segments resolve low frequencies, but between many gaps few fit."""
+    wanted = _GAPPED_COVERAGE * np.count_nonzero(present)
+    while seg > 16:
+        if _segment_starts(present, seg).size * (seg - seg // 2) >= wanted:
+            return seg
+        seg //= 2
+    return 16
 
 
 def _longest_run(present: np.ndarray) -> int:

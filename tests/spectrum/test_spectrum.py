@@ -89,6 +89,20 @@ def test_gaps_leave_out_the_segments_that_hold_them():
     assert "4 of 63 segments left out" in repr(s)
 
 
+def test_default_segments_fit_between_many_gaps():
+    # an outlier every 3000 samples excluded (as MTi-G's 217 events): the default
+    # segment of an unbroken record (n/8) would keep none; the default keeps half the
+    # samples and the longest such segment
+    y = imunoise.simulate(2**18, FS, N=1e-3, seed=2)
+    y[np.arange(1_500, len(y), 3_000)] = np.nan
+    s = imunoise.psd(y, FS)
+    kept = s.segments * s.nperseg // 2
+    assert kept >= 0.5 * np.count_nonzero(np.isfinite(y))
+    longer = imunoise.psd(y, FS, nperseg=2 * s.nperseg)
+    assert longer.segments * s.nperseg < 0.5 * np.count_nonzero(np.isfinite(y))
+    assert abs(s.N - 1e-3) < 3 * s.N_std
+
+
 def test_welch_edf_counts_only_the_overlaps_that_remain():
     # P&W 292b for an unbroken record; segments with no neighbour are independent: 2K
     w = signal.get_window("hann", 64)
