@@ -114,8 +114,10 @@ def detection(data: Path, bursts: int, seed: int, *, still_only: bool) -> None:
             total += len(truth)
             ev = imunoise.events(y, fs)
             for a, b, amp in truth:
+                # the overlapping event whose start is nearest (an event inside a
+                # longer one, a shock during a vibration, is reported as well)
                 hit = np.flatnonzero((ev.start_index < b) & (ev.end_index > a))
-                err = abs(ev.start_index[hit[0]] - a) / fs if hit.size else np.inf
+                err = np.min(np.abs(ev.start_index[hit] - a)) / fs if hit.size else np.inf
                 errors.append(err)
                 amps.append(amp)
         e, a = np.array(errors), np.array(amps)

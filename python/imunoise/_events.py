@@ -32,6 +32,10 @@ blocks, interpolated linearly, so slow bias drift is not an event):
    :math:`(\nu/2)\ln v`, and without the isolated outliers (spike samples whose
    neighbours are quiet), which stay spikes of their own: an outlier just before
    a burst neither becomes its start nor swallows it.
+3. **Bursts inside bursts**: a burst at least :data:`INNER_MIN_WINDOWS` windows long
+   (a vibration) is searched again on its own, with its own noise law and whitened
+   by its own predictor; a shock during it is reported as an event of its own
+   (:attr:`Events.within` names the longer one).
 
 ``false_alarm`` (:math:`p`, default :data:`FALSE_ALARM`) is the design rate of
 false events per sample and channel, split evenly between the two tests.
@@ -62,6 +66,9 @@ from imunoise.readers.log import ImuLog
 
 __all__ = ["Events", "events", "FALSE_ALARM", "OVERLAP_FACTOR", "CHANGE_POINT_DOF",
            "BURST_SCALES"]
+
+#: A burst this many energy windows long is searched for bursts inside it.
+INNER_MIN_WINDOWS = 10
 
 #: Default design rate of false events per sample and channel.
 FALSE_ALARM = 1e-7
@@ -103,6 +110,8 @@ class Events:
         Largest :math:`|x - \text{baseline}|/\hat\sigma` inside each event, over its channels.
     kind : tuple of str
         ``"spike"`` (one to a few samples above the Hampel threshold) or ``"burst"``.
+        A burst inside a longer one (a shock during a vibration) is an event of its
+        own, listed after the longer one (:attr:`within`).
     sigma : ndarray
         Robust noise level :math:`\hat\sigma = 1.4826\,\mathrm{MAD}` of each channel,
         in the channel's unit.
@@ -151,6 +160,18 @@ class Events:
     def duration(self) -> np.ndarray:
         """Length of each event, s."""
         return (self.end_index - self.start_index) / self.fs
+
+    @property
+    def within(self) -> np.ndarray:
+        """Index of the longer event each event lies inside, −1 for none."""
+        out = np.full(len(self), -1, dtype=np.int64)
+        widest = -1  # the event reaching furthest so far; events are sorted by start
+        for i in range(len(self)):
+            if widest >= 0 and self.end_index[i] <= self.end_index[widest]:
+                out[i] = widest
+            else:
+                widest = i
+        return out
 
     @property
     def mask(self) -> np.ndarray:
@@ -214,7 +235,9 @@ class Events:
         return arr
 
     def rows(self) -> list[dict]:
-        """One dict per event: start, end, duration (s), kind, channels, peak (sigmas)."""
+        """One dict per event: start, end, duration (s), kind, channels, peak (sigmas),
+        within (index of the longer event it lies inside, or None)."""
+        within = self.within
         return [
             {
                 "start": float(self.start[i]),
@@ -223,14 +246,18 @@ class Events:
                 "kind": self.kind[i],
                 "channels": ", ".join(self.channels[i]),
                 "peak": float(self.peak[i]),
+                "within": int(within[i]) if within[i] >= 0 else None,
             }
             for i in range(len(self))
         ]
 
     def _facts(self) -> list[str]:
         bursts = sum(k == "burst" for k in self.kind)
+        inside = int(np.count_nonzero(self.within >= 0))
+        nested = f", {inside} inside longer ones" if inside else ""
         parts = [
-            f"{_summary.plural(len(self), 'event')} ({bursts} bursts, {len(self) - bursts} spikes)",
+            f"{_summary.plural(len(self), 'event')} ({bursts} bursts, {len(self) - bursts} "
+            f"spikes{nested})",
             f"{100 * self.share:.3g} % of {self.n_samples} samples",
         ]
         parts += [
@@ -354,7 +381,9 @@ def events(
             if spans:
                 quiet = ~_span_mask(spans, n, pad=w)
         sigma[j] = mad_sigma * np.sqrt(scale)
-        per_channel.append((_join([(a, b, kind, {j}) for a, b, kind in spans], gap, touch), z))
+        inner = _inner_bursts(z, spans, windows, p_v, k_spike, isolated)
+        per_channel.append((_join([(a, b, kind, {j}) for a, b, kind in spans], gap, touch), z,
+                            [(a, b, kind, {j}) for a, b, kind in inner]))
     return _merge_channels(
         per_channel, names, fs, n, gap, windows[-1] // 2, sigma,
         k_spike=k_spike,
@@ -469,6 +498,28 @@ def _bursts(z: np.ndarray, w: int, p_window: float, dof: float, k_spike: float,
                 end = max(end, start + raw_end)
         if end > start:
             out.append((lo + start, lo + end, "burst"))
+    return out
+
+
+def _inner_bursts(z, spans, windows, p_v, k_spike, isolated) -> list[tuple[int, int, str]]:
+    """Bursts inside a long burst (a shock during a vibration): the burst test run on
+    the long burst alone, with its own noise law and whitened by its own predictor."""
+    w = windows[0]
+    out = []
+    for a, b, kind in spans:
+        if kind != "burst" or b - a < INNER_MIN_WINDOWS * w:
+            continue
+        seg, iso = z[a:b], isolated[a:b]
+        scale, rho = _energy_law(seg, w)
+        zs = seg / np.sqrt(scale)
+        e = _whiten(zs, rho, k_spike, iso)
+        scale_e, rho_e = _energy_law(e, w)
+        e = e / np.sqrt(scale_e)
+        tail_dof = _tail_dof(e)
+        for v, p in zip(windows, p_v, strict=True):
+            for s0, s1, _k in _bursts(e, v, p, _dof(rho_e, v), k_spike, iso, tail_dof, zs):
+                if s0 >= w and windows[-1] <= s1 - s0 < (b - a) // 2:
+                    out.append((a + s0, a + s1, "burst"))
     return out
 
 
@@ -682,7 +733,10 @@ def _join_kind(spans: list[tuple], gap: int) -> list[list]:
 
 def _merge_channels(per_channel, names, fs, n, gap, touch, sigma, **thresholds) -> Events:
     """One event per overlapping group of the channels' events."""
-    groups = _join([span for spans, _z in per_channel for span in spans], gap, touch)
+    groups = _join([span for spans, _z, _in in per_channel for span in spans], gap, touch)
+    nested = _join_kind(sorted((span for _s, _z, inner in per_channel for span in inner),
+                               key=lambda span: span[:3]), gap)
+    groups = sorted(groups + nested, key=lambda g: (g[0], g[1]))
     peaks = [
         max(_peak(per_channel[j][1][a:b]) for j in chans)
         for a, b, _k, chans in groups

@@ -106,3 +106,34 @@ def test_raised_noise_just_before_a_burst_does_not_become_its_start():
     found = imunoise.events(x, fs)
     share = np.mean([_onset_found(found, s, s + 20, fs) for s in starts])
     assert share >= 0.75, share
+
+
+def test_a_shock_during_a_vibration_is_an_event_of_its_own():
+    # 40 Hz: 200 s of a 9 Hz vibration at 3× the quiet RMS, with five shocks in it
+    fs = 40.0
+    rng = np.random.default_rng(4)
+    x = rng.standard_normal(24_000)
+    x[2_000:10_000] += 3.0 * _vibration(8_000, fs, 9.0, rng)
+    shocks = [3_100, 4_700, 6_000, 7_400, 8_900]
+    for k, s in enumerate(shocks):
+        x[s:s + 40] += burst(40, fs, 12.0, k)  # 1 s, about 4× the vibration's RMS
+    found = imunoise.events(x, fs)
+    parent = int(np.argmax(found.duration))
+    assert found.start_index[parent] <= 2_040 and found.end_index[parent] >= 9_960
+    inside = np.flatnonzero(found.within == parent)
+    starts = found.start_index[inside]
+    assert all(np.min(np.abs(starts - s)) <= 4 for s in shocks), found.rows()
+    assert len(inside) == len(shocks)
+    assert "5 inside longer ones" in repr(found)
+    assert found.rows()[inside[0]]["within"] == parent
+
+
+def test_a_steady_vibration_holds_no_events_inside_it():
+    fs = 40.0
+    nested = 0
+    for seed in range(6):
+        rng = np.random.default_rng(100 + seed)
+        x = rng.standard_normal(30_000)
+        x[5_000:25_000] += 3.0 * _vibration(20_000, fs, 4.0 + 2 * seed, rng)
+        nested += int(np.count_nonzero(imunoise.events(x, fs).within >= 0))
+    assert nested == 0

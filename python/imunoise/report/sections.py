@@ -387,11 +387,18 @@ def events_section(ctx: Context, doc: Doc) -> None:
     # are given from the first sample of the recording
     offset = (len(ctx.untrimmed) - len(log)) / log.fs if ctx.one_log and ctx.untrimmed else 0.0
     order = np.argsort(found.peak)[::-1][:EVENT_ROWS]
+    within = found.within
+
+    def kind(i: int) -> str:
+        j = within[i]
+        return found.kind[i] if j < 0 else (
+            f"{found.kind[i]} inside the event from {format_number(found.start[j] + offset)} s")
+
     doc.table(
         ["start [s]", "end [s]", "kind", "channels", "peak [σ]"],
         [[format_number(found.start[i] + offset), format_number(found.end[i] + offset),
-          found.kind[i],
-          ", ".join(found.channels[i]), f"{found.peak[i]:.3g}"] for i in sorted(order)],
+          kind(i), ", ".join(found.channels[i]), f"{found.peak[i]:.3g}"]
+         for i in sorted(order)],
         caption=f"Events of the short log ({min(len(found), EVENT_ROWS)} largest of "
                 f"{len(found)})",
     )
