@@ -379,7 +379,12 @@ def psd(
             f"{longest}): a spectrum needs unbroken stretches"
         )
     user_band = None if band is None else _check_band(band, fs)
-    f, p = _welch(data, fs, seg, starts)
+    largest = float(np.nanmax(np.abs(data)))
+    with np.errstate(over="ignore"):
+        f, p = _welch(data, fs, seg, starts) if largest < 1e150 else (None, None)
+    if p is None or not np.all(np.isfinite(p)):
+        raise ValueError(f"x is too large for a spectrum: its power overflows (largest |x| "
+                         f"{largest:.3g})")
     edf = np.full(f.shape, _welch_edf(seg, starts))
     if seg % 2 == 0:
         edf[-1] /= 2  # the Nyquist value is real: one χ² degree of freedom per segment
@@ -578,6 +583,8 @@ def _read_white(f, p, edf, user_band):
             )
         h, std = _fit_levels(f[inside], p[inside], edf[inside], columns=1)
         return np.r_[h, 0.0, 0.0], std, np.array(user_band, dtype=float), np.empty(0)
+    if not np.any(p > 0):  # a constant channel: no noise, no band to choose
+        return np.zeros(3), np.nan, np.array([f[0], f[-1]]), np.empty(0)
     lines = _lines(p)
     keep = ~lines
     top = f.size
@@ -614,9 +621,18 @@ def _fit_levels(f, p, edf, columns: int):
     h0 and its standard deviation (covariance of the active terms, times the reduced
     χ² when above 1)."""
     basis = np.stack([f**-k for k in range(columns)], axis=1)
+    top = float(np.max(p)) if p.size else 0.0
+    if not top > 0:  # a constant channel: no noise at all
+        return np.zeros(columns), 0.0
+    h, std = _fit_scaled(basis, p / top, edf)  # in units of the largest value: the
+    return h * top, std * top                  # weights neither overflow nor underflow
+
+
+def _fit_scaled(basis, p, edf):
+    """:func:`_fit_levels` on ``p`` whose largest value is 1."""
     expected = p.copy()
     for _ in range(4):
-        w = np.sqrt(edf / 2) / np.maximum(expected, np.finfo(float).tiny)
+        w = np.sqrt(edf / 2) / np.maximum(expected, 1e-12)
         h, _ = _optimize.nnls(basis * w[:, None], p * w)
         fitted = basis @ h
         if not np.all(fitted > 0):

@@ -309,3 +309,14 @@ def test_plot_with_model_and_asd():
     assert "ASD" in fig.axes[0].get_ylabel()
     with pytest.raises(TypeError, match="Spectrum"):
         plot.spectrum(model)
+
+
+def test_constant_and_tiny_channels_read_no_noise():
+    # a dead axis next to a live one; values near 1e-144 (squares near the underflow)
+    live = imunoise.simulate(4096, FS, N=1e-3, seed=1)
+    s = imunoise.psd(np.column_stack([np.zeros(4096), live]), FS)
+    assert s.N[0] == 0.0 and s.N[1] == pytest.approx(1e-3, rel=0.1)
+    tiny = imunoise.psd(1e-144 * live, FS)
+    assert tiny.N == pytest.approx(1e-147, rel=0.1)
+    with pytest.raises(ValueError, match="too large for a spectrum"):
+        imunoise.psd(1e200 * live, FS)
