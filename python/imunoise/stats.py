@@ -538,8 +538,13 @@ def distribution(x, *, bins="auto", qq_points: int = 1001) -> Distribution:
     idx[-1] = np.searchsorted(xs, edges[-1], side="right")
     counts = np.diff(idx)
     # Normal fit by maximum likelihood (what scipy.stats.norm.fit returns).
-    mu = float(xs.mean())
-    sigma = float(np.sqrt(np.mean((xs - mu) ** 2)))
+    # in units of the largest |x|: squares and fourth powers of values near 1e100
+    # would overflow
+    scale = float(np.max(np.abs(xs))) or 1.0
+    u = xs / scale
+    mu_u = float(u.mean())
+    sigma_u = float(np.sqrt(np.mean((u - mu_u) ** 2)))
+    mu, sigma = mu_u * scale, sigma_u * scale
     if sigma > 0:
         i = np.arange(1, n + 1, dtype=np.float64)
         cdf = _sstats.norm.cdf(xs, mu, sigma)
@@ -548,15 +553,14 @@ def distribution(x, *, bins="auto", qq_points: int = 1001) -> Distribution:
             ks_p = float(_sstats.kstwo.sf(ks_stat, n))
         else:
             ks_p = float(_sstats.kstwobign.sf(ks_stat * np.sqrt(n)))
-        w = (xs - mu) / float(np.std(xs, ddof=1))
+        w = (u - mu_u) / (sigma_u * np.sqrt(n / (n - 1)))
         logcdf = _sstats.norm.logcdf(w)
         logsf = _sstats.norm.logsf(w)
         ad_stat = float(-n - np.sum((2 * i - 1.0) / n * (logcdf + logsf[::-1])))
         ad_crit = np.around(_AD_NORM / (1.0 + 4.0 / n - 25.0 / n / n), 3)
-        c = xs - mu
-        m2 = sigma**2
-        skew = float(np.mean(c**3) / m2**1.5)
-        kurt = float(np.mean(c**4) / m2**2 - 3.0)
+        standard = (u - mu_u) / sigma_u
+        skew = float(np.mean(standard**3))
+        kurt = float(np.mean(standard**4) - 3.0)
     else:
         ks_stat = ks_p = ad_stat = skew = kurt = float("nan")
         ad_crit = np.full(5, np.nan)
@@ -598,7 +602,9 @@ def _fit_uncertainty(v: np.ndarray, sigma: float) -> dict[str, float]:
         return {"mu_std": float("nan"), "sigma_std": float("nan")}
     means = v[: b * size].reshape(b, size).mean(axis=1)
     mu_std = float(np.std(means, ddof=1) / np.sqrt(b))
-    n_eff = min(float(len(v)), sigma**2 / mu_std**2) if mu_std > 0 else float(len(v))
+    with np.errstate(over="ignore"):  # a ratio above 1e154 is more than len(v) anyway
+        ratio = float(np.square(np.float64(sigma) / mu_std)) if mu_std > 0 else np.inf
+    n_eff = min(float(len(v)), ratio)
     return {"mu_std": mu_std, "sigma_std": sigma / np.sqrt(2.0 * max(n_eff - 1.0, 1.0))}
 
 
