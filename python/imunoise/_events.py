@@ -381,9 +381,12 @@ def events(
             if spans:
                 quiet = ~_span_mask(spans, n, pad=w)
         sigma[j] = mad_sigma * np.sqrt(scale)
-        inner = _inner_bursts(z, spans, windows, p_v, k_spike, isolated)
-        per_channel.append((_join([(a, b, kind, {j}) for a, b, kind in spans], gap, touch), z,
-                            [(a, b, kind, {j}) for a, b, kind in inner]))
+        joined = _join([(a, b, kind, {j}) for a, b, kind in spans], gap, touch)
+        # searched once the channel's spans are joined: a shock that the burst test
+        # found by itself is then inside the vibration it was joined to
+        inner = _inner_bursts(z, [(a, b, kind) for a, b, kind, _c in joined], windows, p_v,
+                              k_spike, isolated)
+        per_channel.append((joined, z, [(a, b, kind, {j}) for a, b, kind in inner]))
     return _merge_channels(
         per_channel, names, fs, n, gap, windows[-1] // 2, sigma,
         k_spike=k_spike,

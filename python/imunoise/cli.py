@@ -575,9 +575,10 @@ def _cmd_events(args) -> int:
     found = events(log, false_alarm=args.false_alarm)
     print(f"# {log.source}: {len(found)} events, {100 * found.share:.3g} % of {len(log)} "
           f"samples (false_alarm {found.false_alarm:g} per sample and channel)")
-    _print_table(["start_s", "end_s", "kind", "peak_sigma", "channels"],
+    _print_table(["start_s", "end_s", "kind", "peak_sigma", "channels", "within"],
                  [[f"{r['start']:.6g}", f"{r['end']:.6g}", r["kind"], f"{r['peak']:.3g}",
-                   r["channels"].replace(" ", "_").replace(",_", ",")] for r in found.rows()])
+                   r["channels"].replace(" ", "_").replace(",_", ","),
+                   "-" if r["within"] is None else str(r["within"])] for r in found.rows()])
     return 0
 
 

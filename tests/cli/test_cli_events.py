@@ -18,6 +18,30 @@ def test_events_lists_the_gyro_x_bursts(capsys):
         assert any(a - 3 <= visible <= b + 3 for a, b in gyro_x)
 
 
+def test_events_names_the_event_a_shock_lies_inside(tmp_path, capsys):
+    from tests.events.test_events import burst
+    from tests.events.test_onsets import _vibration
+
+    fs = 40.0
+    rng = np.random.default_rng(4)
+    gyro = 1e-3 * rng.standard_normal((16_000, 3))
+    gyro[2_000:10_000, 0] += 3e-3 * _vibration(8_000, fs, 9.0, rng)
+    gyro[6_000:6_040, 0] += 1e-3 * burst(40, fs, 12.0, 0)
+    rows = ["time,gyro_x,gyro_y,gyro_z"]
+    rows += [f"{i / fs:.3f},{g[0]:.7f},{g[1]:.7f},{g[2]:.7f}" for i, g in enumerate(gyro)]
+    path = tmp_path / "shock.csv"
+    path.write_text("\n".join(rows) + "\n")
+    assert main(["events", str(path)]) == 0
+    out = capsys.readouterr().out.splitlines()
+    assert out[1].split()[-1] == "within"
+    rows = [line.split() for line in out[2:]]
+    inside = [r for r in rows if r[5] != "-"]
+    assert len(inside) == 1 and abs(float(inside[0][0]) - 150.0) <= 0.1
+    # the vibration is one event or a few (its envelope dips); the shock's is named
+    parent = rows[int(inside[0][5])]
+    assert 50 <= float(parent[0]) < 150 < float(parent[1]) <= 250.1
+
+
 def test_thermal_prints_slopes_in_datasheet_units(tmp_path, capsys):
     fs, n = 10.0, 36_000
     rng = np.random.default_rng(2)
