@@ -86,6 +86,7 @@ from scipy import stats as _stats
 
 from imunoise import _schema, _summary
 from imunoise._core import allan as _core_allan
+from imunoise._runs import true_runs
 from imunoise._validate import confidence_level, sample_rate, samples
 from imunoise.taus import averaging_factors, keep_estimable
 
@@ -867,8 +868,7 @@ def _gapped_samples(x, gaps, kind: str, skips: bool, stacklevel: int = 4):
     if dropped == n:
         raise ValueError(f"x has no valid samples: all {n} are NaN")
     if gaps == "longest":
-        edges = np.diff(np.concatenate(([0], (~bad).astype(np.int8), [0])))
-        starts, ends = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
+        starts, ends = true_runs(~bad)
         i = int(np.argmax(ends - starts))
         a, b = int(starts[i]), int(ends[i])
         warnings.warn(

@@ -67,6 +67,7 @@ from scipy import stats as _stats
 
 from imunoise import _schema, _summary
 from imunoise._core import allan as _core_allan
+from imunoise._runs import true_runs
 from imunoise._validate import no_infinity, positive_finite, sample_rate, samples
 from imunoise.allan import ONE_SIGMA, AllanResult, adev, chi2_interval
 from imunoise.taus import averaging_factors
@@ -474,8 +475,7 @@ def _departures(d: DynamicAllan) -> tuple[Departure, ...]:
         score = np.maximum(z, score)
     out = []
     for j in range(flagged.shape[1]):
-        edges = np.diff(np.r_[0, flagged[:, j].astype(np.int8), 0])
-        for a, b in zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1), strict=True):
+        for a, b in zip(*true_runs(flagged[:, j]), strict=True):
             k = a + int(np.argmax(score[a:b, j]))
             out.append(Departure(start=a * stride / d.fs, end=min(b * stride, d.n_samples) / d.fs,
                                  channel=j, ratio=float(ratio[k, j])))

@@ -69,6 +69,7 @@ from scipy import signal as _signal
 from scipy import stats as _stats
 
 from imunoise import _schema, _summary
+from imunoise._runs import true_runs
 from imunoise._validate import (
     confidence_level,
     integer,
@@ -360,7 +361,6 @@ def psd(
     if n < 16:
         raise ValueError(f"x must have at least 16 samples for a spectrum; got {n}")
     present = ~np.isnan(data).any(axis=1)
-    longest = _longest_run(present)
     if nperseg is None:
         seg = _default_nperseg(n)
         if not present.all():
@@ -371,6 +371,7 @@ def psd(
         raise ValueError(f"nperseg must be <= the number of samples ({n}); got {seg}")
     starts = _segment_starts(present, seg)
     if not starts.size:
+        longest = _longest_run(present)
         raise ValueError(
             f"x has no stretch of nperseg = {seg} samples without a missing (NaN) sample "
             f"(the longest is {longest}); pass nperseg <= {longest}"
@@ -405,7 +406,7 @@ def psd(
         walk=np.asarray(scalar(h[:, 2])), band=np.asarray(scalar(bands)),
         band_auto=user_band is None, lines=tuple(lines), fs=fs, nperseg=seg, n_samples=n,
         confidence=confidence, segments=int(starts.size),
-        segments_skipped=int(1 + (n - seg) // (seg - seg // 2) - starts.size),
+        segments_skipped=_segment_count(n, seg) - int(starts.size),
     )
 
 
@@ -471,12 +472,15 @@ def _default_nperseg(n: int) -> int:
     return min(n, max(16, 1 << max(int(math.floor(math.log2(max(n, 1) / 8))), 0)))
 
 
+def _segment_count(n: int, seg: int) -> int:
+    """Welch's segments of ``seg`` samples, overlapping by half, in ``n`` samples."""
+    return 1 + (n - seg) // (seg - seg // 2)
+
+
 def _segment_starts(present: np.ndarray, seg: int) -> np.ndarray:
     """Starts of Welch's segments (``seg`` samples, overlapping by half) that hold no
     missing sample; ``present`` (n,) is False where a row misses one."""
-    n = len(present)
-    step = seg - seg // 2
-    starts = np.arange(0, n - seg + 1, step)
+    starts = (seg - seg // 2) * np.arange(_segment_count(len(present), seg))
     missing = np.concatenate(([0], np.cumsum(~present)))
     return starts[missing[starts + seg] == missing[starts]]
 
@@ -485,8 +489,7 @@ def _welch(data: np.ndarray, fs: float, seg: int, starts: np.ndarray):
     """Frequencies (0 excluded) and the mean Hann periodogram (F, channels) of the
     segments of ``data`` starting at ``starts``, each with its mean removed:
     ``scipy.signal.welch`` where no segment is left out."""
-    step = seg - seg // 2
-    if starts.size == 1 + (len(data) - seg) // step:
+    if starts.size == _segment_count(len(data), seg):
         f, p = _signal.welch(data, fs=fs, window="hann", nperseg=seg, noverlap=seg // 2,
                              detrend="constant", scaling="density", axis=0)
         return f[1:], p[1:]
@@ -532,9 +535,8 @@ def _gapped_nperseg(present: np.ndarray, seg: int) -> int:
 
 def _longest_run(present: np.ndarray) -> int:
     """Length of the longest run of True in ``present``."""
-    edges = np.diff(np.concatenate(([0], present.astype(np.int8), [0])))
-    runs = np.flatnonzero(edges == -1) - np.flatnonzero(edges == 1)
-    return int(runs.max()) if runs.size else 0
+    starts, stops = true_runs(present)
+    return int((stops - starts).max()) if starts.size else 0
 
 
 def _window_bin_correlation(seg: int) -> np.ndarray:

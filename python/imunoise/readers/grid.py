@@ -52,6 +52,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from imunoise import _summary
+from imunoise._runs import true_runs
 
 __all__ = ["MAX_GRID_RATIO", "Gaps", "TimeGrid"]
 
@@ -193,9 +194,7 @@ class Gaps:
         missing = ~np.asarray(valid, dtype=bool)
         if not missing.any():
             return cls.none(fs, t0)
-        edges = np.diff(np.concatenate(([0], missing.view(np.int8), [0])))
-        starts = np.flatnonzero(edges == 1)
-        ends = np.flatnonzero(edges == -1)
+        starts, ends = true_runs(missing)
         return cls(starts, ends - starts, fs, t0)
 
     @property
