@@ -171,8 +171,7 @@ def false_warmups(logs: int = 10) -> None:
             observed = wu._explained(w.time, w.bias[:, j:j + 1], taus)[0]
             null = imunoise.simulate(len(w.time), 1 / w.block, channels=wu.NULL_RECORDS,
                                      seed=rng, **truth["gyro" if j < 3 else "accel"])
-            p_oracle.append((1 + np.count_nonzero(
-                wu._explained(w.time, null, taus) >= observed)) / (wu.NULL_RECORDS + 1))
+            p_oracle.append(wu._bootstrap_p(observed, wu._explained(w.time, null, taus)))
     for name, p in (("estimated null", np.array(p_est)), ("oracle null", np.array(p_oracle))):
         print(f"   {name}: transients called (p < {wu.ALPHA:g}) {np.sum(p < wu.ALPHA)} of "
               f"{p.size}; p < 0.01: {np.sum(p < 0.01)}, p < 0.05: {np.sum(p < 0.05)}, "

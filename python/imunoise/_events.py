@@ -61,6 +61,7 @@ from scipy import stats as _sstats
 
 from imunoise import _summary
 from imunoise._channels import rate_channels
+from imunoise._runs import true_runs
 from imunoise._validate import positive_finite
 from imunoise.readers.log import ImuLog
 
@@ -369,15 +370,7 @@ def events(
             quiet_level = _sstats.chi2.isf(p_v[-1], _dof(rho, windows[-1])) / _dof(
                 rho, windows[-1])
             isolated = _isolated(z, k_spike, touch, quiet_level)
-            e, rho_e = z, rho
-            if whiten:
-                e = _whiten(z, rho, k_spike, isolated)
-                scale_e, rho_e = _energy_law(np.where(quiet, e, np.nan), w)
-                e = e / np.sqrt(scale_e)
-            tail_dof = _tail_dof(e[quiet])
-            for v, p in zip(windows, p_v, strict=True):
-                spans += _bursts(e, v, p, _dof(rho_e, v), k_spike, isolated, tail_dof,
-                                 z if whiten else None)
+            spans += _burst_test(z, rho, quiet, windows, p_v, k_spike, isolated, whiten=whiten)
             if spans:
                 quiet = ~_span_mask(spans, n, pad=w)
         sigma[j] = mad_sigma * np.sqrt(scale)
@@ -388,7 +381,7 @@ def events(
                               k_spike, isolated)
         per_channel.append((joined, z, [(a, b, kind, {j}) for a, b, kind in inner]))
     return _merge_channels(
-        per_channel, names, fs, n, gap, windows[-1] // 2, sigma,
+        per_channel, names, fs, n, gap, touch, sigma,
         k_spike=k_spike,
         energy=float(_sstats.chi2.isf(p_window, w)) / w,
         window=w,
@@ -491,7 +484,8 @@ def _bursts(z: np.ndarray, w: int, p_window: float, dof: float, k_spike: float,
         else np.full(len(used), next(iter(limits.values()), np.inf))
     hot = energy > limit
     out = []
-    for a, b in _runs(hot):  # windows a .. b-1 flagged: samples a .. b+w-2 involved
+    # windows a .. b-1 flagged: samples a .. b+w-2 involved
+    for a, b in zip(*true_runs(hot), strict=True):
         lo, hi = max(0, a - w // 2), min(n, b - 1 + w + w // 2)
         start, end = _change_points(onset[lo:hi], tail_dof)
         if tail is not None and end > start:
@@ -512,18 +506,31 @@ def _inner_bursts(z, spans, windows, p_v, k_spike, isolated) -> list[tuple[int, 
     for a, b, kind in spans:
         if kind != "burst" or b - a < INNER_MIN_WINDOWS * w:
             continue
-        seg, iso = z[a:b], isolated[a:b]
+        seg = z[a:b]
         scale, rho = _energy_law(seg, w)
-        zs = seg / np.sqrt(scale)
-        e = _whiten(zs, rho, k_spike, iso)
-        scale_e, rho_e = _energy_law(e, w)
-        e = e / np.sqrt(scale_e)
-        tail_dof = _tail_dof(e)
-        for v, p in zip(windows, p_v, strict=True):
-            for s0, s1, _k in _bursts(e, v, p, _dof(rho_e, v), k_spike, iso, tail_dof, zs):
-                if s0 >= w and windows[-1] <= s1 - s0 < (b - a) // 2:
-                    out.append((a + s0, a + s1, "burst"))
+        everywhere = np.ones(b - a, dtype=bool)
+        for s0, s1, _k in _burst_test(seg / np.sqrt(scale), rho, everywhere, windows, p_v,
+                                      k_spike, isolated[a:b], whiten=True):
+            if s0 >= w and windows[-1] <= s1 - s0 < (b - a) // 2:
+                out.append((a + s0, a + s1, "burst"))
     return out
+
+
+def _burst_test(z, rho, quiet, windows, p_v, k_spike, isolated, *,
+                whiten: bool) -> list[tuple[int, int, str]]:
+    """The energy test at every window of ``windows`` on ``z`` (standardised by the
+    law of its ``quiet`` samples, autocorrelation ``rho``), or, with ``whiten``, on
+    its prediction errors, scaled by the law of their quiet samples; the Student-t
+    edges take their ν from the tested series' quiet samples."""
+    e, rho_e = z, rho
+    if whiten:
+        e = _whiten(z, rho, k_spike, isolated)
+        scale_e, rho_e = _energy_law(np.where(quiet, e, np.nan), windows[0])
+        e = e / np.sqrt(scale_e)
+    tail_dof = _tail_dof(e[quiet])
+    return [span for v, p in zip(windows, p_v, strict=True)
+            for span in _bursts(e, v, p, _dof(rho_e, v), k_spike, isolated, tail_dof,
+                                z if whiten else None)]
 
 
 def _whiten(z: np.ndarray, rho: np.ndarray, k_spike: float,
@@ -686,13 +693,6 @@ def _cumulative_log_ratio(seg: np.ndarray, inside: np.ndarray, nu: float) -> np.
 def _peak(z: np.ndarray) -> float:
     a = np.abs(z[np.isfinite(z)])
     return float(a.max()) if a.size else float("nan")
-
-
-def _runs(flags: np.ndarray) -> list[tuple[int, int]]:
-    """(start, stop) of each run of True."""
-    d = np.diff(np.concatenate(([0], flags.astype(np.int8), [0])))
-    return list(zip(np.flatnonzero(d == 1).tolist(), np.flatnonzero(d == -1).tolist(),
-                    strict=True))
 
 
 def _join(spans: list[tuple], gap: int, touch: int) -> list[list]:

@@ -385,9 +385,14 @@ def _null_p_values(x, fs, t, bias, duration, seed) -> np.ndarray:
         coef["K"] = max(coef["K"], float(k_floor[c]))
         null = simulate(len(t), block_rate, channels=NULL_RECORDS, seed=rng,
                         gm=model.gauss_markov(c), **coef)
-        p[j] = (1 + np.count_nonzero(_explained(t[kept], null[kept], taus) >= observed)) / (
-            NULL_RECORDS + 1)
+        p[j] = _bootstrap_p(observed, _explained(t[kept], null[kept], taus))
     return p
+
+
+def _bootstrap_p(observed: float, null: np.ndarray) -> float:
+    """p of ``observed`` among the null records' statistics ``null`` (the observed
+    record counted with them, so p is never 0)."""
+    return (1 + np.count_nonzero(null >= observed)) / (len(null) + 1)
 
 
 def _random_walk_bound(result, model, min_edf: float = 5.0) -> np.ndarray:
