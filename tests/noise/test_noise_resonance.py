@@ -18,7 +18,7 @@ import imunoise.plot
 import matplotlib
 import numpy as np
 import pytest
-from helpers.noise_fit import quiet_fit
+from helpers.noise_fit import clean_five_term_fits, quiet_fit
 from imunoise import export, report
 from imunoise._core import fit as core_fit
 from imunoise.noise import resonance_white_density
@@ -110,10 +110,7 @@ def test_without_the_resonance_the_model_misses_the_curve(resonant):
 
 @pytest.mark.parametrize("seed", [3, 4])
 def test_clean_five_term_data_selects_no_resonance(seed):
-    x = imunoise.simulate(int(2 * 3600 * FS), FS, N=1e-3, B=3e-5, K=2e-6, channels=3,
-                          seed=seed)
-    for grid in ("octave", 10, 20):
-        model = quiet_fit(imunoise.adev(x, FS, taus=grid))
+    for grid, model in clean_five_term_fits(seed):
         assert all(model.resonance(c) == [] for c in range(3)), (grid, model)
         assert np.all(np.isnan(model.resonance_sigma))
 

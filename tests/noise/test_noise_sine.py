@@ -16,7 +16,7 @@ import imunoise.plot
 import matplotlib
 import numpy as np
 import pytest
-from helpers.noise_fit import quiet_fit
+from helpers.noise_fit import clean_five_term_fits, quiet_fit
 
 matplotlib.use("Agg")
 
@@ -76,10 +76,7 @@ def test_without_the_tone_the_model_misses_the_curve(toned):
 
 @pytest.mark.parametrize("seed", [3, 4])
 def test_clean_five_term_data_selects_no_tone(seed):
-    x = imunoise.simulate(int(2 * 3600 * FS), FS, N=1e-3, B=3e-5, K=2e-6, channels=3,
-                          seed=seed)
-    for grid in ("octave", 10, 20):
-        model = quiet_fit(imunoise.adev(x, FS, taus=grid))
+    for grid, model in clean_five_term_fits(seed):
         assert all(model.sine(c) == [] for c in range(3)), (grid, model)
         assert np.all(np.isnan(model.sine_amplitude))
 
