@@ -101,8 +101,8 @@ def main() -> None:
         for method in ("wls", "slopes"):
             m = imunoise.fit(r, method=method)
             if method == "wls":
-                false_tones += sum(bool(m.sine(c)) for c in range(3))
-                false_resonances += sum(bool(m.resonance(c)) for c in range(3))
+                false_tones += sum(bool(m.components.sine(c)) for c in range(3))
+                false_resonances += sum(bool(m.components.resonance(c)) for c in range(3))
             for k, v in TRUTH.items():
                 err[method][k].extend(np.abs(m.value(k) / v - 1))
         params, _ = allan_variance.estimate_parameters(r.taus, r.var)
@@ -114,10 +114,10 @@ def main() -> None:
         x = imunoise.simulate(N_SAMPLES, FS, channels=3, seed=100 + seed, N=TRUTH["N"],
                               K=TRUTH["K"], gm=[(GM_SIGMA, GM_TAU)])
         m = imunoise.fit(imunoise.adev(x, FS, taus=10))
-        false_tones += sum(bool(m.sine(c)) for c in range(3))
-        false_resonances += sum(bool(m.resonance(c)) for c in range(3))
+        false_tones += sum(bool(m.components.sine(c)) for c in range(3))
+        false_resonances += sum(bool(m.components.resonance(c)) for c in range(3))
         for c in range(3):
-            near = [g for g in m.gauss_markov(c) if 0.2 < g[1] / GM_TAU < 5]
+            near = [g for g in m.components.gauss_markov(c) if 0.2 < g[1] / GM_TAU < 5]
             if near:
                 gm_found += 1
                 gm_err["sigma"].append(abs(near[0][0] / GM_SIGMA - 1))

@@ -89,9 +89,10 @@ def allan_variance_dev(taus, var):
 
 def structure(model):
     terms = [t for t in imunoise.noise.TERMS if bool(model.supported[t])]
-    gm = [f"GM({tc:.3g} s)" for _, tc in model.gauss_markov()]
-    tone = [f"sine({f0:.3g} Hz)" for _, f0 in model.sine()]
-    res = [f"res({f:.3g} Hz, Q {math.pi * f * tr:.2g})" for _, f, tr in model.resonance()]
+    gm = [f"GM({tc:.3g} s)" for _, tc in model.components.gauss_markov()]
+    tone = [f"sine({f0:.3g} Hz)" for _, f0 in model.components.sine()]
+    res = [f"res({f:.3g} Hz, Q {math.pi * f * tr:.2g})"
+           for _, f, tr in model.components.resonance()]
     return "+".join(terms + gm + tone + res)
 
 
@@ -122,7 +123,7 @@ def main() -> int:
         eq, co = {}, {}
         for label, grid in GRIDS.items():
             m = imunoise.fit(imunoise.adev(x, fs, taus=grid))
-            eq[label] = [float(m.equivalent(t)[0]) for t in ("N", "B", "K")]
+            eq[label] = [float(m.value(t)[0]) for t in ("N", "B", "K")]
             co[label] = [(float(m.value(t)[0]), float(m.std(t)[0])) for t in ("N", "B", "K")]
         stab.append((name, eq, co))
     print(f"{len(rows)} real channels; imunoise.fit total {fit_time:.2f} s")

@@ -59,8 +59,8 @@ def compare(y, fs):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         model = imunoise.fit(imunoise.adev(y, fs, taus=20))
-    n_fit = np.atleast_1d(model.equivalent("N"))
-    n_fit_std = np.atleast_1d(model.equivalent_std("N"))
+    n_fit = np.atleast_1d(model.value("N"))
+    n_fit_std = np.atleast_1d(model.std("N"))
     return s, n_fit, n_fit_std
 
 

@@ -384,7 +384,7 @@ def _null_p_values(x, fs, t, bias, duration, seed) -> np.ndarray:
         coef = {term: _upper(model, term, c) for term in ("N", "B", "K", "R")}
         coef["K"] = max(coef["K"], float(k_floor[c]))
         null = simulate(len(t), block_rate, channels=NULL_RECORDS, seed=rng,
-                        gm=model.gauss_markov(c), **coef)
+                        gm=model.components.gauss_markov(c), **coef)
         p[j] = _bootstrap_p(observed, _explained(t[kept], null[kept], taus))
     return p
 
@@ -413,7 +413,7 @@ def _random_walk_bound(result, model, min_edf: float = 5.0) -> np.ndarray:
         if usable.size:
             i = usable[-1]
             tau = result.taus[i : i + 1]
-            others = {t: float(np.ravel(model.value(t))[c]) for t in ("Q", "N", "B", "R")}
+            others = {t: float(model.components.value(t)[c]) for t in ("Q", "N", "B", "R")}
             upper = dev[i, c] ** 2 * edf[i, c] / _stats.chi2.ppf(1 - BOUND_CONFIDENCE,
                                                                   edf[i, c])
             rest = upper - float(model_variance(tau, **others)[0])
@@ -425,8 +425,8 @@ def _upper(model, term: str, c: int) -> float:
     """A coefficient of the null model at its value + 2 standard uncertainties: half a
     log estimates the wander loosely, and a null that is too quiet calls wander a
     transient."""
-    value = float(np.ravel(model.value(term))[c])
-    std = float(np.ravel(model.std(term))[c])
+    value = float(model.components.value(term)[c])
+    std = float(model.components.std(term)[c])
     return value + 2 * std if value > 0 and np.isfinite(std) else value
 
 

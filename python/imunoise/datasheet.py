@@ -286,8 +286,8 @@ def compare(models, spec="vn100", *, sensor: str = "gyro", input_units: dict | N
             continue
         info = _units.unit_info(item.term, item.unit, item.sensor)
         iu = input_units.get(item.sensor)
-        # The model's datasheet equivalents: what a datasheet quotes from a curve.
-        eq, eq_std = model.equivalent(item.term), model.equivalent_std(item.term)
+        # The model's datasheet values: what a datasheet quotes from a curve.
+        eq, eq_std = model.value(item.term), model.std(item.term)
         values = _units.convert(eq, item.term, info.name, sensor=item.sensor, input_unit=iu)
         stds = _units.convert(eq_std, item.term, info.name, sensor=item.sensor, input_unit=iu)
         sup = (eq > 0) & np.isfinite(eq)

@@ -14,7 +14,7 @@ key                            noise-model coefficient  unit
 
 (N in rad/√s is numerically rad/s/√Hz, K in rad/s/√s is rad/s²/√Hz.) Kalibr's
 model has no Gauss–Markov state, so the values written are the model's
-datasheet equivalents (:meth:`NoiseModel.equivalent`): Gauss–Markov terms
+datasheet values (``model.N``, ``model.K``: the numbers every view prints): Gauss–Markov terms
 faster than 1 s are folded into the white noise, slower ones into the random
 walk (the walk that bounds them over times shorter than τc). The
 :func:`ekf_dict` export keeps them as bias states instead. The
@@ -83,9 +83,9 @@ def write_atomic(path, text: str) -> Path:
 
 
 def _combine(model, term: str, combine: str, sensor: str, input_unit) -> float:
-    # The model's datasheet equivalent: Kalibr's white + random-walk model has no
+    # The model's datasheet value: Kalibr's white + random-walk model has no
     # Gauss–Markov state, so fast ones count as white noise and slow ones as walk.
-    values = np.atleast_1d(model.equivalent(term))
+    values = model.value(term)
     sup = values > 0
     scale = _units.input_scale(sensor, input_unit)
     if not sup.any():
@@ -223,14 +223,18 @@ def _ekf_axes(model, sensor: str, input_unit, min_samples: float) -> dict:
     scale = _units.input_scale(sensor, input_unit)
     axes = {}
     names = ["x", "y", "z"] if model.channels == 3 else [f"ch{i}" for i in range(model.channels)]
+    # The state-space model is built from the fitted components (a slow
+    # Gauss–Markov term is a state of its own, not part of K); the datasheet
+    # values the other views print go beside it.
+    parts = model.components
     for c, name in enumerate(names):
-        white2 = float(model.value("N")[c]) ** 2
+        white2 = float(parts.value("N")[c]) ** 2
         # A resonance (like a tone) is no bias state; what it adds to the white
         # floor (its spectrum at zero frequency) is measurement noise.
-        for sigma, f_r, tau_r in model.resonance(c):
+        for sigma, f_r, tau_r in parts.resonance(c):
             white2 += resonance_white_density(sigma, f_r, tau_r, model.fs)
         states = []
-        for sigma, tau_c in model.gauss_markov(c):
+        for sigma, tau_c in parts.gauss_markov(c):
             if tau_c * model.fs < min_samples:
                 # Too fast to be a filter state at the IMU rate: white noise.
                 white2 += gm_white_density(sigma, tau_c, model.fs)
@@ -242,9 +246,10 @@ def _ekf_axes(model, sensor: str, input_unit, min_samples: float) -> dict:
             })
         axes[name] = {
             "white_noise_density": math.sqrt(white2) * scale,
-            "random_walk": float(model.value("K")[c]) * scale,
+            "random_walk": float(parts.value("K")[c]) * scale,
             "bias_instability": float(model.value("B")[c]) * scale,
             "gauss_markov": states,
+            "datasheet": {t: float(model.value(t)[c]) * scale for t in ("N", "B", "K")},
         }
     return axes
 
@@ -263,7 +268,10 @@ def ekf_dict(gyro=None, accel=None, *, gyro_unit: str | None = None,
     density of w). Discretised at step Δt: b[k+1] = e^(−Δt/τc)·b[k] + w[k],
     var w[k] = σ²(1 − e^(−2Δt/τc)). A Gauss–Markov term faster than
     ``min_samples`` samples cannot be a state at the IMU rate and is folded
-    into the white noise.
+    into the white noise. These state-space values come from the fitted
+    components (``model.components``); ``datasheet`` holds the model's datasheet
+    values N, B, K (``model.N``…, the numbers the report and the other exports
+    print) in the same SI units, for reference.
     """
     if gyro is None and accel is None:
         raise ValueError("gyro and accel are both None; pass at least one NoiseModel")
@@ -301,6 +309,8 @@ def ekf_yaml(gyro=None, accel=None, **kwargs) -> str:
             lines.append(f"    {axis}:")
             for key in ("white_noise_density", "random_walk", "bias_instability"):
                 lines.append(f"      {key}: {_scalar(a[key])}")
+            lines.append("      datasheet: {" + ", ".join(
+                f"{k}: {_scalar(v)}" for k, v in a["datasheet"].items()) + "}")
             if not a["gauss_markov"]:
                 lines.append("      gauss_markov: []")
                 continue

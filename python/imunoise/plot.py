@@ -343,8 +343,8 @@ def _model_curves(model: NoiseModel, grid: np.ndarray, channel: int) -> dict[str
 
 
 def _readoff_points(model: NoiseModel, channel: int) -> dict[str, float]:
-    """The model's datasheet equivalents N (τ = 1 s), K (τ = 3 s), B for the marks."""
-    return {t: float(np.atleast_1d(model.equivalent(t))[channel]) for t in ("N", "K", "B")}
+    """The model's datasheet values N (τ = 1 s), K (τ = 3 s), B for the marks."""
+    return {t: float(model.value(t)[channel]) for t in ("N", "K", "B")}
 
 
 def allan(

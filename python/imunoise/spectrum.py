@@ -446,18 +446,19 @@ def model_psd(model: NoiseModel, f: npt.ArrayLike) -> np.ndarray:
 
 
 def model_psd_terms(model: NoiseModel, f: npt.ArrayLike) -> dict[str, np.ndarray]:
-    """Each term of ``model`` that is present (non-zero) as its one-sided PSD at ``f``:
+    """Each fitted component of ``model`` that is present (non-zero) as its one-sided
+    PSD at ``f``:
     keys "Q", "N", "B", "K", "R", "GM1", … (GM: the sampled AR1, see the module)."""
     f = _check_frequencies(f)
     fs = float(model.fs)
     channels = 1 if model.one_channel else model.channels
     out: dict[str, np.ndarray] = {}
     for term in POWER_LAWS:
-        c = np.atleast_1d(model.value(term)).astype(float)
+        c = model.components.value(term).astype(float)
         if np.any(c > 0):
             out[term] = term_psd(term, c[None, :], f[:, None], fs=fs)
     for j in range(channels):
-        for k, (sigma, tau_c) in enumerate(model.gauss_markov(j)):
+        for k, (sigma, tau_c) in enumerate(model.components.gauss_markov(j)):
             phi = math.exp(-1.0 / (fs * tau_c))
             gm = (2 * sigma**2 * (1 - phi**2) / fs
                   / np.abs(1 - phi * np.exp(-2j * np.pi * f / fs)) ** 2)

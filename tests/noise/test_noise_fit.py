@@ -49,50 +49,50 @@ def vn_like():
 def test_single_term_recovered_and_others_unsupported(term, value, n, tol):
     x = imunoise.simulate(n, FS, seed=3, **{term: value})
     model = imunoise.fit(allan(x, FS))
-    est = float(getattr(model, term))
-    assert model.supported[term]
+    est = float(getattr(model.components, term))
+    assert model.components.supported[term]
     assert abs(est / value - 1) < tol, (term, est, value)
     # The reported uncertainty is honest (within 4 sigma) unless the term is exact.
-    std = float(getattr(model, term + "_std"))
+    std = float(getattr(model.components, term + "_std"))
     assert np.isfinite(std)
     assert abs(est - value) <= 4 * std + 1e-9 * value
     # White noise alone must not produce a bias instability or a random walk.
     if term == "N":
-        assert not model.supported["B"] and float(model.B) == 0.0
-        assert not model.supported["K"] and float(model.K) == 0.0
-        assert not model.supported["Q"] and not model.supported["R"]
+        assert not model.components.supported["B"] and float(model.components.B) == 0.0
+        assert not model.components.supported["K"] and float(model.components.K) == 0.0
+        assert not model.components.supported["Q"] and not model.components.supported["R"]
 
 
 def test_all_terms_together(vn_like):
     truth, result = vn_like
     model = imunoise.fit(result)
-    assert model.N.shape == (3,)
+    assert model.components.N.shape == (3,)
     for term, tol in (("N", 0.02), ("B", 0.25)):
-        est = model.value(term)
-        assert np.sum(model.supported[term]) >= 2, term
+        est = model.components.value(term)
+        assert np.sum(model.components.supported[term]) >= 2, term
         rel = np.abs(est / truth[term] - 1)
         assert np.median(rel) < tol, (term, est, truth[term])
     # A flicker realisation can look like a Gauss–Markov bump: the flat part is
     # always carried by one of the two.
     for c in range(3):
-        assert model.supported["B"][c] or model.gauss_markov(c), c
+        assert model.components.supported["B"][c] or model.components.gauss_markov(c), c
     # At long tau a random-walk realisation can look like a ramp: on every axis
     # the long-tau rise is carried by K or R, never by nothing.
-    assert np.all(model.supported["K"] | model.supported["R"])
-    assert np.sum(model.supported["K"]) >= 2
+    assert np.all(model.components.supported["K"] | model.components.supported["R"])
+    assert np.sum(model.components.supported["K"]) >= 2
     # Without the ramp term, K itself is recovered.
     nbk = imunoise.fit(result, terms=("N", "B", "K"))
-    assert np.all(nbk.supported["K"])
-    assert np.median(np.abs(nbk.K / truth["K"] - 1)) < 0.4
+    assert np.all(nbk.components.supported["K"])
+    assert np.median(np.abs(nbk.components.K / truth["K"] - 1)) < 0.4
     # uncertainties assume independent taus; overlapping octaves correlate (docs/noise.md)
-    assert np.all(np.abs(nbk.K - truth["K"]) < 5 * nbk.K_std)
+    assert np.all(np.abs(nbk.components.K - truth["K"]) < 5 * nbk.components.K_std)
 
 
 def test_tau_ranges_follow_the_slopes(vn_like):
     truth, result = vn_like
     model = imunoise.fit(result)
-    n_lo, n_hi = model.tau_range["N"][0]
-    k_lo, k_hi = model.tau_range["K"][0]
+    n_lo, n_hi = model.components.tau_range["N"][0]
+    k_lo, k_hi = model.components.tau_range["K"][0]
     assert n_lo == result.taus[0]
     assert n_hi < k_lo  # white noise dominates short taus, the random walk long ones
     assert k_hi == result.taus[-1]
@@ -107,17 +107,18 @@ def test_predict_is_the_model(vn_like):
     parts = sum(v**2 for v in p.terms.values())
     np.testing.assert_allclose(p.dev**2, parts, rtol=1e-12)
     for c in range(3):
-        expect = model_variance(taus, **{k: float(model.value(k)[c]) for k in "QNBKR"})
+        expect = model_variance(taus, **{k: float(model.components.value(k)[c]) for k in "QNBKR"})
         gm = sum(p.terms[k][:, c] ** 2 for k in p.terms if k.startswith("GM"))
         np.testing.assert_allclose(p.dev[:, c] ** 2, expect + gm, rtol=1e-12)
-    np.testing.assert_allclose(p.terms["N"][:, 0], model.N[0] / np.sqrt(taus), rtol=1e-12)
-    np.testing.assert_allclose(p.terms["B"][:, 1], FLICKER * model.B[1], rtol=1e-12)
+    parts = model.components
+    np.testing.assert_allclose(p.terms["N"][:, 0], parts.N[0] / np.sqrt(taus), rtol=1e-12)
+    np.testing.assert_allclose(p.terms["B"][:, 1], FLICKER * model.components.B[1], rtol=1e-12)
 
 
 def test_one_channel_shapes():
     x = imunoise.simulate(20000, FS, N=1e-3, seed=1)
     model = imunoise.fit(allan(x, FS))
-    assert np.ndim(model.N) == 0 and model.channels == 1
+    assert np.ndim(model.components.N) == 0 and model.channels == 1
     assert model.predict([1.0, 2.0]).dev.shape == (2,)
     assert model.kind == "adev" and model.fs == FS
 
@@ -125,24 +126,24 @@ def test_one_channel_shapes():
 def test_terms_restrict_the_model(vn_like):
     _, result = vn_like
     model = imunoise.fit(result, terms=("N", "K"))
-    assert not np.any(model.supported["B"]) and np.all(model.B == 0)
-    assert np.all(model.supported["N"])
+    assert not np.any(model.components.supported["B"]) and np.all(model.components.B == 0)
+    assert np.all(model.components.supported["N"])
 
 
 def test_tau_range_restricts_the_fit(vn_like):
     _, result = vn_like
     model = imunoise.fit(result, tau_range=(0.0, 1.0))
     assert model.taus.max() <= 1.0
-    assert not np.any(model.supported["K"])  # K is invisible below 1 s
+    assert not np.any(model.components.supported["K"])  # K is invisible below 1 s
 
 
 def test_model_is_frozen(vn_like):
     _, result = vn_like
     model = imunoise.fit(result)
     with pytest.raises(AttributeError):
-        model.N = 0
+        model.components.N = 0
     with pytest.raises(ValueError):
-        model.N[0] = 1.0
+        model.components.N[0] = 1.0
 
 
 # -- slope read-off ----------------------------------------------------------
@@ -154,10 +155,10 @@ TAUS = np.logspace(-2, 5, 71)
 def test_slopes_exact_on_single_term_curves(term):
     """On a pure power law the IEEE read-off is exact (closed forms)."""
     model = imunoise.fit(_exact_result(TAUS, **{term: 2.5e-3}), method="slopes")
-    assert float(getattr(model, term)) == pytest.approx(2.5e-3, rel=1e-9)
+    assert float(getattr(model.components, term)) == pytest.approx(2.5e-3, rel=1e-9)
     for other in "QNBKR":
         if other != term and other != "B":
-            assert not model.supported[other], other
+            assert not model.components.supported[other], other
 
 
 def test_slopes_on_vn100_like_curve():
@@ -169,7 +170,7 @@ def test_slopes_on_vn100_like_curve():
         assert float(getattr(slopes, k)) == pytest.approx(v, rel=0.25), k
         # exact curves carry no χ² scatter; the fit's log-bias correction for
         # edf = 1000 (E ln χ²/ν ≈ −1/ν) shifts them by ~1e-3
-        assert float(getattr(wls, k)) == pytest.approx(v, rel=3e-3), k
+        assert float(getattr(wls.components, k)) == pytest.approx(v, rel=3e-3), k
     # B from the flat part: sigma_min / 0.6643, never 0.6643 * sigma^2
     dev = np.sqrt(model_variance(TAUS, **coef))
     assert float(slopes.B) >= dev.min() / FLICKER * 0.99
@@ -184,10 +185,10 @@ def test_slopes_matches_matlab_rule_by_hand():
     s = np.diff(logd) / np.diff(logt)
     i = np.argmin(np.abs(s + 0.5))
     by_hand = 10 ** (logd[i] + 0.5 * logt[i])
-    assert float(model.N) == pytest.approx(by_hand, rel=1e-12)
+    assert float(model.components.N) == pytest.approx(by_hand, rel=1e-12)
     j = np.argmin(np.abs(s - 0.5))
     by_hand_k = 10 ** (logd[j] - 0.5 * logt[j] + 0.5 * np.log10(3.0))
-    assert float(model.K) == pytest.approx(by_hand_k, rel=1e-12)
+    assert float(model.components.K) == pytest.approx(by_hand_k, rel=1e-12)
 
 
 def test_wls_agrees_with_allan_variance_on_an_exact_curve():
@@ -199,8 +200,8 @@ def test_wls_agrees_with_allan_variance_on_an_exact_curve():
     params, _ = allan_variance.estimate_parameters(r.taus, r.var)
     names = {"Q": "quantization", "N": "white", "B": "flicker", "K": "walk", "R": "ramp"}
     for k, v in coef.items():
-        assert float(getattr(ours, k)) == pytest.approx(v, rel=3e-3), k
-        assert float(getattr(ours, k)) == pytest.approx(params[names[k]], rel=3e-3), k
+        assert float(getattr(ours.components, k)) == pytest.approx(v, rel=3e-3), k
+        assert float(getattr(ours.components, k)) == pytest.approx(params[names[k]], rel=3e-3), k
 
 
 @pytest.fixture(scope="module")
@@ -247,7 +248,7 @@ def test_bootstrap_std_matches_the_spread_of_repeated_experiments(truth):
                          **opts)
     bands = {"N": (0.82, 1.25), "K": (0.6, 1.6)}
     for i, term in enumerate(truth):
-        ratio = model.std(term)[0] / spread[i]
+        ratio = model.components.std(term)[0] / spread[i]
         assert bands[term][0] < ratio < bands[term][1], (term, ratio)
 
 
@@ -267,8 +268,9 @@ def test_bootstrap_on_several_channels_and_non_overlapping_adev():
     x[:, 1] *= 10.0
     r = imunoise.adev(x, 20.0, overlapping=False)
     model = imunoise.fit(r, uncertainty="bootstrap", replicates=12, seed=1)
-    assert model.N_std.shape == (2,)
-    np.testing.assert_allclose(model.N_std[1] / model.N_std[0], 10.0, rtol=0.6)
+    assert model.components.N_std.shape == (2,)
+    n_std = model.components.N_std
+    np.testing.assert_allclose(n_std[1] / n_std[0], 10.0, rtol=0.6)
 
 
 @pytest.mark.parametrize(

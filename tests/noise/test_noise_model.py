@@ -35,22 +35,25 @@ def test_gauss_markov_term_is_recovered_and_selected(white_plus_gm):
     truth, r = white_plus_gm
     model = imunoise.fit(r)
     for c in range(2):
-        gm = model.gauss_markov(c)
+        gm = model.components.gauss_markov(c)
         assert len(gm) == 1, gm
         sigma, tau_c = gm[0]
         assert sigma == pytest.approx(truth["sigma"], rel=0.10)
         assert tau_c == pytest.approx(truth["tau_c"], rel=0.20)
-        assert abs(tau_c - truth["tau_c"]) < 4 * np.reshape(model.gm_tau_std, (2, -1))[c, 0]
+        tau_std = np.reshape(model.components.gm_tau_std, (2, -1))[c, 0]
+        assert abs(tau_c - truth["tau_c"]) < 4 * tau_std
         # The true structure: white noise and the bias, nothing else.
-        assert model.supported["N"][c]
-        assert not any(model.supported[t][c] for t in ("Q", "K", "R"))
+        assert model.components.supported["N"][c]
+        assert not any(model.components.supported[t][c] for t in ("Q", "K", "R"))
+        # The datasheet values: the slow bias's +½ slope is K's, the white noise N's.
+        assert model.supported["K"][c] and model.supported["N"][c]
     assert np.all(model.coverage >= 0.9)
 
 
 def test_explicit_terms_fit_exactly_those(white_plus_gm):
     _, r = white_plus_gm
     only = imunoise.fit(r, terms=["N", "GM"])
-    assert all(len(only.gauss_markov(c)) == 1 for c in range(2))
+    assert all(len(only.components.gauss_markov(c)) == 1 for c in range(2))
     assert not np.any(only.supported["B"])
     with pytest.raises(ValueError, match="terms must be 'auto' or"):
         imunoise.fit(r, terms=["N", "GM", "GM", "GM", "GM"])
@@ -62,7 +65,7 @@ def test_five_term_data_selects_no_gauss_markov():
     x = imunoise.simulate(int(3600 * FS), FS, N=1e-3, K=2e-5, channels=2, seed=8)
     model = imunoise.fit(imunoise.adev(x, FS, taus=10))
     for c in range(2):
-        assert model.gauss_markov(c) == []
+        assert model.components.gauss_markov(c) == []
         assert model.N[c] == pytest.approx(1e-3, rel=0.01)
         assert not model.supported["Q"][c] and not model.supported["R"][c]
     # One hour of one random-walk realisation can look flat at its longest taus
@@ -108,8 +111,8 @@ def test_coefficients_do_not_depend_on_the_tau_grid(seed):
         assert vals.max() - vals.min() <= 2 * stds.max(), (term, vals, stds)
     # The datasheet B of the model: a borderline ramp term in or out moves it by
     # up to ~2.6 of its uncertainties (seed 4), never more than 3.
-    beq = np.array([float(m.equivalent("B")[0]) for m in fits.values()])
-    beq_std = np.array([float(m.equivalent_std("B")[0]) for m in fits.values()])
+    beq = np.array([float(m.value("B")[0]) for m in fits.values()])
+    beq_std = np.array([float(m.std("B")[0]) for m in fits.values()])
     assert np.all(beq > 0), beq
     assert beq.max() - beq.min() <= 3 * beq_std.max(), (beq, beq_std)
 
@@ -122,7 +125,7 @@ def test_real_vn100_log_is_followed_on_every_grid():
     for grid in ("octave", 5, 10, 20, 50):
         model = quiet_fit(imunoise.adev(log.gyro, log.fs, taus=grid))
         assert np.all(model.coverage >= 0.8), (grid, model.coverage)
-        n_eq.append(model.equivalent("N"))
+        n_eq.append(model.value("N"))
     n_eq = np.array(n_eq)
     assert np.all(n_eq.max(axis=0) / n_eq.min(axis=0) - 1 < 0.03), n_eq
 
@@ -156,8 +159,8 @@ def test_readoffs_agree_with_the_model_on_ideal_noise():
     for term in ("N", "B"):
         read = float(model.readoff[term]["value"])
         std = float(model.readoff[term]["std"])
-        eq = float(model.equivalent(term)[0])
-        eq_std = float(model.equivalent_std(term)[0])
+        eq = float(model.value(term)[0])
+        eq_std = float(model.std(term)[0])
         assert eq > 0, term
         assert abs(read - eq) <= max(3 * math.hypot(std, eq_std), 0.05 * eq), (
             term, read, eq, std, eq_std)
@@ -171,10 +174,10 @@ def test_readoffs_agree_with_the_model_on_ideal_noise():
 def test_equivalent_white_noise_folds_fast_gauss_markov(white_plus_gm):
     truth, r = white_plus_gm
     model = imunoise.fit(r, terms=["N", "GM"])
-    sigma, tau_c = model.gauss_markov(0)[0]
+    sigma, tau_c = model.components.gauss_markov(0)[0]
     # τc = 20 s > 1 s: the slow term goes to the walk, not to the white noise.
-    assert float(model.equivalent("N")[0]) == pytest.approx(float(model.N[0]), rel=1e-12)
-    assert float(model.equivalent("K")[0]) == pytest.approx(
+    assert float(model.value("N")[0]) == pytest.approx(float(model.N[0]), rel=1e-12)
+    assert float(model.value("K")[0]) == pytest.approx(
         math.sqrt(2 * sigma**2 / tau_c), rel=1e-12)
 
 
@@ -185,7 +188,7 @@ def test_ekf_export(tmp_path, white_plus_gm):
     axes = d["gyroscope"]["axes"]
     assert list(axes) == ["ch0", "ch1"]
     state = axes["ch0"]["gauss_markov"][0]
-    sigma, tau_c = model.gauss_markov(0)[0]
+    sigma, tau_c = model.components.gauss_markov(0)[0]
     assert state["sigma"] == pytest.approx(sigma)
     assert state["correlation_time"] == pytest.approx(tau_c)
     assert state["driving_noise_density"] == pytest.approx(sigma * math.sqrt(2 / tau_c))
@@ -214,6 +217,7 @@ def test_simulate_gauss_markov_is_the_ar1():
 def test_model_json_carries_gauss_markov(white_plus_gm):
     _, r = white_plus_gm
     d = imunoise.fit(r).to_dict()
-    assert len(d["gauss_markov"]) == 2 and d["gauss_markov"][0][0]["tau_c"] > 0
+    parts = d["components"]
+    assert len(parts["gauss_markov"]) == 2 and parts["gauss_markov"][0][0]["tau_c"] > 0
     assert 0 < d["coverage"][0] <= 1
     assert set(d["readoff"]) == {"N", "K", "B"}

@@ -83,19 +83,20 @@ def test_simulate_rejects_a_bad_resonance():
 def test_resonance_is_selected_and_recovered(resonant):
     model = quiet_fit(resonant)
     for c in range(2):
-        assert len(model.resonance(c)) == 1, model
-        sigma, f_r, tau_r = model.resonance(c)[0]
+        assert len(model.components.resonance(c)) == 1, model
+        sigma, f_r, tau_r = model.components.resonance(c)[0]
         stds = [float(np.atleast_1d(a)[c]) for a in (
-            model.resonance_sigma_std, model.resonance_freq_std, model.resonance_tau_std)]
+            model.components.resonance_sigma_std, model.components.resonance_freq_std,
+            model.components.resonance_tau_std)]
         for got, want, u in zip((sigma, f_r, tau_r),
                                 (TRUTH["sigma"], TRUTH["f_r"], TRUTH["tau_r"]), stds,
                                 strict=True):
             assert 0 < u < 0.2 * got
             assert abs(got - want) < 3 * u, (got, want, u)
-        assert model.sine(c) == []
+        assert model.components.sine(c) == []
     assert np.all(model.coverage >= 0.9)
     # The white floor: N and the resonance's zero-frequency density together.
-    n_eq = model.equivalent("N")
+    n_eq = model.value("N")
     n_true = math.sqrt(TRUTH["N"] ** 2 + resonance_white_density(
         TRUTH["sigma"], TRUTH["f_r"], TRUTH["tau_r"], FS))
     np.testing.assert_allclose(n_eq, n_true, rtol=0.03)
@@ -111,8 +112,8 @@ def test_without_the_resonance_the_model_misses_the_curve(resonant):
 @pytest.mark.parametrize("seed", [3, 4])
 def test_clean_five_term_data_selects_no_resonance(seed):
     for grid, model in clean_five_term_fits(seed):
-        assert all(model.resonance(c) == [] for c in range(3)), (grid, model)
-        assert np.all(np.isnan(model.resonance_sigma))
+        assert all(model.components.resonance(c) == [] for c in range(3)), (grid, model)
+        assert np.all(np.isnan(model.components.resonance_sigma))
 
 
 def test_gauss_markov_and_tone_data_select_no_resonance():
@@ -120,8 +121,8 @@ def test_gauss_markov_and_tone_data_select_no_resonance():
                           gm=[(4e-3, 20.0)], sinusoid=(2e-2, 7.3))
     model = quiet_fit(imunoise.adev(x, FS, taus=20))
     for c in range(2):
-        assert model.resonance(c) == []
-        assert len(model.sine(c)) == 1 and len(model.gauss_markov(c)) == 1
+        assert model.components.resonance(c) == []
+        assert len(model.components.sine(c)) == 1 and len(model.components.gauss_markov(c)) == 1
 
 
 def test_resonance_in_prediction_table_dict_repr_plot_and_report(resonant):
@@ -135,11 +136,11 @@ def test_resonance_in_prediction_table_dict_repr_plot_and_report(resonant):
     assert rows["f_r"]["X"] == pytest.approx(TRUTH["f_r"], rel=0.05)
     assert rows["σr"]["label"] == rows["B"]["label"]
     assert rows["σr"]["X"] == pytest.approx(imunoise.units.convert(
-        float(model.resonance(0)[0][0]), "B", rows["B"]["unit"]), rel=1e-12)
-    assert "f_r resonance frequency" in model.table_text("gyro")
+        float(model.components.resonance(0)[0][0]), "B", rows["B"]["unit"]), rel=1e-12)
+    assert "f_r component: resonance frequency" in model.table_text("gyro")
     d = model.to_dict()
     json.dumps(d)
-    assert d["resonance"][1][0]["frequency"] == pytest.approx(TRUTH["f_r"], rel=0.05)
+    assert d["components"]["resonance"][1][0]["frequency"] == pytest.approx(TRUTH["f_r"], rel=0.05)
     assert "resonance" in repr(model) and "resonance" in model._repr_html_()
     fig = imunoise.plot.allan(resonant, model=model)
     assert "resonance" in [ln.get_label() for ln in fig.axes[0].get_lines()]
@@ -151,8 +152,8 @@ def test_the_ekf_export_folds_the_resonance_into_the_white_noise(resonant):
     model = quiet_fit(resonant)
     axes = export.ekf_dict(gyro=model)["gyroscope"]["axes"]
     for c, name in enumerate(["ch0", "ch1"]):
-        sigma, f_r, tau_r = model.resonance(c)[0]
-        want = math.sqrt(float(model.N[c]) ** 2
+        sigma, f_r, tau_r = model.components.resonance(c)[0]
+        want = math.sqrt(float(model.components.N[c]) ** 2
                          + resonance_white_density(sigma, f_r, tau_r, FS))
         assert axes[name]["white_noise_density"] == pytest.approx(want, rel=1e-12)
         assert axes[name]["gauss_markov"] == []
@@ -162,7 +163,7 @@ def test_explicit_resonance_terms_are_checked(resonant):
     with pytest.raises(ValueError, match="'resonance' at most once"):
         imunoise.fit(resonant, terms=["N", "resonance", "resonance"])
     only = quiet_fit(resonant, terms=["N", "resonance"])
-    assert all(len(only.resonance(c)) == 1 for c in range(2))
+    assert all(len(only.components.resonance(c)) == 1 for c in range(2))
     assert not np.any(only.supported["K"])
 
 
@@ -171,7 +172,7 @@ def test_a_table_row_is_a_dash_where_an_axis_has_no_resonance(resonant):
                          imunoise.simulate(int(3600 * FS), FS, N=1e-3, seed=3,
                                            resonance=(2e-2, 30.0, 0.05))])
     model = quiet_fit(imunoise.adev(x, FS, taus=20))
-    assert model.resonance(0) == [] and len(model.resonance(1)) == 1
+    assert model.components.resonance(0) == [] and len(model.components.resonance(1)) == 1
     row = next(r for r in model.table("gyro") if r["term"] == "f_r")
     assert not row["X_supported"] and row["Y_supported"] and row["missing"] == "—"
     assert "—" in model.table_text("gyro")
@@ -182,10 +183,11 @@ def test_bootstrap_simulates_and_refits_the_resonance():
     x = imunoise.simulate(int(1800 * FS), FS, N=t["N"], seed=9,
                           resonance=(t["sigma"], t["f_r"], t["tau_r"]))
     model = quiet_fit(imunoise.adev(x, FS, taus=10), uncertainty="bootstrap", replicates=6, seed=2)
-    assert len(model.resonance(0)) == 1
-    sigma, f_r, tau_r = model.resonance(0)[0]
-    stds = [float(a) for a in (model.resonance_sigma_std, model.resonance_freq_std,
-                               model.resonance_tau_std)]
+    assert len(model.components.resonance(0)) == 1
+    sigma, f_r, tau_r = model.components.resonance(0)[0]
+    parts = model.components
+    stds = [float(a) for a in (parts.resonance_sigma_std, parts.resonance_freq_std,
+                               parts.resonance_tau_std)]
     # The replicates' spread is small next to each value yet not zero.
     for value, std in zip((sigma, f_r, tau_r), stds, strict=True):
         assert 0 < std < 0.2 * value

@@ -55,14 +55,14 @@ def test_tone_is_selected_and_recovered(toned):
     truth, r = toned
     model = quiet_fit(r)
     for c in range(2):
-        tone = model.sine(c)
+        tone = model.components.sine(c)
         assert len(tone) == 1, model
         amp, f0 = tone[0]
         assert f0 == pytest.approx(truth["f0"], rel=0.01)
         assert amp == pytest.approx(truth["A"], rel=0.10)
-        assert abs(amp - truth["A"]) < 4 * np.atleast_1d(model.sine_amplitude_std)[c]
+        assert abs(amp - truth["A"]) < 4 * np.atleast_1d(model.components.sine_amplitude_std)[c]
         assert model.N[c] == pytest.approx(truth["N"], rel=0.02)
-        assert model.gauss_markov(c) == []
+        assert model.components.gauss_markov(c) == []
     assert np.all(model.coverage >= 0.9)
 
 
@@ -77,8 +77,8 @@ def test_without_the_tone_the_model_misses_the_curve(toned):
 @pytest.mark.parametrize("seed", [3, 4])
 def test_clean_five_term_data_selects_no_tone(seed):
     for grid, model in clean_five_term_fits(seed):
-        assert all(model.sine(c) == [] for c in range(3)), (grid, model)
-        assert np.all(np.isnan(model.sine_amplitude))
+        assert all(model.components.sine(c) == [] for c in range(3)), (grid, model)
+        assert np.all(np.isnan(model.components.sine_amplitude))
 
 
 def test_gauss_markov_data_selects_no_tone():
@@ -86,8 +86,8 @@ def test_gauss_markov_data_selects_no_tone():
                           gm=[(4e-3, 20.0)])
     model = quiet_fit(imunoise.adev(x, FS, taus=20))
     for c in range(2):
-        assert model.sine(c) == []
-        assert len(model.gauss_markov(c)) == 1
+        assert model.components.sine(c) == []
+        assert len(model.components.gauss_markov(c)) == 1
 
 
 def test_tone_in_prediction_dict_repr_and_plot(toned):
@@ -95,16 +95,16 @@ def test_tone_in_prediction_dict_repr_and_plot(toned):
     model = quiet_fit(r)
     p = model.predict(r.taus)
     assert "sine" in p.terms
-    x_ = np.pi * model.sine(0)[0][1] * r.taus
+    x_ = np.pi * model.components.sine(0)[0][1] * r.taus
     # Far below fs the sampled form is IEEE 952's.
-    slow = r.taus * model.sine(0)[0][1] < 0.3
-    ieee = model.sine(0)[0][0] ** 2 * np.sin(x_) ** 4 / x_**2
+    slow = r.taus * model.components.sine(0)[0][1] < 0.3
+    ieee = model.components.sine(0)[0][0] ** 2 * np.sin(x_) ** 4 / x_**2
     np.testing.assert_allclose(p.terms["sine"][slow, 0] ** 2, ieee[slow], rtol=0.05)
     total = sum(v**2 for v in p.terms.values())
     np.testing.assert_allclose(total, p.dev**2, rtol=1e-12)
     d = model.to_dict()
     json.dumps(d)
-    assert d["sine"][1][0]["frequency"] == pytest.approx(truth["f0"], rel=0.01)
+    assert d["components"]["sine"][1][0]["frequency"] == pytest.approx(truth["f0"], rel=0.01)
     assert "tone" in repr(model) and "Hz" in repr(model)
     assert "tone" in model._repr_html_()
     fig = imunoise.plot.allan(r, model=model)
@@ -117,7 +117,7 @@ def test_explicit_sine_terms_are_checked(toned):
     with pytest.raises(ValueError, match="'sine' at most once"):
         imunoise.fit(r, terms=["N", "sine", "sine"])
     only = quiet_fit(r, terms=["N", "sine"])
-    assert all(len(only.sine(c)) == 1 for c in range(2))
+    assert all(len(only.components.sine(c)) == 1 for c in range(2))
     assert not np.any(only.supported["K"])
 
 
@@ -125,8 +125,9 @@ def test_bootstrap_simulates_and_refits_the_tone():
     x = imunoise.simulate(int(1800 * FS), FS, N=1e-3, seed=9, sinusoid=(4e-3, 7.3))
     r = imunoise.adev(x, FS, taus=10)
     model = quiet_fit(r, uncertainty="bootstrap", replicates=6, seed=2)
-    assert model.sine(0) != []
-    amp_std, f_std = float(model.sine_amplitude_std), float(model.sine_freq_std)
+    assert model.components.sine(0) != []
+    parts = model.components
+    amp_std, f_std = float(parts.sine_amplitude_std), float(parts.sine_freq_std)
     # The replicates' spread is small next to the tone yet not zero.
-    assert 0 < amp_std < 0.1 * float(model.sine_amplitude)
-    assert 0 < f_std < 0.01 * float(model.sine_freq)
+    assert 0 < amp_std < 0.1 * float(model.components.sine_amplitude)
+    assert 0 < f_std < 0.01 * float(model.components.sine_freq)

@@ -15,11 +15,12 @@ def gm_model():
 
 def test_gauss_markov_and_readoffs_carry_their_uncertainty(gm_model):
     (sentence,) = model_sentences(gm_model, "gyro")
-    sigma, tau = gm_model.gauss_markov(0)[0]
+    sigma, tau = gm_model.components.gauss_markov(0)[0]
     sigma_deg, sigma_std_deg = units.convert(
-        np.array([sigma, float(np.ravel(gm_model.gm_sigma_std)[0])]), "B", "deg/h", sensor="gyro")
+        np.array([sigma, float(np.ravel(gm_model.components.gm_sigma_std)[0])]), "B", "deg/h",
+        sensor="gyro")
     assert f"σ = {numbers.format_value(sigma_deg, sigma_std_deg)} °/h" in sentence
-    tau_std = float(np.ravel(gm_model.gm_tau_std)[0])
+    tau_std = float(np.ravel(gm_model.components.gm_tau_std)[0])
     assert f"τc = {numbers.format_value(tau, tau_std)} s" in sentence
     read = gm_model.readoff["N"]
     n_deg, n_std = units.convert(np.array([float(read["value"]), float(read["std"])]), "N",

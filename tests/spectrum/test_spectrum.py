@@ -275,7 +275,7 @@ def test_real_adis16405_n_agrees_with_adev_where_no_line():
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         model = imunoise.fit(imunoise.adev(g, fs))
-    ratio = s.N / model.equivalent("N")
+    ratio = s.N / model.value("N")
     assert np.all(np.abs(ratio[:2] - 1) < 0.05), ratio
     assert np.all(s.band[:, 1] < 20.0)  # the gyro filter bends the top: excluded
     above = s.f > s.band[2, 1]
@@ -288,11 +288,11 @@ def test_real_vn100_bundled_log():
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         model = imunoise.fit(imunoise.adev(log.gyro, log.fs))
-    ratio = s.N / model.equivalent("N")
+    ratio = s.N / model.value("N")
     # Y: a line at 17–19 Hz; the PSD read-off finds it and leaves it out, and the ADEV
     # model takes it as its tone term, so the two N agree on every axis
     assert np.any((s.lines[1] > 16) & (s.lines[1] < 20)), s.lines
-    assert model.sine(1) and 16 < model.sine(1)[0][1] < 20
+    assert model.components.sine(1) and 16 < model.components.sine(1)[0][1] < 20
     assert np.all(np.abs(ratio - 1) < 0.05), ratio
 
 

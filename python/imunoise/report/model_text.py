@@ -42,7 +42,7 @@ def datasheet_rows(model: NoiseModel, sensor: str) -> tuple[list[str], list[list
 
 
 def model_sentences(model: NoiseModel, sensor: str) -> list[str]:
-    """One sentence per axis: the terms, how well the model follows the curve
+    """One sentence per axis: the fitted components, how well the model follows the curve
     (and, below :data:`POOR_COVERAGE`, that its coefficients only summarise it),
     the Gauss–Markov terms, and whether the model's N and B agree with the
     datasheet read-offs of the curve. Emphasis is Markdown ``**``."""
@@ -50,11 +50,8 @@ def model_sentences(model: NoiseModel, sensor: str) -> list[str]:
     n_unit = units.unit_info("N", None, sensor)
     out = []
     for c, axis in enumerate(axis_names(model.channels)):
-        terms = [t for t in ("N", "B", "K", "Q", "R") if np.atleast_1d(model.supported[t])[c]]
-        gm = model.gauss_markov(c)
-        others = ([f"{len(gm)} Gauss–Markov"] * bool(gm) + ["tone"] * bool(model.sine(c))
-                  + ["resonance"] * bool(model.resonance(c)))
-        parts = [f"{axis}: {' + '.join(terms + others)}"]
+        parts = [f"{axis}: fitted components {model.components.structure(c)}"]
+        parts_of = model.components
         cover = float(np.atleast_1d(model.coverage)[c])
         delta = float(np.atleast_1d(model.discrepancy)[c])
         parts.append(f"follows {cover:.0%} of the taus (inside the 95 % interval or within 5 %)"
@@ -67,16 +64,17 @@ def model_sentences(model: NoiseModel, sensor: str) -> list[str]:
                                              sensor=sensor)
             parts.append(f"Gauss–Markov bias σ = {format_number(value, value_std)} "
                          f"{b_unit.label}, τc = {format_number(tau_c, tau_std)} s")
-        for amplitude, f0 in model.sine(c):
-            amp_std = float(np.atleast_1d(model.sine_amplitude_std)[c])
-            f0_std = float(np.atleast_1d(model.sine_freq_std)[c])
+        for amplitude, f0 in parts_of.sine(c):
+            amp_std = float(np.atleast_1d(parts_of.sine_amplitude_std)[c])
+            f0_std = float(np.atleast_1d(parts_of.sine_freq_std)[c])
             value, value_std = units.convert(np.array([amplitude, amp_std]), "B", b_unit.name,
                                              sensor=sensor)
             parts.append(f"a tone of amplitude {format_number(value, value_std)} "
                          f"{b_unit.label} at {format_number(f0, f0_std)} Hz")
-        for sigma, f_r, tau_r in model.resonance(c):
+        for sigma, f_r, tau_r in parts_of.resonance(c):
             stds = [float(np.atleast_1d(a)[c]) for a in (
-                model.resonance_sigma_std, model.resonance_freq_std, model.resonance_tau_std)]
+                parts_of.resonance_sigma_std, parts_of.resonance_freq_std,
+                parts_of.resonance_tau_std)]
             value, value_std = units.convert(np.array([sigma, stds[0]]), "B", b_unit.name,
                                              sensor=sensor)
             parts.append(f"a resonance (damped oscillation, a band rather than a line) of "
@@ -92,8 +90,9 @@ def model_sentences(model: NoiseModel, sensor: str) -> list[str]:
 
 def _gauss_markov_with_std(model: NoiseModel, c: int) -> list[tuple[float, ...]]:
     """(σ, std of σ, τc, std of τc) of each Gauss–Markov term of channel ``c``."""
+    parts = model.components
     columns = [np.reshape(a, (model.channels, -1))[c] for a in
-               (model.gm_sigma, model.gm_sigma_std, model.gm_tau, model.gm_tau_std)]
+               (parts.gm_sigma, parts.gm_sigma_std, parts.gm_tau, parts.gm_tau_std)]
     return [tuple(map(float, row)) for row in zip(*columns, strict=True)
             if np.isfinite(row[0])]
 
@@ -103,10 +102,10 @@ def _readoff_agreement(model: NoiseModel, c: int, term: str, unit, sensor: str) 
     curve has no such read-off or the model no such value."""
     read = float(np.atleast_1d(model.readoff[term]["value"])[c])
     std = float(np.atleast_1d(model.readoff[term]["std"])[c])
-    eq = float(np.atleast_1d(model.equivalent(term))[c])
+    eq = float(model.value(term)[c])
     if not (np.isfinite(read) and eq > 0):
         return []
-    eq_std = float(np.atleast_1d(model.equivalent_std(term))[c])
+    eq_std = float(model.std(term)[c])
     read_c, std_c, eq_c, eq_std_c = units.convert(np.array([read, std, eq, eq_std]), term,
                                                   unit.name, sensor=sensor)
     diff = abs(read - eq) / max(std, 1e-300)

@@ -311,7 +311,7 @@ def power_spectral_density(ctx: Context, doc: Doc) -> None:
         ctx.add_figure(doc, plot.spectrum(s, model, unit=unit, title=f"{sensor} PSD"),
                        f"psd_{sensor}", f"PSD of {sensor} [({unit})²/Hz], white band shaded, "
                        "N read-off (black)" + (" and the noise model" if model else ""))
-        fitted = (np.atleast_1d(model.equivalent("N")) if model is not None
+        fitted = (model.value("N") if model is not None
                   else np.full(s.channels, np.nan))
         n, n_std = np.atleast_1d(s.N), np.atleast_1d(s.N_std)
         band = np.reshape(s.band, (-1, 2))

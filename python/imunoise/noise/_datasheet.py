@@ -1,0 +1,123 @@
+"""The datasheet values N, B, K that a fitted model implies, with their propagated
+uncertainty: the numbers :class:`~imunoise.noise.NoiseModel` shows as ``N``, ``B``, ``K``.
+
+A datasheet quotes what the curve shows, not which components made it:
+
+- ``N``, the white-noise density: the fitted N together with every Gauss–Markov
+  term faster than 1 s (white at the τ = 1 s read-off: σ²(1+φ)/((1−φ)·fs)) and a
+  resonance damped faster than 1 s (its spectrum at zero frequency). What a
+  filter's white-noise input should be.
+- ``K``, the rate random walk: the fitted K together with every slower
+  Gauss–Markov term's short-τ random-walk rate √(2σ²/τc) (its +½ slope).
+- ``B``, the bias instability: the minimum of the model's deviation over the
+  fitted taus divided by √(2 ln2/π) ≈ 0.6643 — 0 when the curve still falls at
+  the longest tau with a log-log slope below −¼ (no flat part).
+- ``Q`` and ``R`` are the fitted coefficients.
+
+With ``method="slopes"`` every value is the read-off coefficient. Uncertainties
+are propagated from the fit's covariance through a numerical gradient.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from imunoise._core import fit as _core_fit
+from imunoise.noise._terms import (
+    _PARAMS,
+    _RES,
+    _SINE,
+    FLICKER,
+    GM_MAX,
+    TERMS,
+    _is_log_time,
+    gm_white_density,
+    resonance_white_density,
+)
+
+#: Points of the log-spaced grid over the fitted taus on which B's minimum is sought.
+_B_GRID = 200
+#: A minimum at the longest tau is a floor only where the curve's log-log slope
+#: there is above this; below, the curve is still falling.
+_STILL_FALLING = -0.25
+
+
+def datasheet_values(components, taus, method: str) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    """``{term: (values, stds)}``, each of shape (channels,), for Q, N, B, K, R."""
+    out = {}
+    for term in TERMS:
+        if method != "wls" or term not in ("N", "B", "K"):
+            out[term] = (components.value(term).astype(float),
+                         components.std(term).astype(float))
+        else:
+            out[term] = _propagated(components, np.asarray(taus, float), term)
+    return out
+
+
+def _propagated(components, taus, term: str) -> tuple[np.ndarray, np.ndarray]:
+    channels = components.channels
+    values = np.zeros(channels)
+    stds = np.full(channels, np.nan)
+    cov = np.reshape(components.cov, (channels, _PARAMS, _PARAMS))
+    fs = float(components.fs)
+    for c in range(channels):
+        p = parameters(components, c)
+        f0 = value_of(term, p, taus, fs)
+        values[c] = f0
+        if not f0 > 0:
+            continue
+        active = np.flatnonzero(np.diag(cov[c]) > 0)
+        grad = np.zeros(_PARAMS)
+        for j in active:
+            h = 1e-4 if _is_log_time(j) else 1e-4 * p[j]
+            up, down = p.copy(), p.copy()
+            up[j] += h
+            down[j] = max(down[j] - h, 0.0) if not _is_log_time(j) else down[j] - h
+            grad[j] = (value_of(term, up, taus, fs) - value_of(term, down, taus, fs)) / (
+                up[j] - down[j])
+        stds[c] = math.sqrt(max(float(grad @ cov[c] @ grad), 0.0))
+    return values, stds
+
+
+def parameters(components, channel: int) -> np.ndarray:
+    """(Q², N², B², K², R², then σ², ln τc per Gauss–Markov slot, then A²/2,
+    ln f0 of the tone, then σ², ln f_r, ln τr of the resonance) of a channel."""
+    p = np.zeros(_PARAMS)
+    p[:5] = [float(components.value(t)[channel]) ** 2 for t in TERMS]
+    for k, (sigma, tau_c) in enumerate(components.gauss_markov(channel)):
+        p[5 + 2 * k], p[6 + 2 * k] = sigma**2, math.log(tau_c)
+    for amplitude, f0 in components.sine(channel):
+        p[_SINE], p[_SINE + 1] = amplitude**2 / 2, math.log(f0)
+    for sigma, f_r, tau_r in components.resonance(channel):
+        p[_RES], p[_RES + 1], p[_RES + 2] = sigma**2, math.log(f_r), math.log(tau_r)
+    return p
+
+
+def value_of(term: str, p: np.ndarray, taus: np.ndarray, fs: float) -> float:
+    """The datasheet value of ``term`` for the parameter vector ``p``."""
+    gm = [(p[5 + 2 * k], math.exp(p[6 + 2 * k])) for k in range(GM_MAX) if p[5 + 2 * k] > 0]
+    if term == "B":
+        # The tone and the resonance are part of the curve whose floor B is
+        # read from; they are neither white nor a walk, so N and K leave them out.
+        tone = [(p[_SINE], math.exp(p[_SINE + 1]))] if p[_SINE] > 0 else []
+        osc = ([(p[_RES], math.exp(p[_RES + 1]), math.exp(p[_RES + 2]))]
+               if p[_RES] > 0 else [])
+        grid = np.geomspace(taus[0], taus[-1], _B_GRID)
+        dev = np.sqrt(_core_fit.noise_terms(grid, fs, list(p[:5]), gm, tone, osc).sum(axis=1))
+        i = int(np.argmin(dev))
+        slope = np.log(dev[-1] / dev[-2]) / np.log(grid[-1] / grid[-2])
+        if i == grid.size - 1 and slope < _STILL_FALLING:
+            return 0.0
+        return float(dev[i] / FLICKER)
+    total = p[1] if term == "N" else p[3]
+    if term == "N" and p[_RES] > 0 and p[_RES + 2] <= 0.0:  # τr ≤ 1 s
+        total += resonance_white_density(1.0, math.exp(p[_RES + 1]),
+                                         math.exp(p[_RES + 2]), fs) * p[_RES]
+    for q2, tau_c in gm:
+        if term == "N" and tau_c <= 1.0:
+            total += q2 * gm_white_density(1.0, tau_c, fs)
+        elif term == "K" and tau_c > 1.0:
+            total += 2.0 * q2 / tau_c
+    return math.sqrt(max(total, 0.0))

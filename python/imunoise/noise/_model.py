@@ -1,0 +1,405 @@
+"""The noise model a user reads: datasheet values, their uncertainties, tables and
+exports, with the fitted components behind them under one name."""
+
+from __future__ import annotations
+
+import warnings
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from imunoise import _schema, _summary
+from imunoise import numbers as _numbers
+from imunoise import units as _units
+from imunoise._deprecation import old_call_forms
+from imunoise.noise._components import Components, Prediction, check_term
+from imunoise.noise._terms import _NAMES, _SENSOR_NAMES, TERMS
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+
+    from imunoise.allan import AllanResult
+
+
+def _moved(old: str, new: str) -> None:
+    # stacklevel 3: past this helper and the property, at the caller's line
+    warnings.warn(f"NoiseModel.{old} is deprecated; use {new}", DeprecationWarning,
+                  stacklevel=3)
+
+
+@dataclass(frozen=True, repr=False)
+class NoiseModel:
+    """A fitted noise model: the datasheet values N, B, K, Q, R per channel, in the
+    input's units, with the fitted components behind them.
+
+    ``N``, ``B``, ``K``, ``Q``, ``R`` are the numbers a datasheet quotes from the
+    model's curve — the same numbers in every view (the repr, :meth:`table`, the
+    report, ``imunoise fit``, :func:`imunoise.compare` and the Kalibr, OpenVINS
+    and EKF exports). They are computed from all fitted components together: a
+    Gauss–Markov term faster than 1 s is white noise at the τ = 1 s read-off and
+    adds to N; a slower one's +½ slope adds to K; B is the flat minimum of the
+    whole curve divided by 0.6643 (see ``imunoise.noise._datasheet``). The fit's
+    own parameters are :attr:`components`. All arrays are read-only.
+
+    Attributes
+    ----------
+    Q, N, B, K, R : ndarray
+        Datasheet values: quantization (rate·s), white-noise density / angle or
+        velocity random walk (rate·√s = rate/√Hz), bias instability (rate), rate
+        random walk (rate/√s) and rate ramp (rate/s). Shape () for a one-channel
+        result, (channels,) otherwise. 0 where not resolved.
+    Q_std, N_std, B_std, K_std, R_std : ndarray
+        Standard uncertainties, propagated from the fit's covariance (NaN where
+        not resolved).
+    supported : dict[str, ndarray of bool]
+        Whether each datasheet value is resolved by the data (``False``: the
+        value is 0 and means "not resolved", not "absent"). The one meaning of
+        "not resolved" in every view.
+    components : Components
+        The fitted components: IEEE coefficients of the fit, Gauss–Markov terms
+        (σ, τc), the tone (A, f0) and the resonance (σ, f_r, τr), with their
+        uncertainties, covariance and support ranges.
+    method : str
+        ``"wls"`` or ``"slopes"``.
+    kind, fs, overlapping
+        Copied from the Allan result.
+    taus : ndarray
+        The averaging times used by the fit.
+    coverage : ndarray
+        Share of the fitted taus where the model lies inside the measured 95 %
+        confidence interval or within 5 % of the measured deviation, whichever
+        is wider: how well the model follows the curve (1 = everywhere).
+    discrepancy : ndarray
+        ``"wls"``: δ, the relative standard deviation of the Allan variance that
+        the model leaves unexplained beyond the estimates' own scatter.
+    chi2, n_eff : ndarray
+        ``"wls"``: Σ ω r²/var(ln σ̂²), the residual sum with the sampling
+        variance alone and each tau weighted by its share ω of an octave, and
+        n_eff = Σ ω, the octaves of evidence.
+    readoff : dict[str, dict[str, ndarray]]
+        The datasheet read-offs of the measured curve itself, whatever the
+        model: ``"N"`` (slope −½ line at τ = 1 s), ``"K"`` (slope +½ line at
+        τ = 3 s) and ``"B"`` (σ_min/0.6643 at the curve's minimum), each with
+        ``value``, ``std`` and ``tau``, NaN where the curve has no such part;
+        ``"B"`` also has ``low``/``high`` (95 % interval).
+
+    Notes
+    -----
+    Before 0.2, ``N``…``R`` were the fitted IEEE coefficients, now
+    ``components.N``…; ``equivalent(t)`` gave today's ``N``…; ``gm_sigma``,
+    ``sine_freq``, ``resonance_tau``, ``cov``, ``tau_range``, ``gauss_markov()``,
+    ``sine()`` and ``resonance()`` moved to :attr:`components`. The old spellings
+    still work for one release with a ``DeprecationWarning`` naming the new one.
+    """
+
+    Q: np.ndarray
+    N: np.ndarray
+    B: np.ndarray
+    K: np.ndarray
+    R: np.ndarray
+    Q_std: np.ndarray
+    N_std: np.ndarray
+    B_std: np.ndarray
+    K_std: np.ndarray
+    R_std: np.ndarray
+    supported: dict[str, np.ndarray]
+    components: Components
+    method: str
+    kind: str
+    fs: float
+    overlapping: bool
+    taus: np.ndarray
+    coverage: np.ndarray
+    discrepancy: np.ndarray = field(repr=False)
+    chi2: np.ndarray = field(repr=False)
+    n_eff: np.ndarray = field(repr=False)
+    readoff: dict[str, dict[str, np.ndarray]] = field(repr=False)
+
+    # -- shape --------------------------------------------------------------
+    @property
+    def channels(self) -> int:
+        """Number of channels (1 for a one-channel model)."""
+        return 1 if np.ndim(self.N) == 0 else int(np.shape(self.N)[0])
+
+    @property
+    def one_channel(self) -> bool:
+        """True when fitted to a 1-D result (values are 0-d arrays)."""
+        return np.ndim(self.N) == 0
+
+    def value(self, term: str) -> np.ndarray:
+        """Datasheet value ``term`` as an array of shape (channels,)."""
+        check_term(term)
+        return np.atleast_1d(getattr(self, term))
+
+    def std(self, term: str) -> np.ndarray:
+        """Standard uncertainty of ``term`` as an array of shape (channels,)."""
+        check_term(term)
+        return np.atleast_1d(getattr(self, term + "_std"))
+
+    def resolved(self, term: str) -> np.ndarray:
+        """Whether ``term`` is resolved, shape (channels,)."""
+        check_term(term)
+        return np.atleast_1d(self.supported[term])
+
+    # -- curves -------------------------------------------------------------
+    def predict(self, taus=None) -> Prediction:
+        """Model Allan deviation at ``taus`` (default: the fitted taus).
+
+        Returns the total curve σ(τ) and each component's own curve, e.g.
+        ``terms["N"]`` = (fitted N)/√τ, ``terms["GM1"]`` for the first
+        Gauss–Markov term, ``terms["sine"]`` for the tone and
+        ``terms["resonance"]`` for the resonance (when a channel has one).
+        """
+        return self.components.predict(self.taus if taus is None else taus)
+
+    def plot(self, result: AllanResult, **kwargs) -> Figure:
+        """The model over ``result``, the Allan result it was fitted to, with its terms,
+        read-off points and the data/model ratio: :func:`imunoise.plot.allan`."""
+        from imunoise import plot
+
+        return plot.allan(result, self, **kwargs)
+
+    # -- deprecated spellings (0.1) ------------------------------------------
+    def equivalent(self, term: str) -> np.ndarray:
+        """Deprecated: the datasheet value, now ``model.<term>``."""
+        _moved(f"equivalent({term!r})", f"model.{term}")
+        return self.value(term)
+
+    def equivalent_std(self, term: str) -> np.ndarray:
+        """Deprecated: now ``model.<term>_std``."""
+        _moved(f"equivalent_std({term!r})", f"model.{term}_std")
+        return self.std(term)
+
+    def gauss_markov(self, channel: int = 0) -> list[tuple[float, float]]:
+        """Deprecated: now ``model.components.gauss_markov(channel)``."""
+        _moved("gauss_markov()", "model.components.gauss_markov()")
+        return self.components.gauss_markov(channel)
+
+    def sine(self, channel: int = 0) -> list[tuple[float, float]]:
+        """Deprecated: now ``model.components.sine(channel)``."""
+        _moved("sine()", "model.components.sine()")
+        return self.components.sine(channel)
+
+    def resonance(self, channel: int = 0) -> list[tuple[float, float, float]]:
+        """Deprecated: now ``model.components.resonance(channel)``."""
+        _moved("resonance()", "model.components.resonance()")
+        return self.components.resonance(channel)
+
+    def __getattr__(self, name: str):
+        # Only reached for names the class does not define: the fields that moved.
+        if name in _MOVED_FIELDS:
+            _moved(name, f"model.components.{name}")
+            return getattr(self.components, name)
+        raise AttributeError(f"'NoiseModel' object has no attribute {name!r}")
+
+    # -- summaries ----------------------------------------------------------
+    def _axis_facts(self, channel: int) -> str:
+        """``"N=(1.234 ± 0.012)e-4 B=(1.2 ± 0.3)e-5, 1 GM, tone 13.4 Hz, covers 85 %"``:
+        one channel's datasheet values in input units, each rounded to its
+        uncertainty, then the components beyond the IEEE terms."""
+        terms = [f"{t}={_summary.estimate(self.value(t)[channel], self.std(t)[channel])}"
+                 for t in TERMS if self.resolved(t)[channel]]
+        parts = self.components
+        gm = len(parts.gauss_markov(channel))
+        extra = "".join(f", tone {_summary.number(f0)} Hz" for _, f0 in parts.sine(channel))
+        extra += "".join(f", resonance {_summary.number(f)} Hz"
+                         for _, f, _ in parts.resonance(channel))
+        return ((" ".join(terms) or "no term resolved") + (f", {gm} GM" if gm else "") + extra
+                + f", covers {100 * float(np.atleast_1d(self.coverage)[channel]):.3g} %")
+
+    def _title(self) -> str:
+        return (f"{self.method} fit of {self.kind} at {_summary.number(self.fs)} Hz, "
+                f"{_summary.plural(self.channels, 'channel')}")
+
+    def __repr__(self) -> str:
+        names = _schema.axis_names(self.channels)
+        axes = [self._axis_facts(c) if self.one_channel else f"{names[c]}: {self._axis_facts(c)}"
+                for c in range(self.channels)]
+        return _summary.lines(f"NoiseModel({self._title()}", axes)
+
+    def _repr_html_(self) -> str:
+        """One row per axis: each datasheet value ± standard uncertainty in the
+        input's units (``not resolved`` where the data do not resolve it), the
+        fitted components and the coverage."""
+        units = _INPUT_UNITS
+        rows = []
+        for c, name in enumerate(_schema.axis_names(self.channels)):
+            row: list[object] = [name]
+            for t in TERMS:
+                v, e = self.value(t)[c], self.std(t)[c]
+                row.append(_numbers.NOT_RESOLVED if not self.resolved(t)[c]
+                           else _summary.number(v) + (f" ± {e:.2g}" if np.isfinite(e) else ""))
+            row.append(self.components.structure(c))
+            row.append(f"{100 * float(np.atleast_1d(self.coverage)[c]):.3g} %")
+            rows.append(row)
+        return _summary.html_table(
+            ["axis", *(f"{t} [{units[t]}]" for t in TERMS), "components", "coverage"],
+            rows, caption=f"NoiseModel: {self._title()}, {_summary.tau_span(self.taus)}")
+
+    # -- units and tables ---------------------------------------------------
+    @old_call_forms(keyword_only=("units", "input_unit"))
+    def in_units(self, sensor: str = "gyro", *, units: dict[str, str] | None = None,
+                 input_unit: str | None = None) -> dict[str, dict]:
+        """The datasheet values in datasheet units.
+
+        Parameters
+        ----------
+        sensor : {"gyro", "accel"}
+        units : dict, optional
+            Target unit per term, e.g. ``{"N": "deg/s/sqrt(Hz)"}``; missing terms
+            use :data:`imunoise.units.DEFAULT_UNITS`.
+        input_unit : str, optional
+            Unit of the rate data the model was fitted to (``"rad/s"`` default
+            for gyros, ``"m/s^2"`` for accelerometers; also ``"deg/s"``, ``"g"``).
+
+        Returns
+        -------
+        dict
+            ``{term: {"value", "std", "unit", "label", "supported"}}`` with arrays
+            shaped like the model's values.
+        """
+        units = dict(units or {})
+        unknown = set(units) - set(TERMS)
+        if unknown:
+            raise ValueError(f"units keys must be among {TERMS}; got {sorted(unknown)}")
+        out = {}
+        shape = np.shape(self.N)
+        for term in TERMS:
+            info = _units.unit_info(term, units.get(term), sensor)
+            supported = np.reshape(self.resolved(term), shape)
+            out[term] = {
+                "value": _units.convert(getattr(self, term), term, info.name, sensor=sensor,
+                                        input_unit=input_unit),
+                "std": _units.convert(np.where(supported, getattr(self, term + "_std"), np.nan),
+                                      term, info.name, sensor=sensor, input_unit=input_unit),
+                "unit": info.name,
+                "label": info.label,
+                "supported": supported,
+            }
+        return out
+
+    @old_call_forms(keyword_only=("units", "input_unit", "axes", "terms"))
+    def table(self, sensor: str = "gyro", *, units: dict[str, str] | None = None,
+              input_unit: str | None = None, axes: Sequence[str] | None = None,
+              terms: Sequence[str] = ("N", "B", "K", "Q", "R")) -> list[dict]:
+        """Per-axis table in datasheet units: one row per datasheet value, then the
+        fitted components beyond the IEEE terms where any axis has them (``σ1``,
+        ``τc1``, … per Gauss–Markov term, ``A``, ``f0`` of the tone, ``σr``,
+        ``f_r``, ``τr`` of the resonance; σ and A in the unit of B, times in s,
+        frequencies in Hz).
+
+        Each row is a dict with ``term``, ``quantity``, ``unit``, ``label``,
+        ``missing`` (the text of an axis without the value: ``not resolved`` for
+        a datasheet value, ``—`` for a component the axis's model does not have)
+        and, per axis name (default X, Y, Z…), the value, ``<axis>_std`` and
+        ``<axis>_supported``. Render it with :func:`format_table`.
+        """
+        axes = _schema.axis_names(self.channels, axes)
+        conv = self.in_units(sensor, units=units, input_unit=input_unit)
+        rows = []
+        for term in terms:
+            check_term(term)
+            c = conv[term]
+            row = {"term": term, "quantity": _SENSOR_NAMES[sensor].get(term, _NAMES[term]),
+                   "unit": c["unit"], "label": c["label"], "missing": _numbers.NOT_RESOLVED}
+            vals, stds, sup = (np.atleast_1d(c[k]) for k in ("value", "std", "supported"))
+            for i, ax in enumerate(axes):
+                row[ax] = float(vals[i])
+                row[ax + "_std"] = float(stds[i])
+                row[ax + "_supported"] = bool(sup[i])
+            rows.append(row)
+        rate = _units.unit_info("B", (units or {}).get("B"), sensor)
+
+        def to_rate(v):
+            return _units.convert(v, "B", rate.name, sensor=sensor, input_unit=input_unit)
+
+        for term, quantity, unit, values, stds in self.components.other_terms():
+            rate_valued = unit is None
+            row = {"term": term, "quantity": "component: " + quantity, "missing": "—",
+                   "unit": rate.name if rate_valued else unit,
+                   "label": rate.label if rate_valued else unit}
+            for i, ax in enumerate(axes):
+                v, e = float(values[i]), float(stds[i])
+                row[ax] = float(to_rate(v)) if rate_valued and np.isfinite(v) else v
+                row[ax + "_std"] = float(to_rate(e)) if rate_valued and np.isfinite(e) else e
+                row[ax + "_supported"] = bool(np.isfinite(v))
+            rows.append(row)
+        return rows
+
+    def table_text(self, sensor: str = "gyro", **kwargs) -> str:
+        """Text rendering of :meth:`table`."""
+        rows = self.table(sensor, **kwargs)
+        return format_table(rows, _schema.axis_names(self.channels, kwargs.get("axes")))
+
+    # -- exports ------------------------------------------------------------
+    @old_call_forms(keyword_only=("accel", "path"))
+    def to_kalibr(self, *, accel: NoiseModel | None = None, path=None, **kwargs) -> str:
+        """Kalibr ``imu.yaml`` text with this model as the gyroscope.
+
+        See :func:`imunoise.export.kalibr_yaml` for the options; with ``path``
+        the file is also written atomically.
+        """
+        from imunoise import export
+
+        text = export.kalibr_yaml(gyro=self, accel=accel, **kwargs)
+        if path is not None:
+            export.write_atomic(path, text)
+        return text
+
+    def to_dict(self) -> dict:
+        """Plain-Python view of the model (lists and floats), e.g. for JSON: the
+        datasheet values under their names, the fitted components under
+        ``"components"``."""
+        def finite(values):
+            return [float(v) if np.isfinite(v) else None for v in np.atleast_1d(values)]
+
+        d = {"method": self.method, "kind": self.kind, "fs": self.fs,
+             "overlapping": self.overlapping, "channels": self.channels,
+             "taus": self.taus.tolist(), "units": dict(_INPUT_UNITS)}
+        for term in TERMS:
+            d[term] = {"value": self.value(term).tolist(), "std": finite(self.std(term)),
+                       "supported": self.resolved(term).tolist()}
+        d["components"] = self.components.to_dict()
+        d["coverage"] = np.atleast_1d(self.coverage).tolist()
+        d["discrepancy"] = np.atleast_1d(self.discrepancy).tolist()
+        d["readoff"] = {term: {k: finite(a) for k, a in parts.items()}
+                        for term, parts in self.readoff.items()}
+        return d
+
+
+#: Units of the values relative to the input's rate unit.
+_INPUT_UNITS = {"Q": "rate*s", "N": "rate*sqrt(s)", "B": "rate", "K": "rate/sqrt(s)",
+                "R": "rate/s"}
+
+#: Fields that moved from NoiseModel to NoiseModel.components in 0.2.
+_MOVED_FIELDS = frozenset({
+    "gm_sigma", "gm_tau", "gm_sigma_std", "gm_tau_std", "sine_amplitude", "sine_freq",
+    "sine_amplitude_std", "sine_freq_std", "resonance_sigma", "resonance_freq",
+    "resonance_tau", "resonance_sigma_std", "resonance_freq_std", "resonance_tau_std",
+    "cov", "tau_range",
+})
+
+
+def format_table(rows: list[dict], axes: Sequence[str]) -> str:
+    """Render :meth:`NoiseModel.table` rows as fixed-width text.
+
+    Terms the data do not resolve print as ``not resolved`` (the report's and
+    ``imunoise fit``'s wording too), a component an axis's model does not have
+    as ``—``; values carry ``± std``, rounded to it
+    (:func:`imunoise.numbers.format_value`).
+    """
+    def cell(row, ax):
+        if not row[ax + "_supported"]:
+            return row.get("missing", _numbers.NOT_RESOLVED)
+        return _numbers.format_value(row[ax], row[ax + "_std"])
+
+    header = ["coefficient", "unit", *axes]
+    body = [[f"{r['term']} {r['quantity']}", r["label"], *(cell(r, a) for a in axes)]
+            for r in rows]
+    widths = [max(len(str(x[i])) for x in [header, *body]) for i in range(len(header))]
+    lines = ["  ".join(str(x).ljust(w) for x, w in zip(line, widths, strict=True)).rstrip()
+             for line in [header, *body]]
+    lines.insert(1, "  ".join("-" * w for w in widths))
+    return "\n".join(lines)

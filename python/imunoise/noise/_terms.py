@@ -1,0 +1,90 @@
+"""The terms of the noise model: names, constants and the one implementation of
+their Allan variance (Rust, :func:`imunoise._core.fit.noise_terms`)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from imunoise._core import fit as _core_fit
+
+TERMS: tuple[str, ...] = tuple(_core_fit.IEEE_TERM_NAMES)
+"""The five coefficients, in the order used everywhere (Q, N, B, K, R)."""
+
+FLICKER = math.sqrt(_core_fit.FLICKER_FACTOR)
+"""σ_flat / B = √(2 ln2/π) ≈ 0.6643."""
+
+_NAMES = {
+    "Q": "quantization noise",
+    "N": "random walk (white noise)",
+    "B": "bias instability",
+    "K": "rate random walk",
+    "R": "rate ramp",
+}
+_SENSOR_NAMES = {
+    "gyro": {"N": "angle random walk", "Q": "angle quantization"},
+    "accel": {"N": "velocity random walk", "Q": "velocity quantization"},
+}
+# Log-log slope of each term on the deviation curve and the tau where its
+# straight line is read (IEEE 952 Annex C).
+_SLOPE = {"Q": -1.0, "N": -0.5, "B": 0.0, "K": 0.5, "R": 1.0}
+_READ_TAU = {"Q": math.sqrt(3.0), "N": 1.0, "K": 3.0, "R": math.sqrt(2.0)}
+GM_MAX: int = _core_fit.MAX_GAUSS_MARKOV
+"""Most first-order Gauss–Markov terms a model may have."""
+
+_PARAMS: int = _core_fit.PARAMETERS
+"""Parameter slots of the covariance: five IEEE variances, (σ², ln τc) per GM term,
+then (A²/2, ln f0) of the tone."""
+_SINE: int = _core_fit.SINE_SLOT
+"""Slot of the tone's variance A²/2 in the covariance (its ln f0 follows)."""
+_RES: int = _core_fit.RESONANCE_SLOT
+"""Slot of the resonance's variance σ² in the covariance (ln f_r, ln τr follow)."""
+
+
+def gm_white_density(sigma: float, tau_c: float, fs: float) -> float:
+    """N² (rate²·s) that a sampled Gauss–Markov term of standard deviation ``sigma``
+    and correlation time ``tau_c`` contributes at τ ≫ τc: σ²(1+φ)/((1−φ)·fs),
+    φ = exp(−1/(fs·τc)), the −½ asymptote of its Allan variance."""
+    phi = math.exp(-1.0 / (fs * tau_c))
+    return sigma**2 * (1 + phi) / ((1 - phi) * fs)
+
+
+def resonance_white_density(sigma: float, f_r: float, tau_r: float, fs: float) -> float:
+    """N² (rate²·s) that a sampled resonance of standard deviation ``sigma``,
+    frequency ``f_r`` and damping time ``tau_r`` contributes at τ ≫ τr:
+    σ²·Re[(1+z)/(1−z)]/fs, z = exp(−1/(fs·τr) + 2πi·f_r/fs), the −½ asymptote of
+    its Allan variance (its spectrum at zero frequency)."""
+    z = complex(math.exp(-1.0 / (fs * tau_r)), 0.0) * complex(
+        math.cos(2 * math.pi * f_r / fs), math.sin(2 * math.pi * f_r / fs))
+    return sigma**2 * ((1 + z) / (1 - z)).real / fs
+
+
+def _is_log_time(slot: int) -> bool:
+    """Whether covariance slot ``slot`` holds a logarithm (ln τc, ln f0, ln f_r, ln τr)."""
+    return slot > _RES or (5 <= slot < _RES and (slot - 5) % 2 == 1)
+
+
+_CLOSE = 0.05
+"""A model within this relative distance of the measured deviation follows it."""
+
+
+def _terms(taus, fs: float, coef, markov=(), tone=(), resonance=()) -> np.ndarray:
+    """Allan variance of each model term at ``taus``: (len(taus), 5 + len(markov) +
+    len(tone) + len(resonance)), from the one implementation of the model (Rust);
+    ``coef`` holds Q…R, ``markov`` (sigma, tau_c) pairs, ``tone`` (amplitude, f0)
+    pairs, ``resonance`` (sigma, f_r, tau_r) triples."""
+    t = np.ascontiguousarray(np.atleast_1d(np.asarray(taus, dtype=float)))
+    with np.errstate(over="ignore"):  # a coefficient near 1e154 squares to inf, not an error
+        squares = np.square(np.asarray(coef, dtype=float)).tolist()
+    return _core_fit.noise_terms(t, float(fs), squares,
+                             [(s * s, tc) for s, tc in markov],
+                             [(a * a / 2, f0) for a, f0 in tone],
+                             [(s * s, f, tr) for s, f, tr in resonance])
+
+
+def model_variance(taus, Q=0.0, N=0.0, B=0.0, K=0.0, R=0.0) -> np.ndarray:
+    """Allan variance of the five-term IEEE model at ``taus`` (scalar coefficients)."""
+    return _terms(taus, 1.0, (Q, N, B, K, R)).sum(axis=1)
+
+

@@ -1,0 +1,126 @@
+"""One voice: ``model.N`` … ``model.R`` are the datasheet values, and every view
+(repr, table, report sentences, comparison, Kalibr / EKF / JSON exports) prints
+those same numbers; the fitted components live under ``model.components``; the
+old spellings warn and name the new one."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import imunoise
+import numpy as np
+import pytest
+from helpers.noise_fit import quiet_fit
+from imunoise import export, units
+from imunoise.noise import gm_white_density
+from imunoise.report import model_text
+
+FS = 40.0
+
+
+@pytest.fixture(scope="module")
+def fast_gm_model():
+    """White noise + a Gauss–Markov term of τc = 0.1 s (a sensor filter, white at
+    τ = 1 s) + a slow one (τc = 200 s): the datasheet N and K differ from the
+    fitted components'."""
+    x = imunoise.simulate(int(3600 * FS), FS, N=2e-4, channels=3, seed=5,
+                          gm=[(1.5e-3, 0.1), (2e-4, 200.0)])
+    return quiet_fit(imunoise.adev(x, FS, taus=10))
+
+
+def test_values_are_the_datasheet_values_not_the_components(fast_gm_model):
+    m = fast_gm_model
+    parts = m.components
+    for c in range(m.channels):
+        white = float(parts.N[c]) ** 2 + sum(
+            gm_white_density(s, tc, FS) for s, tc in parts.gauss_markov(c) if tc <= 1.0)
+        assert float(m.N[c]) == pytest.approx(math.sqrt(white), rel=1e-12)
+        walk = float(parts.K[c]) ** 2 + sum(
+            2 * s * s / tc for s, tc in parts.gauss_markov(c) if tc > 1.0)
+        assert float(m.K[c]) == pytest.approx(math.sqrt(walk), rel=1e-12)
+        # the fast term makes the datasheet N larger than the fitted white noise
+        assert parts.gauss_markov(c) and float(m.N[c]) > float(parts.N[c])
+        assert m.supported["N"][c] and np.isfinite(m.N_std[c]) and m.N_std[c] > 0
+
+
+def test_every_view_prints_the_same_numbers(fast_gm_model):
+    m = fast_gm_model
+    si = {"N": "rad/sqrt(s)", "B": "rad/s", "K": "rad/s/sqrt(s)"}
+    table = {r["term"]: r for r in m.table("gyro", units=si)}
+    for t in ("N", "B", "K"):
+        for c, ax in enumerate("XYZ"):
+            assert table[t][ax] == pytest.approx(float(m.value(t)[c]), rel=1e-12)
+            assert table[t][ax + "_supported"] == bool(m.supported[t][c])
+    # datasheet units: the default table is the value converted, nothing else
+    deg = m.in_units("gyro")
+    np.testing.assert_allclose(deg["N"]["value"],
+                               units.convert(m.N, "N", deg["N"]["unit"], sensor="gyro"))
+    # repr: the values, rounded to their uncertainty
+    text = repr(m)
+    assert "N=" in text and "no term resolved" not in text
+    # Kalibr: the worst axis of the same N and K
+    kal = export.kalibr_dict(gyro=m)
+    assert kal["gyroscope_noise_density"] == pytest.approx(float(np.max(m.N)), rel=1e-12)
+    assert kal["gyroscope_random_walk"] == pytest.approx(float(np.max(m.K)), rel=1e-12)
+    # EKF: the datasheet values beside the state-space ones
+    ekf = export.ekf_dict(gyro=m)["gyroscope"]["axes"]
+    for c, ax in enumerate("xyz"):
+        assert ekf[ax]["datasheet"]["N"] == pytest.approx(float(m.N[c]), rel=1e-12)
+        assert ekf[ax]["bias_instability"] == pytest.approx(float(m.B[c]), rel=1e-12)
+    # JSON: the values under their names, the components apart
+    d = json.loads(export.model_json(m))
+    np.testing.assert_allclose(d["N"]["value"], m.N, rtol=1e-12)
+    assert d["components"]["gauss_markov"][0]
+    # the comparison with a datasheet measures the same N
+    cmp = imunoise.compare(m, "vn100")
+    rows = [r for r in cmp.rows if r["term"] == "N"]
+    assert rows
+    for r in rows:
+        c = "XYZ".index(r["axis"])
+        want = units.convert(m.N[c], "N", r["unit"], sensor="gyro")
+        assert r["measured"] == pytest.approx(float(want), rel=1e-12)
+
+
+def test_not_resolved_means_one_thing():
+    # white noise alone: no flat part and no walk, in every view
+    x = imunoise.simulate(200_000, FS, N=1e-3, channels=3, seed=3)
+    m = quiet_fit(imunoise.adev(x, FS, taus=10))
+    assert not np.any(m.supported["B"]) and np.all(m.B == 0) and np.all(np.isnan(m.B_std))
+    rows = {r["term"]: r for r in m.table()}
+    assert all(not rows["B"][ax + "_supported"] for ax in "XYZ")
+    assert "not resolved" in m.table_text()
+    header, body = model_text.datasheet_rows(m, "gyro")
+    b_row = next(r for r in body if r[1] == "B")
+    assert b_row[3:] == ["not resolved"] * 3
+    assert "B=" not in repr(m)
+
+
+def test_old_spellings_warn_and_name_the_new_one(fast_gm_model):
+    m = fast_gm_model
+    with pytest.warns(DeprecationWarning, match=r"use model\.N"):
+        np.testing.assert_array_equal(m.equivalent("N"), m.value("N"))
+    with pytest.warns(DeprecationWarning, match=r"use model\.K_std"):
+        np.testing.assert_array_equal(m.equivalent_std("K"), m.std("K"))
+    with pytest.warns(DeprecationWarning, match=r"model\.components\.gm_sigma"):
+        np.testing.assert_array_equal(m.gm_sigma, m.components.gm_sigma)
+    with pytest.warns(DeprecationWarning, match=r"model\.components\.gauss_markov"):
+        assert m.gauss_markov(0) == m.components.gauss_markov(0)
+    with pytest.warns(DeprecationWarning, match=r"model\.components\.cov"):
+        assert m.cov.shape == m.components.cov.shape
+    with pytest.raises(AttributeError, match="no attribute 'nonsense'"):
+        _ = m.nonsense
+
+
+def test_the_warning_points_at_the_caller(fast_gm_model):
+    with pytest.warns(DeprecationWarning) as record:
+        fast_gm_model.equivalent("N")
+    assert record[0].filename == __file__
+
+
+def test_bootstrap_gives_the_datasheet_values_their_own_spread():
+    x = imunoise.simulate(100_000, FS, N=1e-3, K=1e-5, channels=1, seed=4)
+    r = imunoise.adev(x, FS, taus=5)
+    m = quiet_fit(r, uncertainty="bootstrap", replicates=8, seed=1)
+    assert np.isfinite(m.N_std) and m.N_std > 0
+    assert np.isfinite(m.components.N_std)
