@@ -1,20 +1,25 @@
 """Noise-model fit on real still recordings: imunoise vs allan-variance, one run.
 
-For every long still recording in ../shared/data (skipped when absent): the
-overlapping Allan deviation at 20 taus per decade (imunoise.adev), then
+For every long still recording in ../shared/data (skipped when absent), per channel:
 
-* coverage: the share of taus τ ≤ T/10 at which the fitted model lies inside the
-  measured 95 % confidence interval (χ² with the result's EDF) or within 5 % of
-  the measured deviation, whichever is wider — for imunoise.fit (default,
-  terms="auto") and allan_variance.estimate_parameters (its default five terms);
-* the model's structure, coefficients and discrepancy δ;
-* tau-grid stability: the model's datasheet equivalents N, B, K (NoiseModel.equivalent)
-  and the coefficients fitted on octave, 5, 10, 20 and 50 taus per decade; the spread
-  is max − min over the grids in units of the largest standard uncertainty.
+* in-sample coverage: the overlapping Allan deviation at 20 taus per decade
+  (imunoise.adev); the share of taus τ ≤ T/10 at which the fitted model lies inside
+  the measured 95 % confidence interval (χ² with the result's EDF) or within 5 % of
+  the measured deviation — imunoise.fit (terms="auto") and
+  allan_variance.estimate_parameters (its default five terms);
+* out of sample, half against half: fit the first half, and score the coverage of
+  the second half's Allan deviation (τ ≤ T_half/10) by that model, by the first
+  half's own measured curve and by allan-variance fitted on the first half;
+* the fitted structure (model.components) and the number of its components;
+* tau-grid stability of the datasheet values model.N, B, K fitted on octave, 5, 10,
+  20 and 50 taus per decade: the spread max − min in units of the largest
+  standard uncertainty;
+* B against the data's read-off where the curve has a flat minimum: the
+  difference in units of √(u_model² + u_readoff²).
 
 Then the simulated accuracy table of benches/bench_fit.py (--seeds, default 4).
 
-Run:  python benches/bench_fit_real.py [--seeds 4] [--plots DIR]
+Run:  python benches/bench_fit_real.py [--seeds 4] [--plots DIR] [--only NAME]
 """
 
 from __future__ import annotations
@@ -88,25 +93,69 @@ def allan_variance_dev(taus, var):
 
 
 def structure(model):
-    terms = [t for t in imunoise.noise.TERMS if bool(model.supported[t])]
-    gm = [f"GM({tc:.3g} s)" for _, tc in model.components.gauss_markov()]
-    tone = [f"sine({f0:.3g} Hz)" for _, f0 in model.components.sine()]
-    res = [f"res({f:.3g} Hz, Q {math.pi * f * tr:.2g})"
-           for _, f, tr in model.components.resonance()]
+    parts = model.components
+    terms = [t for t in imunoise.noise.TERMS if bool(parts.supported[t])]
+    gm = [f"GM({tc:.3g} s)" for _, tc in parts.gauss_markov()]
+    tone = [f"sine({f0:.3g} Hz)" for _, f0 in parts.sine()]
+    res = [f"res({f:.3g} Hz, Q {math.pi * f * tr:.2g})" for _, f, tr in parts.resonance()]
     return "+".join(terms + gm + tone + res)
+
+
+def half_against_half(x, fs):
+    """Coverage of the second half's curve by the model of the first half, by the
+    first half's own curve and by allan-variance's fit to the first half."""
+    half = len(x) // 2
+    first = imunoise.adev(x[:half], fs, taus=20)
+    second = imunoise.adev(x[half:2 * half], fs, taus=20)
+    limit = half / fs / 10
+    model = imunoise.fit(first)
+    return (coverage(second.taus, second.dev, second.edf, model.predict(second.taus).dev,
+                     limit),
+            coverage(second.taus, second.dev, second.edf, first.dev, limit),
+            coverage(second.taus, second.dev, second.edf,
+                     allan_variance_dev(first.taus, first.var), limit))
+
+
+def b_against_readoff(model):
+    """|B_model − B_readoff| / combined standard uncertainty, NaN without a floor."""
+    read, u_read = (float(np.ravel(model.readoff["B"][k])[0]) for k in ("value", "std"))
+    b, u_b = float(np.ravel(model.B)[0]), float(np.ravel(model.B_std)[0])
+    if not (np.isfinite(read) and b > 0):
+        return math.nan
+    return abs(b - read) / math.hypot(u_read, u_b if np.isfinite(u_b) else 0.0)
+
+
+def grid_spread(x, fs):
+    """Largest spread (max − min over the grids) of model.N, B, K in units of the
+    largest standard uncertainty; NaN where a grid does not resolve the value."""
+    values = {t: [] for t in ("N", "B", "K")}
+    for grid in GRIDS.values():
+        m = imunoise.fit(imunoise.adev(x, fs, taus=grid))
+        for t in values:
+            values[t].append((float(np.ravel(m.value(t))[0]), float(np.ravel(m.std(t))[0])))
+    out = {}
+    for t, pairs in values.items():
+        v = np.array([p[0] for p in pairs])
+        u = np.array([p[1] for p in pairs])
+        out[t] = ((v.max() - v.min()) / u.max() if np.all(v > 0) and np.all(np.isfinite(u))
+                  else (0.0 if np.all(v == 0) else math.nan))
+    return out
 
 
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seeds", type=int, default=4, help="simulated records (0: skip)")
     ap.add_argument("--plots", type=Path, help="write one Allan plot per channel here")
+    ap.add_argument("--only", help="channels whose name contains this")
     args = ap.parse_args()
     recs = recordings()
+    if args.only:
+        recs = {k: v for k, v in recs.items() if args.only in k}
     if not recs:
         print(f"no recordings under {DATA}; nothing to do")
         return 0
     warnings.simplefilter("ignore", RuntimeWarning)
-    rows, stab, fit_time = [], [], 0.0
+    rows, fit_time = [], 0.0
     for name, (x, fs) in recs.items():
         limit = len(x) / fs / 10
         r = imunoise.adev(x, fs, taus=20)
@@ -115,53 +164,38 @@ def main() -> int:
         fit_time += time.perf_counter() - t0
         ours = coverage(r.taus, r.dev, r.edf, model.predict(r.taus).dev, limit)
         theirs = coverage(r.taus, r.dev, r.edf, allan_variance_dev(r.taus, r.var), limit)
-        rows.append((name, ours, theirs, structure(model), float(model.discrepancy)))
         if args.plots:
             args.plots.mkdir(parents=True, exist_ok=True)
             fig = imunoise.plot.allan(r, model=model, title=name)
             fig.savefig(args.plots / (name.replace(" ", "_") + ".png"), dpi=70)
-        eq, co = {}, {}
-        for label, grid in GRIDS.items():
-            m = imunoise.fit(imunoise.adev(x, fs, taus=grid))
-            eq[label] = [float(m.value(t)[0]) for t in ("N", "B", "K")]
-            co[label] = [(float(m.value(t)[0]), float(m.std(t)[0])) for t in ("N", "B", "K")]
-        stab.append((name, eq, co))
+        rows.append(dict(name=name, ours=ours, theirs=theirs, struct=structure(model),
+                         count=model.components.count(), b=b_against_readoff(model),
+                         halves=half_against_half(x, fs), spread=grid_spread(x, fs)))
     print(f"{len(rows)} real channels; imunoise.fit total {fit_time:.2f} s")
     print()
-    print("| channel | imunoise coverage | allan-variance coverage | imunoise model | δ |")
-    print("|---|---|---|---|---|")
-    for name, ours, theirs, struct, delta in rows:
-        print(f"| {name} | {ours:.0%} | {theirs:.0%} | {struct} | {delta:.3f} |")
-    ours = np.array([r[1] for r in rows])
-    theirs = np.array([r[2] for r in rows])
-    print(f"| **median / worst** | **{np.median(ours):.0%} / {ours.min():.0%}** | "
-          f"**{np.median(theirs):.0%} / {theirs.min():.0%}** | | |")
-    print()
-    print("Tau-grid stability (octave, 5, 10, 20, 50 per decade): spread of the model's")
-    print("datasheet equivalents (max/min − 1) and of the coefficients in units of their")
-    print("largest standard uncertainty (—: the term is not in every grid's model)")
-    print()
-    print("| channel | N_eq spread | B_eq spread | K_eq spread | N, B, K coefficient spread / u |")
-    print("|---|---|---|---|---|")
-    worst = 0.0
-    for name, eq, co in stab:
-        e = np.array(list(eq.values()))
-        cells = []
-        for j in range(3):
-            col = e[:, j]
-            cells.append(f"{col.max() / col.min() - 1:.1%}" if col.min() > 0 else "—")
-        spread = []
-        for j in range(3):
-            vals = np.array([co[g][j][0] for g in co])
-            stds = np.array([co[g][j][1] for g in co])
-            if np.all(vals > 0) and np.all(np.isfinite(stds)):
-                z = (vals.max() - vals.min()) / stds.max()
-                worst = max(worst, z)
-                spread.append(f"{z:.1f}")
-            else:
-                spread.append("—")
-        print(f"| {name} | " + " | ".join(cells) + " | " + ", ".join(spread) + " |")
-    print(f"\nlargest coefficient spread: {worst:.1f} standard uncertainties")
+    print("| channel | coverage: imunoise | allan-variance | half vs half: imunoise | "
+          "first half's curve | allan-variance | components | N, B, K grid spread / u | "
+          "B vs read-off / u |")
+    print("|---|---|---|---|---|---|---|---|---|")
+
+    def z(v):
+        return "—" if not np.isfinite(v) else f"{v:.1f}"
+
+    for r in rows:
+        h = r["halves"]
+        print(f"| {r['name']} | {r['ours']:.0%} | {r['theirs']:.0%} | {h[0]:.0%} | {h[1]:.0%} "
+              f"| {h[2]:.0%} | {r['count']}: {r['struct']} | "
+              + ", ".join(z(r["spread"][t]) for t in ("N", "B", "K"))
+              + f" | {z(r['b'])} |")
+    col = {k: np.array([r[k] for r in rows]) for k in ("ours", "theirs", "count", "b")}
+    halves = np.array([r["halves"] for r in rows])
+    spreads = np.array([[r["spread"][t] for t in ("N", "B", "K")] for r in rows])
+    print(f"| **median / worst** | **{np.median(col['ours']):.0%} / {col['ours'].min():.0%}** | "
+          f"{np.median(col['theirs']):.0%} / {col['theirs'].min():.0%} | "
+          + " | ".join(f"{np.median(halves[:, j]):.0%} / {halves[:, j].min():.0%}"
+                       for j in range(3))
+          + f" | median {np.median(col['count']):.0f}, most {col['count'].max()} | "
+          f"worst {np.nanmax(spreads):.1f} | worst {np.nanmax(col['b']):.1f} |")
     if args.seeds:
         print()
         sys.argv = [sys.argv[0], "--seeds", str(args.seeds)]

@@ -11,7 +11,8 @@ import math
 import imunoise
 import numpy as np
 import pytest
-from helpers.noise_fit import quiet_fit
+from helpers.data import shared_file
+from helpers.noise_fit import clean_five_term_fits, quiet_fit
 from imunoise import export, units
 from imunoise.noise import gm_white_density
 from imunoise.report import model_text
@@ -124,3 +125,41 @@ def test_bootstrap_gives_the_datasheet_values_their_own_spread():
     m = quiet_fit(r, uncertainty="bootstrap", replicates=8, seed=1)
     assert np.isfinite(m.N_std) and m.N_std > 0
     assert np.isfinite(m.components.N_std)
+
+
+# -- parsimony and the flat part ------------------------------------------------------
+
+
+@pytest.mark.parametrize("seed", [3, 4])
+def test_clean_five_term_data_get_no_component_beyond_the_ieee_terms(seed):
+    # Each component beyond the IEEE terms must bring strong evidence (6 more in BIC):
+    # a correlated wiggle of the long taus of N + B + K data is no Gauss–Markov term.
+    for grid, m in clean_five_term_fits(seed):
+        for c in range(m.channels):
+            parts = m.components
+            assert not parts.gauss_markov(c) and not parts.sine(c) and not parts.resonance(c), (
+                grid, c, parts.structure(c))
+
+
+def test_vn100_gyro_flat_part_is_b_on_every_grid():
+    """The bundled capture's gyro X is flat at ≈ 1.8e-5 rad/s from 30 to 130 s: the
+    data's read-off finds that floor on every grid, the model has a B there within
+    two standard uncertainties of it, and the datasheet B moves with the grid by
+    less than two of its uncertainties."""
+    log = imunoise.read(shared_file("data/vn100-ascii/live_capture.txt"), fs=40.0)
+    values = []
+    for grid in ("octave", 5, 10, 20, 50):
+        m = quiet_fit(imunoise.adev(log.gyro[:, 0], log.fs, taus=grid))
+        read, u_read = float(m.readoff["B"]["value"]), float(m.readoff["B"]["std"])
+        assert np.isfinite(read) and 30 <= float(m.readoff["B"]["tau"]) <= 130, grid
+        assert m.supported["B"], (grid, m.components.structure())
+        assert abs(float(m.B) - read) <= 2 * math.hypot(u_read, float(m.B_std)), grid
+        values.append((float(m.B), float(m.B_std)))
+    b = np.array(values)
+    assert b[:, 0].max() - b[:, 0].min() <= 2 * b[:, 1].max()
+
+
+def test_a_curve_still_falling_at_its_end_has_no_read_off_floor():
+    x = imunoise.simulate(100_000, FS, N=1e-3, seed=9)
+    m = quiet_fit(imunoise.adev(x, FS, taus=10))
+    assert np.isnan(m.readoff["B"]["value"]) and not m.supported["B"]

@@ -29,6 +29,7 @@ from imunoise.noise._terms import (
     _PARAMS,
     _RES,
     _SINE,
+    FLAT_SLOPE,
     FLICKER,
     GM_MAX,
     TERMS,
@@ -39,9 +40,6 @@ from imunoise.noise._terms import (
 
 #: Points of the log-spaced grid over the fitted taus on which B's minimum is sought.
 _B_GRID = 200
-#: A minimum at the longest tau is a floor only where the curve's log-log slope
-#: there is above this; below, the curve is still falling.
-_STILL_FALLING = -0.25
 
 
 def datasheet_values(components, taus, method: str) -> dict[str, tuple[np.ndarray, np.ndarray]]:
@@ -108,7 +106,7 @@ def value_of(term: str, p: np.ndarray, taus: np.ndarray, fs: float) -> float:
         dev = np.sqrt(_core_fit.noise_terms(grid, fs, list(p[:5]), gm, tone, osc).sum(axis=1))
         i = int(np.argmin(dev))
         slope = np.log(dev[-1] / dev[-2]) / np.log(grid[-1] / grid[-2])
-        if i == grid.size - 1 and slope < _STILL_FALLING:
+        if i == grid.size - 1 and slope < FLAT_SLOPE:  # still falling: no floor
             return 0.0
         return float(dev[i] / FLICKER)
     total = p[1] if term == "N" else p[3]

@@ -9,7 +9,7 @@ import warnings
 
 import numpy as np
 
-from imunoise.noise._terms import _CLOSE, _READ_TAU, _SLOPE, FLICKER, TERMS
+from imunoise.noise._terms import _CLOSE, _READ_TAU, _SLOPE, FLAT_SLOPE, FLICKER, TERMS
 
 
 def measured(result, taus):
@@ -67,13 +67,26 @@ def readoffs(taus, dev, edf, shaped):
         if steady.size < 3:
             continue
         j = int(steady[np.argmin(d[steady])])
-        if 0 < j < steady[-1]:  # a minimum at an end is no flat part
-            lo, hi = interval95(d[j], e[j])
-            out["B"]["value"][c] = d[j] / FLICKER
-            out["B"]["std"][c] = d[j] / FLICKER / math.sqrt(2.0 * e[j])
-            out["B"]["tau"][c] = t[j]
-            out["B"]["low"][c], out["B"]["high"][c] = lo / FLICKER, hi / FLICKER
+        if j == steady[0] or (j == steady[-1] and not _flat_before(t, d, steady)):
+            continue  # a minimum at the start, or at the end of a still falling curve
+        lo, hi = interval95(d[j], e[j])
+        out["B"]["value"][c] = d[j] / FLICKER
+        out["B"]["std"][c] = d[j] / FLICKER / math.sqrt(2.0 * e[j])
+        out["B"]["tau"][c] = t[j]
+        out["B"]["low"][c], out["B"]["high"][c] = lo / FLICKER, hi / FLICKER
     return {k: {f: shaped(a) for f, a in parts.items()} for k, parts in out.items()}
+
+
+def _flat_before(t, d, steady) -> bool:
+    """Whether the curve has flattened at its last steady estimate: its log-log
+    slope over the octave before it is above FLAT_SLOPE (a record that ends inside
+    the flat part still has a bias-instability floor; one whose curve still falls
+    has none)."""
+    j = steady[-1]
+    k = steady[np.argmin(np.abs(np.log(t[steady] / (t[j] / 2))))]
+    if k == j:
+        return False
+    return math.log(d[j] / d[k]) / math.log(t[j] / t[k]) > FLAT_SLOPE
 
 
 

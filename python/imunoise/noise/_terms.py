@@ -65,6 +65,10 @@ def _is_log_time(slot: int) -> bool:
     return slot > _RES or (5 <= slot < _RES and (slot - 5) % 2 == 1)
 
 
+FLAT_SLOPE = -0.25
+"""A curve whose log-log slope is above this has flattened: a minimum at its end is
+a bias-instability floor (slope −½ is white noise, 0 the floor)."""
+
 _CLOSE = 0.05
 """A model within this relative distance of the measured deviation follows it."""
 
