@@ -50,6 +50,20 @@ def format_value(value, std=None, *, unit: str | None = None, digits: int = 4,
     return f"{text} {unit}" if unit else text
 
 
+def rounded(value, std=None, *, digits: int = 4, missing: str = EMPTY) -> str:
+    """``value`` alone, rounded to the decimal place :func:`format_value` gives it
+    beside ``std`` ("0.21004" for 0.2100438 ± 0.000112762, "3.50e-3" for
+    (3.50 ± 0.12)e-3): for figure titles and short text where the ``±`` part would not
+    fit. Without a usable ``std``, ``digits`` significant digits."""
+    text = format_value(value, std, digits=digits, missing=missing)
+    if " ± " not in text:
+        return text
+    head, tail = text.split(" ± ")
+    if head.startswith("("):  # "(3.50 ± 0.12)e-3"
+        return head[1:] + tail[tail.index(")") + 1:]
+    return head
+
+
 def _significant(value: float, digits: int) -> str:
     if value == 0:
         return "0"
