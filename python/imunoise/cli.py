@@ -22,6 +22,7 @@ from imunoise._schema import (
     sensor_label,
 )
 from imunoise.allan import KINDS
+from imunoise.numbers import duration
 from imunoise.readers.csv_reader import (
     LAYOUT_CHANNELS,  # the --kind choices: every public Allan-family statistic
 )
@@ -438,8 +439,8 @@ def _cmd_dadev(args) -> int:
     d = dynamic.dynamic_adev(y, log.fs, window=args.window, step=args.step, taus=taus)
     st = d.stationarity
     names = axis_names(d.channels)
-    print(f"# dynamic ADEV of {args.sensor}: {len(d.times)} windows of {d.window:.6g} s every "
-          f"{d.step:.6g} s, {len(d.taus)} taus {d.taus[0]:.4g}-{d.taus[-1]:.4g} s")
+    print(f"# dynamic ADEV of {args.sensor}: {len(d.times)} windows of {duration(d.window)} "
+          f"every {duration(d.step)}, {len(d.taus)} taus {d.taus[0]:.4g}-{d.taus[-1]:.4g} s")
     outside, worst = np.atleast_1d(st.outside), np.atleast_1d(st.worst_z)
     at_t, at_tau = np.atleast_1d(st.worst_time), np.atleast_1d(st.worst_tau)
     _print_table(["axis", "outside_CI", "expected", "max|z|", "at_t[s]", "at_tau[s]"],
@@ -589,7 +590,7 @@ def _cmd_thermal(args) -> int:
 
     log = _read(args)
     w = warmup(log)
-    print(f"# {log.source}: warm-up: " + (f"settled after {w.settle:.6g} s" if w.settle > 0
+    print(f"# {log.source}: warm-up: " + (f"settled after {duration(w.settle)}" if w.settle > 0
                                            else "no transient"))
     if log.temperature is None:
         _fail(f"{args.log}: the log has no temperature channel; no thermal fit")
