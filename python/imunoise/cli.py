@@ -639,7 +639,8 @@ def main(argv: list[str] | None = None) -> int:
     """Run the command line; returns the exit status (also used as the script's)."""
 
     def _warn(message, category, filename, lineno, file=None, line=None):
-        print(f"imunoise: warning: {_one_line(message)}", file=sys.stderr)
+        # ``file``: the progress bars pass a stream that prints above them
+        print(f"imunoise: warning: {_one_line(message)}", file=file or sys.stderr)
 
     parser = _build_parser()
     old = warnings.showwarning

@@ -56,7 +56,6 @@ from __future__ import annotations
 
 import math
 import numbers
-import warnings
 from dataclasses import dataclass
 from functools import cached_property
 from typing import TYPE_CHECKING
@@ -65,7 +64,7 @@ import numpy as np
 import numpy.typing as npt
 from scipy import stats as _stats
 
-from imunoise import _schema, _summary
+from imunoise import _schema, _summary, _warn
 from imunoise import numbers as _numbers
 from imunoise._core import allan as _core_allan
 from imunoise._runs import true_runs
@@ -517,10 +516,9 @@ def _window_factors(taus, fs: float, width: int) -> np.ndarray:
     m, user_given = averaging_factors(taus, fs, width)
     fits = (m >= 1) & (width + 1 - 2 * m >= 2)
     if user_given and not fits.all():
-        warnings.warn(
+        _warn.warn(
             f"{int(np.count_nonzero(~fits))} of {m.size} taus dropped: a window of {width} "
-            f"samples holds taus from {1 / fs:g} s to {math.floor((width - 1) / 2) / fs:g} s",
-            stacklevel=4,
+            f"samples holds taus from {1 / fs:g} s to {math.floor((width - 1) / 2) / fs:g} s"
         )
     m = np.unique(m[fits])
     if m.size == 0:
