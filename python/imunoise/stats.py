@@ -67,6 +67,8 @@ __all__ = [
     "Distribution",
     "describe",
     "distribution",
+    "attitude_angles",
+    "heading",
     "quantization_step",
     "unwrap_about_circular_mean",
     "SENSOR_CHANNELS",
@@ -219,8 +221,10 @@ def describe(x, fs: float | None = None) -> Description:
     Parameters
     ----------
     x : ImuLog or array_like, shape (n,) or (n, k)
-        An :class:`imunoise.ImuLog` (its gyro, accel, mag, temperature and
-        pressure channels are described, axes named X/Y/Z), or rate samples.
+        An :class:`imunoise.ImuLog` (its gyro, accel, mag, yaw/pitch/roll,
+        temperature and pressure channels are described, axes named X/Y/Z), or
+        rate samples. Yaw is taken about its circular mean (:func:`attitude_angles`)
+        and its mean given in (−180°, 180°].
     fs : float, optional
         Sample rate in Hz; defaults to ``log.fs`` for a log. For arrays without
         ``fs`` the drift is NaN.
@@ -244,15 +248,20 @@ def describe(x, fs: float | None = None) -> Description:
         blocks, names, sensors, units = [], [], [], []
         for sensor in SENSOR_CHANNELS:
             arr = getattr(log, sensor)
-            if arr is None:
+            if arr is None or sensor == "ypr" and not np.isfinite(arr).any():
                 continue
-            arr = arr.reshape(len(arr), -1)
-            blocks.append(arr)
             unit = _schema.CHANNELS[sensor][1]
-            for j in range(arr.shape[1]):
-                names.append(_schema.sensor_label(sensor, j, arr.shape[1]))
-                sensors.append(sensor)
-                units.append(unit)
+            if sensor == "ypr":
+                angles = attitude_angles(arr)
+                arr, labels = np.column_stack(list(angles.values())), list(angles)
+            else:
+                arr = arr.reshape(len(arr), -1)
+                labels = [_schema.sensor_label(sensor, j, arr.shape[1])
+                          for j in range(arr.shape[1])]
+            blocks.append(arr)
+            names += labels
+            sensors += [sensor] * len(labels)
+            units += [unit] * len(labels)
         if not blocks:
             raise ValueError(
                 f"x has none of the channels {SENSOR_CHANNELS}; "
@@ -287,6 +296,9 @@ def describe(x, fs: float | None = None) -> Description:
         var = x.var(axis=0, ddof=1)
         lo, hi = x.min(axis=0), x.max(axis=0)
         drift = np.full(x.shape[1], np.nan) if t is None else _drift(t, x, mean)
+    if "yaw" in names and sensors[names.index("yaw")] == "ypr":
+        mean = mean.copy()
+        mean[names.index("yaw")] = heading(mean[names.index("yaw")])
     return Description(
         names=tuple(names),
         sensors=tuple(sensors),
@@ -747,6 +759,21 @@ def _edges(x: np.ndarray, bins, step: float | None) -> np.ndarray:
     k = max(k, int(np.ceil(levels / MAX_BINS)))
     nb = int(np.ceil(levels / k))
     return lo + (np.arange(nb + 1) * k - 0.5) * step
+
+
+def attitude_angles(ypr) -> dict[str, np.ndarray]:
+    """``{"yaw": …, "pitch": …, "roll": …}`` in degrees from a log's ``ypr`` (n, 3),
+    yaw unwrapped about its circular mean (:func:`unwrap_about_circular_mean`) so a
+    heading near ±180° stays in one piece."""
+    ypr = np.asarray(ypr, dtype=float)
+    return {name: unwrap_about_circular_mean(ypr[:, j]) if name == "yaw" else ypr[:, j]
+            for j, name in enumerate(_schema.ATTITUDE_NAMES)}
+
+
+def heading(angle_deg: float) -> float:
+    """An angle (degrees) moved by whole turns into (−180°, 180°]."""
+    a = (float(angle_deg) + 180.0) % 360.0 - 180.0
+    return 180.0 if a == -180.0 else a
 
 
 def unwrap_about_circular_mean(angle_deg: np.ndarray) -> np.ndarray:

@@ -20,7 +20,7 @@ from imunoise import allan as _allan
 from imunoise._core import __version__
 from imunoise._events import Events, events
 from imunoise._progress import Progress, wanted
-from imunoise._schema import ALLAN_SENSORS, ATTITUDE_NAMES, SAMPLE_SENSORS, sensor_label
+from imunoise._schema import ALLAN_SENSORS, SAMPLE_SENSORS, sensor_label
 from imunoise._thermal import Thermal, thermal
 from imunoise._warmup import Warmup, warmup
 from imunoise.readers.log import ImuLog
@@ -83,9 +83,7 @@ class Context:
         one piece; None when the log has no attitude."""
         if self.short.ypr is None or not np.any(np.isfinite(self.short.ypr)):
             return None
-        ypr = self.short.ypr
-        return {name: stats.unwrap_about_circular_mean(ypr[:, j]) if name == "yaw" else ypr[:, j]
-                for j, name in enumerate(ATTITUDE_NAMES)}
+        return stats.attitude_angles(self.short.ypr)
 
     @cached_property
     def attitude_distributions(self) -> dict[str, stats.Distribution]:

@@ -169,8 +169,7 @@ def attitude(ctx: Context, doc: Doc) -> None:
         ok = v[np.isfinite(v)]
         mean = float(ok.mean())
         if name == "yaw":  # back into (−180°, 180°]
-            mean = (mean + 180.0) % 360.0 - 180.0
-            mean = 180.0 if mean == -180.0 else mean
+            mean = stats.heading(mean)
         d = dists[name]
         rows.append([name, "deg", format_number(mean), format_number(float(ok.std(ddof=1))),
                      format_number(float(ok.var(ddof=1))), format_number(float(ok.min())),
