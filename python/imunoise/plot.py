@@ -292,8 +292,9 @@ def histograms(
 
     The x axis is the distribution's range (its bulk, see
     :func:`imunoise.distribution`); samples beyond it are counted in the panel's
-    upper corners ("← 3", "12 →"). Tick labels use an offset ("+1.342e2") when
-    the values share leading digits, and fewer ticks when labels would touch.
+    upper corners ("← 3", "12 →"). Tick labels use an offset ("−134" under
+    "−0.05 0 0.05") when the values share leading digits, and fewer ticks when
+    labels would touch.
 
     Parameters
     ----------
@@ -345,7 +346,7 @@ HIST_TICKS = 5
 
 def _readable_ticks(fig, axes) -> None:
     """x tick labels that never touch: an offset when the values share leading
-    digits ("−134.20, −134.15" → "−0.05, 0" and "−1.342e2"), then fewer ticks
+    digits ("−134.20, −134.15" → "−0.05, 0" and the offset "−134"), then fewer ticks
     (down to two) until no two labels of a panel, or of neighbouring panels, overlap
     on the renderer."""
     import matplotlib
@@ -360,7 +361,7 @@ def _readable_ticks(fig, axes) -> None:
     for i, ax in enumerate(axes):
         for nbins in range(HIST_TICKS, 1, -1):
             ax.xaxis.set_major_locator(MaxNLocator(nbins=nbins, steps=[1, 2, 2.5, 5, 10]))
-            if not tick_labels_overlap(fig, list(axes[max(i - 1, 0): i + 1]), renderer):
+            if not _tick_labels_overlap(fig, list(axes[max(i - 1, 0): i + 1]), renderer):
                 break
 
 
@@ -391,7 +392,7 @@ def _renderer(fig):
     return fig.canvas.get_renderer()
 
 
-def tick_labels_overlap(fig, axes, renderer=None) -> bool:
+def _tick_labels_overlap(fig, axes, renderer=None) -> bool:
     """Whether any two visible x or y tick labels of ``axes`` (together) overlap on
     the renderer (the figure drawn as it would be saved)."""
     renderer = renderer or _renderer(fig)

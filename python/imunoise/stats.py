@@ -395,7 +395,8 @@ class Distribution:
         Number of valid samples (NaN left out).
     counts : ndarray of int, (B,)
     edges : ndarray, (B + 1,)
-        Histogram bin edges.
+        Histogram bin edges, over the bulk of the data unless ``extent="all"``
+        (see the module notes).
     step : float or None
         Detected quantization step (None: continuous data, ordinary bins).
     level_spacing : float or None
