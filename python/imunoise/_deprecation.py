@@ -9,9 +9,10 @@ from __future__ import annotations
 
 import functools
 import inspect
-import warnings
 from collections.abc import Callable, Mapping, Sequence
 from typing import TypeVar
+
+from imunoise import _warn
 
 F = TypeVar("F", bound=Callable)
 
@@ -42,7 +43,7 @@ def old_call_forms(
                 if old in kwargs:
                     if new in kwargs:
                         raise TypeError(f"{name}() got both {new!r} and its old name {old!r}")
-                    _warn(f"{name}({old}=...) is deprecated; use {new}=")
+                    _deprecated(f"{name}({old}=...) is deprecated; use {new}=")
                     kwargs[new] = kwargs.pop(old)
             extra = args[n_positional:]
             if extra:
@@ -56,7 +57,7 @@ def old_call_forms(
                     if option in kwargs:
                         raise TypeError(f"{name}() got multiple values for {option!r}")
                     kwargs[option] = value
-                _warn(
+                _deprecated(
                     f"passing {', '.join(moved)} to {name}() by position is deprecated; "
                     f"pass {', '.join(f'{o}=' for o in moved)} by keyword"
                 )
@@ -67,6 +68,6 @@ def old_call_forms(
     return decorate
 
 
-def _warn(message: str) -> None:
-    # stacklevel 3: past this helper and the wrapper, at the caller's line
-    warnings.warn(message, DeprecationWarning, stacklevel=3)
+def _deprecated(message: str) -> None:
+    # at the caller's line, past this helper and the wrapper
+    _warn.warn(message, DeprecationWarning)

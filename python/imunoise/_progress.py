@@ -4,11 +4,17 @@ Every long-running entry point (the report, ``imunoise convert``, the batch) tak
 ``progress: bool | None``: True shows bars, False never does, None shows them when
 stderr is a terminal (so pipes, logs and tests stay clean). tqdm is imported only
 when a bar is shown.
+
+While a bar is on screen, warnings are written through ``tqdm.write`` (the bar is
+cleared, the warning printed on its own lines, the bar redrawn), so a warning never
+lands in the middle of a bar's line, on a terminal or in a pipe (``--progress``). A
+step bar's total is fixed when it is made: callers count their steps first.
 """
 
 from __future__ import annotations
 
 import sys
+import warnings
 from collections.abc import Callable
 
 __all__ = ["Progress", "byte_bar", "wanted"]
@@ -43,6 +49,7 @@ class Progress:
             from tqdm import tqdm
 
             self._bar = tqdm(total=total, file=sys.stderr, unit=unit, desc=desc, leave=leave)
+            self._restore = _warnings_above_bars()
 
     @property
     def shown(self) -> bool:
@@ -57,12 +64,6 @@ class Progress:
             self._bar.set_description(what)
         self._bar.update(1)
 
-    def set_total(self, total: int) -> None:
-        """Change the number of steps once it is known (e.g. which report sections apply)."""
-        if self._bar is not None:
-            self._bar.total = total
-            self._bar.refresh()
-
     def bytes(self, label: str) -> Callable[[int, int], None] | None:
         """A :func:`byte_bar` callback when this bar is shown, else None."""
         return byte_bar(label) if self._bar is not None else None
@@ -70,6 +71,8 @@ class Progress:
     def close(self) -> None:
         if self._bar is not None:
             self._bar.close()
+            self._restore()
+            self._bar = None
 
     def __enter__(self) -> Progress:
         return self
@@ -84,12 +87,46 @@ def byte_bar(label: str) -> Callable[[int, int], None]:
     from tqdm import tqdm
 
     bar = tqdm(total=0, file=sys.stderr, unit="B", unit_scale=True, desc=label, leave=False)
+    restore = _warnings_above_bars()
 
     def update(done: int, total: int) -> None:
+        if bar.disable:  # closed
+            return
         bar.total = total
         bar.n = done
         bar.refresh()
         if done >= total:
             bar.close()
+            restore()
 
     return update
+
+
+class _AboveBars:
+    """A text stream for warnings: each line goes out through ``tqdm.write`` to stderr."""
+
+    def write(self, text: str) -> None:
+        from tqdm import tqdm
+
+        for line in text.rstrip("\n").splitlines():
+            tqdm.write(line, file=sys.stderr)
+
+    def flush(self) -> None:
+        sys.stderr.flush()
+
+
+def _warnings_above_bars() -> Callable[[], None]:
+    """Route warnings through :class:`_AboveBars` (keeping whatever formats them, e.g.
+    the CLI's one-line form); returns the function that undoes it."""
+    saved = warnings.showwarning
+
+    def show(message, category, filename, lineno, file=None, line=None):
+        saved(message, category, filename, lineno, _AboveBars(), line)
+
+    warnings.showwarning = show
+
+    def restore() -> None:
+        if warnings.showwarning is show:
+            warnings.showwarning = saved
+
+    return restore

@@ -48,7 +48,7 @@ ATTITUDE_NAMES = ("yaw", "pitch", "roll")
 #: Allan deviation (``adev(x, fs, taus=TAUS_PER_DECADE)``).
 TAUS_PER_DECADE = 10
 #: Channels :func:`imunoise.describe` summarises when given a log.
-STATISTICS_CHANNELS = ("gyro", "accel", "mag", "temperature", "pressure")
+STATISTICS_CHANNELS = ("gyro", "accel", "mag", "ypr", "temperature", "pressure")
 
 
 def column_names(channel: str) -> list[str]:

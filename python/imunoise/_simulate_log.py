@@ -16,12 +16,11 @@ the same floor), instead of 6 % above it.
 from __future__ import annotations
 
 import os
-import warnings
 from pathlib import Path
 
 import numpy as np
 
-from imunoise import _schema
+from imunoise import _schema, _warn
 from imunoise._deprecation import old_call_forms
 from imunoise._simulate import simulate
 from imunoise._validate import positive_finite, sample_rate
@@ -93,10 +92,10 @@ def flicker_for_floor(floor: float, *, sensor: str = "", **terms: float) -> floa
     taus = np.logspace(-4, 8, 2401)  # 200 per decade: the minimum to ~1e-5 relative
     others = float(np.min(model_variance(taus, **terms))) / FLICKER**2
     if others >= floor**2:
-        warnings.warn(
+        _warn.warn(
             f"{sensor or 'sensor'}: the datasheet's other terms alone put the Allan floor at "
-            f"{np.sqrt(others):.3g}, above its bias instability {floor:.3g}; simulating B = 0",
-            stacklevel=3)
+            f"{np.sqrt(others):.3g}, above its bias instability {floor:.3g}; simulating B = 0"
+        )
         return 0.0
     return float(np.sqrt(floor**2 - others))
 

@@ -40,15 +40,8 @@ def estimate(value, std) -> str:
     return _numbers.cell(value, std)
 
 
-def duration(seconds: float) -> str:
-    """``"12.5 s"``, ``"5.51 min"`` or ``"3.2 h"``: three significant digits, by length."""
-    if not math.isfinite(seconds):
-        return "—"
-    if seconds < 120:
-        return f"{seconds:.3g} s"
-    if seconds < 7200:
-        return f"{seconds / 60:.3g} min"
-    return f"{seconds / 3600:.3g} h"
+#: ``"10 ms"``, ``"12.5 s"``, ``"5.51 min"`` or ``"3.2 h"`` (:func:`imunoise.numbers.duration`).
+duration = _numbers.duration
 
 
 def tau_span(taus) -> str:

@@ -74,7 +74,6 @@ autocorrelation", Proc. 18th EFTF (2004).
 
 from __future__ import annotations
 
-import warnings
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from types import MappingProxyType
@@ -84,7 +83,7 @@ import numpy as np
 import numpy.typing as npt
 from scipy import stats as _stats
 
-from imunoise import _schema, _summary
+from imunoise import _schema, _summary, _warn
 from imunoise._core import allan as _core_allan
 from imunoise._runs import true_runs
 from imunoise._validate import confidence_level, sample_rate, samples
@@ -595,9 +594,8 @@ def theoh(x: npt.ArrayLike, fs: float, *, taus: TauSpec = "octave",
         dropped = int(np.count_nonzero(short & (m_avar < 1)))
         m_avar = m_avar[short & (m_avar >= 1)]
         if dropped:
-            warnings.warn(
-                f"{dropped} of {arr.size} taus dropped: theoh needs tau >= 1/fs = {1 / fs:g} s",
-                stacklevel=2,
+            _warn.warn(
+                f"{dropped} of {arr.size} taus dropped: theoh needs tau >= 1/fs = {1 / fs:g} s"
             )
         m_avar = np.unique(m_avar)
         k = int(m_avar.max()) if m_avar.size else 0
@@ -694,10 +692,9 @@ def _keep_gapped(kind, m, var, terms, alpha, identified, edf, fs, user_given):
             f"long enough (pass gaps='splice' to join the runs)"
         )
     if user_given and not keep.all():
-        warnings.warn(
+        _warn.warn(
             f"{int(np.count_nonzero(~keep))} of {len(m)} taus dropped: the gaps in x leave "
-            f"{kind} fewer than 2 terms there (largest usable tau {m[keep].max() / fs:g} s)",
-            stacklevel=4,
+            f"{kind} fewer than 2 terms there (largest usable tau {m[keep].max() / fs:g} s)"
         )
     enough = enough[keep]
     return (
@@ -769,7 +766,7 @@ def chi2_interval(
 def _theo_input(x, fs, confidence, gaps, kind: str):
     """The checked samples, fs and confidence of a Thêo statistic (no gap skipping;
     a record long enough for ThêoBR)."""
-    data, one_d, missing = _gapped_samples(x, gaps, kind, False, stacklevel=4)
+    data, one_d, missing = _gapped_samples(x, gaps, kind, False)
     fs = sample_rate(fs)
     confidence = confidence_level(confidence)
     _check_theo_length(kind, data.shape[0])
@@ -807,10 +804,9 @@ def _keep_theobr(m, n: int, fs: float, user_given: bool, kind: str, lower: float
     dropped = int(np.count_nonzero(~keep))
     if dropped and user_given:
         above = f", above the last AVAR tau {lower / fs:g} s" if lower > 0 else ""
-        warnings.warn(
+        _warn.warn(
             f"{dropped} of {m.size} taus dropped: {kind}'s ThêoBR taus are 0.75·m/fs for "
-            f"even 10 <= m <= {n} (here {7.5 / fs:g} s to {0.75 * n / fs:g} s{above})",
-            stacklevel=3,
+            f"even 10 <= m <= {n} (here {7.5 / fs:g} s to {0.75 * n / fs:g} s{above})"
         )
     return np.unique(m[keep])
 
@@ -822,11 +818,10 @@ def _warn_theobr_cost(kind: str, n: int, m: np.ndarray, channels: int) -> None:
         return
     seconds = channels * _core_allan.theobr_seconds(n + 1, [int(v) for v in m])
     if seconds > 60:
-        warnings.warn(
+        _warn.warn(
             f"{kind}'s bias ratio needs Theo1 at N/30 averaging factors (cost ~N² log²N): "
             f"{n} samples will take roughly {seconds / 60:.0f} minutes; average blocks of "
-            "samples first (x.reshape(-1, b).mean(axis=1) at fs/b) to shorten it",
-            stacklevel=3,
+            "samples first (x.reshape(-1, b).mean(axis=1) at fs/b) to shorten it"
         )
 
 
@@ -837,7 +832,7 @@ def _minimum_samples(statistic: str) -> int:
     return 16
 
 
-def _gapped_samples(x, gaps, kind: str, skips: bool, stacklevel: int = 4):
+def _gapped_samples(x, gaps, kind: str, skips: bool):
     """float64 (n, channels) samples ready for the core, whether x was 1-D, and the
     missing samples per channel (None when the core counts them: ``gaps="skip"``
     for a statistic that skips gaps, without a scan here)."""
@@ -871,17 +866,15 @@ def _gapped_samples(x, gaps, kind: str, skips: bool, stacklevel: int = 4):
         starts, ends = true_runs(~bad)
         i = int(np.argmax(ends - starts))
         a, b = int(starts[i]), int(ends[i])
-        warnings.warn(
+        _warn.warn(
             f"x has {dropped} missing samples (NaN): {kind} analyses the longest gap-free "
-            f"segment, samples {a} to {b - 1}, {b - a} of {n} samples ({100 * (b - a) / n:.3g} %)",
-            stacklevel=stacklevel,
+            f"segment, samples {a} to {b - 1}, {b - a} of {n} samples ({100 * (b - a) / n:.3g} %)"
         )
         return data[a:b], one_d, missing
-    warnings.warn(
+    _warn.warn(
         f"x has {dropped} missing samples (NaN): {kind} splices over them, joining the "
         f"{n - dropped} valid samples as if they were contiguous ({100 * dropped / n:.3g} % "
-        "of the record spliced out); this biases long taus",
-        stacklevel=stacklevel,
+        "of the record spliced out); this biases long taus"
     )
     return data[~bad], one_d, missing
 

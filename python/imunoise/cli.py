@@ -22,6 +22,7 @@ from imunoise._schema import (
     sensor_label,
 )
 from imunoise.allan import KINDS
+from imunoise.numbers import duration
 from imunoise.readers.csv_reader import (
     LAYOUT_CHANNELS,  # the --kind choices: every public Allan-family statistic
 )
@@ -84,6 +85,7 @@ def _build_parser() -> argparse.ArgumentParser:
     a.add_argument("--kind", choices=KINDS, default="adev")
     a.add_argument("--taus", default="octave",
                    help="octave, decade, all, or points per decade (default: %(default)s)")
+    a.add_argument("--plot", default=None, metavar="PNG", help="also save the deviation figure")
 
     f = sub.add_parser("fit", help="fit the noise model and print coefficients",
                        description="Fit Q, N, B, K, R per axis to the Allan deviation and print "
@@ -95,12 +97,18 @@ def _build_parser() -> argparse.ArgumentParser:
     f.add_argument("--bootstrap", type=int, default=0, metavar="REPLICATES",
                    help="uncertainties by parametric bootstrap with this many simulated "
                    "records (>= 5; default: from the fit, taus treated as independent)")
+    f.add_argument("--plot", default=None, metavar="PNG",
+                   help="also save the Allan deviation with the fitted model (one PNG per "
+                   "sensor: NAME_gyro.png, NAME_accel.png when there are two)")
 
     s = sub.add_parser("stats", help="print sample statistics and distribution fits",
                        description="Per channel mean, std, variance, min, max, drift per hour; "
                        "per axis normal fit and normality statistics.")
     s.add_argument("log", metavar="LOG")
     _shared_options(s, fs=True, layout=True)
+    s.add_argument("--plot", default=None, metavar="PNG",
+                   help="also save the histograms with the fitted normal (one PNG per sensor: "
+                   "NAME_gyro.png, NAME_accel.png, ...)")
 
     e = sub.add_parser("events", help="list spikes and bursts (vibration, shocks)",
                        description="Per event: start, end, kind, channels, peak in sigmas "
@@ -329,6 +337,10 @@ def _cmd_adev(args) -> int:
     print(f"# {args.kind} of {args.sensor}, {len(y)} samples at {log.fs:.6g} Hz, "
           f"CI {r.confidence:.1%}")
     _print_table(head, rows)
+    if args.plot:
+        from imunoise import plot
+
+        _save_plot(plot.allan(r, title=f"{args.sensor} {args.kind}", unit=unit), args.plot)
     return 0
 
 
@@ -354,6 +366,11 @@ def _cmd_fit(args) -> int:
         _print_table(head, rows)
         for sentence in report.model_sentences(model, s):
             print(sentence.replace("**", ""))
+        if args.plot:
+            from imunoise import plot
+
+            _save_plot(plot.allan(result, model, title=f"{s} Allan deviation and model",
+                                  unit=CHANNELS[s][1]), _plot_path(args.plot, s, len(sensors)))
     return 0
 
 
@@ -367,14 +384,13 @@ def _cmd_stats(args) -> int:
     print()
     head = ["channel", "step", "spacing", "mu", "sigma", "KS_D", "KS_p", "AD_A2", "skew", "ex_kurt"]
     rows = []
-    for sensor in SAMPLE_SENSORS:
-        y = getattr(log, sensor)
-        if y is None:
-            continue
-        for j in range(y.shape[1]):
-            d = stats.distribution(y[:, j])
+    figures = {}
+    for sensor, columns in _distribution_columns(log).items():
+        dists = {name: stats.distribution(v[np.isfinite(v)]) for name, v in columns.items()}
+        figures[sensor] = dists
+        for name, d in dists.items():
             rows.append([
-                sensor_label(sensor, j, y.shape[1]),
+                name,
                 f"{d.step:.6g}" if d.step else "-",
                 f"{d.level_spacing:.6g}" if d.level_spacing else "-",
                 numbers.cell(d.mu, d.mu_std), numbers.cell(d.sigma, d.sigma_std),
@@ -383,7 +399,51 @@ def _cmd_stats(args) -> int:
                                           d.skewness, d.excess_kurtosis)
             ])
     _print_table(head, rows)
+    if args.plot:
+        from imunoise import plot
+
+        for sensor, dists in figures.items():
+            names = [n.removeprefix(sensor).strip() or n for n in dists]
+            title = "attitude" if sensor == "ypr" else sensor
+            fig = plot.histograms(list(dists.values()), title=f"{title} distribution",
+                                  unit=CHANNELS[sensor][1], names=names)
+            _save_plot(fig, _plot_path(args.plot, sensor, len(figures)))
     return 0
+
+
+def _distribution_columns(log) -> dict[str, dict[str, np.ndarray]]:
+    """Per sensor of the log with samples (and its attitude, yaw about its circular
+    mean): ``{"gyro": {"gyro X": samples, …}, "ypr": {"yaw": …}}``."""
+    from imunoise.stats import attitude_angles
+
+    out = {}
+    for sensor in SAMPLE_SENSORS:
+        y = getattr(log, sensor)
+        if y is not None:
+            out[sensor] = {sensor_label(sensor, j, y.shape[1]): y[:, j]
+                           for j in range(y.shape[1])}
+    if log.ypr is not None and np.isfinite(log.ypr).any():
+        out["ypr"] = attitude_angles(log.ypr)
+    return out
+
+
+def _plot_path(path: str, name: str, count: int) -> Path:
+    """``--plot PATH`` for one of ``count`` figures: PATH itself for one, else
+    ``PATH_name.png`` (PATH without its ``.png``)."""
+    p = Path(path)
+    if count == 1:
+        return p
+    stem = p.name[:-4] if p.name.lower().endswith(".png") else p.name
+    return p.with_name(f"{stem}_{name}.png")
+
+
+def _save_plot(fig, path) -> None:
+    """Write a ``--plot`` figure as PNG (by :func:`imunoise.plot.save`, which gives the
+    path a ``.png`` suffix) and say where."""
+    from imunoise import plot
+
+    written = plot.save(fig, Path(path), formats=("png",))
+    print(f"# figure: {written[0]}")
 
 
 def _sensor_samples(args):
@@ -424,9 +484,7 @@ def _cmd_psd(args) -> int:
     _print_table(["f[Hz]", *[f"{a}_psd" for a in names]],
                  [[f"{f:.6g}", *[f"{v:.6e}" for v in p[i]]] for i, f in enumerate(sm.f)])
     if args.plot:
-        written = plot.save(plot.spectrum(s, unit=unit, title=f"{args.sensor} PSD"),
-                            Path(args.plot).with_suffix(""), formats=("png",))
-        print(f"# figure: {written[0]}")
+        _save_plot(plot.spectrum(s, unit=unit, title=f"{args.sensor} PSD"), args.plot)
     return 0
 
 
@@ -438,8 +496,8 @@ def _cmd_dadev(args) -> int:
     d = dynamic.dynamic_adev(y, log.fs, window=args.window, step=args.step, taus=taus)
     st = d.stationarity
     names = axis_names(d.channels)
-    print(f"# dynamic ADEV of {args.sensor}: {len(d.times)} windows of {d.window:.6g} s every "
-          f"{d.step:.6g} s, {len(d.taus)} taus {d.taus[0]:.4g}-{d.taus[-1]:.4g} s")
+    print(f"# dynamic ADEV of {args.sensor}: {len(d.times)} windows of {duration(d.window)} "
+          f"every {duration(d.step)}, {len(d.taus)} taus {d.taus[0]:.4g}-{d.taus[-1]:.4g} s")
     outside, worst = np.atleast_1d(st.outside), np.atleast_1d(st.worst_z)
     at_t, at_tau = np.atleast_1d(st.worst_time), np.atleast_1d(st.worst_tau)
     _print_table(["axis", "outside_CI", "expected", "max|z|", "at_t[s]", "at_tau[s]"],
@@ -453,9 +511,7 @@ def _cmd_dadev(args) -> int:
     else:
         print("# no departure: the noise level is the same along the log (to one step)")
     if args.plot:
-        written = plot.save(plot.dynamic(d, title=f"{args.sensor} dynamic ADEV"),
-                            Path(args.plot).with_suffix(""), formats=("png",))
-        print(f"# figure: {written[0]}")
+        _save_plot(plot.dynamic(d, title=f"{args.sensor} dynamic ADEV"), args.plot)
     return 0
 
 
@@ -589,7 +645,7 @@ def _cmd_thermal(args) -> int:
 
     log = _read(args)
     w = warmup(log)
-    print(f"# {log.source}: warm-up: " + (f"settled after {w.settle:.6g} s" if w.settle > 0
+    print(f"# {log.source}: warm-up: " + (f"settled after {duration(w.settle)}" if w.settle > 0
                                            else "no transient"))
     if log.temperature is None:
         _fail(f"{args.log}: the log has no temperature channel; no thermal fit")
@@ -638,7 +694,8 @@ def main(argv: list[str] | None = None) -> int:
     """Run the command line; returns the exit status (also used as the script's)."""
 
     def _warn(message, category, filename, lineno, file=None, line=None):
-        print(f"imunoise: warning: {_one_line(message)}", file=sys.stderr)
+        # ``file``: the progress bars pass a stream that prints above them
+        print(f"imunoise: warning: {_one_line(message)}", file=file or sys.stderr)
 
     parser = _build_parser()
     old = warnings.showwarning

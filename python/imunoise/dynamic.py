@@ -56,7 +56,6 @@ from __future__ import annotations
 
 import math
 import numbers
-import warnings
 from dataclasses import dataclass
 from functools import cached_property
 from typing import TYPE_CHECKING
@@ -65,7 +64,8 @@ import numpy as np
 import numpy.typing as npt
 from scipy import stats as _stats
 
-from imunoise import _schema, _summary
+from imunoise import _schema, _summary, _warn
+from imunoise import numbers as _numbers
 from imunoise._core import allan as _core_allan
 from imunoise._runs import true_runs
 from imunoise._validate import no_infinity, positive_finite, sample_rate, samples
@@ -98,12 +98,16 @@ class Departure:
     ratio : float
         Block ADEV / median block ADEV where the departure is clearest (largest |z|
         over the stretch's blocks and the taus searched); > 1 noisier, < 1 quieter.
+    ratio_std : float
+        Its standard uncertainty, ``ratio / sqrt(2 edf)`` from the block's degrees
+        of freedom (what the report rounds the ratio to).
     """
 
     start: float
     end: float
     channel: int
     ratio: float
+    ratio_std: float = float("nan")
 
 
 @dataclass(frozen=True, repr=False)
@@ -140,7 +144,7 @@ class Stationarity:
     def __repr__(self) -> str:
         found = ", ".join(
             f"{_summary.number(d.start)}–{_summary.number(d.end)} s ch{d.channel} "
-            f"×{_summary.number(d.ratio)}" for d in self.intervals[:3]
+            f"×{_numbers.rounded(d.ratio, d.ratio_std)}" for d in self.intervals[:3]
         ) or "none"
         more = f" (+{len(self.intervals) - 3})" if len(self.intervals) > 3 else ""
         return _summary.lines("Stationarity(", [
@@ -458,7 +462,7 @@ def _departures(d: DynamicAllan) -> tuple[Departure, ...]:
     tests = sum(b[1].shape[0] * b[1].shape[1] for b in d._blocks)
     limit = _stats.norm.isf(_ALARM / (2 * max(tests, 1)))
     flagged = None
-    ratio = score = None
+    ratio = score = dof = None
     for t, sums, counts in d._blocks:
         mm = int(d.m[t])
         with np.errstate(invalid="ignore", divide="ignore"):
@@ -469,16 +473,19 @@ def _departures(d: DynamicAllan) -> tuple[Departure, ...]:
             z = np.abs(np.nan_to_num(_chi2_score(var / typical, edf)))
             r = np.sqrt(var / typical)
         if ratio is None:
-            flagged, ratio, score = z > limit, r, z
+            flagged, ratio, score, dof = z > limit, r, z, edf
         flagged |= z > limit
-        ratio = np.where(z > score, r, ratio)  # the ratio where the departure is clearest
+        clearer = z > score
+        ratio = np.where(clearer, r, ratio)  # the ratio where the departure is clearest
+        dof = np.where(clearer, edf, dof)
         score = np.maximum(z, score)
     out = []
     for j in range(flagged.shape[1]):
         for a, b in zip(*true_runs(flagged[:, j]), strict=True):
             k = a + int(np.argmax(score[a:b, j]))
             out.append(Departure(start=a * stride / d.fs, end=min(b * stride, d.n_samples) / d.fs,
-                                 channel=j, ratio=float(ratio[k, j])))
+                                 channel=j, ratio=float(ratio[k, j]),
+                                 ratio_std=float(ratio[k, j] / np.sqrt(2.0 * dof[k, j]))))
     return tuple(sorted(out, key=lambda dep: (dep.start, dep.channel)))
 
 
@@ -509,10 +516,9 @@ def _window_factors(taus, fs: float, width: int) -> np.ndarray:
     m, user_given = averaging_factors(taus, fs, width)
     fits = (m >= 1) & (width + 1 - 2 * m >= 2)
     if user_given and not fits.all():
-        warnings.warn(
+        _warn.warn(
             f"{int(np.count_nonzero(~fits))} of {m.size} taus dropped: a window of {width} "
-            f"samples holds taus from {1 / fs:g} s to {math.floor((width - 1) / 2) / fs:g} s",
-            stacklevel=4,
+            f"samples holds taus from {1 / fs:g} s to {math.floor((width - 1) / 2) / fs:g} s"
         )
     m = np.unique(m[fits])
     if m.size == 0:

@@ -50,6 +50,37 @@ def format_value(value, std=None, *, unit: str | None = None, digits: int = 4,
     return f"{text} {unit}" if unit else text
 
 
+def duration(seconds) -> str:
+    """A time as a person reads it, three significant digits in the unit that suits
+    its length: ``"0 s"``, ``"40 µs"`` (below 1 ms), ``"10 ms"`` (below 1 s),
+    ``"12.5 s"``, ``"5.51 min"`` (from 2 min), ``"3.2 h"`` (from 2 h); ``—`` when
+    not finite. The unit is chosen after rounding (0.9996 s is "1 s", not "1e+03 ms")."""
+    if not _finite(seconds):
+        return EMPTY
+    t = float(seconds)
+    if t == 0:
+        return "0 s"
+    for limit, scale, unit in ((1e-3, 1e-6, "µs"), (1.0, 1e-3, "ms"), (120.0, 1.0, "s"),
+                               (7200.0, 60.0, "min")):
+        if abs(float(f"{t:.3g}")) < limit:
+            return f"{t / scale:.3g} {unit}"
+    return f"{t / 3600.0:.3g} h"
+
+
+def rounded(value, std=None, *, digits: int = 4, missing: str = EMPTY) -> str:
+    """``value`` alone, rounded to the decimal place :func:`format_value` gives it
+    beside ``std`` ("0.21004" for 0.2100438 ± 0.000112762, "3.50e-3" for
+    (3.50 ± 0.12)e-3): for figure titles and short text where the ``±`` part would not
+    fit. Without a usable ``std``, ``digits`` significant digits."""
+    text = format_value(value, std, digits=digits, missing=missing)
+    if " ± " not in text:
+        return text
+    head, tail = text.split(" ± ")
+    if head.startswith("("):  # "(3.50 ± 0.12)e-3"
+        return head[1:] + tail[tail.index(")") + 1:]
+    return head
+
+
 def _significant(value: float, digits: int) -> str:
     if value == 0:
         return "0"

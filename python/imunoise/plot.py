@@ -28,7 +28,7 @@ from imunoise import _summary
 from imunoise._schema import ATTITUDE_NAMES, CHANNELS, axis_names
 from imunoise.allan import AllanResult
 from imunoise.noise import FLICKER, TERMS, NoiseModel, model_variance
-from imunoise.numbers import format_value
+from imunoise.numbers import format_value, rounded
 from imunoise.readers.log import ImuLog
 from imunoise.stats import Distribution
 
@@ -290,6 +290,12 @@ def histograms(
 ) -> Figure:
     """Histograms (as densities) with the fitted normal pdf, one panel per axis.
 
+    The x axis is the distribution's range (its bulk, see
+    :func:`imunoise.distribution`); samples beyond it are counted in the panel's
+    upper corners ("← 3", "12 →"). Tick labels use an offset ("−134" under
+    "−0.05 0 0.05") when the values share leading digits, and fewer ticks when
+    labels would touch.
+
     Parameters
     ----------
     dists : :class:`imunoise.stats.Distribution` or a sequence of them
@@ -312,18 +318,99 @@ def histograms(
             x = np.linspace(d.edges[0], d.edges[-1], 400)
             if d.sigma > 0:
                 ax.plot(x, d.pdf(x), color="k", linewidth=1.1, label="normal fit")
+            ax.set_xlim(d.edges[0], d.edges[-1])
             ax.set_title(
-                f"{names[j]}: μ={d.mu:.4g}, σ={d.sigma:.3g}\n"
-                f"skew {d.skewness:.2f}, ex. kurt {d.excess_kurtosis:.2f}",
+                f"{names[j]}: μ = {rounded(d.mu, d.mu_std)}, σ = {rounded(d.sigma, d.sigma_std)}"
+                f"\nskew {d.skewness:.2f}, ex. kurt {d.excess_kurtosis:.2f}",
                 fontsize=8,
             )
+            for count, xpos, align, text in (
+                    (d.off_scale_below, 0.01, "left", "← {}"),
+                    (d.off_scale_above, 0.99, "right", "{} →")):
+                if count:
+                    ax.text(xpos, 0.98, text.format(count), transform=ax.transAxes,
+                            ha=align, va="top", fontsize=7, color="0.3")
             ax.set_xlabel(unit)
             ax.grid(False)
         axes[0].set_ylabel("density")
         _margins(fig, left=0.6, bottom=0.45, top=0.55, wspace=0.3, title=bool(title))
         if title:
             fig.suptitle(title)
+        _readable_ticks(fig, axes)
     return fig
+
+
+#: Most x ticks a histogram panel tries before dropping to fewer.
+HIST_TICKS = 5
+
+
+def _readable_ticks(fig, axes) -> None:
+    """x tick labels that never touch: an offset when the values share leading
+    digits ("−134.20, −134.15" → "−0.05, 0" and the offset "−134"), then fewer ticks
+    (down to two) until no two labels of a panel, or of neighbouring panels, overlap
+    on the renderer."""
+    import matplotlib
+    from matplotlib.ticker import MaxNLocator
+
+    with matplotlib.rc_context({"axes.formatter.offset_threshold": 2}):
+        for ax in axes:
+            fmt = _plain_offset_formatter()
+            fmt.set_powerlimits((-3, 4))
+            ax.xaxis.set_major_formatter(fmt)
+    renderer = _renderer(fig)
+    for i, ax in enumerate(axes):
+        for nbins in range(HIST_TICKS, 1, -1):
+            ax.xaxis.set_major_locator(MaxNLocator(nbins=nbins, steps=[1, 2, 2.5, 5, 10]))
+            if not _tick_labels_overlap(fig, list(axes[max(i - 1, 0): i + 1]), renderer):
+                break
+
+
+def _plain_offset_formatter():
+    """Matplotlib's scalar formatter (offset on, math text) with the offset written as
+    a plain number ("−134", not "−1.34×10²")."""
+    from matplotlib.ticker import ScalarFormatter
+
+    class PlainOffset(ScalarFormatter):
+        def format_data(self, value):
+            if self.offset and value == self.offset:
+                return f"{value:.12g}"
+            return super().format_data(value)
+
+    return PlainOffset(useOffset=True, useMathText=True)
+
+
+#: Pixels two neighbouring tick labels of an axis keep apart at the least.
+TICK_GAP_PX = 4
+
+
+def _renderer(fig):
+    """The renderer ``fig`` is saved with (an Agg canvas is attached when it has none)."""
+    if not hasattr(fig.canvas, "get_renderer"):
+        from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+        FigureCanvasAgg(fig)
+    return fig.canvas.get_renderer()
+
+
+def _tick_labels_overlap(fig, axes, renderer=None) -> bool:
+    """Whether any two visible x or y tick labels of ``axes`` (together) overlap on
+    the renderer (the figure drawn as it would be saved)."""
+    renderer = renderer or _renderer(fig)
+    from matplotlib.transforms import Bbox
+
+    boxes = []
+    for ax in axes:
+        for axis, (dx, dy) in ((ax.xaxis, (TICK_GAP_PX / 2, 0)), (ax.yaxis, (0, TICK_GAP_PX / 2))):
+            # the ticks as drawn: the locator's positions within the view limits
+            for tick in axis._update_ticks():
+                if tick.label1.get_visible() and tick.label1.get_text():
+                    x0, y0, x1, y1 = tick.label1.get_window_extent(renderer).extents
+                    boxes.append(Bbox.from_extents(x0 - dx, y0 - dy, x1 + dx, y1 + dy))
+    for a in range(len(boxes)):
+        for b in range(a + 1, len(boxes)):
+            if boxes[a].overlaps(boxes[b]):
+                return True
+    return False
 
 
 def _coefficient_curves(coeffs: Mapping[str, float], grid: np.ndarray) -> dict[str, np.ndarray]:

@@ -26,7 +26,20 @@ regularly spaced clusters in the central 98 % of the data and uses their mean
 spacing as the bin unit (``level_spacing``); inner edges that would cut a
 cluster move to the middle of the nearest gap between occupied values, so every
 sensor level sits in one bin (bin widths may then differ slightly; the density
-accounts for it).
+accounts for it). Rare values between the sensor's levels (a print value or two
+that turns up a few times between well-used clusters, as on real VN-100 logs)
+are left out of the spacing estimate: a cluster holding less than
+:data:`RARE_CLUSTER` of its busier neighbour's samples does not count as a level.
+
+Range of the histogram
+----------------------
+The bins cover the bulk of the data, not its extremes: the central 99 % widened
+by :data:`BULK_MARGIN` of its width on each side (±4.6 σ for normal data), never
+beyond the smallest and largest sample. A few vibration spikes then no longer
+squeeze the distribution into a thin spike in an empty axis; the samples left
+outside are counted (``off_scale_below``, ``off_scale_above``) and
+:meth:`Distribution.density` stays comparable to the fitted pdf (it is
+normalised by all valid samples). ``extent="all"`` covers every sample.
 
 Missing samples
 ---------------
@@ -54,6 +67,8 @@ __all__ = [
     "Distribution",
     "describe",
     "distribution",
+    "attitude_angles",
+    "heading",
     "quantization_step",
     "unwrap_about_circular_mean",
     "SENSOR_CHANNELS",
@@ -65,6 +80,14 @@ SENSOR_CHANNELS = _schema.STATISTICS_CHANNELS
 
 #: Largest number of bins :func:`distribution` builds.
 MAX_BINS = 10_000
+#: Probability in each tail outside the bulk of a histogram (central 99 %).
+BULK_TAIL = 0.005
+#: Margin on each side of the bulk, as a fraction of its width (the bulk then
+#: spans 1/(1 + 2·0.4) = 56 % of the axis unless the data end sooner).
+BULK_MARGIN = 0.4
+#: A cluster of print values with less than this fraction of its busier
+#: neighbour's samples is a rare in-between value, not a sensor level.
+RARE_CLUSTER = 0.05
 #: Above this many samples the KS p-value is the asymptotic (Kolmogorov) one.
 KS_EXACT_MAX_N = 10_000
 #: Anderson–Darling critical values for the normal with estimated mean and
@@ -198,8 +221,10 @@ def describe(x, fs: float | None = None) -> Description:
     Parameters
     ----------
     x : ImuLog or array_like, shape (n,) or (n, k)
-        An :class:`imunoise.ImuLog` (its gyro, accel, mag, temperature and
-        pressure channels are described, axes named X/Y/Z), or rate samples.
+        An :class:`imunoise.ImuLog` (its gyro, accel, mag, yaw/pitch/roll,
+        temperature and pressure channels are described, axes named X/Y/Z), or
+        rate samples. Yaw is taken about its circular mean (:func:`attitude_angles`)
+        and its mean given in (−180°, 180°].
     fs : float, optional
         Sample rate in Hz; defaults to ``log.fs`` for a log. For arrays without
         ``fs`` the drift is NaN.
@@ -223,15 +248,20 @@ def describe(x, fs: float | None = None) -> Description:
         blocks, names, sensors, units = [], [], [], []
         for sensor in SENSOR_CHANNELS:
             arr = getattr(log, sensor)
-            if arr is None:
+            if arr is None or sensor == "ypr" and not np.isfinite(arr).any():
                 continue
-            arr = arr.reshape(len(arr), -1)
-            blocks.append(arr)
             unit = _schema.CHANNELS[sensor][1]
-            for j in range(arr.shape[1]):
-                names.append(_schema.sensor_label(sensor, j, arr.shape[1]))
-                sensors.append(sensor)
-                units.append(unit)
+            if sensor == "ypr":
+                angles = attitude_angles(arr)
+                arr, labels = np.column_stack(list(angles.values())), list(angles)
+            else:
+                arr = arr.reshape(len(arr), -1)
+                labels = [_schema.sensor_label(sensor, j, arr.shape[1])
+                          for j in range(arr.shape[1])]
+            blocks.append(arr)
+            names += labels
+            sensors += [sensor] * len(labels)
+            units += [unit] * len(labels)
         if not blocks:
             raise ValueError(
                 f"x has none of the channels {SENSOR_CHANNELS}; "
@@ -266,6 +296,9 @@ def describe(x, fs: float | None = None) -> Description:
         var = x.var(axis=0, ddof=1)
         lo, hi = x.min(axis=0), x.max(axis=0)
         drift = np.full(x.shape[1], np.nan) if t is None else _drift(t, x, mean)
+    if "yaw" in names and sensors[names.index("yaw")] == "ypr":
+        mean = mean.copy()
+        mean[names.index("yaw")] = heading(mean[names.index("yaw")])
     return Description(
         names=tuple(names),
         sensors=tuple(sensors),
@@ -362,7 +395,8 @@ class Distribution:
         Number of valid samples (NaN left out).
     counts : ndarray of int, (B,)
     edges : ndarray, (B + 1,)
-        Histogram bin edges.
+        Histogram bin edges, over the bulk of the data unless ``extent="all"``
+        (see the module notes).
     step : float or None
         Detected quantization step (None: continuous data, ordinary bins).
     level_spacing : float or None
@@ -387,6 +421,10 @@ class Distribution:
         Q–Q data: standard normal quantiles and the matching sample quantiles.
     missing : int
         Missing samples (NaN) in ``x``, left out of everything above.
+    off_scale_below, off_scale_above : int
+        Valid samples below the first and above the last edge (outside the
+        histogram; every statistic above still uses them). :attr:`off_scale`
+        is their sum.
     """
 
     n: int
@@ -408,6 +446,13 @@ class Distribution:
     missing: int = 0
     mu_std: float = float("nan")
     sigma_std: float = float("nan")
+    off_scale_below: int = 0
+    off_scale_above: int = 0
+
+    @property
+    def off_scale(self) -> int:
+        """Valid samples outside the histogram's edges."""
+        return self.off_scale_below + self.off_scale_above
 
     def __post_init__(self) -> None:
         for name in (
@@ -425,9 +470,11 @@ class Distribution:
         return _sstats.norm.pdf(np.asarray(x, dtype=np.float64), self.mu, self.sigma)
 
     def density(self) -> np.ndarray:
-        """Histogram normalised to a density (integrates to 1), comparable to :meth:`pdf`."""
+        """Histogram normalised to a density, comparable to :meth:`pdf`: counts over
+        all ``n`` valid samples times the bin width, so it integrates to the fraction
+        of samples on scale (1 when :attr:`off_scale` is 0)."""
         widths = np.diff(self.edges)
-        return self.counts / (self.counts.sum() * widths)
+        return self.counts / (self.n * widths)
 
     def _items(self) -> list[tuple[str, str]]:
         """(quantity, value) pairs of the summary: μ and σ rounded to their
@@ -438,6 +485,8 @@ class Distribution:
             bins += f" (step {num(self.step)}"
             bins += (f", levels {num(self.level_spacing)} apart)"
                      if self.level_spacing and self.level_spacing != self.step else ")")
+        if self.off_scale:
+            bins += f", {self.off_scale_below} below and {self.off_scale_above} above the range"
         items = [("n", str(self.n)), ("normal fit", f"μ={_summary.estimate(self.mu, self.mu_std)} "
                                        f"σ={_summary.estimate(self.sigma, self.sigma_std)}"),
                  ("KS", f"D={num(self.ks_statistic)} p={num(self.ks_pvalue)}"),
@@ -456,7 +505,7 @@ class Distribution:
 
 
 @old_call_forms(keyword_only=("bins",))
-def distribution(x, *, bins="auto", qq_points: int = 1001) -> Distribution:
+def distribution(x, *, bins="auto", qq_points: int = 1001, extent: str = "bulk") -> Distribution:
     r"""Histogram with quantization-aware bins, normal fit and normality tests.
 
     Parameters
@@ -465,10 +514,16 @@ def distribution(x, *, bins="auto", qq_points: int = 1001) -> Distribution:
         Samples of one channel; NaN marks a missing sample and is left out.
     bins : "auto", str, int or array_like
         ``"auto"`` (or any rule of :func:`numpy.histogram_bin_edges`) gives that
-        rule's bin width, rounded up to a whole number of quantization steps
+        rule's bin width (no narrower than the Rice rule's, :math:`2n^{1/3}` bins
+        over the range), rounded up to a whole number of quantization steps
         when the data are quantized (see the module notes); an int asks for
-        about that many bins (also aligned to the step); an array gives the
-        edges as they are.
+        about that many bins over the range (also aligned to the step); an
+        array gives the edges as they are.
+    extent : {"bulk", "all"}
+        Range the bins cover (rules and int ``bins`` only): ``"bulk"`` the
+        central 99 % with a margin (see the module notes; the samples outside
+        are counted in ``off_scale_below``/``off_scale_above``), ``"all"``
+        every sample.
     qq_points : int
         Number of Q–Q points (sample quantiles at probabilities
         :math:`p_i = (i + 0.5)/m`), so plots stay light for 10⁷ samples.
@@ -520,23 +575,27 @@ def distribution(x, *, bins="auto", qq_points: int = 1001) -> Distribution:
         raise ValueError(f"x needs at least 3 valid samples; got {len(arr)}{extra}")
     if not (isinstance(qq_points, int | np.integer) and qq_points >= 2):
         raise ValueError(f"qq_points must be an integer >= 2; got {qq_points!r}")
+    if extent not in ("bulk", "all"):
+        raise ValueError(f'extent must be "bulk" or "all"; got {extent!r}')
 
     n = len(arr)
     xs = np.sort(arr)
     levels = xs[np.concatenate(([True], xs[1:] != xs[:-1]))]
     step = _step_of_levels(levels)
+    shown = _bulk(xs) if extent == "bulk" else xs
     if step is None:
         spacing = None
-        edges = _edges(xs, bins, None)
+        edges = _edges(shown, bins, None)
     else:
         spacing = _level_spacing(xs, levels, step)
-        edges = _edges(xs, bins, spacing)
+        edges = _edges(shown, bins, spacing)
         if isinstance(bins, str) or np.ndim(bins) == 0:
             edges = _snap(edges, levels, step)
     # Histogram from the sorted samples: [a, b) bins, the last one closed, as np.histogram.
     idx = np.searchsorted(xs, edges, side="left")
     idx[-1] = np.searchsorted(xs, edges[-1], side="right")
     counts = np.diff(idx)
+    off_scale = {"off_scale_below": int(idx[0]), "off_scale_above": int(n - idx[-1])}
     # Normal fit by maximum likelihood (what scipy.stats.norm.fit returns).
     # in units of the largest |x|: squares and fourth powers of values near 1e100
     # would overflow
@@ -587,7 +646,21 @@ def distribution(x, *, bins="auto", qq_points: int = 1001) -> Distribution:
         qq_sample=xs[lo] + (h - lo) * (xs[hi] - xs[lo]),
         missing=missing,
         **_fit_uncertainty(arr, sigma),
+        **off_scale,
     )
+
+
+def _bulk(xs: np.ndarray) -> np.ndarray:
+    """The sorted samples ``xs`` within the histogram's range: the central
+    1 − 2·:data:`BULK_TAIL` widened by :data:`BULK_MARGIN` of its width on each side.
+    When the bulk has no width (one level holds 99 %), every sample."""
+    q_lo, q_hi = np.quantile(xs, [BULK_TAIL, 1.0 - BULK_TAIL])
+    width = q_hi - q_lo
+    if not width > 0:
+        return xs
+    i = np.searchsorted(xs, q_lo - BULK_MARGIN * width, side="left")
+    j = np.searchsorted(xs, q_hi + BULK_MARGIN * width, side="right")
+    return xs[i:j]
 
 
 #: Batches of the batch-means standard error of the normal fit's mean.
@@ -612,21 +685,28 @@ def _level_spacing(xs: np.ndarray, levels: np.ndarray, step: float) -> float:
     """Spacing of the sensor's levels in the central 98 % of ``x`` (see module notes).
 
     Occupied print-grid values are grouped into clusters (runs separated by gaps
-    of more than 1.5 steps). When the cluster starts are regularly spaced (spacing
-    with a coefficient of variation below 0.3, at least 5 clusters) their mean
+    of more than 1.5 steps); a cluster with less than :data:`RARE_CLUSTER` of its
+    busier neighbour's samples is a rare in-between value and left out. When the
+    remaining clusters' centres (count-weighted) are regularly spaced (spacing
+    with a coefficient of variation below 0.3, at least 5 gaps) their mean
     spacing is returned; otherwise (dense levels, or gaps that are just random
     sparsity) ``step``.
     """
     n = len(xs)
     lo, hi = xs[int(0.01 * (n - 1))], xs[int(np.ceil(0.99 * (n - 1)))]
-    v = levels[np.searchsorted(levels, lo): np.searchsorted(levels, hi, side="right")]
+    a, b = np.searchsorted(levels, lo), np.searchsorted(levels, hi, side="right")
+    v = levels[a:b]
     if len(v) < 3:
         return step
-    gaps = np.diff(v)
-    starts = v[1:][gaps > 1.5 * step]
-    if len(starts) < 5:
+    counts = np.diff(np.searchsorted(xs, np.append(v, np.inf), side="left")).astype(float)
+    first = np.flatnonzero(np.concatenate(([True], np.diff(v) > 1.5 * step)))
+    total = np.add.reduceat(counts, first)
+    centre = np.add.reduceat(counts * (v - v[0]), first) / total + v[0]
+    busier = np.maximum(np.append(total[1:], 0.0), np.insert(total[:-1], 0, 0.0))
+    centre = centre[total >= RARE_CLUSTER * busier]
+    if len(centre) < 6:
         return step
-    spacing = np.diff(starts)
+    spacing = np.diff(centre)
     mean = float(spacing.mean())
     if mean < 1.5 * step or spacing.std() > 0.3 * mean:
         return step
@@ -664,6 +744,10 @@ def _edges(x: np.ndarray, bins, step: float | None) -> np.ndarray:
                 f"bins must be a numpy bin rule, an int or edges; got {bins!r}"
             ) from exc
         width = float(rule[1] - rule[0]) if len(rule) > 1 else 0.0
+        # at most the Rice count of bins: on a peaked distribution (a still log with a
+        # few vibration bursts, a moving log's attitude) the Freedman–Diaconis width
+        # follows the narrow peak and cuts the tails into bins of one sample or none
+        width = max(width, (hi - lo) / (2.0 * len(x) ** (1.0 / 3.0)))
     elif isinstance(bins, int | np.integer) and not isinstance(bins, bool) and bins >= 1:
         width = (hi - lo) / int(bins)
     else:
@@ -676,6 +760,21 @@ def _edges(x: np.ndarray, bins, step: float | None) -> np.ndarray:
     k = max(k, int(np.ceil(levels / MAX_BINS)))
     nb = int(np.ceil(levels / k))
     return lo + (np.arange(nb + 1) * k - 0.5) * step
+
+
+def attitude_angles(ypr) -> dict[str, np.ndarray]:
+    """``{"yaw": …, "pitch": …, "roll": …}`` in degrees from a log's ``ypr`` (n, 3),
+    yaw unwrapped about its circular mean (:func:`unwrap_about_circular_mean`) so a
+    heading near ±180° stays in one piece."""
+    ypr = np.asarray(ypr, dtype=float)
+    return {name: unwrap_about_circular_mean(ypr[:, j]) if name == "yaw" else ypr[:, j]
+            for j, name in enumerate(_schema.ATTITUDE_NAMES)}
+
+
+def heading(angle_deg: float) -> float:
+    """An angle (degrees) moved by whole turns into (−180°, 180°]."""
+    a = (float(angle_deg) + 180.0) % 360.0 - 180.0
+    return 180.0 if a == -180.0 else a
 
 
 def unwrap_about_circular_mean(angle_deg: np.ndarray) -> np.ndarray:

@@ -3,9 +3,10 @@
 from __future__ import annotations
 
 import numbers
-import warnings
 
 import numpy as np
+
+from imunoise import _warn
 
 #: Named grids. Their largest m follows allantools: every m below the number of
 #: phase points, then any tau whose estimator has fewer than two terms is dropped.
@@ -87,11 +88,10 @@ def keep_estimable(
     keep = (m >= 1) & (terms > 1)
     dropped = int(np.count_nonzero(~keep))
     if dropped and user_given:
-        warnings.warn(
+        _warn.warn(
             f"{dropped} of {len(m)} taus dropped: {kind} needs tau >= 1/fs = {1 / fs:g} s "
             f"and at least 2 terms in its sum (largest usable tau {m[keep].max() / fs:g} s)"
             if keep.any()
-            else f"{dropped} of {len(m)} taus dropped: none is in range for {kind}",
-            stacklevel=4,
+            else f"{dropped} of {len(m)} taus dropped: none is in range for {kind}"
         )
     return np.unique(m[keep])

@@ -308,3 +308,31 @@ def test_psd_dadev_errors(argv, message, capsys):
     code, _, err = _run([argv[0], str(bundled_log()), "--fs", "40", *argv[1:]], capsys)
     assert code == 2
     assert message in _one_line_error(err)
+
+
+def test_stats_has_attitude_and_plot_options(tmp_path, capsys, read):
+    """yaw/pitch/roll in `stats` (and describe), `--plot` on stats, adev and fit."""
+    from imunoise.cli import bundled_log
+
+    log = read(bundled_log(), fs=40.0)
+    desc = imunoise.describe(log)
+    assert desc.names[-3:] == ("yaw", "pitch", "roll") and desc.units[-1] == "deg"
+    yaw = log.ypr[:, 0]
+    assert -180 < desc.mean[desc.names.index("yaw")] <= 180
+    assert desc.std[desc.names.index("pitch")] == pytest.approx(np.std(log.ypr[:, 1], ddof=1))
+    assert desc.std[desc.names.index("yaw")] <= np.std(yaw, ddof=1) * (1 + 1e-12)
+    code, out, _ = _run(["stats", str(bundled_log()), "--fs", "40",
+                         "--plot", str(tmp_path / "h.png")], capsys)
+    assert code == 0
+    table_rows = [line.split()[0] for line in out.splitlines() if line.strip()]
+    assert table_rows.count("yaw") == 2 and table_rows.count("roll") == 2  # both tables
+    for sensor in ("gyro", "accel", "mag", "ypr"):
+        png = tmp_path / f"h_{sensor}.png"
+        assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and f"# figure: {png}" in out
+    code, out, _ = _run(["adev", str(bundled_log()), "--fs", "40", "--sensor", "accel",
+                         "--plot", str(tmp_path / "a.png")], capsys)
+    assert code == 0 and (tmp_path / "a.png").stat().st_size > 1000
+    code, out, _ = _run(["fit", str(bundled_log()), "--fs", "40", "--sensor", "gyro",
+                         "--plot", str(tmp_path / "f.png")], capsys)
+    assert code == 0 and (tmp_path / "f.png").stat().st_size > 1000
+    assert f"# figure: {tmp_path / 'f.png'}" in out

@@ -8,6 +8,7 @@ import imunoise
 import numpy as np
 import pytest
 from allantools import ci as at_ci
+from imunoise import numbers
 from imunoise._core import allan as core_allan
 from imunoise.allan import chi2_interval
 
@@ -100,6 +101,12 @@ def test_stationarity_finds_twenty_minutes_of_doubled_noise(seed):
         assert abs(dep.start - 7200.0) <= d.step
         assert abs(dep.end - 8400.0) <= d.step
         assert dep.ratio == pytest.approx(2.0, rel=0.1)
+        # the ratio's uncertainty from the block's degrees of freedom: the doubled noise
+        # is resolved (2 within a few of them) and the text rounds to it ("×2.0", not
+        # "×1.98731")
+        assert 0.005 < dep.ratio_std < 0.2 * dep.ratio
+        assert abs(dep.ratio - 2.0) < 4 * dep.ratio_std
+        assert f"×{numbers.rounded(dep.ratio, dep.ratio_std)}" in repr(summary)
     assert not summary.stationary
     assert np.all(summary.worst_z > 5)
     assert np.all(np.abs(summary.worst_time - 7800.0) <= d.window / 2)

@@ -2,8 +2,10 @@
 import math
 
 import pytest
+from imunoise import _summary
 from imunoise.datasheet import COVERAGE_K, verdict
-from imunoise.numbers import cell, format_value
+from imunoise.numbers import cell, duration, format_value, rounded
+from imunoise.report.formatting import format_duration
 
 NAN = math.nan
 
@@ -75,3 +77,30 @@ def test_verdict_errors():
         verdict(1.0, 0.1, 1.0, "maybe")
     with pytest.raises(ValueError, match="spec must be"):
         verdict(1.0, 0.1, 0.0, "max")
+
+
+@pytest.mark.parametrize("seconds, text", [
+    (0.0, "0 s"),
+    (0.01, "10 ms"),          # a tau of one sample at 100 Hz was "0.0 s"
+    (0.025, "25 ms"),
+    (4e-5, "40 µs"),
+    (0.9996, "1 s"),          # the unit after rounding, not "1e+03 ms"
+    (12.54, "12.5 s"),
+    (119.96, "2 min"),
+    (666.0, "11.1 min"),
+    (7300.0, "2.03 h"),
+    (NAN, "—"),
+])
+def test_duration(seconds, text):
+    assert duration(seconds) == text
+
+
+def test_one_time_formatter_and_rounded():
+    # the report's and the reprs' time formatters are the same function
+    assert format_duration is duration and _summary.duration is duration
+    assert rounded(0.904806, 0.05) == "0.905"     # "ADEV ×0.904806" -> to its uncertainty
+    assert rounded(0.904806, 0.012) == "0.905"
+    assert rounded(0.904806, 0.12) == "0.90"
+    assert rounded(3.5e-3, 1.2e-4) == "3.50e-3"
+    assert rounded(9.89168) == "9.892"
+    assert rounded(NAN, 0.1) == "—"

@@ -96,7 +96,7 @@ def test_reprs_say_what_matters(objects):
     issues = repr(objects["issues"])
     assert "bad_checksum=4 (lines 101, 102, 103, …)" in issues
     assert "4 of 13223 samples missing" in issues and "in 2 gaps" in issues
-    assert repr(objects["gaps"]).startswith("Gaps(2 gaps, 4 samples = 0.1 s missing at 40 Hz")
+    assert repr(objects["gaps"]).startswith("Gaps(2 gaps, 4 samples = 100 ms missing at 40 Hz")
     assert repr(objects["no gaps"]) == "Gaps(no gaps at 40 Hz)"
     result = repr(objects["result"])
     for fact in ("adev overlapping", "3 channels", "0.025–", "fs 40 Hz", "13223 samples",

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from types import MappingProxyType
@@ -10,7 +9,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from imunoise import _schema, _summary
+from imunoise import _schema, _summary, _warn
 from imunoise._core import vn as _core_vn
 from imunoise._validate import sample_rate
 from imunoise.readers.grid import Gaps, TimeGrid
@@ -378,13 +377,10 @@ def log_on_grid(
         try:
             grid = TimeGrid.from_timestamps(time)
         except ValueError as exc:
-            warnings.warn(
-                f"{source}: {exc}; samples kept one per row, gaps not detected",
-                stacklevel=3,
-            )
+            _warn.warn(f"{source}: {exc}; samples kept one per row, gaps not detected")
     if grid is None:
         grid = TimeGrid.identity(n)
-    rate = grid.fs if grid.fs is not None else fs_from_median_step(None, fs, source, stacklevel=4)
+    rate = grid.fs if grid.fs is not None else fs_from_median_step(None, fs, source)
     if grid.duplicate_time or grid.time_reversed:
         counts = dict(issues.counts)
         counts["duplicate_time"] += grid.duplicate_time
@@ -403,17 +399,16 @@ def log_on_grid(
 
 
 def fs_from_median_step(
-    median_step: float | None, fs: float | None, source: str, *, stacklevel: int = 3
+    median_step: float | None, fs: float | None, source: str
 ) -> float:
     """1 / ``median_step`` when the log had timestamps, else ``fs``, else
-    :data:`DEFAULT_FS` with a warning (``stacklevel`` points it at the caller's caller)."""
+    :data:`DEFAULT_FS` with a warning (at the user's line that read the log)."""
     if median_step is not None:
         return float(1.0 / median_step)
     if fs is not None:
         return sample_rate(fs)
-    warnings.warn(
+    _warn.warn(
         f"{source}: no timestamps and no fs given; assuming {DEFAULT_FS:g} Hz "
-        "(pass fs= to set the sample rate)",
-        stacklevel=stacklevel,
+        "(pass fs= to set the sample rate)"
     )
     return DEFAULT_FS

@@ -17,13 +17,9 @@ def format_number(v: float, std: float | None = None) -> str:
     return _numbers.cell(v, std, digits=6)
 
 
-def format_duration(seconds: float) -> str:
-    """``"12.5 s"``, ``"3.2 min"`` or ``"5.00 h"``, by length."""
-    if seconds < 120:
-        return f"{seconds:.1f} s"
-    if seconds < 7200:
-        return f"{seconds / 60:.1f} min"
-    return f"{seconds / 3600:.2f} h"
+#: ``"10 ms"``, ``"12.5 s"``, ``"3.2 min"`` or ``"5 h"``: the one time formatter of the
+#: library (:func:`imunoise.numbers.duration`), under the report's name.
+format_duration = _numbers.duration
 
 
 def terms_used(result, i: int) -> str:

@@ -5,6 +5,7 @@ from __future__ import annotations
 import warnings
 from pathlib import Path
 
+from imunoise import _warn
 from imunoise._progress import byte_bar, wanted
 from imunoise.readers.log import ImuLog
 from imunoise.readers.read import read
@@ -53,5 +54,5 @@ def read_log(source, label: str = "input", *, fs: float | None = None,
     if len(log) == 0:
         raise ValueError(f"{label} log {str(path)!r}: no usable records ({log.issues})")
     for w in caught:
-        warnings.warn(w.message, w.category, stacklevel=2)
+        _warn.warn(w.message, w.category)
     return log

@@ -169,8 +169,7 @@ def attitude(ctx: Context, doc: Doc) -> None:
         ok = v[np.isfinite(v)]
         mean = float(ok.mean())
         if name == "yaw":  # back into (−180°, 180°]
-            mean = (mean + 180.0) % 360.0 - 180.0
-            mean = 180.0 if mean == -180.0 else mean
+            mean = stats.heading(mean)
         d = dists[name]
         rows.append([name, "deg", format_number(mean), format_number(float(ok.std(ddof=1))),
                      format_number(float(ok.var(ddof=1))), format_number(float(ok.min())),
@@ -357,7 +356,7 @@ def dynamic_allan(ctx: Context, doc: Doc) -> None:
         names = axis_names(d.channels)
         where = "; ".join(
             f"{format_duration(v.start)} – {format_duration(v.end)} ({names[v.channel]}, "
-            f"ADEV ×{format_number(v.ratio)})" for v in st.intervals[:6])
+            f"ADEV ×{numbers.rounded(v.ratio, v.ratio_std)})" for v in st.intervals[:6])
         more = f" and {len(st.intervals) - 6} more" if len(st.intervals) > 6 else ""
         doc.p(f"The {sensor} noise is not stationary: it departs from its typical level at "
               f"{where}{more} (from the first sample; {share} of the window intervals exclude "
