@@ -39,11 +39,11 @@ import json
 import math
 import os
 import tempfile
-import warnings
 from pathlib import Path
 
 import numpy as np
 
+from imunoise import _warn
 from imunoise import units as _units
 from imunoise.noise import gm_white_density, resonance_white_density
 
@@ -89,11 +89,10 @@ def _combine(model, term: str, combine: str, sensor: str, input_unit) -> float:
     sup = values > 0
     scale = _units.input_scale(sensor, input_unit)
     if not sup.any():
-        warnings.warn(
+        _warn.warn(
             f"the {sensor} model has no resolved {term} on any axis; writing 0 "
             f"(an estimator may need a small positive value)",
             RuntimeWarning,
-            stacklevel=4,
         )
         return 0.0
     v = values[sup] * scale

@@ -13,6 +13,7 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
+from imunoise import _warn
 from imunoise._core import fit as _core_fit
 from imunoise._deprecation import old_call_forms
 from imunoise.noise._components import Components
@@ -308,12 +309,12 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
     cover = coverage(model, taus, dev_all, edf_raw)
     object.__setattr__(model, "coverage", shaped(cover))
     for c in np.flatnonzero(cover < 0.8) if method == "wls" and warn_coverage else ():
-        warnings.warn(
+        _warn.warn(
             f"the noise model follows the Allan deviation of channel {c} at only "
             f"{cover[c]:.0%} of the taus (inside the 95 % interval or within 5 %); its "
             "coefficients summarise a curve they do not describe: plot it with "
             "result.plot(model) or imunoise.plot.allan(result, model=model)",
-            RuntimeWarning, stacklevel=3,  # past old_call_forms' wrapper
+            RuntimeWarning,
         )
     return model
 

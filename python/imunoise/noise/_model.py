@@ -3,14 +3,13 @@ exports, with the fitted components behind them under one name."""
 
 from __future__ import annotations
 
-import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 import numpy as np
 
-from imunoise import _schema, _summary
+from imunoise import _schema, _summary, _warn
 from imunoise import numbers as _numbers
 from imunoise import units as _units
 from imunoise._deprecation import old_call_forms
@@ -24,9 +23,7 @@ if TYPE_CHECKING:
 
 
 def _moved(old: str, new: str) -> None:
-    # stacklevel 3: past this helper and the property, at the caller's line
-    warnings.warn(f"NoiseModel.{old} is deprecated; use {new}", DeprecationWarning,
-                  stacklevel=3)
+    _warn.warn(f"NoiseModel.{old} is deprecated; use {new}", DeprecationWarning)
 
 
 @dataclass(frozen=True, repr=False)

@@ -5,10 +5,10 @@ well a model follows the curve (its coverage)."""
 from __future__ import annotations
 
 import math
-import warnings
 
 import numpy as np
 
+from imunoise import _warn
 from imunoise.noise._terms import _CLOSE, _READ_TAU, _SLOPE, FLAT_SLOPE, FLICKER, TERMS
 
 
@@ -97,8 +97,7 @@ def fit_slopes(t, v, e, mask, tolerance=0.25):
     sup = np.zeros(5, dtype=bool)
     rng = np.full((5, 2), np.nan)
     if t.size < 2:
-        warnings.warn("slope read-off needs at least two taus; no term resolved",
-                      RuntimeWarning, stacklevel=3)
+        _warn.warn("slope read-off needs at least two taus; no term resolved", RuntimeWarning)
         return coef, std, sup, rng
     dev = np.sqrt(v)
     logt, logd = np.log10(t), np.log10(dev)
