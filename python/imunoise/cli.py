@@ -18,7 +18,6 @@ from imunoise._schema import (
     CHANNELS,
     SAMPLE_SENSORS,
     axis_names,
-    column_names,
     sensor_label,
 )
 from imunoise.allan import KINDS
@@ -459,21 +458,6 @@ def _cmd_dadev(args) -> int:
     return 0
 
 
-def _columns(log) -> tuple[list[str], list[np.ndarray]]:
-    names, cols = [], []
-    if log.time is not None:
-        names.append("time")
-        cols.append(np.asarray(log.time))
-    for ch in log.channels:
-        arr = getattr(log, ch)
-        names.extend(column_names(ch))
-        cols.extend([arr] if arr.ndim == 1 else [arr[:, j] for j in range(arr.shape[1])])
-    if len(log.gaps):
-        names.append("valid")
-        cols.append(log.valid.astype(np.float64))
-    return names, cols
-
-
 def _cmd_convert(args) -> int:
     out = Path(args.output)
     suffix = out.suffix.lower()
@@ -482,15 +466,12 @@ def _cmd_convert(args) -> int:
               f"got {str(out)!r}")
     if suffix in ("", ".npy", ".parquet"):
         return _convert_streaming(args, out)
+    from imunoise.writers.table import log_columns, write_csv, write_npz
+
     log = _read(args)
-    names, cols = _columns(log)
     out.parent.mkdir(parents=True, exist_ok=True)
-    if suffix == ".csv":
-        np.savetxt(out, np.column_stack(cols), delimiter=",", header=",".join(names),
-                   comments="", fmt="%.10g")
-    else:
-        np.savez(out, fs=log.fs, **dict(zip(names, cols, strict=True)))
-    print(f"wrote {len(log)} samples x {len(names)} columns to {out}")
+    (write_csv if suffix == ".csv" else write_npz)(log, out)
+    print(f"wrote {len(log)} samples x {len(log_columns(log)[0])} columns to {out}")
     return 0
 
 

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import csv
 import io
+import json
 import math
 import os
 import re
@@ -23,6 +24,7 @@ import numpy as np
 from imunoise._schema import CHANNELS, COLUMN_SUFFIXES, G
 from imunoise.errors import ParseError
 from imunoise.readers._sentences import IssueTally, sentence_rows
+from imunoise.readers.columnar import META_KEY, check_meta, log_from_meta
 from imunoise.readers.log import ImuLog, log_on_grid
 from imunoise.readers.probe import Confidence, Probe
 
@@ -84,6 +86,10 @@ _VECTOR_PREFIXES = {
     "gyro": ("gyro", "gyr", "gyroscope", "g", "w", "omega", "angular_velocity", "ang_vel"),
     "accel": ("acc", "accel", "accelerometer", "acceleration", "a", "linear_acceleration"),
     "mag": ("mag", "magnetometer", "m", "magnetic_field", "b"),
+    # the names imunoise's own writers give (_schema.column_names)
+    "ypr": ("ypr",),
+    "delta_theta": ("delta_theta",),
+    "delta_velocity": ("delta_velocity",),
 }
 _TIME_NAMES = (
     "time",
@@ -200,9 +206,17 @@ def _split(line: str, delimiter: str | None) -> list[str]:
     return line.split(delimiter)
 
 
+def _number(text: str) -> float:
+    """``float(text)``, without Python's digit separators (``1_000``): a logger never
+    writes them, so a field with one is damaged, not a thousand."""
+    if "_" in text:
+        raise ValueError(f"digit separator in {text!r}")
+    return float(text)
+
+
 def _is_number(text: str) -> bool:
     try:
-        float(text)
+        _number(text)
     except ValueError:
         return False
     return True
@@ -225,7 +239,7 @@ def _auto_columns(names: list[str], raw_col: int | None) -> dict[str, list[int]]
                 if min(cols) >= 0:
                     found[channel] = cols
                     break
-        if all(n in index for n in ("yaw", "pitch", "roll")):
+        if "ypr" not in found and all(n in index for n in ("yaw", "pitch", "roll")):
             found["ypr"] = [index["yaw"], index["pitch"], index["roll"]]
         for prefix in ("q", "quat", "quaternion", "orientation"):
             cols = _prefixed(index, prefix, COLUMN_SUFFIXES[4])
@@ -372,6 +386,7 @@ class _Reader:
         self.vn_time: list[np.ndarray | None] = []
         self.messages: dict[str, int] = {}
         self.rows = 0
+        self.meta: dict | None = None  # of a CSV written by imunoise convert
 
     # -- layout -------------------------------------------------------------------
     def _layout(self, line: str, line_no: int, next_line: str | None) -> bool:
@@ -473,6 +488,19 @@ class _Reader:
             conv[ch] = None if unit is None else _unit_factor(ch, unit)
         return conv
 
+    def _comment(self, line: str, line_no: int) -> None:
+        """Keep the metadata of a CSV written by ``imunoise convert`` (its first line,
+        ``# imunoise {...}``); other comments are not data."""
+        prefix = f"# {META_KEY} "
+        if line_no == 1 and line.startswith(prefix):
+            where = f"{self.name} line 1"
+            try:
+                meta = json.loads(line[len(prefix):])
+            except ValueError as exc:
+                raise ValueError(f"{where}: the imunoise metadata is not valid JSON ({exc})"
+                                 ) from None
+            self.meta = check_meta(meta, where)
+
     # -- rows -----------------------------------------------------------------------
     def _bad(self, line_no: int, reason: str) -> None:
         if self.strict:
@@ -490,6 +518,7 @@ class _Reader:
             while start < len(lines) and (
                 not lines[start].strip() or lines[start].lstrip().startswith("#")
             ):
+                self._comment(lines[start], first_line + start)
                 start += 1
             if start == len(lines):
                 return
@@ -551,7 +580,7 @@ class _Reader:
             for j, col in enumerate(self.used):
                 text = fields[col].strip()
                 try:
-                    value = float(text)
+                    value = _number(text)
                 except ValueError:
                     self._bad(line_no, f"column {col + 1} is not a number: {text[:40]!r}")
                     ok = False
@@ -637,6 +666,9 @@ class _Reader:
             channels[ch] = values[:, 0] if CHANNELS[ch][0] == 1 else values
         if time is None:
             time = vn_time
+        restored = _restore_meta(self, channels, time)
+        if restored is not None:
+            return restored
         return log_on_grid(
             fs=fs,
             source=self.name,
@@ -647,6 +679,28 @@ class _Reader:
             messages=messages,
             values_may_be_nan=True,
         )
+
+
+def _restore_meta(reader: _Reader, channels, time) -> ImuLog | None:
+    """The log a CSV of ``imunoise convert`` was written from, when every row is there
+    as written: its rows are that log's grid, with its rate, issues and gaps."""
+    meta = reader.meta
+    if meta is None:
+        return None
+    arrays = dict(channels)
+    if time is not None:
+        arrays["time"] = time
+    n = len(next(iter(arrays.values()), ()))
+    if reader.tally.issues("line").total or n != meta["samples"] or set(arrays) != set(
+            meta["channels"]):
+        warnings.warn(
+            f"{reader.name}: the rows no longer match the imunoise metadata of line 1 "
+            f"({n} rows of {sorted(arrays)}, metadata {meta['samples']} of "
+            f"{sorted(meta['channels'])}); read as a plain CSV",
+            stacklevel=5,
+        )
+        return None
+    return log_from_meta(meta, arrays, reader.name)
 
 
 def _no_columns_message(name: str, names: list[str] | None, first: list[str]) -> str:

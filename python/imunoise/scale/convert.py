@@ -44,6 +44,7 @@ import numpy as np
 from imunoise._core import vn as _core_vn
 from imunoise._schema import CHANNELS, column_names
 from imunoise.readers import registry
+from imunoise.readers.columnar import META_KEY, log_meta, meta_path, read_columnar
 from imunoise.readers.grid import Gaps, TimeGrid
 from imunoise.readers.log import ImuLog, ParseIssues, fs_from_median_step
 from imunoise.readers.vn import richest_table, table_channels, tables_of
@@ -52,7 +53,6 @@ __all__ = ["CHUNK_BYTES", "Conversion", "convert", "load"]
 
 #: Default bytes read per piece by :func:`convert`.
 CHUNK_BYTES = 64 << 20
-_META_VERSION = 1
 
 
 @dataclass(frozen=True)
@@ -192,10 +192,10 @@ class _DirSink(_Sink):
             dest = out / f"{ch}.npy"
             os.replace(self.staging / f"{ch}.npy", dest)
             files.append(dest)
-        meta_path = out / "meta.json"
-        meta_path.write_text(json.dumps(meta, indent=1))
+        meta_file = out / "meta.json"
+        meta_file.write_text(json.dumps(meta, indent=1))
         shutil.rmtree(self.staging, ignore_errors=True)
-        return [*files, meta_path]
+        return [*files, meta_file]
 
 
 def _record_dtype(channels: list[str]) -> np.dtype:
@@ -224,13 +224,9 @@ class _NpySink(_Sink):
 
     def publish(self, out, meta):
         os.replace(self.staging, out)
-        meta_path = _npy_meta_path(out)
-        meta_path.write_text(json.dumps(meta, indent=1))
-        return [out, meta_path]
-
-
-def _npy_meta_path(out: Path) -> Path:
-    return out.with_name(out.stem + ".meta.json")
+        meta_file = meta_path(out)
+        meta_file.write_text(json.dumps(meta, indent=1))
+        return [out, meta_file]
 
 
 class _ParquetSink(_Sink):
@@ -258,7 +254,7 @@ class _ParquetSink(_Sink):
     def close(self, meta):
         if meta is not None:
             self.writer.add_key_value_metadata({
-                "fs": repr(meta["fs"]), "source": meta["source"], "imunoise": json.dumps(meta),
+                "fs": repr(meta["fs"]), "source": meta["source"], META_KEY: json.dumps(meta),
             })
         self.writer.close()
 
@@ -506,26 +502,6 @@ def _stream_vn(path: Path, writer: _Writer, chunk_bytes: int, progress) -> tuple
     return tables_of(summary), steps, shape, grids
 
 
-def _meta(*, fs, source, fmt, issues: ParseIssues, messages, samples, channels, table,
-          gaps: Gaps) -> dict:
-    return {
-        "imunoise_columnar": _META_VERSION,
-        "fs": fs,
-        "source": source,
-        "format": fmt,
-        "samples": samples,
-        "channels": list(channels),
-        "table": table,
-        "messages": dict(messages),
-        "issues": {
-            "counts": dict(issues.counts),
-            "first": {k: list(v) for k, v in issues.first.items()},
-            "location": issues.location,
-        },
-        "gaps": {"index": gaps.index.tolist(), "samples": gaps.samples.tolist()},
-    }
-
-
 def convert(
     path,
     out,
@@ -619,7 +595,7 @@ def convert(
         if primary is None:
             raise ValueError(f"{path}: no usable records ({issues})")
         sink = writer.sinks[primary]
-        meta = _meta(fs=rate, source=str(path), fmt=fmt, issues=issues, messages=messages,
+        meta = log_meta(fs=rate, source=str(path), fmt=fmt, issues=issues, messages=messages,
                      samples=sink.rows, channels=sink.channels, table=primary, gaps=gaps)
         _remove(out, layout)
         files = writer.finish(primary, meta)
@@ -641,22 +617,7 @@ def _remove(out: Path, layout: str) -> None:
             for name in ["meta.json", *(f"{c}.npy" for c in ("time", *CHANNELS))]:
                 (out / name).unlink(missing_ok=True)
     elif layout == "npy":
-        _npy_meta_path(out).unlink(missing_ok=True)
-
-
-def _read_meta(out: Path, layout: str) -> dict:
-    if layout == "parquet":
-        import pyarrow.parquet as pq
-
-        kv = pq.read_metadata(out).metadata or {}
-        raw = kv.get(b"imunoise")
-        if raw is None:
-            raise ValueError(f"{out}: not written by imunoise convert (no 'imunoise' metadata)")
-        return json.loads(raw)
-    meta_path = out / "meta.json" if layout == "dir" else _npy_meta_path(out)
-    if not meta_path.exists():
-        raise ValueError(f"{out}: not written by imunoise convert (no {meta_path.name})")
-    return json.loads(meta_path.read_text())
+        meta_path(out).unlink(missing_ok=True)
 
 
 def load(out) -> ImuLog:
@@ -664,7 +625,8 @@ def load(out) -> ImuLog:
 
     The channels of a directory or ``.npy`` output are read-only memory maps:
     nothing is read until used, and :func:`imunoise.adev` reads them in place.
-    A ``.parquet`` output is read into memory.
+    A ``.parquet`` output is read into memory. :func:`imunoise.read` reads the
+    same outputs (format ``"columnar"``).
 
     Parameters
     ----------
@@ -673,37 +635,20 @@ def load(out) -> ImuLog:
     Returns
     -------
     ImuLog
-        ``source``, ``format``, ``fs``, ``issues`` and ``messages`` are those of
-        the converted log.
+        ``source``, ``format``, ``fs``, ``issues``, ``messages`` and ``gaps`` are
+        those of the converted log.
+
+    Raises
+    ------
+    ValueError
+        When the metadata is missing or contradicts itself or the arrays (the
+        error names the field), e.g. a negative count of missing samples.
     """
     if isinstance(out, Conversion):
         out = out.out
     out = Path(os.fspath(out))
     if not out.exists():
         raise FileNotFoundError(2, "no such file or directory", str(out))
-    layout = "dir" if out.is_dir() else _layout(out)
-    meta = _read_meta(out, layout)
-    channels = meta["channels"]
-    if layout == "dir":
-        arrays = {ch: np.load(out / f"{ch}.npy", mmap_mode="r") for ch in channels}
-    elif layout == "npy":
-        rec = np.load(out, mmap_mode="r")
-        arrays = {ch: rec[ch] for ch in channels}
-    else:
-        import pyarrow.parquet as pq
-
-        table = pq.read_table(out)
-        arrays = {}
-        for ch in channels:
-            cols = [table.column(n).to_numpy() for n in column_names(ch)]
-            arrays[ch] = cols[0] if len(cols) == 1 else np.column_stack(cols)
-    iss = meta["issues"]
-    issues = ParseIssues(counts=iss["counts"], first={k: tuple(v) for k, v in
-                                                      iss["first"].items()},
-                         location=iss["location"])
-    fs = float(meta["fs"])
-    # the gaps as convert found them: no pass over memory-mapped channels for NaN
-    gaps = meta.get("gaps")
-    gaps = None if gaps is None else Gaps(gaps["index"], gaps["samples"], fs)
-    return ImuLog(fs=fs, source=meta["source"], format=meta["format"],
-                  issues=issues, messages=meta["messages"], gaps=gaps, **arrays)
+    if not out.is_dir():
+        _layout(out)  # a suffix convert does not write is an error naming the layouts
+    return read_columnar(out)
