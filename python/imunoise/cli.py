@@ -479,13 +479,14 @@ def _convert_streaming(args, out: Path) -> int:
     from imunoise import scale
     from imunoise._progress import byte_bar, wanted
 
+    source = sys.stdin.buffer if args.log == "-" else args.log
     bar = byte_bar(f"converting {Path(args.log).name}") if wanted(args.progress) else None
     try:
-        done = scale.convert(args.log, out, fs=args.fs, chunk_bytes=int(args.chunk_mb * 2**20),
+        done = scale.convert(source, out, fs=args.fs, chunk_bytes=int(args.chunk_mb * 2**20),
                              progress=bar)
     except ImportError as exc:
         _fail(str(exc))
-    _note_gaps(str(args.log), done)
+    _note_gaps("<stdin>" if args.log == "-" else str(args.log), done)
     print(f"wrote {done.samples} samples ({', '.join(done.channels)}) at {done.fs:.6g} Hz to "
           f"{done.out}; parse issues: {done.issues}")
     return 0

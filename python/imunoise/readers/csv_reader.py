@@ -111,15 +111,36 @@ _CHUNK_BYTES = 1 << 22
 
 
 def sniff(probe: Probe) -> Confidence:
-    """A ``.csv``/``.tsv`` file, or a first line with a delimiter (a weak guess)."""
+    """A ``.csv``/``.tsv`` file; a header of names followed by a row of as many
+    fields (as sure as an extension: a stream has none, and VN sentences in a
+    column must not make it a VN log); else a first line with a delimiter (a weak
+    guess)."""
     if probe.is_dir:
         return Confidence.NO
     if probe.suffix in SUFFIXES:
+        return Confidence.NAME
+    if _has_header(probe.head):
         return Confidence.NAME
     first_line = probe.head.split(b"\n", 1)[0]
     if any(d in first_line for d in (b",", b"\t", b";", b" ")):
         return Confidence.GUESS
     return Confidence.NO
+
+
+def _has_header(head: bytes) -> bool:
+    """A first line (after ``#`` comments) of at least two names, then a line with
+    as many fields."""
+    lines = [ln for ln in head.decode("latin-1").splitlines()
+             if ln.strip() and not ln.lstrip().startswith("#")][:2]
+    if len(lines) < 2 or "$VN" in lines[0]:
+        return False
+    delimiter = next((d for d in (",", "\t", ";") if d in lines[0]), None)
+    if delimiter is None:
+        return False
+    names = _split(lines[0], delimiter)
+    return (len(names) >= 2
+            and all(re.match(r"\s*\"?[A-Za-z_%]", f) and not _is_number(f) for f in names)
+            and len(_split(lines[1], delimiter)) == len(names))
 
 
 def _normalise(name: str) -> tuple[str, str | None]:

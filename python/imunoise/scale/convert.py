@@ -26,8 +26,9 @@ Output layouts (chosen by ``out``):
     ``imunoise``: the JSON of ``meta.json``). :func:`load` reads Parquet into
     memory.
 
-VN-100 logs (ASCII, binary, or both) are streamed; CSV and ROS bags are read
-whole by :func:`imunoise.read` and then written the same way.
+VN-100 logs (ASCII, binary, or both) larger than one piece are streamed; smaller
+ones, CSV and ROS bags are read whole by :func:`imunoise.read` and then written
+the same way (so a log of one piece converts to exactly what ``read`` gives).
 """
 
 from __future__ import annotations
@@ -35,7 +36,8 @@ from __future__ import annotations
 import json
 import os
 import shutil
-from collections.abc import Callable, Iterable, Mapping
+from collections.abc import Callable, Iterable, Iterator, Mapping
+from contextlib import ExitStack
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -455,9 +457,20 @@ class _GridStream:
         return TimeGrid(slot=np.arange(n, dtype=np.int64) + shift, n=n + len(inner))
 
 
-def _stream_vn(path: Path, writer: _Writer, chunk_bytes: int, progress) -> tuple:
-    """Parse ``path`` piece by piece into ``writer`` with one streaming parser (issues,
-    locations and binary configurations run on across pieces as in one read).
+def _blocks(f, first: bytes, chunk_bytes: int) -> Iterator[bytes]:
+    """``first``, then the rest of the open file ``f`` in pieces of ``chunk_bytes``."""
+    block = first
+    while block:
+        yield block
+        if len(block) < chunk_bytes:
+            return
+        block = f.read(chunk_bytes)
+
+
+def _stream_vn(blocks: Iterable[bytes], total: int | None, writer: _Writer, progress) -> tuple:
+    """Parse the pieces ``blocks`` (``total`` bytes, None for a stream) into ``writer``
+    with one streaming parser (issues, locations and binary configurations run on
+    across pieces as in one read).
 
     Returns the parse summary (:class:`~imunoise.readers.vn.VnTables` without rows),
     the timestamp steps and the ``(channels filled, rows)`` of every table, and the
@@ -485,18 +498,13 @@ def _stream_vn(path: Path, writer: _Writer, chunk_bytes: int, progress) -> tuple
                 steps.setdefault(name, _Steps()).add(chans["time"])
             writer.append(name, grid.place(chans, rows.missing.get(name)))
 
-    total = path.stat().st_size
     done = 0
-    with open(path, "rb") as f:
-        while True:
-            block = f.read(chunk_bytes)
-            done += len(block)
-            write(stream.feed(block))
-            if progress is not None:
-                progress(done, max(total, done))
-            if len(block) < chunk_bytes:
-                break
-            del block
+    for block in blocks:
+        done += len(block)
+        write(stream.feed(block))
+        if progress is not None:
+            progress(done, max(total or done, done))
+        del block
     summary = stream.finish()
     write(summary)
     return tables_of(summary), steps, shape, grids
@@ -515,9 +523,11 @@ def convert(
 
     Parameters
     ----------
-    path : str or os.PathLike
-        The log. VN-100 logs (ASCII, binary or both) are streamed with memory
-        bounded by ``chunk_bytes``; CSV and ROS bags are read whole.
+    path : str, os.PathLike or binary file object
+        The log. VN-100 logs (ASCII, binary or both) larger than ``chunk_bytes``
+        are streamed with memory bounded by it; CSV and ROS bags are read whole.
+        A stream (a binary file object such as ``sys.stdin.buffer``, a FIFO) is
+        read once, start to end: its format is detected from the first piece.
     out : str or os.PathLike
         A directory (no suffix), a ``.npy`` or a ``.parquet`` file (see the module
         docstring for the layouts). An existing output is replaced.
@@ -541,9 +551,10 @@ def convert(
     ``load(convert(p, out).out)`` holds exactly the arrays of ``imunoise.read(p)``,
     with the same ``fs`` and parse issue counts.
     """
-    from imunoise.readers.read import FORMATS, detect_format
+    from imunoise.readers.read import FORMATS, detect_format, is_stream, stream_name
 
-    path = Path(os.fspath(path))
+    stream = is_stream(path)
+    name = stream_name(path) if stream else str(Path(os.fspath(path)))
     out = Path(os.fspath(out))
     if isinstance(chunk_bytes, bool) or not isinstance(chunk_bytes, (int, np.integer)):
         raise TypeError(f"chunk_bytes must be an int; got {type(chunk_bytes).__name__}")
@@ -557,19 +568,57 @@ def convert(
             import pyarrow  # noqa: F401
         except ImportError:
             raise ImportError("Parquet output needs pyarrow (pip install pyarrow)") from None
-    if not path.exists():
-        raise FileNotFoundError(2, "no such file", str(path))
-    if format == "auto":
-        format = detect_format(path)
-    out.parent.mkdir(parents=True, exist_ok=True)
+    chunk_bytes = int(chunk_bytes)
+    with ExitStack() as stack:
+        # A log that fits in one piece is converted from imunoise.read's own result
+        # (same grid, same fs to the bit); only larger VN logs are streamed.
+        if stream:  # read once: the format is detected from the first piece, kept
+            f = path if hasattr(path, "read") else stack.enter_context(open(path, "rb"))
+            first = f.read(chunk_bytes)
+            if format == "auto":
+                format = detect_format(first)
+            total = None
+            streamed = registry.get(format).streamable and len(first) == chunk_bytes
+            if not streamed:
+                source = first + f.read()
+                total = len(source)
+        else:
+            path = source = Path(os.fspath(path))
+            if not path.exists():
+                raise FileNotFoundError(2, "no such file", str(path))
+            if format == "auto":
+                format = detect_format(path)
+            total = path.stat().st_size if path.is_file() else None
+            streamed = (registry.get(format).streamable and total is not None
+                        and total > chunk_bytes)
+            if streamed:
+                f = stack.enter_context(open(path, "rb"))
+                first = f.read(chunk_bytes)
+        if streamed:
+            source = _blocks(f, first, chunk_bytes)
+            del first
+        out.parent.mkdir(parents=True, exist_ok=True)
+        return _convert(name, source, out, layout, fs=fs, format=format, total=total,
+                        streamed=streamed, chunk_bytes=chunk_bytes, progress=progress)
+
+
+def _convert(name: str, source, out: Path, layout: str, *, fs, format: str,
+             total: int | None, streamed: bool, chunk_bytes: int, progress) -> Conversion:
+    """:func:`convert` of ``source``: the pieces of a log to stream, or what
+    :func:`imunoise.read` reads whole (a path, or the bytes of a stream)."""
+    from imunoise.readers.read import read
+
     writer = _Writer(out, layout)
+    done = 0
     try:
-        if registry.get(format).streamable and path.is_file():
-            parsed, steps, shape, grids = _stream_vn(path, writer, int(chunk_bytes), progress)
+        if streamed:
+            pieces = _counted(source)
+            parsed, steps, shape, grids = _stream_vn(pieces, total, writer, progress)
+            done = pieces.done
             primary = richest_table(shape)
             step_histogram = steps.get(primary) if primary else None
             rate = fs_from_median_step(
-                step_histogram.median() if step_histogram is not None else None, fs, str(path)
+                step_histogram.median() if step_histogram is not None else None, fs, name
             )
             grid = grids[primary] if primary else _GridStream()
             counts = {**parsed.issues.counts, "duplicate_time": grid.duplicate_time,
@@ -579,9 +628,10 @@ def convert(
             gaps = Gaps(index=[g[0] for g in grid.gaps], samples=[g[1] for g in grid.gaps],
                         fs=rate)
         else:
-            from imunoise.readers.read import read
-
-            log = read(path, format=format, fs=fs, progress=progress)
+            log = read(source, format=format, fs=fs, progress=progress)
+            if log.source == "<bytes>":
+                log = replace(log, source=name)
+            done = len(source) if isinstance(source, bytes) else total
             chans = {ch: getattr(log, ch) for ch in _order([*log.channels, "time"])
                      if getattr(log, ch) is not None}
             primary = "log" if chans and len(log) else None
@@ -593,9 +643,9 @@ def convert(
             rate, issues, messages, fmt = log.fs, log.issues, log.messages, log.format
             gaps = log.gaps
         if primary is None:
-            raise ValueError(f"{path}: no usable records ({issues})")
+            raise ValueError(f"{name}: no usable records ({issues})")
         sink = writer.sinks[primary]
-        meta = log_meta(fs=rate, source=str(path), fmt=fmt, issues=issues, messages=messages,
+        meta = log_meta(fs=rate, source=name, fmt=fmt, issues=issues, messages=messages,
                      samples=sink.rows, channels=sink.channels, table=primary, gaps=gaps)
         _remove(out, layout)
         files = writer.finish(primary, meta)
@@ -605,7 +655,20 @@ def convert(
     issues = replace(issues, samples_missing=gaps.total, gaps=len(gaps), samples=sink.rows)
     return Conversion(out=out, files=tuple(files), samples=sink.rows,
                       channels=tuple(sink.channels), fs=rate, issues=issues,
-                      bytes_read=path.stat().st_size, gaps=gaps)
+                      bytes_read=done or 0, gaps=gaps)
+
+
+class _counted:
+    """The pieces of an iterable, counting their bytes in ``done``."""
+
+    def __init__(self, blocks: Iterable[bytes]):
+        self.blocks = blocks
+        self.done = 0
+
+    def __iter__(self) -> Iterator[bytes]:
+        for block in self.blocks:
+            self.done += len(block)
+            yield block
 
 
 def _remove(out: Path, layout: str) -> None:

@@ -1,0 +1,161 @@
+"""Everything ``imunoise convert`` writes reads back through ``imunoise.read`` and the
+CLI: same samples (bit for bit), time, fs, channels, gaps and issues (issue #24)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import imunoise
+import numpy as np
+import pytest
+from helpers.same_log import assert_same_log
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+from imunoise import scale
+from imunoise.cli import main
+
+DATA = Path(__file__).resolve().parents[1] / "data"
+CSV_LOG = DATA / "vn100-csv" / "stationary_data_5min_0.csv"
+WRITERS = ("dir", "npy", "parquet", "csv", "npz")
+READERS = ("vn-binary", "vn-ascii", "csv")
+
+
+def _source(kind: str, n: int, fs: float, drops: list[int], seed: int, folder: Path) -> Path:
+    rng = np.random.default_rng(seed)
+    keep = np.setdiff1d(np.arange(n), drops)
+    gyro = rng.normal(0, 0.01, (n, 3))[keep]
+    accel = rng.normal([0, 0, -9.8], 0.02, (n, 3))[keep]
+    mag = rng.normal(0.3, 0.01, (n, 3))[keep]
+    # a clock in whole nanoseconds, as the VN-100 and a ROS stamp give it
+    t = (1_700_000_000.0 if kind == "csv" else 12.5) + np.round(np.arange(n) / fs * 1e9)[keep] / 1e9
+    path = folder / f"src-{kind}"
+    if kind == "vn-binary":
+        imunoise.write_vn_binary({"gyro": gyro, "accel": accel, "mag": mag, "time": t},
+                                 path=path.with_suffix(".bin"))
+        return path.with_suffix(".bin")
+    if kind == "vn-ascii":
+        ypr = rng.uniform(-10, 10, (len(keep), 3))
+        imunoise.write_vn_ascii({"ypr": ypr, "mag": mag, "accel": accel, "gyro": gyro},
+                                path=path.with_suffix(".txt"))
+        return path.with_suffix(".txt")
+    rows = ["time,gyro_x,gyro_y,gyro_z,acc_x,acc_y,acc_z"]
+    rows += [",".join(repr(float(v)) for v in (t[i], *gyro[i], *accel[i])) for i in range(len(t))]
+    path = path.with_suffix(".csv")
+    path.write_text("\n".join(rows) + "\n")
+    return path
+
+
+def _convert(src: Path, out: Path, fs: float) -> None:
+    assert main(["convert", str(src), "-o", str(out), "--fs", str(fs), "--no-progress"]) == 0
+
+
+@pytest.mark.parametrize("writer", WRITERS)
+@pytest.mark.parametrize("reader", READERS)
+@settings(max_examples=8, deadline=None,
+          suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(
+    n=st.integers(4, 200),
+    fs=st.sampled_from([40.0, 100.0, 200.0, 800.0]),
+    drops=st.lists(st.integers(1, 190), max_size=6, unique=True),
+    seed=st.integers(0, 2**16),
+)
+def test_every_reader_times_every_writer_round_trips(reader, writer, n, fs, drops, seed,
+                                                     tmp_path_factory, capsys):
+    folder = tmp_path_factory.mktemp("rt")
+    drops = [d for d in drops if d < n - 1]
+    src = _source(reader, n, fs, drops, seed, folder)
+    log = imunoise.read(src, fs=fs)
+    out = folder / {"dir": "out", "npy": "out.npy", "parquet": "out.parquet", "csv": "out.csv",
+                    "npz": "out.npz"}[writer]
+    _convert(src, out, fs)
+    capsys.readouterr()
+    assert_same_log(imunoise.read(out), log)
+    if writer in ("dir", "npy", "parquet"):
+        assert_same_log(scale.load(out), log)
+
+
+@pytest.mark.parametrize("suffix", ["", ".npy", ".parquet", ".csv", ".npz"])
+def test_every_cli_command_reads_what_convert_wrote(suffix, tmp_path, capsys):
+    src = DATA.parent.parent / "python" / "imunoise" / "data" / "vn100_stationary_5min.txt"
+    out = tmp_path / f"live{suffix}"
+    _convert(src, out, 40.0)
+    capsys.readouterr()
+    for command in (["stats"], ["adev", "--taus", "decade"], ["psd"], ["fit", "--sensor", "gyro"]):
+        assert main([*command, str(out)]) == 0, command
+        printed = capsys.readouterr()
+        assert "error" not in printed.err
+    assert main(["stats", str(out)]) == 0
+    assert "13223 samples at 40 Hz" in capsys.readouterr().out
+
+
+def test_csv_export_keeps_every_digit_of_epoch_time(tmp_path, capsys):
+    out = tmp_path / "rt.csv"
+    assert main(["convert", str(CSV_LOG), "-o", str(out)]) == 0
+    log = imunoise.read(CSV_LOG)
+    back = imunoise.read(out)
+    assert len(back) == 13223 and round(back.fs, 4) == 39.9994
+    assert_same_log(back, log)
+    # without the metadata line the time column alone gives the same grid and rate
+    bare = tmp_path / "bare.csv"
+    bare.write_text(out.read_text().split("\n", 1)[1])
+    plain = imunoise.read(bare)
+    assert len(plain) == 13223 and plain.fs == log.fs
+    np.testing.assert_array_equal(plain.time, log.time)
+    capsys.readouterr()
+    assert main(["stats", str(out)]) == 0
+    assert "13223 samples at 39.9994 Hz" in capsys.readouterr().out
+
+
+def test_npz_of_arbitrary_arrays_is_refused_with_what_to_do(tmp_path):
+    path = tmp_path / "mine.npz"
+    np.savez(path, a=np.zeros(10), b=np.ones((10, 3)))
+    with pytest.raises(ValueError, match=r"mine\.npz.*from_arrays"):
+        imunoise.read(path)
+    assert main(["stats", str(path)]) == 2
+
+
+def test_npy_without_metadata_is_refused_with_what_to_do(tmp_path):
+    path = tmp_path / "mine.npy"
+    np.save(path, np.zeros((10, 3)))
+    with pytest.raises(ValueError, match=r"mine\.npy.*mine\.meta\.json.*from_arrays"):
+        imunoise.read(path)
+
+
+def test_convert_names_the_formats_it_writes(tmp_path, capsys):
+    assert main(["convert", str(CSV_LOG), "-o", str(tmp_path / "x.txt")]) == 2
+    err = capsys.readouterr().err
+    assert "x.txt" in err and ".npz" in err and ".parquet" in err
+
+
+@pytest.mark.parametrize(("field", "value"), [
+    ("gaps.samples[0]", -3),
+    ("issues.counts.bad_checksum", -1),
+    ("samples", -5),
+    ("fs", 0),
+    ("messages.VNYMR", -2),
+])
+def test_load_refuses_inconsistent_metadata_naming_the_field(field, value, tmp_path):
+    src = DATA.parent.parent / "python" / "imunoise" / "data" / "vn100_stationary_5min.txt"
+    raw = src.read_bytes().splitlines(keepends=True)
+    damaged = tmp_path / "d.txt"
+    damaged.write_bytes(b"".join(raw[:100] + [b"$VNYMR,garbage*00\r\n"] + raw[101:200]))
+    out = tmp_path / "o.npy"
+    scale.convert(damaged, out, fs=40)
+    meta_file = tmp_path / "o.meta.json"
+    meta = json.loads(meta_file.read_text())
+    assert meta["gaps"]["samples"]
+    target, key = meta, field
+    for part in field.split(".")[:-1]:
+        target = target[part]
+    key = field.split(".")[-1]
+    if key.endswith("]"):
+        key, index = key[:-3], int(key[-2])
+        target[key][index] = value
+    else:
+        target[key] = value
+    meta_file.write_text(json.dumps(meta))
+    with pytest.raises(ValueError, match=rf"'{__import__('re').escape(field)}'"):
+        scale.load(out)
+    with pytest.raises(ValueError, match=rf"'{__import__('re').escape(field)}'"):
+        imunoise.read(out)
