@@ -337,8 +337,10 @@ def read_csv(
         Channel -> unit of the file's values (see :data:`UNITS`), e.g.
         ``{"gyro": "deg/s", "accel": "g", "mag": "uT", "time": "ns"}``. Default: a
         unit written in the header (``gx [deg/s]``, ``acc_x (g)``), else the SI unit
-        of the channel; a time column whose median step exceeds 10^4 is taken as
-        nanoseconds.
+        of the channel. A time column without a unit is in the unit its name
+        ends with (``time_ns``, ``t_us``, ``stamp_ms``), else the one its values
+        and rate say together (epoch times, an IMU's rate: see ``_time_unit``),
+        with a warning when that guess is not seconds.
     delimiter : str, optional
         Field separator. Default: ``,`` if the first line has one, else tab, else
         ``;``, else runs of whitespace.
@@ -676,8 +678,8 @@ class _Reader:
             conv = self.conv[ch]
             if ch == "time":
                 t = values[:, 0]
-                if conv is None and len(t) > 1 and np.median(np.abs(np.diff(t))) > 1e4:
-                    conv = UNITS["ns"][1:]
+                if conv is None:
+                    conv = _time_unit(t, self.names[idx[0]] if self.names else None, self.name)
                 if conv is not None:
                     t = t * conv[0] + conv[1]
                 time = t
@@ -722,6 +724,54 @@ def _restore_meta(reader: _Reader, channels, time) -> ImuLog | None:
         )
         return None
     return log_from_meta(meta, arrays, reader.name)
+
+
+#: Rates (Hz) a time unit may give an IMU log before another unit is looked for.
+PLAUSIBLE_RATES = (1.0, 1e5)
+#: Epoch times (s) between 2001 and 2103: a time column this large in some unit is
+#: an epoch time in that unit.
+EPOCH_SECONDS = (1e9, 4.3e9)
+#: Units a time column without one is tried in, in this order (seconds first).
+_TIME_UNITS = ("s", "ms", "us", "ns")
+
+
+def _time_unit(t: np.ndarray, header: str | None, source: str) -> tuple[float, float] | None:
+    """(factor, offset) of a time column whose unit neither ``units=`` nor the header
+    says; ``None`` for seconds.
+
+    A name ending in ``_ns``/``_us``/``_ms``/``_s`` says it. Else the values and the
+    rate decide together: an epoch time (:data:`EPOCH_SECONDS`) in one of s, ms, µs,
+    ns is in that unit; else seconds when they give a rate in
+    :data:`PLAUSIBLE_RATES`, else the first of ms, µs, ns that does, with a
+    warning (a guess: pass ``units={"time": ...}``).
+    """
+    norm = _normalise(header)[0] if header else ""
+    for unit in _TIME_UNITS:
+        if norm.endswith("_" + unit):
+            return None if unit == "s" else UNITS[unit][1:]
+    steps = np.diff(t)
+    pos = steps[steps > 0]
+    if not len(pos) and len(steps):
+        pos = -steps[steps < 0]  # time that only goes back still has a step
+    if not len(pos):
+        return None
+    step = float(np.median(pos))
+    size = float(np.median(np.abs(t)))
+    rate = {u: 1.0 / (step * UNITS[u][1]) for u in _TIME_UNITS}
+    epoch = [u for u in _TIME_UNITS if EPOCH_SECONDS[0] <= size * UNITS[u][1] <= EPOCH_SECONDS[1]]
+    if epoch:  # the magnitude of a date leaves no doubt
+        return None if epoch[0] == "s" else UNITS[epoch[0]][1:]
+    fits = [u for u in _TIME_UNITS if PLAUSIBLE_RATES[0] <= rate[u] <= PLAUSIBLE_RATES[1]]
+    chosen = fits[0] if fits else "s"
+    if chosen != "s":
+        column = f"time column {header!r}" if header else "time column"
+        warnings.warn(
+            f"{source}: {column} has no unit; taken as {chosen}: a median step of {step:.6g} "
+            f"gives {rate[chosen]:.6g} Hz in {chosen} ({rate['s']:.6g} Hz in seconds); pass "
+            "units={'time': ...} (CLI: --units time=...) to say it",
+            stacklevel=5,
+        )
+    return None if chosen == "s" else UNITS[chosen][1:]
 
 
 def _no_columns_message(name: str, names: list[str] | None, first: list[str]) -> str:
