@@ -159,3 +159,38 @@ def test_load_refuses_inconsistent_metadata_naming_the_field(field, value, tmp_p
         scale.load(out)
     with pytest.raises(ValueError, match=rf"'{__import__('re').escape(field)}'"):
         imunoise.read(out)
+
+
+def _both_streams(n: int = 400, fs: float = 200.0) -> bytes:
+    """Binary packets with a jittered nanosecond TimeStartup, ASCII sentences between
+    them (as serial_both_streams.bin: the binary stream is the richest table)."""
+    rng = np.random.default_rng(11)
+    t = np.round((1.0 + np.arange(n) / fs + rng.normal(0, 2e-5, n)) * 1e9) / 1e9
+    gyro, accel = rng.normal(0, 0.01, (n, 3)), rng.normal(0, 0.01, (n, 3))
+    quat = np.tile([0.0, 0.0, 0.0, 1.0], (n, 1))
+    packets = imunoise.write_vn_binary({"gyro": gyro, "accel": accel, "mag": accel, "ypr": gyro,
+                                        "quaternion": quat, "time": t})
+    size = len(packets) // n
+    lines = imunoise.write_vn_ascii({"ypr": gyro, "mag": accel, "accel": accel, "gyro": gyro},
+                                    ).splitlines(keepends=True)
+    return b"".join(packets[i * size:(i + 1) * size] + lines[i] for i in range(n))
+
+
+@pytest.mark.parametrize("suffix", ["", ".npy", ".parquet"])
+def test_read_and_convert_then_load_agree(suffix, tmp_path):
+    src = tmp_path / "both.bin"
+    src.write_bytes(_both_streams())
+    log = imunoise.read(src)
+    assert log.time is not None and log.issues.counts["bad_checksum"] == 0
+    back = scale.load(scale.convert(src, tmp_path / f"out{suffix}"))
+    assert_same_log(back, log, source=True)
+
+
+def test_read_and_convert_then_load_agree_on_serial_both_streams(tmp_path):
+    from helpers.data import shared_file
+
+    src = shared_file("data/vn100-binary/serial_both_streams.bin")
+    log = imunoise.read(src)
+    back = scale.load(scale.convert(src, tmp_path / "out.npy"))
+    assert back.fs == log.fs  # was 200.00000003 vs 200.00141
+    assert_same_log(back, log, source=True)
