@@ -194,3 +194,29 @@ def test_read_and_convert_then_load_agree_on_serial_both_streams(tmp_path):
     back = scale.load(scale.convert(src, tmp_path / "out.npy"))
     assert back.fs == log.fs  # was 200.00000003 vs 200.00141
     assert_same_log(back, log, source=True)
+
+
+def test_a_streamed_conversion_keeps_reads_clock(tmp_path):
+    """Larger than one piece: the streamed grid finds the same rate (least-squares
+    line, not the median step), gaps, outlier stamp and reset as ``read``."""
+    rng = np.random.default_rng(2)
+    n, fs = 3000, 200.0
+    t = np.round((1 + np.arange(n) / fs * (1 + 3e-5) + rng.normal(0, 2e-5, n)) * 1e9) / 1e9
+    t = np.delete(t, [500, 501, 502, 1700])
+    t[900] = 1.5e9  # one absurd stamp in a CRC-valid packet
+    t[2000:] -= t[2000] - 0.5  # the device restarted: TimeStartup from 0.5 s again
+    gyro = rng.normal(0, 0.01, (len(t), 3))
+    src = tmp_path / "big.bin"
+    imunoise.write_vn_binary({"gyro": gyro, "accel": gyro, "time": t}, path=src)
+    with pytest.warns(UserWarning, match="time_outlier"):
+        log = imunoise.read(src)
+    back = scale.load(scale.convert(src, tmp_path / "big.npy", chunk_bytes=4096))
+    assert back.fs == pytest.approx(log.fs, rel=1e-8)  # the median step is 30 ppm off
+    assert abs(1 / np.median(np.diff(t[:900])) - log.fs) > 1e-3
+    assert len(back) == len(log)
+    np.testing.assert_array_equal(back.gaps.index, log.gaps.index)
+    np.testing.assert_array_equal(np.isnan(back.gyro), np.isnan(log.gyro))
+    for kind in ("time_outlier", "time_reset", "duplicate_time"):
+        assert back.issues.counts[kind] == log.issues.counts[kind], kind
+        assert back.issues.first[kind] == log.issues.first[kind], kind
+    assert log.issues.counts["time_reset"] == 1 and log.issues.counts["time_outlier"] == 1

@@ -55,7 +55,7 @@ import numpy as np
 from imunoise import _summary
 from imunoise._runs import true_runs
 
-__all__ = ["MAX_GRID_RATIO", "Gaps", "TimeGrid"]
+__all__ = ["MAX_GRID_RATIO", "Gaps", "TimeGrid", "outlier_stamps"]
 
 #: Timestamps that would make a grid this many times longer than the samples
 #: (over 99 % missing) are not taken as a sample clock.
@@ -285,7 +285,7 @@ class Gaps:
         )
 
 
-def _outliers(t: np.ndarray, steps: np.ndarray, dt0: float) -> tuple[np.ndarray, np.ndarray]:
+def outlier_stamps(t: np.ndarray, steps: np.ndarray, dt0: float) -> tuple[np.ndarray, np.ndarray]:
     """Timestamps one bad value made: indices and the times their neighbours give them.
 
     The residual ``r = t - i * dt0`` of a clock with gaps only grows (a step per
@@ -402,7 +402,7 @@ class TimeGrid:
         if n < 3 or len(pos) < 2:  # too short to find gaps; the rate of what is there
             return cls(np.arange(n, dtype=np.int64), n, fs=1.0 / float(np.median(pos)))
         dt0 = float(np.median(pos))
-        out, out_t = _outliers(t, steps, dt0)
+        out, out_t = outlier_stamps(t, steps, dt0)
         if len(out):
             t = t.copy()
             t[out] = out_t

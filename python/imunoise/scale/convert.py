@@ -47,7 +47,15 @@ from imunoise._core import vn as _core_vn
 from imunoise._schema import CHANNELS, column_names
 from imunoise.readers import registry
 from imunoise.readers.columnar import META_KEY, log_meta, meta_path, read_columnar
-from imunoise.readers.grid import Gaps, TimeGrid
+from imunoise.readers.grid import (
+    FIRST_KEPT,
+    OUTLIER_WINDOW,
+    RESET_STEPS,
+    SAME_STEP,
+    Gaps,
+    TimeGrid,
+    outlier_stamps,
+)
 from imunoise.readers.log import ImuLog, ParseIssues, fs_from_median_step
 from imunoise.readers.vn import richest_table, table_channels, tables_of
 
@@ -379,7 +387,12 @@ class _GridStream:
     With timestamps, the nominal step is the median positive step of the first
     piece that has two, and every sample goes ``round(step / dt)`` rows after the
     one before; a sample that does not advance the grid (a duplicate, or a
-    timestamp that goes back) is dropped and counted. Without timestamps, every
+    timestamp that goes back) is dropped and counted. As in ``read``, an outlier
+    stamp (:func:`~imunoise.readers.grid.outlier_stamps`, judged with the last
+    stamps of the piece before) is replaced by its neighbours' time and a jump
+    back of more than :data:`~imunoise.readers.grid.RESET_STEPS` steps starts a
+    new segment right after the last row; the rate is the least-squares line
+    through (row, time) of the samples kept (:meth:`rate`). Without timestamps, every
     damaged record of the table is a NaN row at its place; damaged records after
     the last good one of a piece wait for the next piece (at the end they are the
     capture's edge, not a gap).
@@ -393,12 +406,103 @@ class _GridStream:
         self.gaps: list[list[int]] = []  # [first row, rows] of NaN runs, merged
         self.duplicate_time = 0
         self.time_reversed = 0
+        self.time_outlier = 0
+        self.time_reset = 0
+        self.first: dict[str, list[int]] = {}  # 1-based sample numbers, as TimeGrid.first
+        self.seen = 0  # timestamped samples so far
+        self.tail = np.zeros(0)  # the last kept stamps: context for outliers
+        # per segment of the clock (a reset starts one): the least-squares line
+        # through (row, time) of its kept samples, about its first
+        self.segments: list[dict] = []
+        self.single = True  # every step one nominal step so far
+        self.piece_resets = np.zeros(0, np.int64)  # where the clock restarted in a piece
+        self.held: dict[str, np.ndarray] | None = None  # the last samples, for the next piece
 
-    def place(self, chans: dict[str, np.ndarray], missing) -> dict[str, np.ndarray]:
+    def _note(self, kind: str, where: np.ndarray) -> None:
+        kept = self.first.setdefault(kind, [])
+        kept.extend(int(self.seen + i + 1) for i in where[:FIRST_KEPT - len(kept)])
+
+    def _fit(self, rows: np.ndarray, t: np.ndarray, new_segment: bool = False) -> None:
+        if not len(rows):
+            return
+        if new_segment or not self.segments:
+            self.segments.append({"origin": (float(rows[0]), float(t[0])), "sums": np.zeros(5),
+                                  "span": (float(t[0]), float(t[0])), "steps": _Steps()})
+        seg = self.segments[-1]
+        x, y = rows - seg["origin"][0], t - seg["origin"][1]
+        seg["sums"] += (len(x), x.sum(), y.sum(), x @ x, x @ y)  # n, Σx, Σy, Σx², Σxy
+        seg["span"] = (seg["span"][0], float(t[-1]))
+
+    def _fit_piece(self, rows: np.ndarray, t: np.ndarray, kept: np.ndarray) -> None:
+        """Fit the kept samples of a piece, a new segment after each reset."""
+        bounds = [0, *self.piece_resets.tolist(), len(kept)]
+        for i, (a, b) in enumerate(zip(bounds[:-1], bounds[1:], strict=True)):
+            sel = kept[a:b]
+            self._fit(rows[a:b][sel], t[a:b][sel], new_segment=i > 0)
+            if self.segments:
+                self.segments[-1]["steps"].add(t[a:b])
+
+    def rate(self, median: float | None) -> float | None:
+        """1 / the nominal step, decided as :meth:`TimeGrid.from_timestamps` decides
+        it for the longest segment of the clock: the span over its samples when
+        every step was one nominal step, else the least-squares slope; its median
+        step when either agrees with it to ``SAME_STEP`` (``median``, the whole
+        table's, when the segment has too few samples)."""
+        if median is None:
+            return None
+        seg = max(self.segments, key=lambda g: g["sums"][0], default=None)
+        if seg is None or seg["sums"][0] < 3:
+            return 1.0 / median
+        n, sx, sy, sxx, sxy = seg["sums"]
+        median = seg["steps"].median() or median  # the segment's own, as read has it
+        if self.single:
+            dt = (seg["span"][1] - seg["span"][0]) / (n - 1)
+        else:
+            denom = n * sxx - sx * sx
+            dt = (n * sxy - sx * sy) / denom if denom > 0 else median
+            if not 0.5 * median < dt < 2.0 * median:
+                dt = median
+        if abs(dt - median) <= SAME_STEP * median:
+            dt = median
+        return 1.0 / dt
+
+    def flush(self) -> dict[str, np.ndarray] | None:
+        """The rows of the samples held back at the end of the last piece, placed."""
+        if self.held is None or not len(self.held["time"]):
+            return None
+        held, self.held = self.held, None
+        return self.place(held, None, final=True)
+
+    def place(self, chans: dict[str, np.ndarray], missing, *,
+              final: bool = False) -> dict[str, np.ndarray]:
+        """The rows of a piece on the grid. With timestamps the last
+        :data:`~imunoise.readers.grid.OUTLIER_WINDOW` samples wait for the next
+        piece (or :meth:`flush`): an outlier is judged with samples on both sides."""
+        t = chans.get("time")
+        ahead = np.zeros(0)
+        if t is not None:
+            if self.held is not None:
+                chans = {c: np.concatenate([self.held[c], a]) for c, a in chans.items()}
+                self.held = None
+            if not final:
+                cut = max(len(chans["time"]) - OUTLIER_WINDOW, 0)
+                self.held = {c: a[cut:] for c, a in chans.items()}
+                chans = {c: a[:cut] for c, a in chans.items()}
+                ahead = self.held["time"]
         n = len(next(iter(chans.values())))
         t = chans.get("time")
-        grid = self._time_grid(t) if t is not None else self._missing_grid(n, missing)
+        if t is not None:
+            grid, t = self._time_grid(t, ahead)
+            chans = {**chans, "time": t}
+            if grid is not None:
+                keep = grid.slot >= 0
+                self._fit_piece(self.rows + grid.slot, t, keep)
+                self.tail = np.concatenate([self.tail, t[keep]])[-OUTLIER_WINDOW:]
+        else:
+            grid = self._missing_grid(n, missing)
         if grid is None or grid.is_identity:
+            if t is not None and n and grid is None:
+                self._fit(self.rows + np.arange(n), t)
             self.rows += n
             if t is not None and n:
                 self.last_t = float(t[-1])
@@ -419,26 +523,48 @@ class _GridStream:
         self.rows += grid.n
         return out
 
-    def _time_grid(self, t: np.ndarray) -> TimeGrid | None:
+    def _time_grid(self, t: np.ndarray, ahead: np.ndarray) -> tuple[TimeGrid | None, np.ndarray]:
+        """The grid of one piece's stamps and the stamps with outliers replaced
+        (``ahead``: the stamps that follow, held for the next piece)."""
         t = np.asarray(t, dtype=np.float64)
         if self.dt is None:
             pos = np.diff(t)[np.diff(t) > 0]
             if len(pos) < 2:
-                return None
+                self.seen += len(t)
+                return None, t
             self.dt = float(np.median(pos))
         if not len(t):
-            return None
+            return None, t
+        context = np.concatenate([self.tail, t, ahead])
+        if len(context) >= 3:
+            out, out_t = outlier_stamps(context, np.diff(context), self.dt)
+            mine = (out >= len(self.tail)) & (out < len(self.tail) + len(t))
+            if mine.any():
+                t = t.copy()
+                t[out[mine] - len(self.tail)] = out_t[mine]
+                self.time_outlier += int(mine.sum())
+                self._note("time_outlier", out[mine] - len(self.tail))
         first = [t[0] - self.dt] if self.last_t is None else [self.last_t]
         steps = np.diff(t, prepend=first)
-        k = np.rint(steps / self.dt).astype(np.int64)
+        reset = steps < -RESET_STEPS * self.dt
+        self.piece_resets = np.flatnonzero(reset)
+        with np.errstate(over="ignore", invalid="ignore"):
+            k = np.where(reset, 1, np.rint(steps / self.dt)).astype(np.int64)
         drop = k < 1
-        self.time_reversed += int((steps < 0).sum())
+        back = (steps < 0) & ~reset
+        self.time_reversed += int(back.sum())
+        self.time_reset += int(reset.sum())
         self.duplicate_time += int((drop & (steps >= 0)).sum())
+        self._note("time_reversed", np.flatnonzero(back))
+        self._note("time_reset", np.flatnonzero(reset))
+        self._note("duplicate_time", np.flatnonzero(drop & (steps >= 0)))
+        self.single = self.single and bool(np.all(k[1 if self.last_t is None else 0:] == 1))
+        self.seen += len(t)
         k[drop] = 0
         slot = np.cumsum(k) - 1
         slot[drop] = -1
         n_out = int(slot.max()) + 1 if (~drop).any() else 0
-        return TimeGrid(slot=slot, n=n_out)
+        return TimeGrid(slot=slot, n=n_out), t
 
     def _missing_grid(self, n: int, missing) -> TimeGrid | None:
         p = np.sort(np.asarray(missing if missing is not None else (), dtype=np.int64))
@@ -489,7 +615,8 @@ def _stream_vn(blocks: Iterable[bytes], total: int | None, writer: _Writer, prog
             grid = grids.setdefault(name, _GridStream())
             n = len(next(iter(chans.values())))
             if n == 0:
-                grid.place(chans, rows.missing.get(name))  # damaged records only
+                if "time" not in chans:
+                    grid.place(chans, rows.missing.get(name))  # damaged records only
                 continue
             filled = sum(1 for k in chans if k != "time")
             prev = shape.get(name, (filled, 0))
@@ -507,6 +634,10 @@ def _stream_vn(blocks: Iterable[bytes], total: int | None, writer: _Writer, prog
         del block
     summary = stream.finish()
     write(summary)
+    for name, grid in grids.items():  # the stamps held back for the outlier window
+        rest = grid.flush()
+        if rest is not None:
+            writer.append(name, rest)
     return tables_of(summary), steps, shape, grids
 
 
@@ -617,13 +748,14 @@ def _convert(name: str, source, out: Path, layout: str, *, fs, format: str,
             done = pieces.done
             primary = richest_table(shape)
             step_histogram = steps.get(primary) if primary else None
-            rate = fs_from_median_step(
-                step_histogram.median() if step_histogram is not None else None, fs, name
-            )
             grid = grids[primary] if primary else _GridStream()
-            counts = {**parsed.issues.counts, "duplicate_time": grid.duplicate_time,
-                      "time_reversed": grid.time_reversed}
-            issues = replace(parsed.issues, counts=counts)
+            median = step_histogram.median() if step_histogram is not None else None
+            line = grid.rate(median)
+            rate = fs_from_median_step(None if line is None else 1.0 / line, fs, name)
+            kinds = ("duplicate_time", "time_reversed", "time_outlier", "time_reset")
+            counts = {**parsed.issues.counts, **{k: getattr(grid, k) for k in kinds}}
+            first = {**parsed.issues.first, **{k: tuple(grid.first.get(k, ())) for k in kinds}}
+            issues = replace(parsed.issues, counts=counts, first=first)
             messages, fmt = parsed.messages, parsed.format
             gaps = Gaps(index=[g[0] for g in grid.gaps], samples=[g[1] for g in grid.gaps],
                         fs=rate)
