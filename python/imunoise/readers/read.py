@@ -116,10 +116,11 @@ def read(
         binary file object (``sys.stdin.buffer``) or the path of a FIFO or of
         ``/dev/stdin``. A stream is read once, start to end, its format detected
         from those bytes; the log is named by the path or the object's ``name``.
-    format : {"auto", "vn-ascii", "vn-binary", "csv", "rosbag"}
+    format : {"auto", "vn-ascii", "vn-binary", "csv", "rosbag", "columnar"}
         ``"auto"`` detects the format from the extension and content
         (:func:`detect_format`). Both VN formats use the same reader, which
-        accepts ASCII and binary interleaved in one stream.
+        accepts ASCII and binary interleaved in one stream; ``"columnar"`` is
+        what ``imunoise convert`` writes (:mod:`imunoise.readers.columnar`).
     strict : bool
         Raise :class:`~imunoise.errors.ParseError` (a ``ValueError``) at the first
         damaged record, with its issue kind, line (or message number, or byte
