@@ -277,7 +277,10 @@ def _positive_float(text: str) -> float:
 def _read(args):
     from imunoise.report import read_log
 
-    log = read_log(args.log, "input", fs=args.fs, **_read_options(args))
+    try:
+        log = read_log(args.log, "input", fs=args.fs, **_read_options(args))
+    except ImportError as exc:  # e.g. a Parquet log without pyarrow
+        _fail(str(exc))
     _note_gaps(log.source, log)
     return log
 

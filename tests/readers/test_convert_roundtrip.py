@@ -96,9 +96,12 @@ def test_csv_export_keeps_every_digit_of_epoch_time(tmp_path, capsys):
     back = imunoise.read(out)
     assert len(back) == 13223 and round(back.fs, 4) == 39.9994
     assert_same_log(back, log)
-    # without the metadata line the time column alone gives the same grid and rate
+    # a plain CSV for other tools (header, rows); without the metadata beside it the
+    # time column alone gives the same grid and rate
+    assert out.read_text().startswith("time,gyro_x,")
+    assert (tmp_path / "rt.meta.json").is_file()
     bare = tmp_path / "bare.csv"
-    bare.write_text(out.read_text().split("\n", 1)[1])
+    bare.write_text(out.read_text())
     plain = imunoise.read(bare)
     assert len(plain) == 13223 and plain.fs == log.fs
     np.testing.assert_array_equal(plain.time, log.time)
@@ -220,3 +223,37 @@ def test_a_streamed_conversion_keeps_reads_clock(tmp_path):
         assert back.issues.counts[kind] == log.issues.counts[kind], kind
         assert back.issues.first[kind] == log.issues.first[kind], kind
     assert log.issues.counts["time_reset"] == 1 and log.issues.counts["time_outlier"] == 1
+
+
+def test_an_unknown_format_is_named_with_what_to_do(tmp_path):
+    path = tmp_path / "blob.xyz"
+    path.write_bytes(bytes(range(0x80, 0xF0)) * 8)  # no VN sync byte, no delimiter
+    with pytest.raises(ValueError, match=r"blob\.xyz.*format=.*from_arrays"):
+        imunoise.read(path)
+
+
+def test_metadata_beside_a_csv_is_used_only_when_it_is_imunoise_and_fits(tmp_path, capsys):
+    out = tmp_path / "rt.csv"
+    assert main(["convert", str(CSV_LOG), "-o", str(out)]) == 0
+    log = imunoise.read(CSV_LOG)
+    lines = out.read_text().splitlines(keepends=True)
+    cut = tmp_path / "cut.csv"  # rows removed by hand: the metadata no longer fits
+    cut.write_text("".join(lines[:1000] + lines[1100:]))
+    (tmp_path / "cut.meta.json").write_text((tmp_path / "rt.meta.json").read_text())
+    with pytest.warns(UserWarning, match="no longer match"):
+        plain = imunoise.read(cut)
+    assert len(plain.gaps) == 1 and plain.gaps.samples[0] == 100
+    assert plain.fs == pytest.approx(log.fs, rel=1e-6)
+    mine = tmp_path / "mine.csv"  # someone else's mine.meta.json is not imunoise's
+    mine.write_text(out.read_text())
+    (tmp_path / "mine.meta.json").write_text('{"author": "me"}')
+    assert len(imunoise.read(mine)) == 13223
+
+
+@pytest.mark.parametrize("suffix", ["", ".npy", ".parquet", ".csv", ".npz"])
+def test_a_ros_bag_round_trips_through_every_writer(suffix, tmp_path, capsys):
+    bag = DATA / "vn100-ros" / "11sec_motion_0.mcap"
+    log = imunoise.read(bag)
+    out = tmp_path / f"bag{suffix}"
+    assert main(["convert", str(bag), "-o", str(out)]) == 0
+    assert_same_log(imunoise.read(out), log, source=True)

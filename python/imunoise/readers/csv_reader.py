@@ -18,13 +18,14 @@ import os
 import re
 import warnings
 from collections.abc import Callable, Mapping, Sequence
+from pathlib import Path
 
 import numpy as np
 
 from imunoise._schema import CHANNELS, COLUMN_SUFFIXES, G
 from imunoise.errors import ParseError
 from imunoise.readers._sentences import IssueTally, sentence_rows
-from imunoise.readers.columnar import META_KEY, check_meta, log_from_meta
+from imunoise.readers.columnar import check_meta, log_from_meta, meta_path
 from imunoise.readers.log import ImuLog, log_on_grid
 from imunoise.readers.probe import Confidence, Probe
 
@@ -382,6 +383,7 @@ def read_csv(
     with fh:
         chunks = _lines(fh, total, progress)
         state = _Reader(name, strict, columns, units, delimiter, tally)
+        state.meta = _convert_meta(name)
         state.total = total
         for first_line, lines in chunks:
             state.feed(first_line, lines)
@@ -511,19 +513,6 @@ class _Reader:
             conv[ch] = None if unit is None else _unit_factor(ch, unit)
         return conv
 
-    def _comment(self, line: str, line_no: int) -> None:
-        """Keep the metadata of a CSV written by ``imunoise convert`` (its first line,
-        ``# imunoise {...}``); other comments are not data."""
-        prefix = f"# {META_KEY} "
-        if line_no == 1 and line.startswith(prefix):
-            where = f"{self.name} line 1"
-            try:
-                meta = json.loads(line[len(prefix):])
-            except ValueError as exc:
-                raise ValueError(f"{where}: the imunoise metadata is not valid JSON ({exc})"
-                                 ) from None
-            self.meta = check_meta(meta, where)
-
     # -- rows -----------------------------------------------------------------------
     def _bad(self, line_no: int, reason: str) -> None:
         if self.strict:
@@ -541,7 +530,6 @@ class _Reader:
             while start < len(lines) and (
                 not lines[start].strip() or lines[start].lstrip().startswith("#")
             ):
-                self._comment(lines[start], first_line + start)
                 start += 1
             if start == len(lines):
                 return
@@ -704,6 +692,24 @@ class _Reader:
         )
 
 
+def _convert_meta(name: str) -> dict | None:
+    """The metadata ``imunoise convert`` wrote beside a CSV (``OUT.meta.json``), checked;
+    ``None`` when there is none (or the file of that name is not imunoise's)."""
+    if name == _BYTES:
+        return None
+    meta_file = meta_path(Path(name))
+    if not meta_file.is_file():
+        return None
+    where = str(meta_file)
+    try:
+        meta = json.loads(meta_file.read_bytes())
+    except (ValueError, UnicodeDecodeError) as exc:
+        raise ValueError(f"{where}: the imunoise metadata is not valid JSON ({exc})") from None
+    if not isinstance(meta, dict) or "imunoise_columnar" not in meta:
+        return None  # someone else's file of that name
+    return check_meta(meta, where)
+
+
 def _restore_meta(reader: _Reader, channels, time) -> ImuLog | None:
     """The log a CSV of ``imunoise convert`` was written from, when every row is there
     as written: its rows are that log's grid, with its rate, issues and gaps."""
@@ -717,7 +723,7 @@ def _restore_meta(reader: _Reader, channels, time) -> ImuLog | None:
     if reader.tally.issues("line").total or n != meta["samples"] or set(arrays) != set(
             meta["channels"]):
         warnings.warn(
-            f"{reader.name}: the rows no longer match the imunoise metadata of line 1 "
+            f"{reader.name}: the rows no longer match the imunoise metadata beside it "
             f"({n} rows of {sorted(arrays)}, metadata {meta['samples']} of "
             f"{sorted(meta['channels'])}); read as a plain CSV",
             stacklevel=5,

@@ -44,10 +44,12 @@ def detect_format(source: str | os.PathLike | bytes) -> str:
         return best
     if probe.is_dir:
         raise ValueError(f"source {str(probe.path)!r} is a directory but not a ROS 2 bag")
+    name = "the bytes" if probe.path is None else repr(str(probe.path))
     raise ValueError(
-        "format='auto' could not recognise the source (no VN sentence or packet, no ROS "
-        "bag magic, no delimited text); pass format= one of "
-        f"{FORMATS[1:]}"
+        f"format='auto' could not recognise {name} (no VN sentence or packet, no ROS bag "
+        "magic, no .npy/.npz/Parquet of imunoise convert, no delimited text); pass format= "
+        f"one of {FORMATS[1:]}, or build the log from arrays with "
+        "imunoise.ImuLog.from_arrays(fs, gyro=..., accel=...)"
     )
 
 

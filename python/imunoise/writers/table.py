@@ -3,10 +3,10 @@
 Both carry the metadata of :func:`imunoise.readers.columnar.log_meta` (rate,
 source, format, issues, messages, gaps), so that :func:`imunoise.read` gives
 back the log that was written: the ``.npz`` as an entry ``imunoise`` (a JSON
-string), the CSV as its first line, a comment ``# imunoise {...}`` that the CSV
-reader skips as a comment and restores from. Every value is written with the
-shortest text that parses back to the same float64 (numpy's round-trip repr):
-epoch times keep their nanoseconds, samples are bit-identical.
+string), the CSV in ``OUT.meta.json`` beside it (the CSV itself stays a plain
+header and rows for any other tool). Every value is written with the shortest
+text that parses back to the same float64 (numpy's round-trip repr): epoch
+times keep their nanoseconds, samples are bit-identical.
 """
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from imunoise._schema import column_names
-from imunoise.readers.columnar import META_KEY, log_meta
+from imunoise.readers.columnar import META_KEY, log_meta, meta_path
 from imunoise.readers.log import ImuLog
 
 __all__ = ["log_columns", "write_csv", "write_npz"]
@@ -51,26 +51,27 @@ def _meta(log: ImuLog) -> dict:
                     gaps=log.gaps)
 
 
-def write_csv(log: ImuLog, out) -> Path:
-    """Write ``log`` as CSV: the metadata comment, a header, one row per grid row
-    (NaN in missing rows); returns the path."""
+def write_csv(log: ImuLog, out) -> list[Path]:
+    """Write ``log`` as CSV (a header, one row per grid row, NaN in missing rows) and
+    its metadata as ``OUT.meta.json``; returns both paths."""
     out = Path(os.fspath(out))
     names, cols = log_columns(log)
     with open(out, "w", encoding="utf-8", newline="\n") as fh:
-        fh.write(f"# {META_KEY} {json.dumps(_meta(log), separators=(',', ':'))}\n")
         fh.write(",".join(names) + "\n")
         for start in range(0, len(log), _CSV_ROWS):
             text = [c[start:start + _CSV_ROWS].astype(str) for c in cols]  # round-trip repr
             fh.write("".join(",".join(row) + "\n" for row in zip(*text, strict=True)))
-    return out
+    meta_file = meta_path(out)
+    meta_file.write_text(json.dumps(_meta(log), indent=1))
+    return [out, meta_file]
 
 
-def write_npz(log: ImuLog, out) -> Path:
+def write_npz(log: ImuLog, out) -> list[Path]:
     """Write ``log`` as ``.npz``: ``fs``, the flat columns and the metadata; returns
-    the path."""
+    ``[path]``."""
     out = Path(os.fspath(out))
     names, cols = log_columns(log)
     with open(out, "wb") as fh:
         np.savez(fh, fs=np.float64(log.fs), **dict(zip(names, cols, strict=True)),
                  **{META_KEY: np.array(json.dumps(_meta(log)))})
-    return out
+    return [out]
