@@ -18,7 +18,6 @@ from imunoise._schema import (
     CHANNELS,
     SAMPLE_SENSORS,
     axis_names,
-    column_names,
     sensor_label,
 )
 from imunoise.allan import KINDS
@@ -286,7 +285,10 @@ def _positive_float(text: str) -> float:
 def _read(args):
     from imunoise.report import read_log
 
-    log = read_log(args.log, "input", fs=args.fs, **_read_options(args))
+    try:
+        log = read_log(args.log, "input", fs=args.fs, **_read_options(args))
+    except ImportError as exc:  # e.g. a Parquet log without pyarrow
+        _fail(str(exc))
     _note_gaps(log.source, log)
     return log
 
@@ -515,21 +517,6 @@ def _cmd_dadev(args) -> int:
     return 0
 
 
-def _columns(log) -> tuple[list[str], list[np.ndarray]]:
-    names, cols = [], []
-    if log.time is not None:
-        names.append("time")
-        cols.append(np.asarray(log.time))
-    for ch in log.channels:
-        arr = getattr(log, ch)
-        names.extend(column_names(ch))
-        cols.extend([arr] if arr.ndim == 1 else [arr[:, j] for j in range(arr.shape[1])])
-    if len(log.gaps):
-        names.append("valid")
-        cols.append(log.valid.astype(np.float64))
-    return names, cols
-
-
 def _cmd_convert(args) -> int:
     out = Path(args.output)
     suffix = out.suffix.lower()
@@ -538,15 +525,12 @@ def _cmd_convert(args) -> int:
               f"got {str(out)!r}")
     if suffix in ("", ".npy", ".parquet"):
         return _convert_streaming(args, out)
+    from imunoise.writers.table import log_columns, write_csv, write_npz
+
     log = _read(args)
-    names, cols = _columns(log)
     out.parent.mkdir(parents=True, exist_ok=True)
-    if suffix == ".csv":
-        np.savetxt(out, np.column_stack(cols), delimiter=",", header=",".join(names),
-                   comments="", fmt="%.10g")
-    else:
-        np.savez(out, fs=log.fs, **dict(zip(names, cols, strict=True)))
-    print(f"wrote {len(log)} samples x {len(names)} columns to {out}")
+    (write_csv if suffix == ".csv" else write_npz)(log, out)
+    print(f"wrote {len(log)} samples x {len(log_columns(log)[0])} columns to {out}")
     return 0
 
 
@@ -554,13 +538,14 @@ def _convert_streaming(args, out: Path) -> int:
     from imunoise import scale
     from imunoise._progress import byte_bar, wanted
 
+    source = sys.stdin.buffer if args.log == "-" else args.log
     bar = byte_bar(f"converting {Path(args.log).name}") if wanted(args.progress) else None
     try:
-        done = scale.convert(args.log, out, fs=args.fs, chunk_bytes=int(args.chunk_mb * 2**20),
+        done = scale.convert(source, out, fs=args.fs, chunk_bytes=int(args.chunk_mb * 2**20),
                              progress=bar)
     except ImportError as exc:
         _fail(str(exc))
-    _note_gaps(str(args.log), done)
+    _note_gaps("<stdin>" if args.log == "-" else str(args.log), done)
     print(f"wrote {done.samples} samples ({', '.join(done.channels)}) at {done.fs:.6g} Hz to "
           f"{done.out}; parse issues: {done.issues}")
     return 0

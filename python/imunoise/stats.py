@@ -245,6 +245,9 @@ def describe(x, fs: float | None = None) -> Description:
     if isinstance(x, ImuLog):
         log = x
         fs = log.fs if fs is None else fs
+        if len(log) < 2:
+            raise ValueError(f"x: the log {log.source!r} has {len(log) or 'no'} samples; "
+                             "describe needs at least 2")
         blocks, names, sensors, units = [], [], [], []
         for sensor in SENSOR_CHANNELS:
             arr = getattr(log, sensor)

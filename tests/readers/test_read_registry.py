@@ -12,7 +12,7 @@ YMR = b"$VNYMR,+100.949,-007.330,+000.715,-00.0049,-00.2449,+00.5397,-01.258,-00
 
 
 def test_every_format_has_one_entry():
-    assert FORMATS == ("auto", "vn-ascii", "vn-binary", "csv", "rosbag")
+    assert FORMATS == ("auto", "vn-ascii", "vn-binary", "csv", "rosbag", "columnar")
     assert registry.names() == FORMATS[1:]
     # what scale.convert needs to know: which formats the VN stream parser reads
     assert {f.name for f in registry.FORMATS if f.streamable} == {"vn-ascii", "vn-binary"}

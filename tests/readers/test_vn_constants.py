@@ -17,6 +17,8 @@ def test_issue_kinds_are_the_parsers_then_the_grids():
         "device_error",
         "duplicate_time",
         "time_reversed",
+        "time_outlier",
+        "time_reset",
     )
     assert ISSUE_KINDS[: len(_core_vn.ISSUE_KINDS)] == _core_vn.ISSUE_KINDS
 

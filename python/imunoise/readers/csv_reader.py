@@ -12,17 +12,21 @@ from __future__ import annotations
 
 import csv
 import io
+import json
 import math
 import os
 import re
 import warnings
 from collections.abc import Callable, Mapping, Sequence
+from pathlib import Path
 
 import numpy as np
 
+from imunoise import _warn
 from imunoise._schema import CHANNELS, COLUMN_SUFFIXES, G
 from imunoise.errors import ParseError
 from imunoise.readers._sentences import IssueTally, sentence_rows
+from imunoise.readers.columnar import check_meta, log_from_meta, meta_path
 from imunoise.readers.log import ImuLog, log_on_grid
 from imunoise.readers.probe import Confidence, Probe
 
@@ -84,6 +88,10 @@ _VECTOR_PREFIXES = {
     "gyro": ("gyro", "gyr", "gyroscope", "g", "w", "omega", "angular_velocity", "ang_vel"),
     "accel": ("acc", "accel", "accelerometer", "acceleration", "a", "linear_acceleration"),
     "mag": ("mag", "magnetometer", "m", "magnetic_field", "b"),
+    # the names imunoise's own writers give (_schema.column_names)
+    "ypr": ("ypr",),
+    "delta_theta": ("delta_theta",),
+    "delta_velocity": ("delta_velocity",),
 }
 _TIME_NAMES = (
     "time",
@@ -105,15 +113,36 @@ _CHUNK_BYTES = 1 << 22
 
 
 def sniff(probe: Probe) -> Confidence:
-    """A ``.csv``/``.tsv`` file, or a first line with a delimiter (a weak guess)."""
+    """A ``.csv``/``.tsv`` file; a header of names followed by a row of as many
+    fields (as sure as an extension: a stream has none, and VN sentences in a
+    column must not make it a VN log); else a first line with a delimiter (a weak
+    guess)."""
     if probe.is_dir:
         return Confidence.NO
     if probe.suffix in SUFFIXES:
+        return Confidence.NAME
+    if _has_header(probe.head):
         return Confidence.NAME
     first_line = probe.head.split(b"\n", 1)[0]
     if any(d in first_line for d in (b",", b"\t", b";", b" ")):
         return Confidence.GUESS
     return Confidence.NO
+
+
+def _has_header(head: bytes) -> bool:
+    """A first line (after ``#`` comments) of at least two names, then a line with
+    as many fields."""
+    lines = [ln for ln in head.decode("latin-1").splitlines()
+             if ln.strip() and not ln.lstrip().startswith("#")][:2]
+    if len(lines) < 2 or "$VN" in lines[0]:
+        return False
+    delimiter = next((d for d in (",", "\t", ";") if d in lines[0]), None)
+    if delimiter is None:
+        return False
+    names = _split(lines[0], delimiter)
+    return (len(names) >= 2
+            and all(re.match(r"\s*\"?[A-Za-z_%]", f) and not _is_number(f) for f in names)
+            and len(_split(lines[1], delimiter)) == len(names))
 
 
 def _normalise(name: str) -> tuple[str, str | None]:
@@ -200,9 +229,17 @@ def _split(line: str, delimiter: str | None) -> list[str]:
     return line.split(delimiter)
 
 
+def _number(text: str) -> float:
+    """``float(text)``, without Python's digit separators (``1_000``): a logger never
+    writes them, so a field with one is damaged, not a thousand."""
+    if "_" in text:
+        raise ValueError(f"digit separator in {text!r}")
+    return float(text)
+
+
 def _is_number(text: str) -> bool:
     try:
-        float(text)
+        _number(text)
     except ValueError:
         return False
     return True
@@ -225,7 +262,7 @@ def _auto_columns(names: list[str], raw_col: int | None) -> dict[str, list[int]]
                 if min(cols) >= 0:
                     found[channel] = cols
                     break
-        if all(n in index for n in ("yaw", "pitch", "roll")):
+        if "ypr" not in found and all(n in index for n in ("yaw", "pitch", "roll")):
             found["ypr"] = [index["yaw"], index["pitch"], index["roll"]]
         for prefix in ("q", "quat", "quaternion", "orientation"):
             cols = _prefixed(index, prefix, COLUMN_SUFFIXES[4])
@@ -302,8 +339,10 @@ def read_csv(
         Channel -> unit of the file's values (see :data:`UNITS`), e.g.
         ``{"gyro": "deg/s", "accel": "g", "mag": "uT", "time": "ns"}``. Default: a
         unit written in the header (``gx [deg/s]``, ``acc_x (g)``), else the SI unit
-        of the channel; a time column whose median step exceeds 10^4 is taken as
-        nanoseconds.
+        of the channel. A time column without a unit is in the unit its name
+        ends with (``time_ns``, ``t_us``, ``stamp_ms``), else the one its values
+        and rate say together (epoch times, an IMU's rate: see ``_time_unit``),
+        with a warning when that guess is not seconds.
     delimiter : str, optional
         Field separator. Default: ``,`` if the first line has one, else tab, else
         ``;``, else runs of whitespace.
@@ -345,6 +384,7 @@ def read_csv(
     with fh:
         chunks = _lines(fh, total, progress)
         state = _Reader(name, strict, columns, units, delimiter, tally)
+        state.meta = _convert_meta(name)
         state.total = total
         for first_line, lines in chunks:
             state.feed(first_line, lines)
@@ -372,6 +412,7 @@ class _Reader:
         self.vn_time: list[np.ndarray | None] = []
         self.messages: dict[str, int] = {}
         self.rows = 0
+        self.meta: dict | None = None  # of a CSV written by imunoise convert
 
     # -- layout -------------------------------------------------------------------
     def _layout(self, line: str, line_no: int, next_line: str | None) -> bool:
@@ -551,7 +592,7 @@ class _Reader:
             for j, col in enumerate(self.used):
                 text = fields[col].strip()
                 try:
-                    value = float(text)
+                    value = _number(text)
                 except ValueError:
                     self._bad(line_no, f"column {col + 1} is not a number: {text[:40]!r}")
                     ok = False
@@ -626,8 +667,8 @@ class _Reader:
             conv = self.conv[ch]
             if ch == "time":
                 t = values[:, 0]
-                if conv is None and len(t) > 1 and np.median(np.abs(np.diff(t))) > 1e4:
-                    conv = UNITS["ns"][1:]
+                if conv is None:
+                    conv = _time_unit(t, self.names[idx[0]] if self.names else None, self.name)
                 if conv is not None:
                     t = t * conv[0] + conv[1]
                 time = t
@@ -637,6 +678,9 @@ class _Reader:
             channels[ch] = values[:, 0] if CHANNELS[ch][0] == 1 else values
         if time is None:
             time = vn_time
+        restored = _restore_meta(self, channels, time)
+        if restored is not None:
+            return restored
         return log_on_grid(
             fs=fs,
             source=self.name,
@@ -647,6 +691,92 @@ class _Reader:
             messages=messages,
             values_may_be_nan=True,
         )
+
+
+def _convert_meta(name: str) -> dict | None:
+    """The metadata ``imunoise convert`` wrote beside a CSV (``OUT.meta.json``), checked;
+    ``None`` when there is none (or the file of that name is not imunoise's)."""
+    if name == _BYTES:
+        return None
+    meta_file = meta_path(Path(name))
+    if not meta_file.is_file():
+        return None
+    where = str(meta_file)
+    try:
+        meta = json.loads(meta_file.read_bytes())
+    except (ValueError, UnicodeDecodeError) as exc:
+        raise ValueError(f"{where}: the imunoise metadata is not valid JSON ({exc})") from None
+    if not isinstance(meta, dict) or "imunoise_columnar" not in meta:
+        return None  # someone else's file of that name
+    return check_meta(meta, where)
+
+
+def _restore_meta(reader: _Reader, channels, time) -> ImuLog | None:
+    """The log a CSV of ``imunoise convert`` was written from, when every row is there
+    as written: its rows are that log's grid, with its rate, issues and gaps."""
+    meta = reader.meta
+    if meta is None:
+        return None
+    arrays = dict(channels)
+    if time is not None:
+        arrays["time"] = time
+    n = len(next(iter(arrays.values()), ()))
+    if reader.tally.issues("line").total or n != meta["samples"] or set(arrays) != set(
+            meta["channels"]):
+        _warn.warn(
+            f"{reader.name}: the rows no longer match the imunoise metadata beside it "
+            f"({n} rows of {sorted(arrays)}, metadata {meta['samples']} of "
+            f"{sorted(meta['channels'])}); read as a plain CSV"
+        )
+        return None
+    return log_from_meta(meta, arrays, reader.name)
+
+
+#: Rates (Hz) a time unit may give an IMU log before another unit is looked for.
+PLAUSIBLE_RATES = (1.0, 1e5)
+#: Epoch times (s) between 2001 and 2103: a time column this large in some unit is
+#: an epoch time in that unit.
+EPOCH_SECONDS = (1e9, 4.3e9)
+#: Units a time column without one is tried in, in this order (seconds first).
+_TIME_UNITS = ("s", "ms", "us", "ns")
+
+
+def _time_unit(t: np.ndarray, header: str | None, source: str) -> tuple[float, float] | None:
+    """(factor, offset) of a time column whose unit neither ``units=`` nor the header
+    says; ``None`` for seconds.
+
+    A name ending in ``_ns``/``_us``/``_ms``/``_s`` says it. Else the values and the
+    rate decide together: an epoch time (:data:`EPOCH_SECONDS`) in one of s, ms, µs,
+    ns is in that unit; else seconds when they give a rate in
+    :data:`PLAUSIBLE_RATES`, else the first of ms, µs, ns that does, with a
+    warning (a guess: pass ``units={"time": ...}``).
+    """
+    norm = _normalise(header)[0] if header else ""
+    for unit in _TIME_UNITS:
+        if norm.endswith("_" + unit):
+            return None if unit == "s" else UNITS[unit][1:]
+    steps = np.diff(t)
+    pos = steps[steps > 0]
+    if not len(pos) and len(steps):
+        pos = -steps[steps < 0]  # time that only goes back still has a step
+    if not len(pos):
+        return None
+    step = float(np.median(pos))
+    size = float(np.median(np.abs(t)))
+    rate = {u: 1.0 / (step * UNITS[u][1]) for u in _TIME_UNITS}
+    epoch = [u for u in _TIME_UNITS if EPOCH_SECONDS[0] <= size * UNITS[u][1] <= EPOCH_SECONDS[1]]
+    if epoch:  # the magnitude of a date leaves no doubt
+        return None if epoch[0] == "s" else UNITS[epoch[0]][1:]
+    fits = [u for u in _TIME_UNITS if PLAUSIBLE_RATES[0] <= rate[u] <= PLAUSIBLE_RATES[1]]
+    chosen = fits[0] if fits else "s"
+    if chosen != "s":
+        column = f"time column {header!r}" if header else "time column"
+        _warn.warn(
+            f"{source}: {column} has no unit; taken as {chosen}: a median step of {step:.6g} "
+            f"gives {rate[chosen]:.6g} Hz in {chosen} ({rate['s']:.6g} Hz in seconds); pass "
+            "units={'time': ...} (CLI: --units time=...) to say it"
+        )
+    return None if chosen == "s" else UNITS[chosen][1:]
 
 
 def _no_columns_message(name: str, names: list[str] | None, first: list[str]) -> str:

@@ -47,18 +47,32 @@ be seen and are not reported.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections.abc import Mapping
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from imunoise import _summary
 from imunoise._runs import true_runs
 
-__all__ = ["MAX_GRID_RATIO", "Gaps", "TimeGrid"]
+__all__ = ["MAX_GRID_RATIO", "Gaps", "TimeGrid", "outlier_stamps"]
 
 #: Timestamps that would make a grid this many times longer than the samples
 #: (over 99 % missing) are not taken as a sample clock.
 MAX_GRID_RATIO = 100
+#: A timestamp this many nominal steps away from the line of its neighbours (that
+#: they do not follow) is an outlier: counted as ``time_outlier``, its sample kept
+#: at the place its neighbours give it (bunched host stamps stay well inside).
+OUTLIER_STEPS = 10
+#: Samples on each side of a sample whose median residual places it.
+OUTLIER_WINDOW = 5
+#: A step back by more than this many nominal steps (after outliers) is a reset of
+#: the clock (a device restart): the log is split there into segments kept in
+#: file order, each on its own grid, counted as ``time_reset``.
+RESET_STEPS = 10
+#: Locations kept per kind of timestamp problem in ``TimeGrid.first`` (the parse
+#: issues' ``first``).
+FIRST_KEPT = 5
 #: Refits of the clock line through its own slots.
 REFITS = 2
 #: Samples per block of the phase tracker (:func:`_phase`).
@@ -271,6 +285,43 @@ class Gaps:
         )
 
 
+def outlier_stamps(t: np.ndarray, steps: np.ndarray, dt0: float) -> tuple[np.ndarray, np.ndarray]:
+    """Timestamps one bad value made: indices and the times their neighbours give them.
+
+    The residual ``r = t - i * dt0`` of a clock with gaps only grows (a step per
+    gap), so in a window centred on a sample its median is the sample's own
+    residual; a sample :data:`OUTLIER_STEPS` steps away from that median, with
+    neighbours that do not follow it, is an outlier (a corrupt value, one bad
+    stamp). Only samples beside a step that is not one nominal step are looked
+    at. The first and last sample (no window around them) are outliers only when
+    their step to the neighbour is absurd (more than :data:`MAX_GRID_RATIO` times
+    the samples in steps, or backwards by more than :data:`OUTLIER_STEPS`).
+    """
+    n = len(t)
+    with np.errstate(over="ignore", invalid="ignore"):  # an absurd stamp overflows
+        odd = np.flatnonzero(np.rint(steps / dt0) != 1)
+    cand = np.unique(np.concatenate([odd, odd + 1]))
+    if not len(cand):
+        return np.zeros(0, np.int64), np.zeros(0)
+    r = t - np.arange(n) * dt0
+    k = np.minimum(np.minimum(cand, n - 1 - cand), OUTLIER_WINDOW)
+    offsets = np.arange(-OUTLIER_WINDOW, OUTLIER_WINDOW + 1)
+    idx = np.clip(cand[:, None] + offsets, 0, n - 1)
+    window = np.where(np.abs(offsets) <= k[:, None], r[idx], np.nan)
+    with np.errstate(invalid="ignore"):
+        med = np.nanmedian(window, axis=1)
+    bad = (k > 0) & (np.abs(r[cand] - med) > OUTLIER_STEPS * dt0)
+    for end, nb in ((0, 1), (n - 1, n - 2)):  # the ends: only absurd steps
+        if n > 2 and end in cand:
+            step = (t[nb] - t[end]) * (1 if end == 0 else -1)
+            if step > MAX_GRID_RATIO * n * dt0 or step < -OUTLIER_STEPS * dt0:
+                j = int(np.searchsorted(cand, end))
+                bad[j] = True
+                med[j] = r[nb]  # on its neighbour's line, one step away
+    out = cand[bad]
+    return out, med[bad] + out * dt0
+
+
 @dataclass(frozen=True)
 class TimeGrid:
     """Where each sample of a log sits on a uniform grid.
@@ -289,6 +340,18 @@ class TimeGrid:
     duplicate_time, time_reversed : int
         Samples dropped because their slot was taken; timestamps smaller than
         the one before.
+    time_outlier : int
+        Timestamps that did not fit their neighbours (:data:`OUTLIER_STEPS`):
+        their samples are kept, placed (and timed) by their neighbours.
+    time_reset : int
+        Places where the clock restarted (:data:`RESET_STEPS`): the log is the
+        segments between them, in file order, each on its own grid.
+    first : Mapping[str, tuple[int, ...]]
+        For each of those kinds, the 1-based numbers (in input order) of the
+        first samples concerned (for ``time_reset``: the first sample of each new
+        segment).
+    fixed : tuple of (indices, times) or None
+        The outliers and the times their neighbours give them.
     """
 
     slot: np.ndarray
@@ -297,6 +360,10 @@ class TimeGrid:
     t0: float = 0.0
     duplicate_time: int = 0
     time_reversed: int = 0
+    time_outlier: int = 0
+    time_reset: int = 0
+    first: Mapping[str, tuple[int, ...]] = field(default_factory=dict)
+    fixed: tuple[np.ndarray, np.ndarray] | None = None
 
     @classmethod
     def identity(cls, n: int) -> TimeGrid:
@@ -306,8 +373,12 @@ class TimeGrid:
     def from_timestamps(cls, time) -> TimeGrid:
         """The grid of timestamps ``time`` (seconds, or any unit: ``fs`` is per unit).
 
-        Timestamps with no positive finite step give the identity grid without a
-        rate; with one, or only two samples, the identity grid at that rate.
+        Timestamps with no finite step give the identity grid without a rate;
+        timestamps that only go back, the identity grid at the rate of their steps
+        with every step counted as ``time_reversed``; one positive step, or only
+        two samples, the identity grid at that rate. Outlier timestamps are put
+        back on their neighbours' line and resets split the log into segments
+        (see the attributes) before the steps below.
 
         Raises
         ------
@@ -319,11 +390,62 @@ class TimeGrid:
         n = len(t)
         steps = np.diff(t)
         pos = steps[steps > 0]
-        if not np.isfinite(t).all() or not len(pos):
+        if not np.isfinite(t).all():
             return cls.identity(n)
+        if not len(pos):
+            back = np.flatnonzero(steps < 0)
+            if not len(back):
+                return cls.identity(n)
+            return cls(np.arange(n, dtype=np.int64), n, fs=1.0 / float(np.median(-steps[back])),
+                       t0=float(t[0]), time_reversed=len(back),
+                       first={"time_reversed": tuple(int(i) + 2 for i in back[:FIRST_KEPT])})
         if n < 3 or len(pos) < 2:  # too short to find gaps; the rate of what is there
             return cls(np.arange(n, dtype=np.int64), n, fs=1.0 / float(np.median(pos)))
-        dt0 = median = float(np.median(pos))
+        dt0 = float(np.median(pos))
+        out, out_t = outlier_stamps(t, steps, dt0)
+        if len(out):
+            t = t.copy()
+            t[out] = out_t
+            steps = np.diff(t)
+        resets = np.flatnonzero(steps < -RESET_STEPS * dt0)
+        if len(resets) and len(resets) <= n // 20:
+            grid = cls._segments(t, resets + 1)
+        else:
+            grid = cls._one_clock(t, steps, dt0)
+        if not len(out):
+            return grid
+        first = {**grid.first, "time_outlier": tuple(int(i) + 1 for i in out[:FIRST_KEPT])}
+        return replace(grid, time_outlier=len(out), first=first, fixed=(out, out_t))
+
+    @classmethod
+    def _segments(cls, t: np.ndarray, starts: np.ndarray) -> TimeGrid:
+        """The grid of a clock that restarted before each sample of ``starts``: one
+        grid per segment, one after the other in file order (no rows between them:
+        the time between segments is not known); the rate of the longest."""
+        bounds = [0, *starts.tolist(), len(t)]
+        grids = [cls.from_timestamps(t[a:b]) for a, b in zip(bounds[:-1], bounds[1:], strict=True)]
+        slots, offset = [], 0
+        first: dict[str, list[int]] = {"time_reset": [int(i) + 1 for i in starts[:FIRST_KEPT]]}
+        for a, g in zip(bounds, grids, strict=False):
+            slots.append(np.where(g.slot >= 0, g.slot + offset, -1))
+            offset += g.n
+            for kind, where in g.first.items():
+                first.setdefault(kind, []).extend(int(w) + a for w in where)
+        longest = max(range(len(grids)), key=lambda k: bounds[k + 1] - bounds[k])
+        return cls(
+            slot=np.concatenate(slots), n=offset, fs=grids[longest].fs, t0=grids[0].t0,
+            duplicate_time=sum(g.duplicate_time for g in grids),
+            time_reversed=sum(g.time_reversed for g in grids),
+            time_outlier=sum(g.time_outlier for g in grids),
+            time_reset=len(starts) + sum(g.time_reset for g in grids),
+            first={k: tuple(sorted(v)[:FIRST_KEPT]) for k, v in first.items()},
+        )
+
+    @classmethod
+    def _one_clock(cls, t: np.ndarray, steps: np.ndarray, dt0: float) -> TimeGrid:
+        """The grid of timestamps of one clock (no reset), ``dt0`` their median step."""
+        n = len(t)
+        median = dt0
         single = np.rint(steps / dt0) == 1
         if single.all():  # the common case: nothing missing, nothing out of order
             span = float(t[-1] - t[0]) / (n - 1)
@@ -355,13 +477,16 @@ class TimeGrid:
         slot -= lo
         t0 = a + lo * dt
         slot[repeat] = -1
+        back = np.flatnonzero(steps < 0)
         return cls(
             slot=slot,
             n=int(slot.max()) + 1,
             fs=1.0 / dt,
             t0=t0,
             duplicate_time=duplicates,
-            time_reversed=int((steps < 0).sum()),
+            time_reversed=len(back),
+            first={"duplicate_time": tuple(int(i) + 1 for i in np.flatnonzero(repeat)[:FIRST_KEPT]),
+                   "time_reversed": tuple(int(i) + 2 for i in back[:FIRST_KEPT])},
         )
 
     @classmethod
@@ -414,6 +539,9 @@ class TimeGrid:
 
         ``before`` is the time of the row just before row 0 (a piece of a stream);
         without it, row 0 holds a sample."""
+        if time is not None and self.fixed is not None:
+            time = np.array(time, dtype=np.float64)
+            time[self.fixed[0]] = self.fixed[1]
         if time is None or self.is_identity:
             return time
         keep = self.slot >= 0

@@ -36,13 +36,24 @@ DEFAULT_FS = 40.0
 #: - ``duplicate_time``: a sample whose grid slot was taken (same or too-close
 #:   timestamp): dropped
 #: - ``time_reversed``: a timestamp smaller than the one before: kept, placed by its time
-ISSUE_KINDS = (*_core_vn.ISSUE_KINDS, "duplicate_time", "time_reversed")
+#: - ``time_outlier``: a timestamp its neighbours do not follow (one corrupt value):
+#:   the sample kept, placed and timed by its neighbours
+#: - ``time_reset``: the clock restarted (time jumped back): the log continues with
+#:   a new segment, in file order
+#:
+#: The locations (``first``) of these four time kinds are 1-based sample numbers
+#: in the order the samples were read, whatever the format.
+ISSUE_KINDS = (*_core_vn.ISSUE_KINDS, "duplicate_time", "time_reversed", "time_outlier",
+               "time_reset")
+
+#: Issue kinds found on the time grid, located by sample number.
+TIME_KINDS = ("duplicate_time", "time_reversed", "time_outlier", "time_reset")
 
 #: Locations of each issue kind a summary (repr) shows.
 FIRST_SHOWN = 3
 
 #: Kinds that count something other than a skipped record.
-_NOT_RECORDS = ("bytes_skipped", "time_reversed")
+_NOT_RECORDS = ("bytes_skipped", "time_reversed", "time_outlier", "time_reset")
 
 
 @dataclass(frozen=True, repr=False)
@@ -57,7 +68,7 @@ class ParseIssues:
     first : Mapping[str, tuple[int, ...]]
         The first few locations of each kind: 1-based line numbers for text
         formats, 0-based byte offsets for binary ones, 1-based message numbers
-        for bags.
+        for bags; for the time kinds (:data:`TIME_KINDS`) 1-based sample numbers.
     location : str
         ``"line"``, ``"byte"`` or ``"message"``: what the numbers in ``first`` are.
     samples_missing : int
@@ -115,7 +126,8 @@ class ParseIssues:
             return ""
         shown = ", ".join(str(w) for w in where[:FIRST_SHOWN])
         more = ", …" if self.counts[kind] > FIRST_SHOWN else ""
-        return f"{self.location}{'s' if len(where) > 1 else ''} {shown}{more}"
+        unit = "sample" if kind in TIME_KINDS else self.location
+        return f"{unit}{'s' if len(where) > 1 else ''} {shown}{more}"
 
     def __repr__(self) -> str:
         parts = [f"{k}={v}" + (f" ({self._first(k)})" if self.first[k] else "")
@@ -381,11 +393,12 @@ def log_on_grid(
     if grid is None:
         grid = TimeGrid.identity(n)
     rate = grid.fs if grid.fs is not None else fs_from_median_step(None, fs, source)
-    if grid.duplicate_time or grid.time_reversed:
-        counts = dict(issues.counts)
-        counts["duplicate_time"] += grid.duplicate_time
-        counts["time_reversed"] += grid.time_reversed
-        issues = replace(issues, counts=counts)
+    found = {kind: getattr(grid, kind) for kind in TIME_KINDS}
+    if any(found.values()):
+        counts = {k: v + found.get(k, 0) for k, v in issues.counts.items()}
+        first = {k: issues.first[k] + tuple(grid.first.get(k, ())) for k in ISSUE_KINDS}
+        issues = replace(issues, counts=counts, first=first)
+        _warn_time(source, n, found, grid)
     return ImuLog(
         fs=rate,
         source=source,
@@ -396,6 +409,25 @@ def log_on_grid(
         gaps=None if values_may_be_nan else grid.gaps(rate),
         **{name: grid.place(values) for name, values in channels.items()},
     )
+
+
+def _warn_time(source: str, n: int, found: Mapping[str, int], grid: TimeGrid) -> None:
+    """One warning for timestamps that needed a decision: time that only goes back,
+    outliers, resets."""
+    notes = []
+    if found["time_reversed"] and found["time_reversed"] >= n - 1:
+        notes.append("the time decreases at every step: samples kept in file order at the "
+                     "rate of its steps")
+    if found["time_outlier"]:
+        notes.append(f"{found['time_outlier']} timestamp(s) far off their neighbours' line "
+                     f"(samples {list(grid.first.get('time_outlier', ()))}...) taken as "
+                     "corrupt: placed by their neighbours (time_outlier)")
+    if found["time_reset"]:
+        notes.append(f"the clock restarts {found['time_reset']} time(s) (at samples "
+                     f"{list(grid.first.get('time_reset', ()))}...): the log is "
+                     f"{found['time_reset'] + 1} segments in file order (time_reset)")
+    if notes:
+        _warn.warn(f"{source}: " + "; ".join(notes))
 
 
 def fs_from_median_step(

@@ -2,9 +2,13 @@
 
 from __future__ import annotations
 
+import dataclasses
 import os
+import stat
+import warnings
 from collections.abc import Callable, Mapping, Sequence
 
+from imunoise import _warn
 from imunoise._deprecation import old_call_forms
 from imunoise.readers import registry
 from imunoise.readers.log import ImuLog
@@ -41,11 +45,56 @@ def detect_format(source: str | os.PathLike | bytes) -> str:
         return best
     if probe.is_dir:
         raise ValueError(f"source {str(probe.path)!r} is a directory but not a ROS 2 bag")
+    name = "the bytes" if probe.path is None else repr(str(probe.path))
     raise ValueError(
-        "format='auto' could not recognise the source (no VN sentence or packet, no ROS "
-        "bag magic, no delimited text); pass format= one of "
-        f"{FORMATS[1:]}"
+        f"format='auto' could not recognise {name} (no VN sentence or packet, no ROS bag "
+        "magic, no .npy/.npz/Parquet of imunoise convert, no delimited text); pass format= "
+        f"one of {FORMATS[1:]}, or build the log from arrays with "
+        "imunoise.ImuLog.from_arrays(fs, gyro=..., accel=...)"
     )
+
+
+_BYTES = "<bytes>"  # the readers' name of a log given as bytes
+
+#: Name of a log read from a file object without a ``name`` (e.g. a pipe's buffer).
+STREAM_NAME = "<stream>"
+
+
+def is_stream(source) -> bool:
+    """True for what can be read only once, start to end: a binary file object, or
+    a path that is not a regular file or directory (a FIFO, ``/dev/stdin``, a
+    character device)."""
+    if hasattr(source, "read"):
+        return True
+    if not isinstance(source, str | os.PathLike):
+        return False
+    try:
+        mode = os.stat(os.fspath(source)).st_mode
+    except OSError:
+        return False
+    return not (stat.S_ISREG(mode) or stat.S_ISDIR(mode))
+
+
+def stream_name(source) -> str:
+    """The name a stream's log is known by: its path, or the file object's name."""
+    if isinstance(source, str | os.PathLike):
+        return os.fspath(source)
+    name = getattr(source, "name", None)
+    return name if isinstance(name, str) and not name.isdigit() else STREAM_NAME
+
+
+def read_stream(source) -> bytes:
+    """Every byte of a stream, read once from where it stands to its end (a pipe, a
+    FIFO or stdin cannot be rewound, so formats are detected from these bytes and
+    the reader is given them: nothing is read twice, nothing is lost)."""
+    if isinstance(source, str | os.PathLike):
+        with open(os.fspath(source), "rb") as f:
+            return f.read()
+    data = source.read()
+    if isinstance(data, str):
+        raise TypeError(f"{stream_name(source)}: a stream must be opened in binary mode "
+                        "(e.g. sys.stdin.buffer, open(path, 'rb'))")
+    return bytes(data)
 
 
 @old_call_forms(keyword_only=("format",))
@@ -65,12 +114,16 @@ def read(
 
     Parameters
     ----------
-    source : str, os.PathLike or bytes
-        A file (or ROS 2 bag directory), or the bytes of a log.
-    format : {"auto", "vn-ascii", "vn-binary", "csv", "rosbag"}
+    source : str, os.PathLike, bytes or binary file object
+        A file (or ROS 2 bag directory), the bytes of a log, or a stream: a
+        binary file object (``sys.stdin.buffer``) or the path of a FIFO or of
+        ``/dev/stdin``. A stream is read once, start to end, its format detected
+        from those bytes; the log is named by the path or the object's ``name``.
+    format : {"auto", "vn-ascii", "vn-binary", "csv", "rosbag", "columnar"}
         ``"auto"`` detects the format from the extension and content
         (:func:`detect_format`). Both VN formats use the same reader, which
-        accepts ASCII and binary interleaved in one stream.
+        accepts ASCII and binary interleaved in one stream; ``"columnar"`` is
+        what ``imunoise convert`` writes (:mod:`imunoise.readers.columnar`).
     strict : bool
         Raise :class:`~imunoise.errors.ParseError` (a ``ValueError``) at the first
         damaged record, with its issue kind, line (or message number, or byte
@@ -105,8 +158,19 @@ def read(
     choices = ("auto", *registry.names())
     if format not in choices:
         raise ValueError(f"format must be one of {choices}; got {format!r}")
+    if is_stream(source):
+        name = stream_name(source)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            log = read(read_stream(source), format=format, strict=strict, fs=fs,
+                       progress=progress, columns=columns, units=units, delimiter=delimiter,
+                       time_column=time_column)
+        for w in caught:  # name the stream, not "<bytes>"
+            _warn.warn(str(w.message).replace(_BYTES, name), w.category)
+        return dataclasses.replace(log, source=name) if log.source == _BYTES else log
     if not isinstance(source, (bytes, bytearray, memoryview, str, os.PathLike)):
-        raise TypeError(f"source must be a path or bytes; got {type(source).__name__}")
+        raise TypeError(f"source must be a path, bytes or a binary file object; got "
+                        f"{type(source).__name__}")
     layout = {k: v for k, v in (("columns", columns), ("units", units),
                                  ("delimiter", delimiter), ("time_column", time_column))
               if v is not None}

@@ -10,7 +10,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass
 
-from imunoise.readers import csv_reader, rosbag_reader
+from imunoise.readers import columnar, csv_reader, rosbag_reader
 from imunoise.readers.log import ImuLog
 from imunoise.readers.probe import Confidence, Probe
 from imunoise.readers.vn import read_vn
@@ -66,6 +66,8 @@ FORMATS: tuple[Format, ...] = (
     Format("vn-binary", _sniff_vn_binary, read_vn, streamable=True),
     Format("csv", csv_reader.sniff, csv_reader.read_csv),
     Format("rosbag", rosbag_reader.sniff, rosbag_reader.read_rosbag),
+    # what `imunoise convert` writes: .npy + meta, a directory of .npy, .npz, .parquet
+    Format("columnar", columnar.sniff, columnar.read_columnar),
 )
 
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import sys
 import warnings
 from pathlib import Path
 
@@ -19,8 +20,9 @@ def read_log(source, label: str = "input", *, fs: float | None = None,
 
     Parameters
     ----------
-    source : path or ImuLog
-        A log file (any format :func:`imunoise.read` knows); an ``ImuLog`` is
+    source : path, ``"-"``, binary file object or ImuLog
+        A log file (any format :func:`imunoise.read` knows), ``"-"`` for
+        standard input, a stream (read once, start to end); an ``ImuLog`` is
         returned as it is.
     label : str
         The log's role in messages, e.g. ``"short"``: "short log 'x.txt' does
@@ -44,15 +46,22 @@ def read_log(source, label: str = "input", *, fs: float | None = None,
     """
     if isinstance(source, ImuLog):
         return source
-    path = Path(source)
-    if not path.exists():
-        raise OSError(f"{label} log {str(path)!r} does not exist")
-    callback = byte_bar(f"reading {path.name}") if wanted(progress) else None
+    if source == "-":  # the command line's name for standard input
+        source = sys.stdin.buffer
+    if hasattr(source, "read"):
+        path, name = source, getattr(source, "name", "<stream>")
+    else:
+        path = Path(source)
+        name = str(path)
+        if not path.exists():
+            raise OSError(f"{label} log {name!r} does not exist")
+    callback = (byte_bar(f"reading {Path(str(name)).name}")
+                if wanted(progress) and not hasattr(path, "read") else None)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         log = read(path, fs=fs, progress=callback, **read_options)
     if len(log) == 0:
-        raise ValueError(f"{label} log {str(path)!r}: no usable records ({log.issues})")
+        raise ValueError(f"{label} log {name!r}: no usable records ({log.issues})")
     for w in caught:
         _warn.warn(w.message, w.category)
     return log

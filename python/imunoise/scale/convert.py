@@ -26,8 +26,9 @@ Output layouts (chosen by ``out``):
     ``imunoise``: the JSON of ``meta.json``). :func:`load` reads Parquet into
     memory.
 
-VN-100 logs (ASCII, binary, or both) are streamed; CSV and ROS bags are read
-whole by :func:`imunoise.read` and then written the same way.
+VN-100 logs (ASCII, binary, or both) larger than one piece are streamed; smaller
+ones, CSV and ROS bags are read whole by :func:`imunoise.read` and then written
+the same way (so a log of one piece converts to exactly what ``read`` gives).
 """
 
 from __future__ import annotations
@@ -35,7 +36,8 @@ from __future__ import annotations
 import json
 import os
 import shutil
-from collections.abc import Callable, Iterable, Mapping
+from collections.abc import Callable, Iterable, Iterator, Mapping
+from contextlib import ExitStack
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -44,7 +46,16 @@ import numpy as np
 from imunoise._core import vn as _core_vn
 from imunoise._schema import CHANNELS, column_names
 from imunoise.readers import registry
-from imunoise.readers.grid import Gaps, TimeGrid
+from imunoise.readers.columnar import META_KEY, log_meta, meta_path, read_columnar
+from imunoise.readers.grid import (
+    FIRST_KEPT,
+    OUTLIER_WINDOW,
+    RESET_STEPS,
+    SAME_STEP,
+    Gaps,
+    TimeGrid,
+    outlier_stamps,
+)
 from imunoise.readers.log import ImuLog, ParseIssues, fs_from_median_step
 from imunoise.readers.vn import richest_table, table_channels, tables_of
 
@@ -52,7 +63,6 @@ __all__ = ["CHUNK_BYTES", "Conversion", "convert", "load"]
 
 #: Default bytes read per piece by :func:`convert`.
 CHUNK_BYTES = 64 << 20
-_META_VERSION = 1
 
 
 @dataclass(frozen=True)
@@ -192,10 +202,10 @@ class _DirSink(_Sink):
             dest = out / f"{ch}.npy"
             os.replace(self.staging / f"{ch}.npy", dest)
             files.append(dest)
-        meta_path = out / "meta.json"
-        meta_path.write_text(json.dumps(meta, indent=1))
+        meta_file = out / "meta.json"
+        meta_file.write_text(json.dumps(meta, indent=1))
         shutil.rmtree(self.staging, ignore_errors=True)
-        return [*files, meta_path]
+        return [*files, meta_file]
 
 
 def _record_dtype(channels: list[str]) -> np.dtype:
@@ -224,13 +234,9 @@ class _NpySink(_Sink):
 
     def publish(self, out, meta):
         os.replace(self.staging, out)
-        meta_path = _npy_meta_path(out)
-        meta_path.write_text(json.dumps(meta, indent=1))
-        return [out, meta_path]
-
-
-def _npy_meta_path(out: Path) -> Path:
-    return out.with_name(out.stem + ".meta.json")
+        meta_file = meta_path(out)
+        meta_file.write_text(json.dumps(meta, indent=1))
+        return [out, meta_file]
 
 
 class _ParquetSink(_Sink):
@@ -258,7 +264,7 @@ class _ParquetSink(_Sink):
     def close(self, meta):
         if meta is not None:
             self.writer.add_key_value_metadata({
-                "fs": repr(meta["fs"]), "source": meta["source"], "imunoise": json.dumps(meta),
+                "fs": repr(meta["fs"]), "source": meta["source"], META_KEY: json.dumps(meta),
             })
         self.writer.close()
 
@@ -381,7 +387,12 @@ class _GridStream:
     With timestamps, the nominal step is the median positive step of the first
     piece that has two, and every sample goes ``round(step / dt)`` rows after the
     one before; a sample that does not advance the grid (a duplicate, or a
-    timestamp that goes back) is dropped and counted. Without timestamps, every
+    timestamp that goes back) is dropped and counted. As in ``read``, an outlier
+    stamp (:func:`~imunoise.readers.grid.outlier_stamps`, judged with the last
+    stamps of the piece before) is replaced by its neighbours' time and a jump
+    back of more than :data:`~imunoise.readers.grid.RESET_STEPS` steps starts a
+    new segment right after the last row; the rate is the least-squares line
+    through (row, time) of the samples kept (:meth:`rate`). Without timestamps, every
     damaged record of the table is a NaN row at its place; damaged records after
     the last good one of a piece wait for the next piece (at the end they are the
     capture's edge, not a gap).
@@ -395,12 +406,103 @@ class _GridStream:
         self.gaps: list[list[int]] = []  # [first row, rows] of NaN runs, merged
         self.duplicate_time = 0
         self.time_reversed = 0
+        self.time_outlier = 0
+        self.time_reset = 0
+        self.first: dict[str, list[int]] = {}  # 1-based sample numbers, as TimeGrid.first
+        self.seen = 0  # timestamped samples so far
+        self.tail = np.zeros(0)  # the last kept stamps: context for outliers
+        # per segment of the clock (a reset starts one): the least-squares line
+        # through (row, time) of its kept samples, about its first
+        self.segments: list[dict] = []
+        self.single = True  # every step one nominal step so far
+        self.piece_resets = np.zeros(0, np.int64)  # where the clock restarted in a piece
+        self.held: dict[str, np.ndarray] | None = None  # the last samples, for the next piece
 
-    def place(self, chans: dict[str, np.ndarray], missing) -> dict[str, np.ndarray]:
+    def _note(self, kind: str, where: np.ndarray) -> None:
+        kept = self.first.setdefault(kind, [])
+        kept.extend(int(self.seen + i + 1) for i in where[:FIRST_KEPT - len(kept)])
+
+    def _fit(self, rows: np.ndarray, t: np.ndarray, new_segment: bool = False) -> None:
+        if not len(rows):
+            return
+        if new_segment or not self.segments:
+            self.segments.append({"origin": (float(rows[0]), float(t[0])), "sums": np.zeros(5),
+                                  "span": (float(t[0]), float(t[0])), "steps": _Steps()})
+        seg = self.segments[-1]
+        x, y = rows - seg["origin"][0], t - seg["origin"][1]
+        seg["sums"] += (len(x), x.sum(), y.sum(), x @ x, x @ y)  # n, Σx, Σy, Σx², Σxy
+        seg["span"] = (seg["span"][0], float(t[-1]))
+
+    def _fit_piece(self, rows: np.ndarray, t: np.ndarray, kept: np.ndarray) -> None:
+        """Fit the kept samples of a piece, a new segment after each reset."""
+        bounds = [0, *self.piece_resets.tolist(), len(kept)]
+        for i, (a, b) in enumerate(zip(bounds[:-1], bounds[1:], strict=True)):
+            sel = kept[a:b]
+            self._fit(rows[a:b][sel], t[a:b][sel], new_segment=i > 0)
+            if self.segments:
+                self.segments[-1]["steps"].add(t[a:b])
+
+    def rate(self, median: float | None) -> float | None:
+        """1 / the nominal step, decided as :meth:`TimeGrid.from_timestamps` decides
+        it for the longest segment of the clock: the span over its samples when
+        every step was one nominal step, else the least-squares slope; its median
+        step when either agrees with it to ``SAME_STEP`` (``median``, the whole
+        table's, when the segment has too few samples)."""
+        if median is None:
+            return None
+        seg = max(self.segments, key=lambda g: g["sums"][0], default=None)
+        if seg is None or seg["sums"][0] < 3:
+            return 1.0 / median
+        n, sx, sy, sxx, sxy = seg["sums"]
+        median = seg["steps"].median() or median  # the segment's own, as read has it
+        if self.single:
+            dt = (seg["span"][1] - seg["span"][0]) / (n - 1)
+        else:
+            denom = n * sxx - sx * sx
+            dt = (n * sxy - sx * sy) / denom if denom > 0 else median
+            if not 0.5 * median < dt < 2.0 * median:
+                dt = median
+        if abs(dt - median) <= SAME_STEP * median:
+            dt = median
+        return 1.0 / dt
+
+    def flush(self) -> dict[str, np.ndarray] | None:
+        """The rows of the samples held back at the end of the last piece, placed."""
+        if self.held is None or not len(self.held["time"]):
+            return None
+        held, self.held = self.held, None
+        return self.place(held, None, final=True)
+
+    def place(self, chans: dict[str, np.ndarray], missing, *,
+              final: bool = False) -> dict[str, np.ndarray]:
+        """The rows of a piece on the grid. With timestamps the last
+        :data:`~imunoise.readers.grid.OUTLIER_WINDOW` samples wait for the next
+        piece (or :meth:`flush`): an outlier is judged with samples on both sides."""
+        t = chans.get("time")
+        ahead = np.zeros(0)
+        if t is not None:
+            if self.held is not None:
+                chans = {c: np.concatenate([self.held[c], a]) for c, a in chans.items()}
+                self.held = None
+            if not final:
+                cut = max(len(chans["time"]) - OUTLIER_WINDOW, 0)
+                self.held = {c: a[cut:] for c, a in chans.items()}
+                chans = {c: a[:cut] for c, a in chans.items()}
+                ahead = self.held["time"]
         n = len(next(iter(chans.values())))
         t = chans.get("time")
-        grid = self._time_grid(t) if t is not None else self._missing_grid(n, missing)
+        if t is not None:
+            grid, t = self._time_grid(t, ahead)
+            chans = {**chans, "time": t}
+            if grid is not None:
+                keep = grid.slot >= 0
+                self._fit_piece(self.rows + grid.slot, t, keep)
+                self.tail = np.concatenate([self.tail, t[keep]])[-OUTLIER_WINDOW:]
+        else:
+            grid = self._missing_grid(n, missing)
         if grid is None or grid.is_identity:
+            if t is not None and n and grid is None:
+                self._fit(self.rows + np.arange(n), t)
             self.rows += n
             if t is not None and n:
                 self.last_t = float(t[-1])
@@ -421,26 +523,48 @@ class _GridStream:
         self.rows += grid.n
         return out
 
-    def _time_grid(self, t: np.ndarray) -> TimeGrid | None:
+    def _time_grid(self, t: np.ndarray, ahead: np.ndarray) -> tuple[TimeGrid | None, np.ndarray]:
+        """The grid of one piece's stamps and the stamps with outliers replaced
+        (``ahead``: the stamps that follow, held for the next piece)."""
         t = np.asarray(t, dtype=np.float64)
         if self.dt is None:
             pos = np.diff(t)[np.diff(t) > 0]
             if len(pos) < 2:
-                return None
+                self.seen += len(t)
+                return None, t
             self.dt = float(np.median(pos))
         if not len(t):
-            return None
+            return None, t
+        context = np.concatenate([self.tail, t, ahead])
+        if len(context) >= 3:
+            out, out_t = outlier_stamps(context, np.diff(context), self.dt)
+            mine = (out >= len(self.tail)) & (out < len(self.tail) + len(t))
+            if mine.any():
+                t = t.copy()
+                t[out[mine] - len(self.tail)] = out_t[mine]
+                self.time_outlier += int(mine.sum())
+                self._note("time_outlier", out[mine] - len(self.tail))
         first = [t[0] - self.dt] if self.last_t is None else [self.last_t]
         steps = np.diff(t, prepend=first)
-        k = np.rint(steps / self.dt).astype(np.int64)
+        reset = steps < -RESET_STEPS * self.dt
+        self.piece_resets = np.flatnonzero(reset)
+        with np.errstate(over="ignore", invalid="ignore"):
+            k = np.where(reset, 1, np.rint(steps / self.dt)).astype(np.int64)
         drop = k < 1
-        self.time_reversed += int((steps < 0).sum())
+        back = (steps < 0) & ~reset
+        self.time_reversed += int(back.sum())
+        self.time_reset += int(reset.sum())
         self.duplicate_time += int((drop & (steps >= 0)).sum())
+        self._note("time_reversed", np.flatnonzero(back))
+        self._note("time_reset", np.flatnonzero(reset))
+        self._note("duplicate_time", np.flatnonzero(drop & (steps >= 0)))
+        self.single = self.single and bool(np.all(k[1 if self.last_t is None else 0:] == 1))
+        self.seen += len(t)
         k[drop] = 0
         slot = np.cumsum(k) - 1
         slot[drop] = -1
         n_out = int(slot.max()) + 1 if (~drop).any() else 0
-        return TimeGrid(slot=slot, n=n_out)
+        return TimeGrid(slot=slot, n=n_out), t
 
     def _missing_grid(self, n: int, missing) -> TimeGrid | None:
         p = np.sort(np.asarray(missing if missing is not None else (), dtype=np.int64))
@@ -459,9 +583,20 @@ class _GridStream:
         return TimeGrid(slot=np.arange(n, dtype=np.int64) + shift, n=n + len(inner))
 
 
-def _stream_vn(path: Path, writer: _Writer, chunk_bytes: int, progress) -> tuple:
-    """Parse ``path`` piece by piece into ``writer`` with one streaming parser (issues,
-    locations and binary configurations run on across pieces as in one read).
+def _blocks(f, first: bytes, chunk_bytes: int) -> Iterator[bytes]:
+    """``first``, then the rest of the open file ``f`` in pieces of ``chunk_bytes``."""
+    block = first
+    while block:
+        yield block
+        if len(block) < chunk_bytes:
+            return
+        block = f.read(chunk_bytes)
+
+
+def _stream_vn(blocks: Iterable[bytes], total: int | None, writer: _Writer, progress) -> tuple:
+    """Parse the pieces ``blocks`` (``total`` bytes, None for a stream) into ``writer``
+    with one streaming parser (issues, locations and binary configurations run on
+    across pieces as in one read).
 
     Returns the parse summary (:class:`~imunoise.readers.vn.VnTables` without rows),
     the timestamp steps and the ``(channels filled, rows)`` of every table, and the
@@ -480,7 +615,8 @@ def _stream_vn(path: Path, writer: _Writer, chunk_bytes: int, progress) -> tuple
             grid = grids.setdefault(name, _GridStream())
             n = len(next(iter(chans.values())))
             if n == 0:
-                grid.place(chans, rows.missing.get(name))  # damaged records only
+                if "time" not in chans:
+                    grid.place(chans, rows.missing.get(name))  # damaged records only
                 continue
             filled = sum(1 for k in chans if k != "time")
             prev = shape.get(name, (filled, 0))
@@ -489,41 +625,20 @@ def _stream_vn(path: Path, writer: _Writer, chunk_bytes: int, progress) -> tuple
                 steps.setdefault(name, _Steps()).add(chans["time"])
             writer.append(name, grid.place(chans, rows.missing.get(name)))
 
-    total = path.stat().st_size
     done = 0
-    with open(path, "rb") as f:
-        while True:
-            block = f.read(chunk_bytes)
-            done += len(block)
-            write(stream.feed(block))
-            if progress is not None:
-                progress(done, max(total, done))
-            if len(block) < chunk_bytes:
-                break
-            del block
+    for block in blocks:
+        done += len(block)
+        write(stream.feed(block))
+        if progress is not None:
+            progress(done, max(total or done, done))
+        del block
     summary = stream.finish()
     write(summary)
+    for name, grid in grids.items():  # the stamps held back for the outlier window
+        rest = grid.flush()
+        if rest is not None:
+            writer.append(name, rest)
     return tables_of(summary), steps, shape, grids
-
-
-def _meta(*, fs, source, fmt, issues: ParseIssues, messages, samples, channels, table,
-          gaps: Gaps) -> dict:
-    return {
-        "imunoise_columnar": _META_VERSION,
-        "fs": fs,
-        "source": source,
-        "format": fmt,
-        "samples": samples,
-        "channels": list(channels),
-        "table": table,
-        "messages": dict(messages),
-        "issues": {
-            "counts": dict(issues.counts),
-            "first": {k: list(v) for k, v in issues.first.items()},
-            "location": issues.location,
-        },
-        "gaps": {"index": gaps.index.tolist(), "samples": gaps.samples.tolist()},
-    }
 
 
 def convert(
@@ -539,9 +654,11 @@ def convert(
 
     Parameters
     ----------
-    path : str or os.PathLike
-        The log. VN-100 logs (ASCII, binary or both) are streamed with memory
-        bounded by ``chunk_bytes``; CSV and ROS bags are read whole.
+    path : str, os.PathLike or binary file object
+        The log. VN-100 logs (ASCII, binary or both) larger than ``chunk_bytes``
+        are streamed with memory bounded by it; CSV and ROS bags are read whole.
+        A stream (a binary file object such as ``sys.stdin.buffer``, a FIFO) is
+        read once, start to end: its format is detected from the first piece.
     out : str or os.PathLike
         A directory (no suffix), a ``.npy`` or a ``.parquet`` file (see the module
         docstring for the layouts). An existing output is replaced.
@@ -565,9 +682,10 @@ def convert(
     ``load(convert(p, out).out)`` holds exactly the arrays of ``imunoise.read(p)``,
     with the same ``fs`` and parse issue counts.
     """
-    from imunoise.readers.read import FORMATS, detect_format
+    from imunoise.readers.read import FORMATS, detect_format, is_stream, stream_name
 
-    path = Path(os.fspath(path))
+    stream = is_stream(path)
+    name = stream_name(path) if stream else str(Path(os.fspath(path)))
     out = Path(os.fspath(out))
     if isinstance(chunk_bytes, bool) or not isinstance(chunk_bytes, (int, np.integer)):
         raise TypeError(f"chunk_bytes must be an int; got {type(chunk_bytes).__name__}")
@@ -581,31 +699,71 @@ def convert(
             import pyarrow  # noqa: F401
         except ImportError:
             raise ImportError("Parquet output needs pyarrow (pip install pyarrow)") from None
-    if not path.exists():
-        raise FileNotFoundError(2, "no such file", str(path))
-    if format == "auto":
-        format = detect_format(path)
-    out.parent.mkdir(parents=True, exist_ok=True)
+    chunk_bytes = int(chunk_bytes)
+    with ExitStack() as stack:
+        # A log that fits in one piece is converted from imunoise.read's own result
+        # (same grid, same fs to the bit); only larger VN logs are streamed.
+        if stream:  # read once: the format is detected from the first piece, kept
+            f = path if hasattr(path, "read") else stack.enter_context(open(path, "rb"))
+            first = f.read(chunk_bytes)
+            if format == "auto":
+                format = detect_format(first)
+            total = None
+            streamed = registry.get(format).streamable and len(first) == chunk_bytes
+            if not streamed:
+                source = first + f.read()
+                total = len(source)
+        else:
+            path = source = Path(os.fspath(path))
+            if not path.exists():
+                raise FileNotFoundError(2, "no such file", str(path))
+            if format == "auto":
+                format = detect_format(path)
+            total = path.stat().st_size if path.is_file() else None
+            streamed = (registry.get(format).streamable and total is not None
+                        and total > chunk_bytes)
+            if streamed:
+                f = stack.enter_context(open(path, "rb"))
+                first = f.read(chunk_bytes)
+        if streamed:
+            source = _blocks(f, first, chunk_bytes)
+            del first
+        out.parent.mkdir(parents=True, exist_ok=True)
+        return _convert(name, source, out, layout, fs=fs, format=format, total=total,
+                        streamed=streamed, chunk_bytes=chunk_bytes, progress=progress)
+
+
+def _convert(name: str, source, out: Path, layout: str, *, fs, format: str,
+             total: int | None, streamed: bool, chunk_bytes: int, progress) -> Conversion:
+    """:func:`convert` of ``source``: the pieces of a log to stream, or what
+    :func:`imunoise.read` reads whole (a path, or the bytes of a stream)."""
+    from imunoise.readers.read import read
+
     writer = _Writer(out, layout)
+    done = 0
     try:
-        if registry.get(format).streamable and path.is_file():
-            parsed, steps, shape, grids = _stream_vn(path, writer, int(chunk_bytes), progress)
+        if streamed:
+            pieces = _counted(source)
+            parsed, steps, shape, grids = _stream_vn(pieces, total, writer, progress)
+            done = pieces.done
             primary = richest_table(shape)
             step_histogram = steps.get(primary) if primary else None
-            rate = fs_from_median_step(
-                step_histogram.median() if step_histogram is not None else None, fs, str(path)
-            )
             grid = grids[primary] if primary else _GridStream()
-            counts = {**parsed.issues.counts, "duplicate_time": grid.duplicate_time,
-                      "time_reversed": grid.time_reversed}
-            issues = replace(parsed.issues, counts=counts)
+            median = step_histogram.median() if step_histogram is not None else None
+            line = grid.rate(median)
+            rate = fs_from_median_step(None if line is None else 1.0 / line, fs, name)
+            kinds = ("duplicate_time", "time_reversed", "time_outlier", "time_reset")
+            counts = {**parsed.issues.counts, **{k: getattr(grid, k) for k in kinds}}
+            first = {**parsed.issues.first, **{k: tuple(grid.first.get(k, ())) for k in kinds}}
+            issues = replace(parsed.issues, counts=counts, first=first)
             messages, fmt = parsed.messages, parsed.format
             gaps = Gaps(index=[g[0] for g in grid.gaps], samples=[g[1] for g in grid.gaps],
                         fs=rate)
         else:
-            from imunoise.readers.read import read
-
-            log = read(path, format=format, fs=fs, progress=progress)
+            log = read(source, format=format, fs=fs, progress=progress)
+            if log.source == "<bytes>":
+                log = replace(log, source=name)
+            done = len(source) if isinstance(source, bytes) else total
             chans = {ch: getattr(log, ch) for ch in _order([*log.channels, "time"])
                      if getattr(log, ch) is not None}
             primary = "log" if chans and len(log) else None
@@ -617,9 +775,9 @@ def convert(
             rate, issues, messages, fmt = log.fs, log.issues, log.messages, log.format
             gaps = log.gaps
         if primary is None:
-            raise ValueError(f"{path}: no usable records ({issues})")
+            raise ValueError(f"{name}: no usable records ({issues})")
         sink = writer.sinks[primary]
-        meta = _meta(fs=rate, source=str(path), fmt=fmt, issues=issues, messages=messages,
+        meta = log_meta(fs=rate, source=name, fmt=fmt, issues=issues, messages=messages,
                      samples=sink.rows, channels=sink.channels, table=primary, gaps=gaps)
         _remove(out, layout)
         files = writer.finish(primary, meta)
@@ -629,7 +787,20 @@ def convert(
     issues = replace(issues, samples_missing=gaps.total, gaps=len(gaps), samples=sink.rows)
     return Conversion(out=out, files=tuple(files), samples=sink.rows,
                       channels=tuple(sink.channels), fs=rate, issues=issues,
-                      bytes_read=path.stat().st_size, gaps=gaps)
+                      bytes_read=done or 0, gaps=gaps)
+
+
+class _counted:
+    """The pieces of an iterable, counting their bytes in ``done``."""
+
+    def __init__(self, blocks: Iterable[bytes]):
+        self.blocks = blocks
+        self.done = 0
+
+    def __iter__(self) -> Iterator[bytes]:
+        for block in self.blocks:
+            self.done += len(block)
+            yield block
 
 
 def _remove(out: Path, layout: str) -> None:
@@ -641,22 +812,7 @@ def _remove(out: Path, layout: str) -> None:
             for name in ["meta.json", *(f"{c}.npy" for c in ("time", *CHANNELS))]:
                 (out / name).unlink(missing_ok=True)
     elif layout == "npy":
-        _npy_meta_path(out).unlink(missing_ok=True)
-
-
-def _read_meta(out: Path, layout: str) -> dict:
-    if layout == "parquet":
-        import pyarrow.parquet as pq
-
-        kv = pq.read_metadata(out).metadata or {}
-        raw = kv.get(b"imunoise")
-        if raw is None:
-            raise ValueError(f"{out}: not written by imunoise convert (no 'imunoise' metadata)")
-        return json.loads(raw)
-    meta_path = out / "meta.json" if layout == "dir" else _npy_meta_path(out)
-    if not meta_path.exists():
-        raise ValueError(f"{out}: not written by imunoise convert (no {meta_path.name})")
-    return json.loads(meta_path.read_text())
+        meta_path(out).unlink(missing_ok=True)
 
 
 def load(out) -> ImuLog:
@@ -664,7 +820,8 @@ def load(out) -> ImuLog:
 
     The channels of a directory or ``.npy`` output are read-only memory maps:
     nothing is read until used, and :func:`imunoise.adev` reads them in place.
-    A ``.parquet`` output is read into memory.
+    A ``.parquet`` output is read into memory. :func:`imunoise.read` reads the
+    same outputs (format ``"columnar"``).
 
     Parameters
     ----------
@@ -673,37 +830,20 @@ def load(out) -> ImuLog:
     Returns
     -------
     ImuLog
-        ``source``, ``format``, ``fs``, ``issues`` and ``messages`` are those of
-        the converted log.
+        ``source``, ``format``, ``fs``, ``issues``, ``messages`` and ``gaps`` are
+        those of the converted log.
+
+    Raises
+    ------
+    ValueError
+        When the metadata is missing or contradicts itself or the arrays (the
+        error names the field), e.g. a negative count of missing samples.
     """
     if isinstance(out, Conversion):
         out = out.out
     out = Path(os.fspath(out))
     if not out.exists():
         raise FileNotFoundError(2, "no such file or directory", str(out))
-    layout = "dir" if out.is_dir() else _layout(out)
-    meta = _read_meta(out, layout)
-    channels = meta["channels"]
-    if layout == "dir":
-        arrays = {ch: np.load(out / f"{ch}.npy", mmap_mode="r") for ch in channels}
-    elif layout == "npy":
-        rec = np.load(out, mmap_mode="r")
-        arrays = {ch: rec[ch] for ch in channels}
-    else:
-        import pyarrow.parquet as pq
-
-        table = pq.read_table(out)
-        arrays = {}
-        for ch in channels:
-            cols = [table.column(n).to_numpy() for n in column_names(ch)]
-            arrays[ch] = cols[0] if len(cols) == 1 else np.column_stack(cols)
-    iss = meta["issues"]
-    issues = ParseIssues(counts=iss["counts"], first={k: tuple(v) for k, v in
-                                                      iss["first"].items()},
-                         location=iss["location"])
-    fs = float(meta["fs"])
-    # the gaps as convert found them: no pass over memory-mapped channels for NaN
-    gaps = meta.get("gaps")
-    gaps = None if gaps is None else Gaps(gaps["index"], gaps["samples"], fs)
-    return ImuLog(fs=fs, source=meta["source"], format=meta["format"],
-                  issues=issues, messages=meta["messages"], gaps=gaps, **arrays)
+    if not out.is_dir():
+        _layout(out)  # a suffix convert does not write is an error naming the layouts
+    return read_columnar(out)
