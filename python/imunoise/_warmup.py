@@ -381,7 +381,11 @@ def _null_p_values(x, fs, t, bias, duration, seed) -> np.ndarray:
     for c, j in enumerate(np.flatnonzero(ok)):
         kept = np.isfinite(bias[:, j])  # blocks a gap emptied are left out of both
         observed = _explained(t[kept], bias[kept, j:j + 1], taus)[0]
-        coef = {term: _upper(model, term, c) for term in ("N", "B", "K", "R")}
+        # No rate ramp in the null: a trend is what the test looks for, and a ramp
+        # the half log's fit took for its long-tau rise (a random-walk realisation
+        # can look like one) explained the transient away; the rise goes to the
+        # random-walk bound instead.
+        coef = {term: _upper(model, term, c) for term in ("N", "B", "K")}
         coef["K"] = max(coef["K"], float(k_floor[c]))
         null = simulate(len(t), block_rate, channels=NULL_RECORDS, seed=rng,
                         gm=model.components.gauss_markov(c), **coef)
@@ -413,7 +417,7 @@ def _random_walk_bound(result, model, min_edf: float = 5.0) -> np.ndarray:
         if usable.size:
             i = usable[-1]
             tau = result.taus[i : i + 1]
-            others = {t: float(model.components.value(t)[c]) for t in ("Q", "N", "B", "R")}
+            others = {t: float(model.components.value(t)[c]) for t in ("Q", "N", "B")}
             upper = dev[i, c] ** 2 * edf[i, c] / _stats.chi2.ppf(1 - BOUND_CONFIDENCE,
                                                                   edf[i, c])
             rest = upper - float(model_variance(tau, **others)[0])

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from imunoise import _schema, _summary
-from imunoise.noise._terms import GM_MAX, TERMS, _terms
+from imunoise.noise._terms import GM_MAX, TERMS, term_variances
 
 
 def check_term(term: str) -> None:
@@ -201,7 +201,7 @@ class Components:
         parts = np.zeros((t.size, len(names), self.channels))
         for c in range(self.channels):
             markov, tone, osc = self.gauss_markov(c), self.sine(c), self.resonance(c)
-            var = _terms(t, self.fs, [self.value(k)[c] for k in TERMS], markov, tone, osc)
+            var = term_variances(t, self.fs, [self.value(k)[c] for k in TERMS], markov, tone, osc)
             cols = [*range(len(TERMS) + len(markov)), *([names.index("sine")] if tone else []),
                     *([names.index("resonance")] if osc else [])]
             parts[:, cols, c] = var

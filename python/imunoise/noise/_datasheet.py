@@ -26,15 +26,15 @@ import numpy as np
 
 from imunoise._core import fit as _core_fit
 from imunoise.noise._terms import (
-    _PARAMS,
-    _RES,
-    _SINE,
     FLAT_SLOPE,
     FLICKER,
     GM_MAX,
+    PARAMS,
+    RES_SLOT,
+    SINE_SLOT,
     TERMS,
-    _is_log_time,
     gm_white_density,
+    is_log_time,
     resonance_white_density,
 )
 
@@ -58,7 +58,7 @@ def _propagated(components, taus, term: str) -> tuple[np.ndarray, np.ndarray]:
     channels = components.channels
     values = np.zeros(channels)
     stds = np.full(channels, np.nan)
-    cov = np.reshape(components.cov, (channels, _PARAMS, _PARAMS))
+    cov = np.reshape(components.cov, (channels, PARAMS, PARAMS))
     fs = float(components.fs)
     for c in range(channels):
         p = parameters(components, c)
@@ -67,12 +67,12 @@ def _propagated(components, taus, term: str) -> tuple[np.ndarray, np.ndarray]:
         if not f0 > 0:
             continue
         active = np.flatnonzero(np.diag(cov[c]) > 0)
-        grad = np.zeros(_PARAMS)
+        grad = np.zeros(PARAMS)
         for j in active:
-            h = 1e-4 if _is_log_time(j) else 1e-4 * p[j]
+            h = 1e-4 if is_log_time(j) else 1e-4 * p[j]
             up, down = p.copy(), p.copy()
             up[j] += h
-            down[j] = max(down[j] - h, 0.0) if not _is_log_time(j) else down[j] - h
+            down[j] = max(down[j] - h, 0.0) if not is_log_time(j) else down[j] - h
             grad[j] = (value_of(term, up, taus, fs) - value_of(term, down, taus, fs)) / (
                 up[j] - down[j])
         stds[c] = math.sqrt(max(float(grad @ cov[c] @ grad), 0.0))
@@ -82,14 +82,14 @@ def _propagated(components, taus, term: str) -> tuple[np.ndarray, np.ndarray]:
 def parameters(components, channel: int) -> np.ndarray:
     """(Q², N², B², K², R², then σ², ln τc per Gauss–Markov slot, then A²/2,
     ln f0 of the tone, then σ², ln f_r, ln τr of the resonance) of a channel."""
-    p = np.zeros(_PARAMS)
+    p = np.zeros(PARAMS)
     p[:5] = [float(components.value(t)[channel]) ** 2 for t in TERMS]
     for k, (sigma, tau_c) in enumerate(components.gauss_markov(channel)):
         p[5 + 2 * k], p[6 + 2 * k] = sigma**2, math.log(tau_c)
     for amplitude, f0 in components.sine(channel):
-        p[_SINE], p[_SINE + 1] = amplitude**2 / 2, math.log(f0)
+        p[SINE_SLOT], p[SINE_SLOT + 1] = amplitude**2 / 2, math.log(f0)
     for sigma, f_r, tau_r in components.resonance(channel):
-        p[_RES], p[_RES + 1], p[_RES + 2] = sigma**2, math.log(f_r), math.log(tau_r)
+        p[RES_SLOT], p[RES_SLOT + 1], p[RES_SLOT + 2] = sigma**2, math.log(f_r), math.log(tau_r)
     return p
 
 
@@ -99,9 +99,9 @@ def value_of(term: str, p: np.ndarray, taus: np.ndarray, fs: float) -> float:
     if term == "B":
         # The tone and the resonance are part of the curve whose floor B is
         # read from; they are neither white nor a walk, so N and K leave them out.
-        tone = [(p[_SINE], math.exp(p[_SINE + 1]))] if p[_SINE] > 0 else []
-        osc = ([(p[_RES], math.exp(p[_RES + 1]), math.exp(p[_RES + 2]))]
-               if p[_RES] > 0 else [])
+        tone = [(p[SINE_SLOT], math.exp(p[SINE_SLOT + 1]))] if p[SINE_SLOT] > 0 else []
+        osc = ([(p[RES_SLOT], math.exp(p[RES_SLOT + 1]), math.exp(p[RES_SLOT + 2]))]
+               if p[RES_SLOT] > 0 else [])
         grid = np.geomspace(taus[0], taus[-1], _B_GRID)
         dev = np.sqrt(_core_fit.noise_terms(grid, fs, list(p[:5]), gm, tone, osc).sum(axis=1))
         i = int(np.argmin(dev))
@@ -110,9 +110,9 @@ def value_of(term: str, p: np.ndarray, taus: np.ndarray, fs: float) -> float:
             return 0.0
         return float(dev[i] / FLICKER)
     total = p[1] if term == "N" else p[3]
-    if term == "N" and p[_RES] > 0 and p[_RES + 2] <= 0.0:  # τr ≤ 1 s
-        total += resonance_white_density(1.0, math.exp(p[_RES + 1]),
-                                         math.exp(p[_RES + 2]), fs) * p[_RES]
+    if term == "N" and p[RES_SLOT] > 0 and p[RES_SLOT + 2] <= 0.0:  # τr ≤ 1 s
+        total += resonance_white_density(1.0, math.exp(p[RES_SLOT + 1]),
+                                         math.exp(p[RES_SLOT + 2]), fs) * p[RES_SLOT]
     for q2, tau_c in gm:
         if term == "N" and tau_c <= 1.0:
             total += q2 * gm_white_density(1.0, tau_c, fs)

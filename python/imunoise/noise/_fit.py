@@ -20,7 +20,7 @@ from imunoise.noise._components import Components
 from imunoise.noise._datasheet import datasheet_values
 from imunoise.noise._model import NoiseModel
 from imunoise.noise._readoff import coverage, fit_slopes, measured, readoffs
-from imunoise.noise._terms import _PARAMS, _RES, _SINE, GM_MAX, TERMS, _terms
+from imunoise.noise._terms import GM_MAX, PARAMS, RES_SLOT, SINE_SLOT, TERMS, term_variances
 
 
 def _extract(result, tau_range):
@@ -206,7 +206,7 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
     osc = np.full((channels, 3), np.nan)  # sigma, f_r, tau_r
     osc_std = np.full((channels, 3), np.nan)
     stats = np.full((channels, 3), np.nan)  # discrepancy, chi2, n_eff
-    cov = np.full((channels, _PARAMS, _PARAMS), np.nan)
+    cov = np.full((channels, PARAMS, PARAMS), np.nan)
     usable = []
     for c in range(channels):
         ok = np.isfinite(var[:, c]) & (var[:, c] > 0) & np.isfinite(edf[:, c]) & (edf[:, c] > 0)
@@ -235,7 +235,7 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
             markov = [(a, b) for a, b in gm[c] if np.isfinite(a)]
             tones = [tuple(sine[c])] if np.isfinite(sine[c, 0]) else []
             oscs = [tuple(osc[c])] if np.isfinite(osc[c, 0]) else []
-            parts = _terms(taus[usable[c]], result.fs, coef[c], markov, tones, oscs)
+            parts = term_variances(taus[usable[c]], result.fs, coef[c], markov, tones, oscs)
             rng[c] = _support_range(parts, taus[usable[c]], sup[c])
     else:
         for c in range(channels):
@@ -409,18 +409,18 @@ def _fit_wls(t, v, e, fs, mask, gm_count, oscillators, select):
         # s² = A²/2, so u(A) = u(s²)/A.
         amplitude = math.sqrt(2 * s2)
         sine[:] = amplitude, f0
-        sine_std[:] = (math.sqrt(max(cov[_SINE, _SINE], 0.0)) / amplitude,
-                       f0 * math.sqrt(max(cov[_SINE + 1, _SINE + 1], 0.0)))
+        sine_std[:] = (math.sqrt(max(cov[SINE_SLOT, SINE_SLOT], 0.0)) / amplitude,
+                       f0 * math.sqrt(max(cov[SINE_SLOT + 1, SINE_SLOT + 1], 0.0)))
     osc = np.full(3, np.nan)
     osc_std = np.full(3, np.nan)
     for r2, f_r, tau_r in r.resonance:
         # u(σ) = u(σ²)/(2σ); f_r, τr from their logarithms (NaN: f_r on the fs/2 bound).
         sigma = math.sqrt(r2)
         osc[:] = sigma, f_r, tau_r
-        osc_std[:] = (math.sqrt(max(cov[_RES, _RES], 0.0)) / (2 * sigma),
-                      f_r * math.sqrt(cov[_RES + 1, _RES + 1]) if np.isfinite(
-                          cov[_RES + 1, _RES + 1]) else np.nan,
-                      tau_r * math.sqrt(max(cov[_RES + 2, _RES + 2], 0.0)))
+        osc_std[:] = (math.sqrt(max(cov[RES_SLOT, RES_SLOT], 0.0)) / (2 * sigma),
+                      f_r * math.sqrt(cov[RES_SLOT + 1, RES_SLOT + 1]) if np.isfinite(
+                          cov[RES_SLOT + 1, RES_SLOT + 1]) else np.nan,
+                      tau_r * math.sqrt(max(cov[RES_SLOT + 2, RES_SLOT + 2], 0.0)))
     return (np.where(supported, coef, 0.0), std, supported, markov, markov_std, sine, sine_std,
             osc, osc_std, (delta, chi2, n_eff), cov)
 

@@ -14,7 +14,7 @@ from imunoise import numbers as _numbers
 from imunoise import units as _units
 from imunoise._deprecation import old_call_forms
 from imunoise.noise._components import Components, Prediction, check_term
-from imunoise.noise._terms import _NAMES, _SENSOR_NAMES, TERMS
+from imunoise.noise._terms import NAMES, SENSOR_NAMES, TERMS
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -299,7 +299,7 @@ class NoiseModel:
         for term in terms:
             check_term(term)
             c = conv[term]
-            row = {"term": term, "quantity": _SENSOR_NAMES[sensor].get(term, _NAMES[term]),
+            row = {"term": term, "quantity": SENSOR_NAMES[sensor].get(term, NAMES[term]),
                    "unit": c["unit"], "label": c["label"], "missing": _numbers.NOT_RESOLVED}
             vals, stds, sup = (np.atleast_1d(c[k]) for k in ("value", "std", "supported"))
             for i, ax in enumerate(axes):

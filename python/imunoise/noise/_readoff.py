@@ -9,7 +9,7 @@ import math
 import numpy as np
 
 from imunoise import _warn
-from imunoise.noise._terms import _CLOSE, _READ_TAU, _SLOPE, FLAT_SLOPE, FLICKER, TERMS
+from imunoise.noise._terms import CLOSE, FLAT_SLOPE, FLICKER, READ_TAU, SLOPE, TERMS
 
 
 def measured(result, taus):
@@ -39,7 +39,7 @@ def coverage(model, taus, dev, edf):
     pred = np.reshape(model.predict(taus).dev, dev.shape)
     lo, hi = interval95(dev, edf)
     inside = (pred >= lo) & (pred <= hi)
-    close = np.abs(pred / dev - 1.0) <= _CLOSE
+    close = np.abs(pred / dev - 1.0) <= CLOSE
     ok = np.isfinite(dev) & (dev > 0)
     hits = np.where(ok, inside | close, False).sum(axis=0)
     return hits / np.maximum(ok.sum(axis=0), 1)
@@ -105,7 +105,7 @@ def fit_slopes(t, v, e, mask, tolerance=0.25):
     for i, term in enumerate(TERMS):
         if not mask[i]:
             continue
-        target = _SLOPE[term]
+        target = SLOPE[term]
         j = int(np.argmin(np.abs(slope - target)))
         if abs(slope[j] - target) > tolerance:
             continue  # no part of the curve has this slope: not resolved
@@ -117,7 +117,7 @@ def fit_slopes(t, v, e, mask, tolerance=0.25):
         else:
             # σ of the line at the reading τ equals the coefficient there:
             # N/√1, K·√(3/3), √3·Q/√3, R·√2/√2.
-            value = sigma * (_READ_TAU[term] / tau) ** target
+            value = sigma * (READ_TAU[term] / tau) ** target
         coef[i] = value
         std[i] = value * rel
         sup[i] = True

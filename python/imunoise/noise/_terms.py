@@ -15,30 +15,30 @@ TERMS: tuple[str, ...] = tuple(_core_fit.IEEE_TERM_NAMES)
 FLICKER = math.sqrt(_core_fit.FLICKER_FACTOR)
 """σ_flat / B = √(2 ln2/π) ≈ 0.6643."""
 
-_NAMES = {
+NAMES = {
     "Q": "quantization noise",
     "N": "random walk (white noise)",
     "B": "bias instability",
     "K": "rate random walk",
     "R": "rate ramp",
 }
-_SENSOR_NAMES = {
+SENSOR_NAMES = {
     "gyro": {"N": "angle random walk", "Q": "angle quantization"},
     "accel": {"N": "velocity random walk", "Q": "velocity quantization"},
 }
 # Log-log slope of each term on the deviation curve and the tau where its
 # straight line is read (IEEE 952 Annex C).
-_SLOPE = {"Q": -1.0, "N": -0.5, "B": 0.0, "K": 0.5, "R": 1.0}
-_READ_TAU = {"Q": math.sqrt(3.0), "N": 1.0, "K": 3.0, "R": math.sqrt(2.0)}
+SLOPE = {"Q": -1.0, "N": -0.5, "B": 0.0, "K": 0.5, "R": 1.0}
+READ_TAU = {"Q": math.sqrt(3.0), "N": 1.0, "K": 3.0, "R": math.sqrt(2.0)}
 GM_MAX: int = _core_fit.MAX_GAUSS_MARKOV
 """Most first-order Gauss–Markov terms a model may have."""
 
-_PARAMS: int = _core_fit.PARAMETERS
+PARAMS: int = _core_fit.PARAMETERS
 """Parameter slots of the covariance: five IEEE variances, (σ², ln τc) per GM term,
 then (A²/2, ln f0) of the tone."""
-_SINE: int = _core_fit.SINE_SLOT
+SINE_SLOT: int = _core_fit.SINE_SLOT
 """Slot of the tone's variance A²/2 in the covariance (its ln f0 follows)."""
-_RES: int = _core_fit.RESONANCE_SLOT
+RES_SLOT: int = _core_fit.RESONANCE_SLOT
 """Slot of the resonance's variance σ² in the covariance (ln f_r, ln τr follow)."""
 
 
@@ -60,20 +60,20 @@ def resonance_white_density(sigma: float, f_r: float, tau_r: float, fs: float) -
     return sigma**2 * ((1 + z) / (1 - z)).real / fs
 
 
-def _is_log_time(slot: int) -> bool:
+def is_log_time(slot: int) -> bool:
     """Whether covariance slot ``slot`` holds a logarithm (ln τc, ln f0, ln f_r, ln τr)."""
-    return slot > _RES or (5 <= slot < _RES and (slot - 5) % 2 == 1)
+    return slot > RES_SLOT or (5 <= slot < RES_SLOT and (slot - 5) % 2 == 1)
 
 
 FLAT_SLOPE = -0.25
 """A curve whose log-log slope is above this has flattened: a minimum at its end is
 a bias-instability floor (slope −½ is white noise, 0 the floor)."""
 
-_CLOSE = 0.05
+CLOSE = 0.05
 """A model within this relative distance of the measured deviation follows it."""
 
 
-def _terms(taus, fs: float, coef, markov=(), tone=(), resonance=()) -> np.ndarray:
+def term_variances(taus, fs: float, coef, markov=(), tone=(), resonance=()) -> np.ndarray:
     """Allan variance of each model term at ``taus``: (len(taus), 5 + len(markov) +
     len(tone) + len(resonance)), from the one implementation of the model (Rust);
     ``coef`` holds Q…R, ``markov`` (sigma, tau_c) pairs, ``tone`` (amplitude, f0)
@@ -89,6 +89,6 @@ def _terms(taus, fs: float, coef, markov=(), tone=(), resonance=()) -> np.ndarra
 
 def model_variance(taus, Q=0.0, N=0.0, B=0.0, K=0.0, R=0.0) -> np.ndarray:
     """Allan variance of the five-term IEEE model at ``taus`` (scalar coefficients)."""
-    return _terms(taus, 1.0, (Q, N, B, K, R)).sum(axis=1)
+    return term_variances(taus, 1.0, (Q, N, B, K, R)).sum(axis=1)
 
 
