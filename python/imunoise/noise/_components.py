@@ -22,6 +22,33 @@ def check_term(term: str) -> None:
         raise ValueError(f"term must be one of {TERMS}; got {term!r}")
 
 
+class PerTerm:
+    """Accessors shared by :class:`Components` and the model: the values ``Q``…``R``
+    and their ``*_std`` as arrays of shape () for one channel or (channels,)."""
+
+    N: np.ndarray
+
+    @property
+    def channels(self) -> int:
+        """Number of channels (1 for a one-channel fit)."""
+        return 1 if np.ndim(self.N) == 0 else int(np.shape(self.N)[0])
+
+    @property
+    def one_channel(self) -> bool:
+        """True when fitted to a 1-D result (values are 0-d arrays)."""
+        return np.ndim(self.N) == 0
+
+    def value(self, term: str) -> np.ndarray:
+        """``term`` (one of Q, N, B, K, R) as an array of shape (channels,)."""
+        check_term(term)
+        return np.atleast_1d(getattr(self, term))
+
+    def std(self, term: str) -> np.ndarray:
+        """Standard uncertainty of ``term``, shape (channels,)."""
+        check_term(term)
+        return np.atleast_1d(getattr(self, term + "_std"))
+
+
 @dataclass(frozen=True, repr=False)
 class Prediction:
     """Model Allan deviation: the total curve and each term's curve.
@@ -57,7 +84,7 @@ class Prediction:
 
 
 @dataclass(frozen=True, repr=False)
-class Components:
+class Components(PerTerm):
     """The fitted components of a noise model, per channel, in the input's units.
 
     These are the fit's own parameters. The datasheet values a user quotes are
@@ -135,25 +162,6 @@ class Components:
     resonance_tau_std: np.ndarray
     cov: np.ndarray
     fs: float
-
-    @property
-    def channels(self) -> int:
-        """Number of channels (1 for a one-channel model)."""
-        return 1 if np.ndim(self.N) == 0 else int(np.shape(self.N)[0])
-
-    @property
-    def one_channel(self) -> bool:
-        return np.ndim(self.N) == 0
-
-    def value(self, term: str) -> np.ndarray:
-        """IEEE coefficient ``term`` of the fit as an array of shape (channels,)."""
-        check_term(term)
-        return np.atleast_1d(getattr(self, term))
-
-    def std(self, term: str) -> np.ndarray:
-        """Standard uncertainty of the coefficient ``term``, shape (channels,)."""
-        check_term(term)
-        return np.atleast_1d(getattr(self, term + "_std"))
 
     def gauss_markov(self, channel: int = 0) -> list[tuple[float, float]]:
         """The (sigma, tau_c) of each Gauss–Markov term of ``channel``."""

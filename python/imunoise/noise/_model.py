@@ -13,7 +13,7 @@ from imunoise import _schema, _summary, _warn
 from imunoise import numbers as _numbers
 from imunoise import units as _units
 from imunoise._deprecation import old_call_forms
-from imunoise.noise._components import Components, Prediction, check_term
+from imunoise.noise._components import Components, PerTerm, Prediction, check_term
 from imunoise.noise._terms import NAMES, SENSOR_NAMES, TERMS
 
 if TYPE_CHECKING:
@@ -27,7 +27,7 @@ def _moved(old: str, new: str) -> None:
 
 
 @dataclass(frozen=True, repr=False)
-class NoiseModel:
+class NoiseModel(PerTerm):
     """A fitted noise model: the datasheet values N, B, K, Q, R per channel, in the
     input's units, with the fitted components behind them.
 
@@ -114,27 +114,7 @@ class NoiseModel:
     n_eff: np.ndarray = field(repr=False)
     readoff: dict[str, dict[str, np.ndarray]] = field(repr=False)
 
-    # -- shape --------------------------------------------------------------
-    @property
-    def channels(self) -> int:
-        """Number of channels (1 for a one-channel model)."""
-        return 1 if np.ndim(self.N) == 0 else int(np.shape(self.N)[0])
-
-    @property
-    def one_channel(self) -> bool:
-        """True when fitted to a 1-D result (values are 0-d arrays)."""
-        return np.ndim(self.N) == 0
-
-    def value(self, term: str) -> np.ndarray:
-        """Datasheet value ``term`` as an array of shape (channels,)."""
-        check_term(term)
-        return np.atleast_1d(getattr(self, term))
-
-    def std(self, term: str) -> np.ndarray:
-        """Standard uncertainty of ``term`` as an array of shape (channels,)."""
-        check_term(term)
-        return np.atleast_1d(getattr(self, term + "_std"))
-
+    # -- per term (channels, one_channel, value, std: PerTerm) ---------------
     def resolved(self, term: str) -> np.ndarray:
         """Whether ``term`` is resolved, shape (channels,)."""
         check_term(term)
