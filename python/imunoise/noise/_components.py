@@ -22,11 +22,23 @@ def check_term(term: str) -> None:
         raise ValueError(f"term must be one of {TERMS}; got {term!r}")
 
 
+@dataclass(frozen=True, repr=False)
 class PerTerm:
-    """Accessors shared by :class:`Components` and the model: the values ``Q``…``R``
-    and their ``*_std`` as arrays of shape () for one channel or (channels,)."""
+    """What :class:`Components` and the model share: the values ``Q``…``R``, their
+    ``*_std`` (arrays of shape () for one channel or (channels,)), which are
+    ``supported``, and their accessors."""
 
+    Q: np.ndarray
     N: np.ndarray
+    B: np.ndarray
+    K: np.ndarray
+    R: np.ndarray
+    Q_std: np.ndarray
+    N_std: np.ndarray
+    B_std: np.ndarray
+    K_std: np.ndarray
+    R_std: np.ndarray
+    supported: dict[str, np.ndarray]
 
     @property
     def channels(self) -> int:
@@ -134,17 +146,6 @@ class Components(PerTerm):
         Sample rate of the data (Hz): the terms' sampled forms depend on it.
     """
 
-    Q: np.ndarray
-    N: np.ndarray
-    B: np.ndarray
-    K: np.ndarray
-    R: np.ndarray
-    Q_std: np.ndarray
-    N_std: np.ndarray
-    B_std: np.ndarray
-    K_std: np.ndarray
-    R_std: np.ndarray
-    supported: dict[str, np.ndarray]
     tau_range: dict[str, np.ndarray]
     gm_sigma: np.ndarray
     gm_tau: np.ndarray

@@ -91,17 +91,6 @@ class NoiseModel(PerTerm):
     still work for one release with a ``DeprecationWarning`` naming the new one.
     """
 
-    Q: np.ndarray
-    N: np.ndarray
-    B: np.ndarray
-    K: np.ndarray
-    R: np.ndarray
-    Q_std: np.ndarray
-    N_std: np.ndarray
-    B_std: np.ndarray
-    K_std: np.ndarray
-    R_std: np.ndarray
-    supported: dict[str, np.ndarray]
     components: Components
     method: str
     kind: str
