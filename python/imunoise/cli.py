@@ -13,6 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
+from imunoise import _atomic
 from imunoise._schema import (
     ALLAN_SENSORS,
     CHANNELS,
@@ -71,6 +72,8 @@ def _build_parser() -> argparse.ArgumentParser:
     r.add_argument("-o", "--output", default="imunoise-report", metavar="DIR",
                    help="output directory (default: %(default)s)")
     _shared_options(r, spec=True, fs=True, progress=True, layout=True)
+    r.add_argument("--force", action="store_true",
+                   help="write into an existing folder that is not an imunoise report")
     r.add_argument("--trim", choices=["auto"], default=None,
                    help="'auto': analyse the long log from the end of its warm-up transient "
                    "(the report states what was cut)")
@@ -189,6 +192,8 @@ def _build_parser() -> argparse.ArgumentParser:
                        description="Report on a real 5-minute VN-100 log shipped with imunoise "
                        "and a simulated 5-hour VN-100 log, then print where the report is.")
     d.add_argument("-o", "--output", default="imunoise-demo", metavar="DIR")
+    d.add_argument("--force", action="store_true",
+                   help="write into an existing folder that is not an imunoise report")
     d.add_argument("--hours", type=_positive_float, default=5.0,
                    help="length of the simulated long log (default: %(default)s)")
     d.add_argument("--seed", type=int, default=1)
@@ -300,7 +305,8 @@ def _cmd_report(args) -> int:
 
     spec = None if args.spec.lower() == "none" else args.spec
     rep = report.build(args.short_log, args.long_log, args.output, spec=spec, fs=args.fs,
-                       progress=args.progress, read_options=_read_options(args), trim=args.trim)
+                       progress=args.progress, read_options=_read_options(args), trim=args.trim,
+                       force=args.force)
     for log in rep.logs:
         _note_gaps(log.source, log)
     print(f"report written to {rep.html}")
@@ -480,16 +486,18 @@ def _cmd_convert(args) -> int:
     if suffix not in ("", ".npy", ".csv", ".parquet", ".npz"):
         _fail(f"--output must be a directory or end in .npy, .parquet, .csv or .npz; "
               f"got {str(out)!r}")
+    _atomic.refuse_input(out, [args.log])
     if suffix in ("", ".npy", ".parquet"):
         return _convert_streaming(args, out)
     log = _read(args)
     names, cols = _columns(log)
     out.parent.mkdir(parents=True, exist_ok=True)
-    if suffix == ".csv":
-        np.savetxt(out, np.column_stack(cols), delimiter=",", header=",".join(names),
-                   comments="", fmt="%.10g")
-    else:
-        np.savez(out, fs=log.fs, **dict(zip(names, cols, strict=True)))
+    with _atomic.replacing(out, inputs=[args.log]) as fh:
+        if suffix == ".csv":
+            np.savetxt(fh, np.column_stack(cols), delimiter=",", header=",".join(names),
+                       comments="", fmt="%.10g")
+        else:
+            np.savez(fh, fs=log.fs, **dict(zip(names, cols, strict=True)))
     print(f"wrote {len(log)} samples x {len(names)} columns to {out}")
     return 0
 
@@ -519,6 +527,7 @@ def _cmd_batch(args) -> int:
         _fail(f"--output must end in .parquet or .csv; got {str(out)!r}")
     if args.serial and args.scheduler:
         _fail("--serial and --scheduler exclude each other")
+    _atomic.refuse_input(out, args.logs)
     client = False if args.serial else args.scheduler
     try:
         df = scale.batch(args.logs, client=client, spec=args.spec, fs=args.fs,
@@ -526,13 +535,14 @@ def _cmd_batch(args) -> int:
     except ImportError as exc:
         _fail(str(exc))
     out.parent.mkdir(parents=True, exist_ok=True)
-    if suffix == ".csv":
-        df.to_csv(out, index=False)
-    else:
-        try:
-            df.to_parquet(out, index=False)
-        except ImportError:
-            _fail("Parquet output needs pyarrow (pip install pyarrow); or use a .csv output")
+    with _atomic.replacing(out, inputs=args.logs) as fh:
+        if suffix == ".csv":
+            fh.write(df.to_csv(index=False).encode("utf-8"))
+        else:
+            try:
+                df.to_parquet(fh, index=False)
+            except ImportError:
+                _fail("Parquet output needs pyarrow (pip install pyarrow); or use a .csv output")
     failed = df.loc[df["error"].notna(), "path"].tolist()
     logs = df["path"].nunique()
     print(f"wrote {len(df)} rows for {logs} logs to {out}"
@@ -562,7 +572,8 @@ def _cmd_demo(args) -> int:
     short = bundled_log()
     long = still_log(args.hours, 40.0, spec="vn100", seed=args.seed)
     # The bundled log is VN ASCII without timestamps, recorded at 40 Hz.
-    rep = report.build(short, long, args.output, spec="vn100", fs=40.0, progress=args.progress)
+    rep = report.build(short, long, args.output, spec="vn100", fs=40.0, progress=args.progress,
+                       force=args.force)
     print(f"demo report: {rep.html.resolve()}")
     print(f"             {rep.markdown.resolve()}")
     return 0

@@ -41,6 +41,7 @@ from pathlib import Path
 
 import numpy as np
 
+from imunoise import _atomic
 from imunoise._core import vn as _core_vn
 from imunoise._schema import CHANNELS, column_names
 from imunoise.readers import registry
@@ -112,7 +113,7 @@ class _NpyAppender:
         self.dtype = np.dtype(dtype)
         self.row_shape = row_shape
         self.rows = 0
-        self.f = open(path, "wb")  # noqa: SIM115 - closed in close()
+        self.f = open(path, "xb")  # noqa: SIM115 - closed in close()
         self._header()
         self.data_start = self.f.tell()
 
@@ -169,7 +170,7 @@ class _Sink:
 class _DirSink(_Sink):
     def __init__(self, staging: Path, channels: list[str]):
         super().__init__(staging, channels)
-        staging.mkdir(parents=True, exist_ok=True)
+        staging.mkdir()
         self.files = {
             ch: _NpyAppender(staging / f"{ch}.npy", np.float64,
                              () if _width(ch) == 1 else (_width(ch),))
@@ -186,16 +187,30 @@ class _DirSink(_Sink):
             f.close()
 
     def publish(self, out, meta):
-        out.mkdir(parents=True, exist_ok=True)
-        files = []
-        for ch in self.channels:
-            dest = out / f"{ch}.npy"
-            os.replace(self.staging / f"{ch}.npy", dest)
-            files.append(dest)
-        meta_path = out / "meta.json"
-        meta_path.write_text(json.dumps(meta, indent=1))
-        shutil.rmtree(self.staging, ignore_errors=True)
-        return [*files, meta_path]
+        _atomic.write_text(self.staging / "meta.json", json.dumps(meta, indent=1))
+        _atomic.sync(self.staging)
+        names = [f"{ch}.npy" for ch in self.channels] + ["meta.json"]
+        if not out.exists():
+            os.rename(self.staging, out)
+        elif out.is_dir() and _only_ours(out) and _atomic.exchange_dir(self.staging, out):
+            shutil.rmtree(self.staging, ignore_errors=True)  # the old output, swapped out
+        else:
+            # files of others in out: replace ours one by one, meta.json last, so a
+            # directory whose meta.json is old still has every old channel file
+            for name in names:
+                _atomic.publish(self.staging / name, out / name)
+            for stale in _OUR_FILES.difference(names):
+                (out / stale).unlink(missing_ok=True)
+            shutil.rmtree(self.staging, ignore_errors=True)
+        return [out / name for name in names]
+
+
+#: Every file a directory output may hold.
+_OUR_FILES = frozenset(["meta.json", *(f"{c}.npy" for c in ("time", *CHANNELS))])
+
+
+def _only_ours(out: Path) -> bool:
+    return all(p.name in _OUR_FILES for p in out.iterdir())
 
 
 def _record_dtype(channels: list[str]) -> np.dtype:
@@ -223,9 +238,9 @@ class _NpySink(_Sink):
         self.file.close()
 
     def publish(self, out, meta):
-        os.replace(self.staging, out)
         meta_path = _npy_meta_path(out)
-        meta_path.write_text(json.dumps(meta, indent=1))
+        _atomic.publish(self.staging, out)
+        _atomic.write_text(meta_path, json.dumps(meta, indent=1))
         return [out, meta_path]
 
 
@@ -263,7 +278,7 @@ class _ParquetSink(_Sink):
         self.writer.close()
 
     def publish(self, out, meta):
-        os.replace(self.staging, out)
+        _atomic.publish(self.staging, out)
         return [out]
 
 
@@ -288,20 +303,15 @@ class _Writer:
         self.layout = layout
         self.sinks: dict[str, _Sink] = {}
 
-    def _staging(self, k: int) -> Path:
-        name = f".{self.out.name}.partial-{k}"
-        if self.layout == "npy":
-            name += ".npy"
-        elif self.layout == "parquet":
-            name += ".parquet"
-        return self.out.parent / name
+    def _staging(self) -> Path:
+        return _atomic.temporary_beside(self.out)
 
     def append(self, table: str, cols: Mapping[str, np.ndarray]) -> None:
         sink = self.sinks.get(table)
         if sink is None:
             channels = _order(cols)
             cls = {"dir": _DirSink, "npy": _NpySink, "parquet": _ParquetSink}[self.layout]
-            sink = cls(self._staging(len(self.sinks)), channels)
+            sink = cls(self._staging(), channels)
             self.sinks[table] = sink
         sink.append(cols)
 
@@ -583,6 +593,12 @@ def convert(
             raise ImportError("Parquet output needs pyarrow (pip install pyarrow)") from None
     if not path.exists():
         raise FileNotFoundError(2, "no such file", str(path))
+    _atomic.refuse_input(out, [path])
+    if layout == "dir" and out.exists() and not out.is_dir():
+        raise ValueError(f"out {str(out)!r} exists and is not a directory")
+    if layout == "dir" and out.is_dir():
+        for name in _OUR_FILES:
+            _atomic.refuse_input(out / name, [path])
     if format == "auto":
         format = detect_format(path)
     out.parent.mkdir(parents=True, exist_ok=True)
@@ -621,7 +637,6 @@ def convert(
         sink = writer.sinks[primary]
         meta = _meta(fs=rate, source=str(path), fmt=fmt, issues=issues, messages=messages,
                      samples=sink.rows, channels=sink.channels, table=primary, gaps=gaps)
-        _remove(out, layout)
         files = writer.finish(primary, meta)
     except BaseException:
         writer.abort()
@@ -630,18 +645,6 @@ def convert(
     return Conversion(out=out, files=tuple(files), samples=sink.rows,
                       channels=tuple(sink.channels), fs=rate, issues=issues,
                       bytes_read=path.stat().st_size, gaps=gaps)
-
-
-def _remove(out: Path, layout: str) -> None:
-    """Clear a previous output at ``out`` (only what a conversion writes)."""
-    if layout == "dir":
-        if out.exists() and not out.is_dir():
-            raise ValueError(f"out {str(out)!r} exists and is not a directory")
-        if out.is_dir():
-            for name in ["meta.json", *(f"{c}.npy" for c in ("time", *CHANNELS))]:
-                (out / name).unlink(missing_ok=True)
-    elif layout == "npy":
-        _npy_meta_path(out).unlink(missing_ok=True)
 
 
 def _read_meta(out: Path, layout: str) -> dict:
