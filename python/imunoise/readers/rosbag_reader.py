@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import errno
 import os
+import re
 import tempfile
 import warnings
 from collections.abc import Callable, Mapping
@@ -201,17 +202,50 @@ def _read_bag(path, name, strict, fs, progress, topic, msg_defs, typestore) -> I
     )
     default = _typestore(typestore, msg_defs) if (typestore or msg_defs) else None
     try:
-        reader = AnyReader([path], default_typestore=default)
-        reader.open()
-    except AnyReaderError as exc:
-        if default is not None or "type definitions" not in str(exc):
-            raise ValueError(f"{name}: cannot open bag: {exc}") from exc
-        reader = AnyReader([path], default_typestore=_typestore(None, None))
-        reader.open()
-    try:
-        return _read(reader, name, total, strict, fs, progress, topic)
-    finally:
-        reader.close()
+        try:
+            reader = AnyReader([path], default_typestore=default)
+            reader.open()
+        except AnyReaderError as exc:
+            if default is not None or "type definitions" not in str(exc):
+                raise ValueError(f"{name}: cannot open bag: {exc}") from exc
+            reader = AnyReader([path], default_typestore=_typestore(None, None))
+            reader.open()
+        try:
+            return _read(reader, name, total, strict, fs, progress, topic)
+        finally:
+            reader.close()
+    except Exception as exc:
+        if _ours(exc):
+            raise
+        raise _damaged(exc, name) from exc
+
+
+def _ours(exc: BaseException) -> bool:
+    """True for the errors this module raises on purpose (they name the bag, the
+    topic or the argument); False for what a damaged bag makes a library (rosbags,
+    apsw/sqlite, struct, the codecs ...) or a builtin raise."""
+    if isinstance(exc, ParseError | FileNotFoundError | MemoryError):
+        return True
+    if type(exc) not in (ValueError, TypeError):
+        return False
+    tb = exc.__traceback__
+    while tb is not None and tb.tb_next is not None:
+        tb = tb.tb_next
+    return tb is not None and tb.tb_frame.f_globals.get("__name__") == __name__
+
+
+def _damaged(exc: Exception, name: str) -> ParseError:
+    """A library's exception on a damaged bag as a :class:`ParseError` naming the
+    file, the byte offset when the library said it, and the cause."""
+    text = " ".join(str(exc).split()) or "no detail"
+    found = re.search(r"offset (\d+)", text)
+    truncated = re.search(r"truncat|unexpected end|eof|short read|not enough", text, re.I)
+    return ParseError(
+        f"damaged bag: {type(exc).__name__}: {text[:300]}",
+        kind="truncated_record" if truncated else "malformed_field",
+        offset=int(found.group(1)) if found else None,
+        source=None if name == _BYTES else name,
+    )
 
 
 def _read(reader, name, total, strict, fs, progress, topic) -> ImuLog:
