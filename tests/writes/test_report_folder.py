@@ -59,3 +59,10 @@ def test_a_report_replaces_its_own_files_removes_stale_ones_and_keeps_others(tmp
     assert (out / "notes.txt").read_text() == "mine"
     assert {p.name for p in second.figures} == {p.name for p in first.figures}
     assert not [p for p in out.rglob(".*") if p.name != MANIFEST]
+
+
+def test_a_report_that_fails_to_read_its_log_creates_nothing(tmp_path, capsys):
+    out = tmp_path / "never"
+    assert main(["report", str(tmp_path / "missing.txt"), "-o", str(out)]) == 2
+    assert "does not exist" in capsys.readouterr().err
+    assert not out.exists()

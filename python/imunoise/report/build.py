@@ -293,6 +293,7 @@ def build(
         short_log = read_log(short, "short", fs=fs, progress=bar.shown, **options)
         long_log = short_log if long is None else read_log(long, "long", fs=fs,
                                                            progress=bar.shown, **options)
+        folder.mark(out, previous)
         (out / "figures").mkdir(parents=True, exist_ok=True)
         ctx = Context(short=short_log, long=long_log, one_log=long is None, spec=spec,
                       out_dir=out)

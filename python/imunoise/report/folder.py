@@ -7,7 +7,8 @@ with someone else's); :func:`settle` removes what the previous report wrote and
 this one did not (figures of sections that no longer apply) and records the new
 list. Every file is written atomically (:mod:`imunoise._atomic`), so an
 interrupted report leaves each file either old or new, never partial, and the
-manifest still names the folder a report.
+manifest still names the folder a report: :func:`mark` writes it before the first
+file.
 """
 
 from __future__ import annotations
@@ -19,7 +20,7 @@ from pathlib import Path
 
 from imunoise import _atomic
 
-__all__ = ["MANIFEST", "claim", "settle"]
+__all__ = ["MANIFEST", "claim", "mark", "settle"]
 
 #: The file that marks a folder as an imunoise report and lists its files.
 MANIFEST = "imunoise-report.json"
@@ -52,7 +53,8 @@ def _write(out: Path, files: Iterable[str]) -> None:
 
 
 def claim(out, *, force: bool = False, inputs: Iterable = ()) -> list[str]:
-    """Make ``out`` the report's folder; returns the files the previous report listed.
+    """Check that a report may be written into ``out`` (nothing is created); returns
+    the files the previous report there listed.
 
     Raises ``ValueError`` when ``out`` is a file, or an existing non-empty folder
     without :data:`MANIFEST` and ``force`` is False, or when an input log is one
@@ -73,9 +75,15 @@ def claim(out, *, force: bool = False, inputs: Iterable = ()) -> list[str]:
             )
     for name in {*previous, *FIXED}:
         _atomic.refuse_input(out / name, inputs)
-    out.mkdir(parents=True, exist_ok=True)
-    _write(out, previous)  # from now on the folder is a report, even if interrupted
     return previous
+
+
+def mark(out, previous: Iterable[str]) -> None:
+    """Create ``out`` and its manifest (still listing ``previous``) before the first
+    file is written: an interrupted report leaves a folder known to be a report."""
+    out = Path(os.fspath(out))
+    out.mkdir(parents=True, exist_ok=True)
+    _write(out, previous)
 
 
 def settle(out, written: Iterable, previous: Iterable[str], *, inputs: Iterable = ()) -> None:
