@@ -500,6 +500,7 @@ def _stream_vn(path: Path, writer: _Writer, chunk_bytes: int, progress) -> tuple
             writer.append(name, grid.place(chans, rows.missing.get(name)))
 
     total = path.stat().st_size
+    chunk_bytes = min(chunk_bytes, total + 1)  # a piece never asks for more than the file
     done = 0
     with open(path, "rb") as f:
         while True:
@@ -558,7 +559,8 @@ def convert(
     fs : float, optional
         Sample rate of logs without timestamps, as for :func:`imunoise.read`.
     chunk_bytes : int
-        Bytes read per piece (default 64 MiB); peak memory is a few times this.
+        Bytes read per piece (default 64 MiB, at least 4096; at most the file's
+        size is read at once); peak memory is a few times this.
     format : str
         As for :func:`imunoise.read` (``"auto"`` detects it).
     progress : callable, optional
