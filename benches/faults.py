@@ -19,7 +19,8 @@ the whole run. After each run:
 * a run that finished leaves exactly the new output (a report: no stale figure).
 
 bags: bit flips, truncations and zeroed blocks of a ROS 1 bag, a ROS 2 db3 and an
-MCAP (tests/helpers/bags.py; the real bags of ../shared/data/vn100-ros when present):
+MCAP (tests/helpers/bags.py; with --shared also the real bags of
+../shared/data/vn100-ros):
 ``imunoise.read`` must raise nothing but ParseError or a ValueError/OSError naming
 the file.
 
@@ -338,14 +339,14 @@ def report_faults(runs: int, seed: int, work: Path, *, quiet: bool = False,
 # -- bags ------------------------------------------------------------------------------
 
 
-def bag_faults(per_bag: int, seed: int, work: Path) -> dict[str, Counter]:
+def bag_faults(per_bag: int, seed: int, work: Path, shared: bool = False) -> dict[str, Counter]:
     sys.path.insert(0, str(ROOT / "tests"))
     sys.path.insert(0, str(ROOT / "python"))
     from helpers.bags import mutate, outcome, small_bags
 
     bags = dict(small_bags(work / "bags"))
     for rel in ("vn100-ros/ros1_stationary.bag", "vn100-ros/ros2_circle_0.db3"):
-        if (SHARED / rel).exists():
+        if shared and (SHARED / rel).exists():
             bags["shared " + Path(rel).name] = SHARED / rel
     results: dict[str, Counter] = {}
     for name, path in bags.items():
@@ -373,12 +374,14 @@ def main(argv=None) -> int:
     p.add_argument("--runs", type=int, default=100, help="runs (half kill -9, half SIGINT)")
     p.add_argument("--per-bag", type=int, default=10_000)
     p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--shared", action="store_true",
+                   help="bags: also the real (MB-sized, slower) bags of ../shared/data")
     p.add_argument("--quiet", action="store_true")
     args = p.parse_args(argv)
     with tempfile.TemporaryDirectory(prefix="imunoise-faults-") as tmp:
         work = Path(tmp)
         if args.what == "bags":
-            results = bag_faults(args.per_bag, args.seed, work)
+            results = bag_faults(args.per_bag, args.seed, work, args.shared)
             return 1 if any(c["LEAK"] for c in results.values()) else 0
         run = convert_faults if args.what == "convert" else report_faults
         summary = run(args.runs, args.seed, work, quiet=args.quiet)
