@@ -7,7 +7,9 @@ warnings are one line each, ``imunoise: warning: ...``.
 from __future__ import annotations
 
 import argparse
+import signal
 import sys
+import threading
 import warnings
 from pathlib import Path
 
@@ -654,6 +656,7 @@ def main(argv: list[str] | None = None) -> int:
     parser = _build_parser()
     old = warnings.showwarning
     warnings.showwarning = _warn
+    old_term = _exit_on_sigterm()
     try:
         try:
             args = parser.parse_args(argv)
@@ -674,6 +677,22 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     finally:
         warnings.showwarning = old
+        if old_term is not None:
+            signal.signal(signal.SIGTERM, old_term)
+
+
+def _exit_on_sigterm():
+    """SIGTERM (``kill``) unwinds like Ctrl-C, so the temporaries of the file being
+    written are removed, and exits 143; returns the handler it replaced (None when
+    not in the main thread, where handlers cannot be set)."""
+    if threading.current_thread() is not threading.main_thread():
+        return None
+
+    def _terminated(signum, frame):
+        print("imunoise: terminated", file=sys.stderr)
+        raise SystemExit(128 + signum)
+
+    return signal.signal(signal.SIGTERM, _terminated)
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -86,3 +86,23 @@ def test_temporaries_of_killed_runs_are_removed_next_time_and_said(tmp_path):
         _atomic.write_text(tmp_path / "out.csv", "new")
     assert sorted(_hidden(tmp_path)) == [live.name]
     assert (tmp_path / "out.csv").read_text() == "new"
+
+
+def test_sigterm_unwinds_like_ctrl_c(tmp_path, capsys):
+    """The CLI turns SIGTERM into an exit (143) that removes the temporary being written."""
+    import signal
+    import time
+
+    from imunoise import cli
+
+    old = cli._exit_on_sigterm()
+    try:
+        with pytest.raises(SystemExit) as info, _atomic.replacing(tmp_path / "o.csv") as fh:
+            fh.write(b"half")
+            os.kill(os.getpid(), signal.SIGTERM)
+            time.sleep(5)  # the handler interrupts this
+    finally:
+        signal.signal(signal.SIGTERM, old)
+    assert info.value.code == 143
+    assert list(tmp_path.iterdir()) == []
+    assert "terminated" in capsys.readouterr().err
