@@ -539,7 +539,7 @@ def _cmd_batch(args) -> int:
     out.parent.mkdir(parents=True, exist_ok=True)
     with _atomic.replacing(out, inputs=args.logs) as fh:
         if suffix == ".csv":
-            fh.write(df.to_csv(index=False).encode("utf-8"))
+            df.to_csv(fh, index=False)
         else:
             try:
                 df.to_parquet(fh, index=False)
