@@ -52,3 +52,18 @@ def test_the_cli_gives_one_line_for_a_library_error(bags, tmp_path, capsys):
     assert main(["stats", str(bad)]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "zeroed.bag" in err[0]
+
+
+def test_a_size_field_beyond_memory_is_a_parse_error(bags, monkeypatch):
+    """rosbags reads a record of the size the file claims: a damaged size made it raise
+    MemoryError (when the machine could not give the memory), which leaked."""
+    import imunoise
+    from imunoise.errors import ParseError
+    from rosbags.highlevel import AnyReader
+
+    def claims_too_much(self):
+        raise MemoryError
+
+    monkeypatch.setattr(AnyReader, "open", claims_too_much)
+    with pytest.raises(ParseError, match=r"11sec_motion_0\.mcap.*size field asks for more"):
+        imunoise.read(bags["mcap"])

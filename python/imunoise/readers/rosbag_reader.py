@@ -52,6 +52,7 @@ MAG = "sensor_msgs/msg/MagneticField"
 TEMPERATURE = "sensor_msgs/msg/Temperature"
 TESLA_TO_GAUSS = 1e4
 _BATCH = 20_000  # messages per call of the VN parser
+_PREALLOC = 1 << 16  # rows allocated before the first message of a sensor topic
 
 #: What a topic is (see _classify_topics) and, for a VN message, the attribute
 #: path of its sentence field.
@@ -224,7 +225,7 @@ def _ours(exc: BaseException) -> bool:
     """True for the errors this module raises on purpose (they name the bag, the
     topic or the argument); False for what a damaged bag makes a library (rosbags,
     apsw/sqlite, struct, the codecs ...) or a builtin raise."""
-    if isinstance(exc, ParseError | FileNotFoundError | MemoryError):
+    if isinstance(exc, ParseError | FileNotFoundError):
         return True
     if type(exc) not in (ValueError, TypeError):
         return False
@@ -238,6 +239,8 @@ def _damaged(exc: Exception, name: str) -> ParseError:
     """A library's exception on a damaged bag as a :class:`ParseError` naming the
     file, the byte offset when the library said it, and the cause."""
     text = " ".join(str(exc).split()) or "no detail"
+    if isinstance(exc, MemoryError):  # rosbags reads a record of the size it claims
+        text = "a record's size field asks for more memory than there is"
     found = re.search(r"offset (\d+)", text)
     truncated = re.search(r"truncat|unexpected end|eof|short read|not enough", text, re.I)
     return ParseError(
@@ -507,7 +510,8 @@ def _parse_error(reason: str, number: int, name: str) -> ParseError:
 
 def _sensor_arrays(reader, conns, kind, tally, strict, name, tick):
     """Stamps (ns) and arrays of an Imu or MagneticField topic."""
-    n = sum(c.msgcount for c in conns)
+    # the bag's message count may be damaged: start from at most _PREALLOC rows and grow
+    n = min(sum(c.msgcount for c in conns), _PREALLOC)
     stamps = np.zeros(n, dtype=np.int64)
     width = 10 if kind == "imu" else 3
     out = np.zeros((n, width), dtype=np.float64)
@@ -540,10 +544,11 @@ def _sensor_arrays(reader, conns, kind, tally, strict, name, tick):
                 raise _parse_error("non-finite value", number, name)
             tally.add("malformed_field", number)
             continue
-        if k >= n:  # msgcount was short: grow
-            stamps = np.concatenate([stamps, np.zeros_like(stamps)])
-            out = np.concatenate([out, np.zeros_like(out)])
-            quat_flag = np.concatenate([quat_flag, np.zeros_like(quat_flag)])
+        if k >= len(stamps):  # more messages than allocated (or than msgcount said): grow
+            extra = max(len(stamps), 1024)
+            stamps = np.concatenate([stamps, np.zeros(extra, dtype=np.int64)])
+            out = np.concatenate([out, np.zeros((extra, width))])
+            quat_flag = np.concatenate([quat_flag, np.zeros(extra, dtype=bool)])
         out[k] = values
         stamps[k] = _stamp(msg) or t
         quat_flag[k] = has_q
