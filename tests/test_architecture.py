@@ -140,3 +140,53 @@ def test_no_use_cycle_between_rust_modules():
         if a in uses.get(b, ()) and not (a.startswith(b + "::") or b.startswith(a + "::"))
     ]
     assert not related, f"Rust modules that use each other: {sorted(set(related))}"
+
+
+#: Modules that may write a file other than through imunoise._atomic, and why.
+_OWN_WRITES = {
+    "imunoise._atomic": "the helper itself",
+    "imunoise.scale.convert": "appends to its staging files, themselves _atomic temporaries",
+    "imunoise.readers.rosbag_reader": "bytes given as a bag go to a scratch TemporaryDirectory",
+}
+_WRITERS = {"write_text", "write_bytes", "savefig", "savetxt", "save", "savez",
+            "savez_compressed", "to_csv", "to_parquet", "replace", "rename", "mkstemp"}
+
+
+def _handles(tree) -> set[str]:
+    """Names bound by ``with _atomic.replacing(...) as name``: writing into them is fine."""
+    names = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.With):
+            for item in node.items:
+                call = item.context_expr
+                if (isinstance(call, ast.Call) and isinstance(call.func, ast.Attribute)
+                        and call.func.attr == "replacing"
+                        and isinstance(item.optional_vars, ast.Name)):
+                    names.add(item.optional_vars.id)
+    return names
+
+
+@pytest.mark.parametrize("name", sorted(n for n in MODULES if n not in _OWN_WRITES))
+def test_every_write_goes_through_the_atomic_helper(name):
+    tree = ast.parse(MODULES[name].read_text())
+    handles = _handles(tree)
+    for node in ast.walk(tree):
+        if not isinstance(node, ast.Call):
+            continue
+        func = node.func
+        if isinstance(func, ast.Name) and func.id == "open" and len(node.args) > 1:
+            mode = node.args[1]
+            assert not (isinstance(mode, ast.Constant) and set(str(mode.value)) & set("wax+")), \
+                f"{name}:{node.lineno} opens a file for writing; use imunoise._atomic"
+        if not isinstance(func, ast.Attribute) or func.attr not in _WRITERS:
+            continue
+        owner = func.value
+        if isinstance(owner, ast.Name) and owner.id in ("_atomic", "plot"):
+            continue  # plot.save writes through _atomic
+        into_handle = node.args and isinstance(node.args[0], ast.Name) \
+            and node.args[0].id in handles
+        if func.attr in ("replace", "rename") and not (isinstance(owner, ast.Name)
+                                                       and owner.id == "os"):
+            continue  # str.replace, dataclasses.replace ...
+        assert into_handle, (f"{name}:{node.lineno} writes with .{func.attr}() outside "
+                             "imunoise._atomic")

@@ -30,7 +30,9 @@ from imunoise.readers.log import ImuLog
 from imunoise.units import convert_back
 from imunoise.writers.vn import write_vn_ascii, write_vn_binary
 
-__all__ = ["DEFAULT_K", "flicker_for_floor", "noise_of_spec", "simulate_log", "still_log"]
+__all__ = [
+    "DEFAULT_K", "MAX_SAMPLES", "flicker_for_floor", "noise_of_spec", "simulate_log", "still_log",
+]
 
 #: Rate random walk used where the datasheet gives none (typical MEMS values):
 #: gyro rad/s/√s, accelerometer m/s²/√s.
@@ -41,6 +43,9 @@ _STILL_MEAN = {"gyro": (0.0, 0.0, 0.0), "accel": (0.0, 0.0, -_schema.G)}
 _STILL_YPR = (-77.7, -1.3, 0.15)  # deg
 _STILL_MAG = (0.045, 0.247, -0.338)  # Gauss
 _FORMATS = ("vn-ascii", "vn-binary")
+#: Most samples a simulated log may have (hours x 3600 x fs): 69 h at 40 Hz, 2.8 h at
+#: 1 kHz. The log is built in memory, about 400 bytes per sample (4 GB at the bound).
+MAX_SAMPLES = 10_000_000
 
 
 def noise_of_spec(spec="vn100") -> dict[str, dict[str, float]]:
@@ -105,7 +110,14 @@ def still_log(hours: float, fs: float = 40.0, *, spec="vn100", seed=None) -> Imu
     accelerometer simulated, attitude and magnetic field constant."""
     hours = positive_finite(hours, "hours")
     fs = sample_rate(fs)
-    n = int(round(hours * 3600.0 * fs))
+    samples = hours * 3600.0 * fs
+    if samples > MAX_SAMPLES:
+        raise ValueError(
+            f"hours={hours:g} at fs={fs:g} Hz gives {samples:.4g} samples; at most "
+            f"{MAX_SAMPLES:,} are simulated (about 400 bytes of memory each; "
+            f"{MAX_SAMPLES / fs / 3600:.4g} h at this rate)"
+        )
+    n = int(round(samples))
     if n < 2:
         raise ValueError(f"hours={hours:g} at fs={fs:g} Hz gives {n} samples; at least 2 needed")
     noise = noise_of_spec(spec)

@@ -7,12 +7,15 @@ warnings are one line each, ``imunoise: warning: ...``.
 from __future__ import annotations
 
 import argparse
+import signal
 import sys
+import threading
 import warnings
 from pathlib import Path
 
 import numpy as np
 
+from imunoise import _atomic
 from imunoise._schema import (
     ALLAN_SENSORS,
     CHANNELS,
@@ -71,6 +74,8 @@ def _build_parser() -> argparse.ArgumentParser:
     r.add_argument("-o", "--output", default="imunoise-report", metavar="DIR",
                    help="output directory (default: %(default)s)")
     _shared_options(r, spec=True, fs=True, progress=True, layout=True)
+    r.add_argument("--force", action="store_true",
+                   help="write into an existing folder that is not an imunoise report")
     r.add_argument("--trim", choices=["auto"], default=None,
                    help="'auto': analyse the long log from the end of its warm-up transient "
                    "(the report states what was cut)")
@@ -196,6 +201,8 @@ def _build_parser() -> argparse.ArgumentParser:
                        description="Report on a real 5-minute VN-100 log shipped with imunoise "
                        "and a simulated 5-hour VN-100 log, then print where the report is.")
     d.add_argument("-o", "--output", default="imunoise-demo", metavar="DIR")
+    d.add_argument("--force", action="store_true",
+                   help="write into an existing folder that is not an imunoise report")
     d.add_argument("--hours", type=_positive_float, default=5.0,
                    help="length of the simulated long log (default: %(default)s)")
     d.add_argument("--seed", type=int, default=1)
@@ -310,7 +317,8 @@ def _cmd_report(args) -> int:
 
     spec = None if args.spec.lower() == "none" else args.spec
     rep = report.build(args.short_log, args.long_log, args.output, spec=spec, fs=args.fs,
-                       progress=args.progress, read_options=_read_options(args), trim=args.trim)
+                       progress=args.progress, read_options=_read_options(args), trim=args.trim,
+                       force=args.force)
     for log in rep.logs:
         _note_gaps(log.source, log)
     print(f"report written to {rep.html}")
@@ -523,13 +531,14 @@ def _cmd_convert(args) -> int:
     if suffix not in ("", ".npy", ".csv", ".parquet", ".npz"):
         _fail(f"--output must be a directory or end in .npy, .parquet, .csv or .npz; "
               f"got {str(out)!r}")
+    _atomic.refuse_input(out, [args.log])
     if suffix in ("", ".npy", ".parquet"):
         return _convert_streaming(args, out)
     from imunoise.writers.table import log_columns, write_csv, write_npz
 
     log = _read(args)
     out.parent.mkdir(parents=True, exist_ok=True)
-    (write_csv if suffix == ".csv" else write_npz)(log, out)
+    (write_csv if suffix == ".csv" else write_npz)(log, out, inputs=[args.log])
     print(f"wrote {len(log)} samples x {len(log_columns(log)[0])} columns to {out}")
     return 0
 
@@ -560,6 +569,7 @@ def _cmd_batch(args) -> int:
         _fail(f"--output must end in .parquet or .csv; got {str(out)!r}")
     if args.serial and args.scheduler:
         _fail("--serial and --scheduler exclude each other")
+    _atomic.refuse_input(out, args.logs)
     client = False if args.serial else args.scheduler
     try:
         df = scale.batch(args.logs, client=client, spec=args.spec, fs=args.fs,
@@ -567,13 +577,14 @@ def _cmd_batch(args) -> int:
     except ImportError as exc:
         _fail(str(exc))
     out.parent.mkdir(parents=True, exist_ok=True)
-    if suffix == ".csv":
-        df.to_csv(out, index=False)
-    else:
-        try:
-            df.to_parquet(out, index=False)
-        except ImportError:
-            _fail("Parquet output needs pyarrow (pip install pyarrow); or use a .csv output")
+    with _atomic.replacing(out, inputs=args.logs) as fh:
+        if suffix == ".csv":
+            df.to_csv(fh, index=False)
+        else:
+            try:
+                df.to_parquet(fh, index=False)
+            except ImportError:
+                _fail("Parquet output needs pyarrow (pip install pyarrow); or use a .csv output")
     failed = df.loc[df["error"].notna(), "path"].tolist()
     logs = df["path"].nunique()
     print(f"wrote {len(df)} rows for {logs} logs to {out}"
@@ -603,7 +614,8 @@ def _cmd_demo(args) -> int:
     short = bundled_log()
     long = still_log(args.hours, 40.0, spec="vn100", seed=args.seed)
     # The bundled log is VN ASCII without timestamps, recorded at 40 Hz.
-    rep = report.build(short, long, args.output, spec="vn100", fs=40.0, progress=args.progress)
+    rep = report.build(short, long, args.output, spec="vn100", fs=40.0, progress=args.progress,
+                       force=args.force)
     print(f"demo report: {rep.html.resolve()}")
     print(f"             {rep.markdown.resolve()}")
     return 0
@@ -685,6 +697,7 @@ def main(argv: list[str] | None = None) -> int:
     parser = _build_parser()
     old = warnings.showwarning
     warnings.showwarning = _warn
+    old_term = _exit_on_sigterm()
     try:
         try:
             args = parser.parse_args(argv)
@@ -705,6 +718,22 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     finally:
         warnings.showwarning = old
+        if old_term is not None:
+            signal.signal(signal.SIGTERM, old_term)
+
+
+def _exit_on_sigterm():
+    """SIGTERM (``kill``) unwinds like Ctrl-C, so the temporaries of the file being
+    written are removed, and exits 143; returns the handler it replaced (None when
+    not in the main thread, where handlers cannot be set)."""
+    if threading.current_thread() is not threading.main_thread():
+        return None
+
+    def _terminated(signum, frame):
+        print("imunoise: terminated", file=sys.stderr)
+        raise SystemExit(128 + signum)
+
+    return signal.signal(signal.SIGTERM, _terminated)
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -81,6 +81,11 @@ __all__ = ["Departure", "DynamicAllan", "Stationarity", "dynamic_adev"]
 _BLOCK = 4096
 # Family-wise false-alarm rate of the interval search.
 _ALARM = 0.01
+#: Most windows :func:`dynamic_adev` computes (the record length over the step):
+#: eight arrays of windows x taus x channels are kept, 64 bytes per cell (0.4 GB at
+#: the bound with 20 taus and 3 channels).
+MAX_WINDOWS = 100_000
+
 # A block takes part in the interval search at taus with m <= step / _BLOCK_TERMS_PER_M.
 _BLOCK_TERMS_PER_M = 10
 
@@ -321,6 +326,14 @@ def dynamic_adev(
             f"({width / fs:g} s at {fs:g} Hz)"
         )
     stride = max(width // 6, 1) if step is None else _samples_of("step", step, fs)
+    windows = (n - width) // stride + 1
+    if windows > MAX_WINDOWS:
+        shortest = -(-(n - width) // (MAX_WINDOWS - 1))
+        raise ValueError(
+            f"step={stride / fs:g} s gives {windows:,} windows; at most {MAX_WINDOWS:,} are "
+            f"computed (every window keeps an ADEV per tau and channel): use a step of at "
+            f"least {shortest / fs:g} s ({shortest} samples) for this record"
+        )
     m = _window_factors(taus, fs, width)
     whole = adev(data[:, 0] if one_d else data, fs, taus=m / fs, confidence=confidence)
     if not np.array_equal(whole.m, m):

@@ -24,8 +24,8 @@ doubt) or ``"rms"`` (√ of the mean square over axes). Kalibr's documentation
 also suggests inflating the values of a still-bench characterisation for a
 moving platform; do that with ``inflate`` (default 1: the measured values).
 
-All files are written atomically: a temporary file in the same directory is
-written, flushed and ``os.replace``-d onto the target.
+All files are written atomically (:mod:`imunoise._atomic`): a unique temporary
+beside the target is written, fsync-ed and renamed onto it.
 
 References
 ----------
@@ -37,13 +37,11 @@ from __future__ import annotations
 
 import json
 import math
-import os
-import tempfile
 from pathlib import Path
 
 import numpy as np
 
-from imunoise import _warn
+from imunoise import _atomic, _warn
 from imunoise import units as _units
 from imunoise.noise import gm_white_density, resonance_white_density
 
@@ -55,31 +53,10 @@ __all__ = [
     "kalibr_yaml",
     "openvins_yaml",
     "model_json",
-    "write_atomic",
     "write_kalibr",
     "write_openvins",
     "write_json",
 ]
-
-
-def write_atomic(path, text: str) -> Path:
-    """Write ``text`` to ``path`` atomically (temp file in the same dir + os.replace)."""
-    path = Path(path)
-    directory = path.parent if str(path.parent) else Path(".")
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=directory)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as fh:
-            fh.write(text)
-            fh.flush()
-            os.fsync(fh.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        try:
-            os.unlink(tmp)
-        except OSError:
-            pass
-        raise
-    return path
 
 
 def _combine(model, term: str, combine: str, sensor: str, input_unit) -> float:
@@ -324,19 +301,19 @@ def ekf_yaml(gyro=None, accel=None, **kwargs) -> str:
 
 def write_ekf(path, gyro=None, accel=None, **kwargs) -> Path:
     """Write :func:`ekf_yaml` atomically; returns the path."""
-    return write_atomic(path, ekf_yaml(gyro, accel, **kwargs))
+    return _atomic.write_text(path, ekf_yaml(gyro, accel, **kwargs))
 
 
 def write_kalibr(path, gyro=None, accel=None, **kwargs) -> Path:
     """Write a Kalibr ``imu.yaml`` atomically; returns the path."""
-    return write_atomic(path, kalibr_yaml(gyro, accel, **kwargs))
+    return _atomic.write_text(path, kalibr_yaml(gyro, accel, **kwargs))
 
 
 def write_openvins(path, gyro=None, accel=None, **kwargs) -> Path:
     """Write an OpenVINS ``kalibr_imu_chain.yaml`` atomically; returns the path."""
-    return write_atomic(path, openvins_yaml(gyro, accel, **kwargs))
+    return _atomic.write_text(path, openvins_yaml(gyro, accel, **kwargs))
 
 
 def write_json(path, model=None, **models) -> Path:
     """Write the full model(s) as JSON atomically; returns the path."""
-    return write_atomic(path, model_json(model, **models))
+    return _atomic.write_text(path, model_json(model, **models))

@@ -24,7 +24,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from imunoise import _summary
+from imunoise import _atomic, _summary
 from imunoise._schema import ATTITUDE_NAMES, CHANNELS, axis_names
 from imunoise.allan import AllanResult
 from imunoise.noise import FLICKER, TERMS, NoiseModel, model_variance
@@ -614,7 +614,8 @@ def save(fig: Figure, path, *, formats: Sequence[str] = ("png", "svg")) -> list[
     with style():
         for fmt in formats:
             out = path.with_suffix(f".{fmt}")
-            fig.savefig(out, format=fmt)
+            with _atomic.replacing(out) as fh:
+                fig.savefig(fh, format=fmt)
             written.append(out)
     return written
 

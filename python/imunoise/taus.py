@@ -52,6 +52,13 @@ def averaging_factors(taus, fs: float, n_samples: int) -> tuple[np.ndarray, bool
     if isinstance(taus, numbers.Integral) and not isinstance(taus, bool):
         if taus < 1:
             raise ValueError(f"taus as points per decade must be >= 1; got {taus}")
+        most = max_points_per_decade(n_samples)
+        if taus > most:
+            raise ValueError(
+                f"taus as points per decade must be at most {most} for {n_samples} samples "
+                f"(3 per sample: denser grids give no new averaging factor; taus='all' "
+                f"takes every one); got {taus}"
+            )
         decades = np.log10(n_phase - 1) if n_phase > 2 else 0.0
         exponents = np.arange(int(np.floor(decades * taus)) + 1) / taus
         m = np.round(10.0**exponents)
@@ -70,9 +77,28 @@ def averaging_factors(taus, fs: float, n_samples: int) -> tuple[np.ndarray, bool
         raise ValueError("taus must not be empty")
     if not np.all(np.isfinite(arr)):
         raise ValueError("taus must be finite")
+    if np.any(arr <= 0):
+        i = int(np.flatnonzero(arr <= 0)[0])
+        raise ValueError(f"taus must be > 0 s; got taus[{i}] = {arr[i]:g}")
     # float m first: a huge tau must not wrap around when cast to int
     m = np.round(arr.astype(np.float64) * fs)
+    outside = (m < 1) | (m >= n_phase)
+    if outside.all():
+        shown = ", ".join(f"taus[{i}] = {arr[i]:g} s" for i in np.flatnonzero(outside)[:3])
+        raise ValueError(
+            f"no tau is within the record: {shown}{' ...' if arr.size > 3 else ''}; "
+            f"{n_samples} samples at {fs:g} Hz give taus from 1/fs = {1 / fs:g} s to "
+            f"{max(n_samples, 1) / fs:g} s at most"
+        )
     return np.clip(m, 0, n_phase).astype(np.int64), True
+
+
+def max_points_per_decade(n_samples: int) -> int:
+    """Largest ``taus`` as points per decade for ``n_samples`` samples: at 3 per
+    sample consecutive grid points near the longest tau are less than one sample
+    apart (ratio 10**(1/p), p = 3 n), so every whole averaging factor is reached and
+    more points only repeat them."""
+    return 3 * max(int(n_samples), 1)
 
 
 def _unique_in_range(m, n_phase: int) -> np.ndarray:

@@ -72,8 +72,22 @@ def test_bad_tau_specifications():
         imunoise.adev(GOOD, 1.0, taus=[])
     with pytest.raises(ValueError, match="taus must be finite"):
         imunoise.adev(GOOD, 1.0, taus=[1.0, np.nan])
-    with pytest.raises(ValueError, match="too few for any tau"), pytest.warns(UserWarning):
+    # each names the bad tau (all said "too few samples for any tau")
+    with pytest.raises(ValueError, match=r"no tau is within the record: taus\[0\] = 1e\+06 s"):
         imunoise.adev(GOOD, 1.0, taus=[1e6])
+    with pytest.raises(ValueError, match=r"taus\[0\] = 1e\+300 s.*to 2.5 s at most"):
+        imunoise.adev(GOOD, 40.0, taus=[1e300])
+    for bad in (0, -1):
+        with pytest.raises(ValueError, match=rf"taus must be > 0 s; got taus\[1\] = {bad}"):
+            imunoise.adev(GOOD, 40.0, taus=[1.0, bad])
+
+
+def test_points_per_decade_are_bounded_by_the_record():
+    n = len(GOOD)
+    with pytest.raises(ValueError, match=rf"at most {3 * n} for {n} samples.*got 1000000000"):
+        imunoise.adev(GOOD, 1.0, taus=10**9)  # grew to 24 GB before
+    dense = imunoise.adev(GOOD, 1.0, taus=3 * n)
+    assert np.array_equal(dense.taus, imunoise.adev(GOOD, 1.0, taus="all").taus)
 
 
 def test_out_of_range_taus_are_dropped_with_one_warning():

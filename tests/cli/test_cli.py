@@ -235,7 +235,7 @@ def test_convert_quaternion_columns_round_trip(tmp_path, capsys, suffix):
                fmt="%.9f")
     log = imunoise.read(src)
     np.testing.assert_allclose(log.quaternion, q, atol=1e-9)
-    out = tmp_path / f"q{suffix}"
+    out = tmp_path / f"out{suffix}"  # not q.csv: that is the input
     assert main(["convert", str(src), "-o", str(out)]) == 0
     capsys.readouterr()
     if suffix == ".npz":

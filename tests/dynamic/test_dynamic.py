@@ -189,3 +189,15 @@ def test_explicit_taus_beyond_the_window_are_dropped_with_a_warning():
         d = imunoise.dynamic_adev(y, 1.0, window=100.0, taus=[1.0, 10.0, 80.0])
     np.testing.assert_array_equal(d.taus, [1.0, 10.0])
     assert d.stationarity is d.stationarity  # computed once
+
+
+def test_window_count_is_bounded(monkeypatch):
+    """A one-sample step over a long record asked for millions of windows at once."""
+    from imunoise import dynamic
+
+    monkeypatch.setattr(dynamic, "MAX_WINDOWS", 100)
+    y = np.random.default_rng(0).normal(size=2000)
+    with pytest.raises(ValueError, match=r"step=1 s gives 1,991 windows; at most 100.*at least "
+                                         r"21 s \(21 samples\)"):
+        imunoise.dynamic_adev(y, 1.0, window=10.0, step=1.0)
+    assert len(imunoise.dynamic_adev(y, 1.0, window=10.0, step=21.0).times) <= 100

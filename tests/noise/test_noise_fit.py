@@ -279,6 +279,9 @@ def test_bootstrap_on_several_channels_and_non_overlapping_adev():
         ({"uncertainty": "mc"}, ValueError, "uncertainty must be 'independent' or 'bootstrap'"),
         ({"uncertainty": "bootstrap", "replicates": 2}, ValueError, "replicates must be >= 5"),
         ({"uncertainty": "bootstrap", "replicates": 7.5}, TypeError, "replicates must be an"),
+        # 10**9 replicates tried to allocate 1.19 TiB at once
+        ({"uncertainty": "bootstrap", "replicates": 10**9}, ValueError,
+         "replicates must be at most 100,000 for a record of 2,000 samples"),
     ],
 )
 def test_bootstrap_bad_arguments(kwargs, error, match):

@@ -105,7 +105,7 @@ def test_convert_replaces_and_rejects(logs, tmp_path):
     scale.convert(logs["binary"], out)
     done = scale.convert(logs["ascii"], out, fs=FS)  # fewer channels: no stale time.npy
     assert sorted(p.name for p in out.iterdir()) == sorted(p.name for p in done.files)
-    assert not list(tmp_path.glob(".*partial*"))
+    assert not list(tmp_path.glob(".*"))
     with pytest.raises(ValueError, match="out must be"):
         scale.convert(logs["ascii"], tmp_path / "x.csv")
     with pytest.raises(ValueError, match="chunk_bytes"):
@@ -115,7 +115,7 @@ def test_convert_replaces_and_rejects(logs, tmp_path):
     with pytest.raises(ValueError, match="no usable records"):
         scale.convert(empty, tmp_path / "e.npy", format="vn-ascii", fs=FS)
     assert not (tmp_path / "e.npy").exists()
-    assert not list(tmp_path.glob(".*partial*"))
+    assert not list(tmp_path.glob(".*"))
 
 
 def test_cli_convert_streams(logs, tmp_path, capsys):

@@ -51,6 +51,9 @@ def test_still_log_is_reproducible_and_validates():
         still_log(-1.0)
     with pytest.raises(ValueError, match="gives 0 samples"):
         still_log(1e-6, 40.0)
+    # 3.6e9 samples grew until the kernel killed it; now refused before any allocation
+    with pytest.raises(ValueError, match=r"gives 3\.6e\+09 samples; at most 10,000,000"):
+        still_log(1000.0, 1000.0)
     with pytest.raises(ValueError, match="format must be one of vn-ascii, vn-binary; got 'csv'"):
         simulate_log("x.csv", 0.01, format="csv")
     with pytest.warns(DeprecationWarning, match="format to simulate_log"):

@@ -22,6 +22,10 @@ from imunoise.noise._model import NoiseModel
 from imunoise.noise._readoff import coverage, fit_slopes, measured, readoffs
 from imunoise.noise._terms import GM_MAX, PARAMS, RES_SLOT, SINE_SLOT, TERMS, term_variances
 
+#: Most simulated samples (replicates x record length) of ``fit(uncertainty=
+#: "bootstrap")``: they are held at once, 8 bytes each (1.6 GB at the bound).
+MAX_BOOTSTRAP_SAMPLES = 200_000_000
+
 
 def _extract(result, tau_range):
     """Validate an Allan result; return taus (T,), var (T, C), edf (T, C), 1-D flag."""
@@ -191,6 +195,17 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
             raise TypeError(f"replicates must be an integer; got {replicates!r}")
         if replicates < 5:
             raise ValueError(f"replicates must be >= 5; got {replicates}")
+        n = _record_length(result)
+        if replicates * n > MAX_BOOTSTRAP_SAMPLES:
+            most = MAX_BOOTSTRAP_SAMPLES // n
+            raise ValueError(
+                (f"replicates must be at most {most:,} for a record of {n:,} samples"
+                 if most >= 5 else
+                 f"a record of {n:,} samples is too long for a bootstrap (use "
+                 f"uncertainty='independent')")
+                + f" (the simulated records, replicates x samples, are held at once: at most "
+                f"{MAX_BOOTSTRAP_SAMPLES:,}); got replicates={replicates:,}"
+            )
     mask, gm_count, oscillators, select = _parse_terms(terms)
     taus, var, edf, one = _extract(result, tau_range)
     dev_all, edf_raw = measured(result, taus)

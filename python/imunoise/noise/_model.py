@@ -307,11 +307,11 @@ class NoiseModel(PerTerm):
         See :func:`imunoise.export.kalibr_yaml` for the options; with ``path``
         the file is also written atomically.
         """
-        from imunoise import export
+        from imunoise import _atomic, export
 
         text = export.kalibr_yaml(gyro=self, accel=accel, **kwargs)
         if path is not None:
-            export.write_atomic(path, text)
+            _atomic.write_text(path, text)
         return text
 
     def to_dict(self) -> dict:

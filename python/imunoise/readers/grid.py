@@ -58,7 +58,9 @@ from imunoise._runs import true_runs
 __all__ = ["MAX_GRID_RATIO", "Gaps", "TimeGrid", "outlier_stamps"]
 
 #: Timestamps that would make a grid this many times longer than the samples
-#: (over 99 % missing) are not taken as a sample clock.
+#: (over 99 % missing) are not taken as a sample clock; damaged records that would
+#: fill a grid this many times longer than the good ones are an error
+#: (:meth:`TimeGrid.from_missing`): a reader never allocates more missing rows.
 MAX_GRID_RATIO = 100
 #: A timestamp this many nominal steps away from the line of its neighbours (that
 #: they do not follow) is an outlier: counted as ``time_outlier``, its sample kept
@@ -493,9 +495,18 @@ class TimeGrid:
     def from_missing(cls, n_records: int, positions) -> TimeGrid:
         """The grid of ``n_records`` good records with one missing sample before
         record ``p`` for every ``p`` in ``positions`` (repeats allowed; positions
-        0 and ``n_records``, before the first and after the last record, ignored)."""
+        0 and ``n_records``, before the first and after the last record, ignored).
+
+        Raises ``ValueError`` when the grid would be more than
+        :data:`MAX_GRID_RATIO` times longer than the good records."""
         p = np.asarray(positions, dtype=np.int64).reshape(-1)
         p = p[(p > 0) & (p < n_records)]
+        if n_records + len(p) > MAX_GRID_RATIO * n_records:
+            raise ValueError(
+                f"{len(p)} damaged records among {n_records} good ones would be "
+                f"{len(p)} missing rows, more than {MAX_GRID_RATIO}x the samples: the log "
+                f"is not a sample sequence (a damaged or crafted file)"
+            )
         shift = np.searchsorted(np.sort(p), np.arange(n_records), side="right")
         slot = np.arange(n_records, dtype=np.int64) + shift
         return cls(slot=slot, n=n_records + len(p))

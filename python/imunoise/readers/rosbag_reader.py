@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import errno
 import os
+import re
 import tempfile
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
@@ -51,6 +52,7 @@ MAG = "sensor_msgs/msg/MagneticField"
 TEMPERATURE = "sensor_msgs/msg/Temperature"
 TESLA_TO_GAUSS = 1e4
 _BATCH = 20_000  # messages per call of the VN parser
+_PREALLOC = 1 << 16  # rows allocated before the first message of a sensor topic
 
 #: What a topic is (see _classify_topics) and, for a VN message, the attribute
 #: path of its sentence field.
@@ -201,17 +203,52 @@ def _read_bag(path, name, strict, fs, progress, topic, msg_defs, typestore) -> I
     )
     default = _typestore(typestore, msg_defs) if (typestore or msg_defs) else None
     try:
-        reader = AnyReader([path], default_typestore=default)
-        reader.open()
-    except AnyReaderError as exc:
-        if default is not None or "type definitions" not in str(exc):
-            raise ValueError(f"{name}: cannot open bag: {exc}") from exc
-        reader = AnyReader([path], default_typestore=_typestore(None, None))
-        reader.open()
-    try:
-        return _read(reader, name, total, strict, fs, progress, topic)
-    finally:
-        reader.close()
+        try:
+            reader = AnyReader([path], default_typestore=default)
+            reader.open()
+        except AnyReaderError as exc:
+            if default is not None or "type definitions" not in str(exc):
+                raise ValueError(f"{name}: cannot open bag: {exc}") from exc
+            reader = AnyReader([path], default_typestore=_typestore(None, None))
+            reader.open()
+        try:
+            return _read(reader, name, total, strict, fs, progress, topic)
+        finally:
+            reader.close()
+    except Exception as exc:
+        if _ours(exc):
+            raise
+        raise _damaged(exc, name) from exc
+
+
+def _ours(exc: BaseException) -> bool:
+    """True for the errors this module raises on purpose (they name the bag, the
+    topic or the argument); False for what a damaged bag makes a library (rosbags,
+    apsw/sqlite, struct, the codecs ...) or a builtin raise."""
+    if isinstance(exc, ParseError | FileNotFoundError):
+        return True
+    if type(exc) not in (ValueError, TypeError):
+        return False
+    tb = exc.__traceback__
+    while tb is not None and tb.tb_next is not None:
+        tb = tb.tb_next
+    return tb is not None and tb.tb_frame.f_globals.get("__name__") == __name__
+
+
+def _damaged(exc: Exception, name: str) -> ParseError:
+    """A library's exception on a damaged bag as a :class:`ParseError` naming the
+    file, the byte offset when the library said it, and the cause."""
+    text = " ".join(str(exc).split()) or "no detail"
+    if isinstance(exc, MemoryError):  # rosbags reads a record of the size it claims
+        text = "a record's size field asks for more memory than there is"
+    found = re.search(r"offset (\d+)", text)
+    truncated = re.search(r"truncat|unexpected end|eof|short read|not enough", text, re.I)
+    return ParseError(
+        f"damaged bag: {type(exc).__name__}: {text[:300]}",
+        kind="truncated_record" if truncated else "malformed_field",
+        offset=int(found.group(1)) if found else None,
+        source=None if name == _BYTES else name,
+    )
 
 
 def _read(reader, name, total, strict, fs, progress, topic) -> ImuLog:
@@ -472,7 +509,8 @@ def _parse_error(reason: str, number: int, name: str) -> ParseError:
 
 def _sensor_arrays(reader, conns, kind, tally, strict, name, tick):
     """Stamps (ns) and arrays of an Imu or MagneticField topic."""
-    n = sum(c.msgcount for c in conns)
+    # the bag's message count may be damaged: start from at most _PREALLOC rows and grow
+    n = min(sum(c.msgcount for c in conns), _PREALLOC)
     stamps = np.zeros(n, dtype=np.int64)
     width = 10 if kind == "imu" else 3
     out = np.zeros((n, width), dtype=np.float64)
@@ -505,10 +543,11 @@ def _sensor_arrays(reader, conns, kind, tally, strict, name, tick):
                 raise _parse_error("non-finite value", number, name)
             tally.add("malformed_field", number)
             continue
-        if k >= n:  # msgcount was short: grow
-            stamps = np.concatenate([stamps, np.zeros_like(stamps)])
-            out = np.concatenate([out, np.zeros_like(out)])
-            quat_flag = np.concatenate([quat_flag, np.zeros_like(quat_flag)])
+        if k >= len(stamps):  # more messages than allocated (or than msgcount said): grow
+            extra = max(len(stamps), 1024)
+            stamps = np.concatenate([stamps, np.zeros(extra, dtype=np.int64)])
+            out = np.concatenate([out, np.zeros((extra, width))])
+            quat_flag = np.concatenate([quat_flag, np.zeros(extra, dtype=bool)])
         out[k] = values
         stamps[k] = _stamp(msg) or t
         quat_flag[k] = has_q

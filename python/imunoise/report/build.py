@@ -8,6 +8,7 @@ Adding a section is one function in :mod:`.sections` and one entry in
 from __future__ import annotations
 
 import datetime as _dt
+import os
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from functools import cached_property
@@ -15,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from imunoise import _schema, export, noise, plot, stats
+from imunoise import _atomic, _schema, export, noise, plot, stats
 from imunoise import allan as _allan
 from imunoise._core import __version__
 from imunoise._events import Events, events
@@ -24,7 +25,7 @@ from imunoise._schema import ALLAN_SENSORS, SAMPLE_SENSORS, sensor_label
 from imunoise._thermal import Thermal, thermal
 from imunoise._warmup import Warmup, warmup
 from imunoise.readers.log import ImuLog
-from imunoise.report import sections
+from imunoise.report import folder, sections
 from imunoise.report.document import Doc
 from imunoise.report.formatting import format_duration
 from imunoise.report.inputs import read_log
@@ -246,6 +247,7 @@ def build(
     progress: bool | None = None,
     read_options: Mapping[str, object] | None = None,
     trim: str | None = None,
+    force: bool = False,
 ) -> Report:
     """Analyse the logs and write the report directory.
 
@@ -256,7 +258,10 @@ def build(
     long : path or ImuLog, optional
         Long still recording (hours): Allan deviation and noise model. Default: ``short``.
     out_dir : path
-        Directory to write (created; existing report files are replaced).
+        Folder to write (created). A folder of an earlier report (it holds
+        ``imunoise-report.json``) is updated: its files are replaced and those this
+        report does not write (figures of sections that no longer apply) removed.
+        An existing folder holding anything else needs ``force=True``.
     spec : str or None
         Datasheet to compare against (name or file, see :func:`imunoise.compare`);
         None skips the comparison.
@@ -272,14 +277,20 @@ def build(
         ``"auto"``: analyse the long log from the settle point of its warm-up
         (:func:`imunoise.warmup`); the report says what was cut, at its top and in
         the warm-up section. None (default): the whole log.
+    force : bool
+        Write into an existing folder that is not a report (default False: refused
+        with a ``ValueError``).
     """
     if trim not in (None, "auto"):
         raise ValueError(f"trim must be None or 'auto'; got {trim!r}")
     out = Path(out_dir)
+    inputs = [p for p in (short, long) if isinstance(p, str | os.PathLike)]
+    previous = folder.claim(out, force=force, inputs=inputs)
     options = dict(read_options or {})
     short_log = read_log(short, "short", fs=fs, progress=wanted(progress), **options)
     long_log = short_log if long is None else read_log(long, "long", fs=fs,
                                                        progress=wanted(progress), **options)
+    folder.mark(out, previous)
     (out / "figures").mkdir(parents=True, exist_ok=True)
     ctx = Context(short=short_log, long=long_log, one_log=long is None, spec=spec, out_dir=out)
     if trim == "auto":
@@ -300,8 +311,10 @@ def build(
         bar.step("writing")
         model_files = _write_model_files(ctx.models, out, long_log.fs)
         md_path, html_path = out / "report.md", out / "report.html"
-        md_path.write_text(doc.markdown(out), encoding="utf-8")
-        html_path.write_text(doc.html(TITLE), encoding="utf-8")
+        _atomic.write_text(md_path, doc.markdown(out))
+        _atomic.write_text(html_path, doc.html(TITLE))
+        folder.settle(out, [*ctx.figures, *model_files, md_path, html_path], previous,
+                      inputs=inputs)
     return Report(
         out_dir=out,
         html=html_path,

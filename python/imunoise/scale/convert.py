@@ -43,6 +43,7 @@ from pathlib import Path
 
 import numpy as np
 
+from imunoise import _atomic
 from imunoise._core import vn as _core_vn
 from imunoise._schema import CHANNELS, column_names
 from imunoise.readers import registry
@@ -63,6 +64,9 @@ __all__ = ["CHUNK_BYTES", "Conversion", "convert", "load"]
 
 #: Default bytes read per piece by :func:`convert`.
 CHUNK_BYTES = 64 << 20
+#: Largest piece read at once from a stream, whose size is unknown (a file piece is
+#: at most the file).
+MAX_STREAM_PIECE = 1 << 30
 
 
 @dataclass(frozen=True)
@@ -122,7 +126,7 @@ class _NpyAppender:
         self.dtype = np.dtype(dtype)
         self.row_shape = row_shape
         self.rows = 0
-        self.f = open(path, "wb")  # noqa: SIM115 - closed in close()
+        self.f = open(path, "xb")  # noqa: SIM115 - closed in close()
         self._header()
         self.data_start = self.f.tell()
 
@@ -179,7 +183,7 @@ class _Sink:
 class _DirSink(_Sink):
     def __init__(self, staging: Path, channels: list[str]):
         super().__init__(staging, channels)
-        staging.mkdir(parents=True, exist_ok=True)
+        staging.mkdir()
         self.files = {
             ch: _NpyAppender(staging / f"{ch}.npy", np.float64,
                              () if _width(ch) == 1 else (_width(ch),))
@@ -196,16 +200,30 @@ class _DirSink(_Sink):
             f.close()
 
     def publish(self, out, meta):
-        out.mkdir(parents=True, exist_ok=True)
-        files = []
-        for ch in self.channels:
-            dest = out / f"{ch}.npy"
-            os.replace(self.staging / f"{ch}.npy", dest)
-            files.append(dest)
-        meta_file = out / "meta.json"
-        meta_file.write_text(json.dumps(meta, indent=1))
-        shutil.rmtree(self.staging, ignore_errors=True)
-        return [*files, meta_file]
+        _atomic.write_text(self.staging / "meta.json", json.dumps(meta, indent=1))
+        _atomic.sync(self.staging)
+        names = [f"{ch}.npy" for ch in self.channels] + ["meta.json"]
+        if not out.exists():
+            os.rename(self.staging, out)
+        elif out.is_dir() and _only_ours(out) and _atomic.exchange_dir(self.staging, out):
+            shutil.rmtree(self.staging, ignore_errors=True)  # the old output, swapped out
+        else:
+            # files of others in out: replace ours one by one, meta.json last, so a
+            # directory whose meta.json is old still has every old channel file
+            for name in names:
+                _atomic.publish(self.staging / name, out / name)
+            for stale in _OUR_FILES.difference(names):
+                (out / stale).unlink(missing_ok=True)
+            shutil.rmtree(self.staging, ignore_errors=True)
+        return [out / name for name in names]
+
+
+#: Every file a directory output may hold.
+_OUR_FILES = frozenset(["meta.json", *(f"{c}.npy" for c in ("time", *CHANNELS))])
+
+
+def _only_ours(out: Path) -> bool:
+    return all(p.name in _OUR_FILES for p in out.iterdir())
 
 
 def _record_dtype(channels: list[str]) -> np.dtype:
@@ -233,9 +251,9 @@ class _NpySink(_Sink):
         self.file.close()
 
     def publish(self, out, meta):
-        os.replace(self.staging, out)
         meta_file = meta_path(out)
-        meta_file.write_text(json.dumps(meta, indent=1))
+        _atomic.publish(self.staging, out)
+        _atomic.write_text(meta_file, json.dumps(meta, indent=1))
         return [out, meta_file]
 
 
@@ -269,7 +287,7 @@ class _ParquetSink(_Sink):
         self.writer.close()
 
     def publish(self, out, meta):
-        os.replace(self.staging, out)
+        _atomic.publish(self.staging, out)
         return [out]
 
 
@@ -294,20 +312,15 @@ class _Writer:
         self.layout = layout
         self.sinks: dict[str, _Sink] = {}
 
-    def _staging(self, k: int) -> Path:
-        name = f".{self.out.name}.partial-{k}"
-        if self.layout == "npy":
-            name += ".npy"
-        elif self.layout == "parquet":
-            name += ".parquet"
-        return self.out.parent / name
+    def _staging(self) -> Path:
+        return _atomic.temporary_beside(self.out)
 
     def append(self, table: str, cols: Mapping[str, np.ndarray]) -> None:
         sink = self.sinks.get(table)
         if sink is None:
             channels = _order(cols)
             cls = {"dir": _DirSink, "npy": _NpySink, "parquet": _ParquetSink}[self.layout]
-            sink = cls(self._staging(len(self.sinks)), channels)
+            sink = cls(self._staging(), channels)
             self.sinks[table] = sink
         sink.append(cols)
 
@@ -665,7 +678,8 @@ def convert(
     fs : float, optional
         Sample rate of logs without timestamps, as for :func:`imunoise.read`.
     chunk_bytes : int
-        Bytes read per piece (default 64 MiB); peak memory is a few times this.
+        Bytes read per piece (default 64 MiB, at least 4096; at most the file's
+        size is read at once); peak memory is a few times this.
     format : str
         As for :func:`imunoise.read` (``"auto"`` detects it).
     progress : callable, optional
@@ -704,6 +718,7 @@ def convert(
         # A log that fits in one piece is converted from imunoise.read's own result
         # (same grid, same fs to the bit); only larger VN logs are streamed.
         if stream:  # read once: the format is detected from the first piece, kept
+            chunk_bytes = min(chunk_bytes, MAX_STREAM_PIECE)
             f = path if hasattr(path, "read") else stack.enter_context(open(path, "rb"))
             first = f.read(chunk_bytes)
             if format == "auto":
@@ -719,7 +734,15 @@ def convert(
                 raise FileNotFoundError(2, "no such file", str(path))
             if format == "auto":
                 format = detect_format(path)
+            _atomic.refuse_input(out, [path])
+            if layout == "dir" and out.exists() and not out.is_dir():
+                raise ValueError(f"out {str(out)!r} exists and is not a directory")
+            if layout == "dir" and out.is_dir():
+                for our_file in _OUR_FILES:
+                    _atomic.refuse_input(out / our_file, [path])
             total = path.stat().st_size if path.is_file() else None
+            if total is not None:  # a piece never asks for more than the file
+                chunk_bytes = min(chunk_bytes, total + 1)
             streamed = (registry.get(format).streamable and total is not None
                         and total > chunk_bytes)
             if streamed:
@@ -779,7 +802,6 @@ def _convert(name: str, source, out: Path, layout: str, *, fs, format: str,
         sink = writer.sinks[primary]
         meta = log_meta(fs=rate, source=name, fmt=fmt, issues=issues, messages=messages,
                      samples=sink.rows, channels=sink.channels, table=primary, gaps=gaps)
-        _remove(out, layout)
         files = writer.finish(primary, meta)
     except BaseException:
         writer.abort()
@@ -803,16 +825,6 @@ class _counted:
             yield block
 
 
-def _remove(out: Path, layout: str) -> None:
-    """Clear a previous output at ``out`` (only what a conversion writes)."""
-    if layout == "dir":
-        if out.exists() and not out.is_dir():
-            raise ValueError(f"out {str(out)!r} exists and is not a directory")
-        if out.is_dir():
-            for name in ["meta.json", *(f"{c}.npy" for c in ("time", *CHANNELS))]:
-                (out / name).unlink(missing_ok=True)
-    elif layout == "npy":
-        meta_path(out).unlink(missing_ok=True)
 
 
 def load(out) -> ImuLog:

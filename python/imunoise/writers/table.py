@@ -13,10 +13,12 @@ from __future__ import annotations
 
 import json
 import os
+from collections.abc import Iterable
 from pathlib import Path
 
 import numpy as np
 
+from imunoise import _atomic
 from imunoise._schema import column_names
 from imunoise.readers.columnar import META_KEY, log_meta, meta_path
 from imunoise.readers.log import ImuLog
@@ -51,27 +53,28 @@ def _meta(log: ImuLog) -> dict:
                     gaps=log.gaps)
 
 
-def write_csv(log: ImuLog, out) -> list[Path]:
+def write_csv(log: ImuLog, out, *, inputs: Iterable = ()) -> list[Path]:
     """Write ``log`` as CSV (a header, one row per grid row, NaN in missing rows) and
-    its metadata as ``OUT.meta.json``; returns both paths."""
+    its metadata as ``OUT.meta.json``, each atomically (``inputs`` are refused as
+    outputs); returns both paths."""
     out = Path(os.fspath(out))
     names, cols = log_columns(log)
-    with open(out, "w", encoding="utf-8", newline="\n") as fh:
-        fh.write(",".join(names) + "\n")
+    with _atomic.replacing(out, inputs=inputs) as fh:
+        fh.write((",".join(names) + "\n").encode())
         for start in range(0, len(log), _CSV_ROWS):
             text = [c[start:start + _CSV_ROWS].astype(str) for c in cols]  # round-trip repr
-            fh.write("".join(",".join(row) + "\n" for row in zip(*text, strict=True)))
+            fh.write("".join(",".join(row) + "\n" for row in zip(*text, strict=True)).encode())
     meta_file = meta_path(out)
-    meta_file.write_text(json.dumps(_meta(log), indent=1))
+    _atomic.write_text(meta_file, json.dumps(_meta(log), indent=1), inputs=inputs)
     return [out, meta_file]
 
 
-def write_npz(log: ImuLog, out) -> list[Path]:
-    """Write ``log`` as ``.npz``: ``fs``, the flat columns and the metadata; returns
-    ``[path]``."""
+def write_npz(log: ImuLog, out, *, inputs: Iterable = ()) -> list[Path]:
+    """Write ``log`` as ``.npz`` atomically: ``fs``, the flat columns and the
+    metadata; returns ``[path]``."""
     out = Path(os.fspath(out))
     names, cols = log_columns(log)
-    with open(out, "wb") as fh:
+    with _atomic.replacing(out, inputs=inputs) as fh:
         np.savez(fh, fs=np.float64(log.fs), **dict(zip(names, cols, strict=True)),
                  **{META_KEY: np.array(json.dumps(_meta(log)))})
     return [out]

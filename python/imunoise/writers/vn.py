@@ -12,6 +12,7 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 
+from imunoise import _atomic
 from imunoise._core import vn as _core_vn
 from imunoise.readers.log import ImuLog
 
@@ -87,8 +88,7 @@ def _length(data) -> int:
 
 def _finish(out: bytes, path) -> bytes:
     if path is not None:
-        with open(os.fspath(path), "wb") as f:
-            f.write(out)
+        _atomic.write_bytes(path, out)
     return out
 
 

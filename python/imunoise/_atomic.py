@@ -1,0 +1,250 @@
+"""Every file imunoise writes goes through this module.
+
+A target is never written in place: the bytes go to a temporary beside it with a
+unique name (``.<name>.<pid>-<random>.imunoise-tmp<suffix>``, so two writers of
+one target never share it), are flushed to disk (``fsync``) and then renamed onto
+the target, which therefore holds either its old content or the complete new one.
+An exception (Ctrl-C included) removes the temporary. A process killed outright
+(``kill -9``) cannot clean up: the next write into the same directory removes the
+temporaries of processes that no longer run and warns about them.
+
+A replaced file keeps its permission bits; a new file gets the umask's (as
+``open`` would give it). An output that is one of the inputs is refused.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import ctypes
+import errno
+import os
+import re
+import secrets
+import shutil
+import sys
+import warnings
+from collections.abc import Iterable, Iterator
+from pathlib import Path
+from typing import BinaryIO
+
+__all__ = [
+    "TEMP_TAG",
+    "exchange_dir",
+    "refuse_input",
+    "remove_stale",
+    "publish",
+    "replacing",
+    "sync",
+    "temporary_beside",
+    "write_bytes",
+    "write_text",
+]
+
+#: The mark in the name of every temporary imunoise writes.
+TEMP_TAG = ".imunoise-tmp"
+_TEMP_NAME = re.compile(r"^\..+\.(\d+)-[0-9a-f]{8}" + re.escape(TEMP_TAG) + r"(\.[^.]+)?$")
+_cleaned: set[str] = set()  # directories already swept by this process
+
+
+def _alive(pid: int) -> bool:
+    if pid == os.getpid():
+        return True
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except (PermissionError, OverflowError):
+        return True
+    return True
+
+
+def remove_stale(directory) -> list[Path]:
+    """Remove the temporaries left in ``directory`` by imunoise processes that were
+    killed before they could (their process no longer runs); warns when there were
+    any. Returns what was removed."""
+    directory = Path(directory)
+    removed: list[Path] = []
+    try:
+        entries = list(os.scandir(directory))
+    except OSError:
+        return removed
+    for entry in entries:
+        m = _TEMP_NAME.match(entry.name)
+        if m is None or _alive(int(m.group(1))):
+            continue
+        path = Path(entry.path)
+        try:
+            if entry.is_dir(follow_symlinks=False):
+                shutil.rmtree(path)
+            else:
+                path.unlink()
+        except FileNotFoundError:
+            continue
+        except OSError:
+            continue
+        removed.append(path)
+    if removed:
+        names = ", ".join(p.name for p in removed[:3]) + (" ..." if len(removed) > 3 else "")
+        warnings.warn(
+            f"removed {len(removed)} temporary file(s) left in {str(directory)!r} by an "
+            f"interrupted imunoise run: {names}",
+            stacklevel=3,
+        )
+    return removed
+
+
+def _sweep_once(directory: Path) -> None:
+    key = os.path.abspath(directory)
+    if key not in _cleaned:
+        _cleaned.add(key)
+        remove_stale(directory)
+
+
+def temporary_beside(target) -> Path:
+    """A fresh unique temporary name in ``target``'s directory (nothing is created);
+    stale temporaries of killed runs in that directory are removed first."""
+    target = Path(os.fspath(target))
+    directory = target.parent
+    _sweep_once(directory)
+    name = f".{target.name}.{os.getpid()}-{secrets.token_hex(4)}{TEMP_TAG}{target.suffix}"
+    return directory / name
+
+
+def refuse_input(target, inputs: Iterable) -> None:
+    """Raise ``ValueError`` when ``target`` is one of ``inputs`` (the same file,
+    whatever the path says: links and ``..`` included)."""
+    target = os.fspath(target)
+    if not os.path.exists(target):
+        return
+    for source in inputs:
+        if source is None or not isinstance(source, str | os.PathLike):
+            continue
+        source = os.fspath(source)
+        try:
+            same = os.path.samefile(target, source)
+        except OSError:
+            continue
+        if same:
+            raise ValueError(
+                f"output {target!r} is the input {source!r}: writing it would destroy the "
+                f"input; choose another output"
+            )
+
+
+def _fsync_dir(directory: Path) -> None:
+    try:
+        fd = os.open(directory, os.O_RDONLY)
+    except OSError:  # pragma: no cover - e.g. Windows: directories cannot be opened
+        return
+    try:
+        os.fsync(fd)
+    except OSError:  # pragma: no cover - some file systems refuse fsync of a directory
+        pass
+    finally:
+        os.close(fd)
+
+
+def _keep_mode(tmp: Path, target: Path) -> None:
+    try:
+        mode = os.stat(target).st_mode
+    except FileNotFoundError:
+        return
+    os.chmod(tmp, mode & 0o7777)
+
+
+def sync(path) -> None:
+    """Flush the file at ``path`` (or, for a directory, every file in it and the
+    directory itself) to disk."""
+    path = Path(path)
+    if path.is_dir():
+        for child in path.iterdir():
+            if child.is_file():
+                sync(child)
+        _fsync_dir(path)
+        return
+    fd = os.open(path, os.O_RDONLY)
+    try:
+        os.fsync(fd)
+    finally:
+        os.close(fd)
+
+
+def publish(tmp, target) -> Path:
+    """Flush the finished temporary file ``tmp`` to disk, give it the mode of the
+    file it replaces, and rename it onto ``target``."""
+    tmp, target = Path(tmp), Path(target)
+    sync(tmp)
+    _keep_mode(tmp, target)
+    os.replace(tmp, target)
+    _fsync_dir(target.parent)
+    return target
+
+
+def _discard(path: Path) -> None:
+    with contextlib.suppress(FileNotFoundError):
+        if path.is_dir() and not path.is_symlink():
+            shutil.rmtree(path, ignore_errors=True)
+        else:
+            path.unlink()
+
+
+@contextlib.contextmanager
+def replacing(target, *, inputs: Iterable = ()) -> Iterator[BinaryIO]:
+    """Open a binary file to write ``target``'s new content into.
+
+    On a normal exit the content is flushed, fsync-ed and renamed onto ``target``;
+    on an exception (``KeyboardInterrupt`` included) the temporary is removed and
+    ``target`` is left as it was. ``inputs`` are refused as the target.
+    """
+    target = Path(os.fspath(target))
+    refuse_input(target, inputs)
+    tmp = temporary_beside(target)
+    fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_BINARY", 0), 0o666)
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            yield fh
+            fh.flush()
+            os.fsync(fh.fileno())
+        _keep_mode(tmp, target)
+        os.replace(tmp, target)
+    except BaseException:
+        _discard(tmp)
+        raise
+    _fsync_dir(target.parent)
+
+
+def write_bytes(target, data: bytes, *, inputs: Iterable = ()) -> Path:
+    """Write ``data`` to ``target`` atomically; returns ``target`` as a Path."""
+    with replacing(target, inputs=inputs) as fh:
+        fh.write(data)
+    return Path(os.fspath(target))
+
+
+def write_text(target, text: str, *, inputs: Iterable = ()) -> Path:
+    """Write ``text`` (UTF-8, ``\\n`` line ends) to ``target`` atomically."""
+    return write_bytes(target, text.encode("utf-8"), inputs=inputs)
+
+
+_RENAME_EXCHANGE = 2
+
+
+def exchange_dir(staging, target) -> bool:
+    """Swap the directories ``staging`` and ``target`` in one step (Linux
+    ``renameat2(RENAME_EXCHANGE)``); False where the system cannot."""
+    if not sys.platform.startswith("linux"):  # pragma: no cover
+        return False
+    try:
+        libc = ctypes.CDLL(None, use_errno=True)
+        renameat2 = libc.renameat2
+    except (OSError, AttributeError):  # pragma: no cover - old C library
+        return False
+    at_fdcwd = -100
+    rc = renameat2(at_fdcwd, os.fsencode(staging), at_fdcwd, os.fsencode(target),
+                   _RENAME_EXCHANGE)
+    if rc == 0:
+        _fsync_dir(Path(os.fspath(target)).parent)
+        return True
+    err = ctypes.get_errno()
+    if err in (errno.ENOSYS, errno.EINVAL, errno.ENOTSUP, errno.EXDEV):  # pragma: no cover
+        return False
+    raise OSError(err, os.strerror(err), os.fspath(target))  # pragma: no cover
