@@ -235,11 +235,18 @@ impl<'a> Job<'a> {
     /// Pairs not started before `stop` is raised are NaN.
     fn estimate_pairs(&self, swept: &[Option<f64>], stop: &Interrupt) -> Vec<(f64, Option<i32>)> {
         // ThêoBR's bias ratio belongs to a channel, not a tau: computed once each.
-        let ratios: Option<Vec<f64>> = if self.plan.iter().any(|(s, _)| *s == Statistic::TheoBR) {
-            let refs: Vec<&[f64]> = self.phases.iter().map(|p| p.c.as_slice()).collect();
-            estimators::theobr::bias_ratios(&refs, stop)
-        } else {
+        // The sweep behind it also gives Theo1 at ThêoBR's factors up to ≈ 0.13·N.
+        let theobr_ms: Vec<usize> = self
+            .plan
+            .iter()
+            .filter(|(s, _)| *s == Statistic::TheoBR)
+            .map(|&(_, m)| m)
+            .collect();
+        let ratios = if theobr_ms.is_empty() {
             None
+        } else {
+            let refs: Vec<&[f64]> = self.phases.iter().map(|p| p.c.as_slice()).collect();
+            estimators::theobr::bias_ratios(&refs, &theobr_ms, stop)
         };
         self.pairs
             .par_iter()
@@ -253,7 +260,7 @@ impl<'a> Job<'a> {
                 let var = match (swept[i], statistic, &ratios, &phase.gaps) {
                     (Some(v), _, _, _) => v,
                     (None, Statistic::TheoBR, Some(r), _) => {
-                        r[c] * Statistic::Theo1.estimate(&phase.c, m, stop).var
+                        r[c].kappa * r[c].theo1_var(&phase.c, m, stop)
                     }
                     (None, _, _, None) => statistic.estimate(&phase.c, m, stop).var,
                     (None, _, _, Some(g)) => statistic

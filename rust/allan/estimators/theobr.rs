@@ -82,20 +82,58 @@ fn ratio(c: &[f64], i: usize, stop: &Interrupt) -> f64 {
 /// estimators at the factors checked.
 const CHECK_TOLERANCE: f64 = 1e-9;
 
+/// κ and Theo1 of one phase.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BiasRatio {
+    pub kappa: f64,
+    /// (m, Theo1 variance) for the requested factors the sweep reached, by m.
+    pub theo1: Vec<(usize, f64)>,
+}
+
+impl BiasRatio {
+    /// Theo1 at m from the sweep, else by its own estimator.
+    pub fn theo1_var(&self, c: &[f64], m: usize, stop: &Interrupt) -> f64 {
+        match self.theo1.binary_search_by_key(&m, |&(k, _)| k) {
+            Ok(i) => self.theo1[i].1,
+            Err(_) => theo1_var(c, m, stop),
+        }
+    }
+}
+
 /// The n + 1 ratios of one phase from the exact all-factor sweep
-/// (`fast::theo1_sweep`), or `None` if it could not run or disagrees with the
-/// per-factor estimators at the first and the middle ratio.
-fn swept_ratios(c: &[f64], n: usize, stop: &Interrupt) -> Option<Vec<f64>> {
+/// (`fast::theo1_sweep`), with Theo1 at the factors of `extra` it passes on the
+/// way; `None` if it could not run or disagrees with the per-factor estimators
+/// at the first and the middle ratio.
+fn swept_ratios(
+    c: &[f64],
+    n: usize,
+    extra: &[usize],
+    stop: &Interrupt,
+) -> Option<(Vec<f64>, Vec<(usize, f64)>)> {
     let n_phase = c.len();
     let (avar_ms, theo_ms): (Vec<usize>, Vec<usize>) = (0..=n).map(ratio_factors).unzip();
     let max_lag = 2 * avar_ms[n];
     let exact = ExactPhase::new(c, max_lag)?;
-    let sums = theo1_sums(&exact, &theo_ms, stop)?;
-    let theo: Vec<f64> = theo_ms
+    let top = theo_ms[n];
+    let mut swept_ms: Vec<usize> = theo_ms
+        .iter()
+        .chain(extra.iter().filter(|&&m| m % 2 == 0 && m >= 2 && m <= top))
+        .copied()
+        .collect();
+    swept_ms.sort_unstable();
+    swept_ms.dedup();
+    let sums = theo1_sums(&exact, &swept_ms, stop)?;
+    let theo_at: Vec<(usize, f64)> = swept_ms
         .iter()
         .zip(&sums)
-        .map(|(&m, s)| s / (0.75 * (n_phase - m) as f64 * (m * m) as f64))
+        .map(|(&m, s)| (m, s / (0.75 * (n_phase - m) as f64 * (m * m) as f64)))
         .collect();
+    let find = |m: usize| {
+        theo_at[theo_at.binary_search_by_key(&m, |&(k, _)| k).ok()?]
+            .1
+            .into()
+    };
+    let theo: Vec<f64> = theo_ms.iter().map(|&m| find(m)).collect::<Option<_>>()?;
     let avar: Vec<f64> = avar_ms
         .par_iter()
         .map(|&m| {
@@ -112,52 +150,64 @@ fn swept_ratios(c: &[f64], n: usize, stop: &Interrupt) -> Option<Vec<f64>> {
             return None;
         }
     }
-    Some(
+    let extras = theo_at
+        .into_iter()
+        .filter(|(m, _)| extra.contains(m))
+        .collect();
+    Some((
         avar.iter()
             .zip(&theo)
             .map(|(&a, &t)| ratio_of(a, t))
             .collect(),
-    )
+        extras,
+    ))
 }
 
-/// The bias ratio κ of each phase (all of the same length), or `None` when the
-/// phases are shorter than [`MIN_PHASE_POINTS`]. Each phase's ratios come from
-/// the exact sweep, or, if that fails its check, factor by factor. The value is
-/// meaningless once `stop` is raised (the caller checks it).
-pub fn bias_ratios(phases: &[&[f64]], stop: &Interrupt) -> Option<Vec<f64>> {
+/// The bias ratio κ of each phase (all of the same length) with Theo1 at the
+/// factors of `ms` the sweep reached, or `None` when the phases are shorter
+/// than [`MIN_PHASE_POINTS`]. Each phase's ratios come from the exact sweep,
+/// or, if that fails its check, factor by factor. The values are meaningless
+/// once `stop` is raised (the caller checks it).
+pub fn bias_ratios(phases: &[&[f64]], ms: &[usize], stop: &Interrupt) -> Option<Vec<BiasRatio>> {
     let n_phase = phases.first()?.len();
     let n = ratio_count(n_phase)?;
     if phases.iter().any(|c| c.len() != n_phase) {
         return None;
     }
-    let per_phase: Vec<Vec<f64>> = phases
+    let per_phase: Vec<(Vec<f64>, Vec<(usize, f64)>)> = phases
         .par_iter()
-        .map(|c| match swept_ratios(c, n, stop) {
-            Some(ratios) => ratios,
-            None if stop.raised() => vec![f64::NAN],
-            None => (0..=n)
-                .into_par_iter()
-                .map(|i| {
-                    if stop.raised() {
-                        f64::NAN
-                    } else {
-                        ratio(c, i, stop)
-                    }
-                })
-                .collect(),
+        .map(|c| match swept_ratios(c, n, ms, stop) {
+            Some(found) => found,
+            None if stop.raised() => (vec![f64::NAN], Vec::new()),
+            None => (
+                (0..=n)
+                    .into_par_iter()
+                    .map(|i| {
+                        if stop.raised() {
+                            f64::NAN
+                        } else {
+                            ratio(c, i, stop)
+                        }
+                    })
+                    .collect(),
+                Vec::new(),
+            ),
         })
         .collect();
     Some(
         per_phase
-            .iter()
-            .map(|r| r.iter().sum::<Neumaier>().value() / r.len() as f64)
+            .into_iter()
+            .map(|(r, theo1)| BiasRatio {
+                kappa: r.iter().sum::<Neumaier>().value() / r.len() as f64,
+                theo1,
+            })
             .collect(),
     )
 }
 
 /// The bias ratio κ of one phase (see [`bias_ratios`]).
 pub fn bias_ratio(c: &[f64], stop: &Interrupt) -> Option<f64> {
-    bias_ratios(&[c], stop).map(|v| v[0])
+    bias_ratios(&[c], &[], stop).map(|v| v[0].kappa)
 }
 
 /// Work of ThêoBR on one phase of `n_phase` points at `ms`, as (direct steps,
@@ -267,21 +317,37 @@ mod tests {
         assert_eq!(bias_ratio(&flat, &NEVER), Some(1.0));
         let a = sample(200);
         let b = sample(201);
-        assert_eq!(bias_ratios(&[&a, &b], &NEVER), None);
+        assert_eq!(bias_ratios(&[&a, &b], &[], &NEVER), None);
     }
 
     #[test]
     fn several_phases_give_their_own_ratios() {
         let a = sample(300);
         let b: Vec<f64> = (0..301).map(|k| ((k * 37) % 17) as f64).collect();
-        let both = bias_ratios(&[&a, &b], &NEVER).unwrap();
-        assert_eq!(
-            both,
-            vec![
-                bias_ratio(&a, &NEVER).unwrap(),
-                bias_ratio(&b, &NEVER).unwrap()
-            ]
-        );
+        let both = bias_ratios(&[&a, &b], &[], &NEVER).unwrap();
+        let kappas: Vec<f64> = both.iter().map(|r| r.kappa).collect();
+        let alone = [&a, &b].map(|c| bias_ratio(c, &NEVER).unwrap());
+        assert_eq!(kappas, alone);
+    }
+
+    #[test]
+    fn the_sweep_passes_its_check_and_gives_theo1_on_the_way() {
+        // The four noise types; the sweep's values are the definition's.
+        for order in 0..4 {
+            let mut c = crate::allan::test_signals::integrated_noise(1501, 11, order);
+            if order == 0 {
+                c = c.windows(2).map(|w| w[1] - w[0]).collect(); // white PM
+            }
+            let n = ratio_count(c.len()).unwrap();
+            let (ratios, theo1) = swept_ratios(&c, n, &[10, 100, 198, 600], &NEVER).unwrap();
+            assert_eq!(ratios.len(), n + 1);
+            let ms: Vec<usize> = theo1.iter().map(|t| t.0).collect();
+            assert_eq!(ms, vec![10, 100, 198]);
+            for (m, var) in theo1 {
+                let want = naive_theo1(&c, m);
+                assert!((var - want).abs() <= 1e-10 * want, "m {m}: {var} vs {want}");
+            }
+        }
     }
 
     #[test]
