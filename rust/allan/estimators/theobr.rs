@@ -100,16 +100,14 @@ impl BiasRatio {
     }
 }
 
+/// The n + 1 ratios of one phase and (m, Theo1) at the extra factors swept.
+type Swept = (Vec<f64>, Vec<(usize, f64)>);
+
 /// The n + 1 ratios of one phase from the exact all-factor sweep
 /// (`fast::theo1_sweep`), with Theo1 at the factors of `extra` it passes on the
 /// way; `None` if it could not run or disagrees with the per-factor estimators
 /// at the first and the middle ratio.
-fn swept_ratios(
-    c: &[f64],
-    n: usize,
-    extra: &[usize],
-    stop: &Interrupt,
-) -> Option<(Vec<f64>, Vec<(usize, f64)>)> {
+fn swept_ratios(c: &[f64], n: usize, extra: &[usize], stop: &Interrupt) -> Option<Swept> {
     let n_phase = c.len();
     let (avar_ms, theo_ms): (Vec<usize>, Vec<usize>) = (0..=n).map(ratio_factors).unzip();
     let max_lag = 2 * avar_ms[n];
@@ -174,7 +172,7 @@ pub fn bias_ratios(phases: &[&[f64]], ms: &[usize], stop: &Interrupt) -> Option<
     if phases.iter().any(|c| c.len() != n_phase) {
         return None;
     }
-    let per_phase: Vec<(Vec<f64>, Vec<(usize, f64)>)> = phases
+    let per_phase: Vec<Swept> = phases
         .par_iter()
         .map(|c| match swept_ratios(c, n, ms, stop) {
             Some(found) => found,

@@ -49,7 +49,7 @@ impl<'a> Triangles<'a> {
 
     /// Adds rows (and, at even rows, anti-diagonals) until A, C describe m.
     fn advance(&mut self, m: usize) {
-        while self.rows + 4 <= m && self.rows % 2 == 0 {
+        while self.rows + 4 <= m && self.rows.is_multiple_of(2) {
             self.add_four_rows(self.rows);
             self.rows += 4;
         }
@@ -66,7 +66,7 @@ impl<'a> Triangles<'a> {
         for (a, &x) in self.a[1..=l].iter_mut().rev().zip(&q[..l]) {
             *a = a.wrapping_add(x as i128 * ql);
         }
-        if l % 2 == 0 {
+        if l.is_multiple_of(2) {
             // Pairs (j, l − j), j ≤ l/2, at lag e = l − 2j: C index l/2 − j.
             let c = l / 2;
             for (i, slot) in self.c[..=c].iter_mut().enumerate() {
