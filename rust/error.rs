@@ -26,7 +26,7 @@ pub enum CoreError {
         kind: std::io::ErrorKind,
         message: String,
     },
-    /// The computation was stopped by an [`crate::interrupt::Interrupt`] (maps
+    /// The computation was stopped by a raised `Interrupt` (`interrupt.rs`; maps
     /// to `KeyboardInterrupt`).
     Interrupted,
 }
