@@ -26,6 +26,9 @@ pub enum CoreError {
         kind: std::io::ErrorKind,
         message: String,
     },
+    /// The computation was stopped by a raised `Interrupt` (`interrupt.rs`; maps
+    /// to `KeyboardInterrupt`).
+    Interrupted,
 }
 
 impl fmt::Display for CoreError {
@@ -50,6 +53,7 @@ impl fmt::Display for CoreError {
                 }
                 write!(f, "{kind}: {reason}")
             }
+            CoreError::Interrupted => f.write_str("interrupted"),
         }
     }
 }

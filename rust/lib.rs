@@ -7,6 +7,7 @@
 pub mod allan;
 pub mod error;
 pub mod fit;
+pub mod interrupt;
 mod memory;
 pub mod vn;
 

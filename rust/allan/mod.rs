@@ -29,6 +29,7 @@ use std::collections::BTreeMap;
 use rayon::prelude::*;
 
 use crate::error::{CoreError, CoreResult};
+use crate::interrupt::{Interrupt, NEVER};
 pub use estimators::Estimate;
 pub use phase::{column_phases, row_major_phases, Gaps, Phase};
 pub use statistic::Statistic;
@@ -59,18 +60,25 @@ pub struct Analysis {
 /// (channel, tau) pairs.
 pub fn analyse(phases: &[Phase], statistic: Statistic, ms: &[usize]) -> CoreResult<Analysis> {
     let plan: Vec<(Statistic, usize)> = ms.iter().map(|&m| (statistic, m)).collect();
-    analyse_plan(phases, &plan)
+    analyse_plan(phases, &plan, &NEVER)
 }
 
 /// [`analyse`] with a statistic per tau: `plan[t]` = (statistic, m). ThêoH is
 /// the plan of overlapping AVAR at its short taus and ThêoBR at its long ones.
 /// Noise types missing at some taus are filled from the nearest identified taus
-/// of the whole plan, so order the plan by τ.
-pub fn analyse_plan(phases: &[Phase], plan: &[(Statistic, usize)]) -> CoreResult<Analysis> {
+/// of the whole plan, so order the plan by τ. Raising `stop` ends the work
+/// early with [`CoreError::Interrupted`].
+pub fn analyse_plan(
+    phases: &[Phase],
+    plan: &[(Statistic, usize)],
+    stop: &Interrupt,
+) -> CoreResult<Analysis> {
     let n_phase = check_phases(phases, plan)?;
     let job = Job::new(phases, plan, n_phase)?;
     let swept = job.sweep_blocked();
-    let estimates = job.estimate_pairs(&swept);
+    stop.check()?;
+    let estimates = job.estimate_pairs(&swept, stop);
+    stop.check()?;
     let (var, mut alpha, alpha_identified) = job.gather(estimates)?;
     for c in 0..job.channels {
         noise_id::fill_from_nearest(&mut alpha, &alpha_identified, c, job.channels, plan.len());
@@ -224,26 +232,37 @@ impl<'a> Job<'a> {
 
     /// The variance of every pair (from the sweep where it ran) and the noise type
     /// identified there, if the series is long enough.
-    fn estimate_pairs(&self, swept: &[Option<f64>]) -> Vec<(f64, Option<i32>)> {
+    /// Pairs not started before `stop` is raised are NaN.
+    fn estimate_pairs(&self, swept: &[Option<f64>], stop: &Interrupt) -> Vec<(f64, Option<i32>)> {
         // ThêoBR's bias ratio belongs to a channel, not a tau: computed once each.
-        let ratios: Option<Vec<f64>> = if self.plan.iter().any(|(s, _)| *s == Statistic::TheoBR) {
-            let refs: Vec<&[f64]> = self.phases.iter().map(|p| p.c.as_slice()).collect();
-            estimators::theobr::bias_ratios(&refs)
-        } else {
+        // The sweep behind it also gives Theo1 at ThêoBR's factors up to ≈ 0.13·N.
+        let theobr_ms: Vec<usize> = self
+            .plan
+            .iter()
+            .filter(|(s, _)| *s == Statistic::TheoBR)
+            .map(|&(_, m)| m)
+            .collect();
+        let ratios = if theobr_ms.is_empty() {
             None
+        } else {
+            let refs: Vec<&[f64]> = self.phases.iter().map(|p| p.c.as_slice()).collect();
+            estimators::theobr::bias_ratios(&refs, &theobr_ms, stop)
         };
         self.pairs
             .par_iter()
             .enumerate()
             .map(|(i, &(t, c))| {
+                if stop.raised() {
+                    return (f64::NAN, None);
+                }
                 let (statistic, m) = self.plan[t];
                 let phase = &self.phases[c];
                 let var = match (swept[i], statistic, &ratios, &phase.gaps) {
                     (Some(v), _, _, _) => v,
                     (None, Statistic::TheoBR, Some(r), _) => {
-                        r[c] * Statistic::Theo1.estimate(&phase.c, m).var
+                        r[c].kappa * r[c].theo1_var(&phase.c, m, stop)
                     }
-                    (None, _, _, None) => statistic.estimate(&phase.c, m).var,
+                    (None, _, _, None) => statistic.estimate(&phase.c, m, stop).var,
                     (None, _, _, Some(g)) => statistic
                         .estimate_in_segments(&phase.c, &g.segments, m)
                         .map_or(f64::NAN, |e| e.var),
@@ -335,7 +354,7 @@ mod tests {
         let phases = column_phases(vec![y.iter().copied(), z.iter().copied()]).unwrap();
         let oadev = Statistic::Allan { overlapping: true };
         let plan = [(oadev, 1), (oadev, 8), (Statistic::TheoBR, 16)];
-        let mixed = analyse_plan(&phases, &plan).unwrap();
+        let mixed = analyse_plan(&phases, &plan, &NEVER).unwrap();
         let avar = analyse(&phases, oadev, &[1, 8]).unwrap();
         let theobr = analyse(&phases, Statistic::TheoBR, &[16]).unwrap();
         assert_eq!(mixed.var[..4], avar.var[..]);
@@ -343,7 +362,7 @@ mod tests {
         assert_eq!(mixed.var[4..], theobr.var[..]);
         assert_eq!(mixed.terms, vec![399, 399, 385, 385, 385 * 8, 385 * 8]);
         // The slow single-tau path gives the same ThêoBR.
-        let alone = Statistic::TheoBR.estimate(&phases[1].c, 16).var;
+        let alone = Statistic::TheoBR.estimate(&phases[1].c, 16, &NEVER).var;
         assert!((alone - mixed.var[5]).abs() <= 1e-14 * alone);
     }
 

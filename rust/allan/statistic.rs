@@ -17,6 +17,7 @@ use super::estimators::{mtot_htot, theo1, theobr, Estimate};
 use super::fast::blocked::Difference;
 use super::uncertainty::edf::{EdfModel, Estimator};
 use crate::error::CoreError;
+use crate::interrupt::Interrupt;
 
 /// Which statistic to compute.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -169,8 +170,8 @@ impl Statistic {
     }
 
     /// The variance at averaging factor `m` over the cumulative phase `c` of a
-    /// record without missing samples.
-    pub fn estimate(self, c: &[f64], m: usize) -> Estimate {
+    /// record without missing samples; meaningless once `stop` is raised.
+    pub fn estimate(self, c: &[f64], m: usize, stop: &Interrupt) -> Estimate {
         if let Some(estimator) = self.difference_variance() {
             return estimator.estimate(c, m);
         }
@@ -180,13 +181,13 @@ impl Statistic {
         }
         let var = match self {
             Statistic::Total => difference::totvar(c, m),
-            Statistic::ModifiedTotal => mtot_htot::mtot_var(c, m),
-            Statistic::HadamardTotal => mtot_htot::htot_var(c, m),
-            Statistic::Theo1 => theo1::theo1_var(c, m),
+            Statistic::ModifiedTotal => mtot_htot::mtot_var(c, m, stop),
+            Statistic::HadamardTotal => mtot_htot::htot_var(c, m, stop),
+            Statistic::Theo1 => theo1::theo1_var(c, m, stop),
             // One tau alone pays for the whole bias ratio; `analyse` computes the
             // ratio once per channel instead.
-            Statistic::TheoBR => match theobr::bias_ratio(c) {
-                Some(ratio) => ratio * theo1::theo1_var(c, m),
+            Statistic::TheoBR => match theobr::bias_ratio(c, stop) {
+                Some(ratio) => ratio * theo1::theo1_var(c, m, stop),
                 None => return Estimate::EMPTY,
             },
             Statistic::Allan { .. } | Statistic::Modified | Statistic::Hadamard { .. } => {

@@ -10,6 +10,7 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 
+use super::interrupt::run_interruptible;
 use crate::allan::estimators::theobr;
 use crate::allan::{self, Statistic};
 
@@ -86,7 +87,7 @@ fn run_plan<'py>(
     plan: Vec<(Statistic, usize)>,
 ) -> PyResult<AnalysisArrays> {
     let view = x.as_array();
-    let result = py.detach(|| {
+    let result = run_interruptible(py, |stop| {
         // A C-ordered array with several channels is scattered row by row in one
         // pass, one contiguous channel is copied as a slice; anything else
         // (Fortran order, strided views) is gathered column by column.
@@ -102,7 +103,7 @@ fn run_plan<'py>(
                 allan::column_phases(columns)?
             }
         };
-        allan::analyse_plan(&phases, &plan)
+        allan::analyse_plan(&phases, &plan, stop)
     })?;
     let shape = (plan.len(), result.channels);
     let as_u64 = |v: &[usize]| v.iter().map(|&t| t as u64).collect::<Vec<u64>>();

@@ -4,7 +4,9 @@
 //! name (`_core.allan`, `_core.vn`, `_core.fit`), so the Python side mirrors this
 //! folder.
 
-use pyo3::exceptions::{PyFileNotFoundError, PyOSError, PyPermissionError, PyValueError};
+use pyo3::exceptions::{
+    PyFileNotFoundError, PyKeyboardInterrupt, PyOSError, PyPermissionError, PyValueError,
+};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
@@ -12,6 +14,7 @@ use crate::error::CoreError;
 
 mod allan;
 mod fit;
+mod interrupt;
 mod vn;
 
 impl From<CoreError> for PyErr {
@@ -49,6 +52,7 @@ pub(crate) fn core_error_to_py(err: CoreError, source: Option<String>) -> PyErr 
             std::io::ErrorKind::PermissionDenied => PyPermissionError::new_err(message),
             _ => PyOSError::new_err(message),
         },
+        CoreError::Interrupted => PyKeyboardInterrupt::new_err("interrupted"),
         other => PyValueError::new_err(other.to_string()),
     }
 }

@@ -14,6 +14,7 @@ pub mod theobr;
 use rayon::prelude::*;
 
 use crate::allan::sum::Neumaier;
+use crate::interrupt::Interrupt;
 
 /// A variance estimate and the number of terms it averages.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -36,8 +37,15 @@ const CHUNK_WORK: usize = 1 << 18;
 
 /// Sum over `count` subsequences of `inner(i, zp, p)`, in parallel chunks with
 /// per-chunk scratch buffers; chunk results are combined in order with
-/// compensation so the answer does not depend on the thread count.
-fn sum_over_subsequences<F>(count: usize, m: usize, per_item: usize, inner: F) -> f64
+/// compensation so the answer does not depend on the thread count. Chunks
+/// started after `stop` is raised are skipped (the sum is then meaningless).
+fn sum_over_subsequences<F>(
+    count: usize,
+    m: usize,
+    per_item: usize,
+    inner: F,
+    stop: &Interrupt,
+) -> f64
 where
     F: Fn(usize, &mut [f64], &mut [f64]) -> f64 + Sync,
 {
@@ -46,6 +54,9 @@ where
     let parts: Vec<f64> = (0..chunks)
         .into_par_iter()
         .map(|k| {
+            if stop.raised() {
+                return 0.0;
+            }
             let mut zp = vec![0.0; 3 * m + 1];
             let mut p = vec![0.0; 9 * m + 1];
             (k * chunk..((k + 1) * chunk).min(count))

@@ -28,6 +28,7 @@ use super::difference::DifferenceVariance;
 use super::sum_over_subsequences;
 use crate::allan::fast::reflected::reflected_sum;
 use crate::allan::sum::Neumaier;
+use crate::interrupt::Interrupt;
 
 /// Averaging factors from here on use `fast::reflected`'s O(n) expansion; below
 /// it the direct sum is cheaper and the expansion's blocks would be too short to
@@ -98,8 +99,9 @@ fn reflected_second_differences(zp: &[f64], m: usize, p: &mut [f64]) -> f64 {
     lanes.iter().sum()
 }
 
-/// Modified total variance at averaging factor m (needs 3m ≤ N = c.len()).
-pub fn mtot_var(c: &[f64], m: usize) -> f64 {
+/// Modified total variance at averaging factor m (needs 3m ≤ N = c.len());
+/// meaningless once `stop` is raised.
+pub fn mtot_var(c: &[f64], m: usize, stop: &Interrupt) -> f64 {
     let n = c.len();
     let l = 3 * m;
     let terms = n + 1 - l;
@@ -126,17 +128,18 @@ pub fn mtot_var(c: &[f64], m: usize) -> f64 {
         reflected_second_differences(zp, m, p)
     };
     let total = if m < REFLECTED_FROM {
-        sum_over_subsequences(terms, m, 15 * m, inner)
+        sum_over_subsequences(terms, m, 15 * m, inner, stop)
     } else {
-        reflected_sum(|k| c[k], n, m)
+        reflected_sum(|k| c[k], n, m, stop)
     };
     let mf = m as f64;
     total / (12.0 * mf.powi(5) * terms as f64)
 }
 
 /// Hadamard total variance at averaging factor m (needs 3m ≤ n = c.len() − 1);
-/// at m = 1 the overlapping Hadamard variance, as Stable32 and allantools.
-pub fn htot_var(c: &[f64], m: usize) -> f64 {
+/// at m = 1 the overlapping Hadamard variance, as Stable32 and allantools;
+/// meaningless once `stop` is raised.
+pub fn htot_var(c: &[f64], m: usize, stop: &Interrupt) -> f64 {
     if m == 1 {
         return DifferenceVariance::Hadamard { overlapping: true }
             .estimate(c, 1)
@@ -161,9 +164,9 @@ pub fn htot_var(c: &[f64], m: usize) -> f64 {
         reflected_second_differences(zp, m, p)
     };
     let total = if m < REFLECTED_FROM {
-        sum_over_subsequences(terms, m, 15 * m, inner)
+        sum_over_subsequences(terms, m, 15 * m, inner, stop)
     } else {
-        reflected_sum(|k| c[k + 1] - c[k], n, m)
+        reflected_sum(|k| c[k + 1] - c[k], n, m, stop)
     };
     let mf = m as f64;
     total / (36.0 * mf.powi(3) * terms as f64)
@@ -174,6 +177,7 @@ mod tests {
     use super::*;
     use crate::allan::phase::cumulative_phase;
     use crate::allan::test_signals::detrended_reflection;
+    use crate::interrupt::NEVER;
 
     /// Direct transcription of the definitions (as allantools computes them),
     /// on phase values, without any of the tricks above.
@@ -205,7 +209,7 @@ mod tests {
     fn mtot_matches_the_definition() {
         let c = sample();
         for m in [1, 2, 3, 7, 50, 100] {
-            let (a, b) = (mtot_var(&c, m), naive_mtot(&c, m));
+            let (a, b) = (mtot_var(&c, m, &NEVER), naive_mtot(&c, m));
             assert!((a - b).abs() <= 1e-12 * b, "m {m}: {a} vs {b}");
         }
     }
@@ -219,7 +223,7 @@ mod tests {
         for m in [2, 3, 10, 99] {
             // naive_mtot(y) = Σ/(2 m² terms) with Σ the mean of (D/m)²; HTOT = Σ/(6 terms).
             let expected = naive_mtot(&y, m) * 2.0 * (m * m) as f64 / 6.0;
-            let got = htot_var(&c, m);
+            let got = htot_var(&c, m, &NEVER);
             assert!((got - expected).abs() <= 1e-12 * expected, "m {m}");
         }
     }
@@ -229,7 +233,7 @@ mod tests {
         let c = sample();
         let shifted: Vec<f64> = c.iter().map(|v| v + 1e9).collect();
         for m in [1, 5, 33] {
-            let (a, b) = (mtot_var(&c, m), mtot_var(&shifted, m));
+            let (a, b) = (mtot_var(&c, m, &NEVER), mtot_var(&shifted, m, &NEVER));
             assert!((a - b).abs() <= 1e-9 * a, "m {m}: {a} vs {b}");
         }
     }

@@ -13,6 +13,7 @@
 
 use super::sum_over_subsequences;
 use crate::allan::fast::theo1_fft::theo1_sum;
+use crate::interrupt::Interrupt;
 
 /// Averaging factors from here on use the O(N log² m) expansion, which is
 /// cheaper than the direct sum there.
@@ -27,8 +28,9 @@ pub fn terms(n_phase: usize, m: usize) -> usize {
     }
 }
 
-/// Theo1 variance at even averaging factor m (needs m < N = c.len()).
-pub fn theo1_var(c: &[f64], m: usize) -> f64 {
+/// Theo1 variance at even averaging factor m (needs m < N = c.len());
+/// meaningless once `stop` is raised.
+pub fn theo1_var(c: &[f64], m: usize, stop: &Interrupt) -> f64 {
     let n = c.len();
     let h = m / 2;
     let outer = n - m;
@@ -56,9 +58,9 @@ pub fn theo1_var(c: &[f64], m: usize) -> f64 {
     };
     let total = if m < FFT_FROM {
         // Scratch buffers are unused here: ask for the smallest.
-        sum_over_subsequences(outer, 0, h.max(1), inner)
+        sum_over_subsequences(outer, 0, h.max(1), inner, stop)
     } else {
-        theo1_sum(c, m)
+        theo1_sum(c, m, stop)
     };
     let mf = m as f64;
     total / (0.75 * outer as f64 * mf * mf)
@@ -84,6 +86,7 @@ mod tests {
     use super::*;
     use crate::allan::phase::cumulative_phase;
     use crate::allan::test_signals::naive_theo1;
+    use crate::interrupt::NEVER;
 
     #[test]
     fn theo1_matches_the_definition() {
@@ -92,7 +95,7 @@ mod tests {
             .collect();
         let c = cumulative_phase(y.into_iter()).unwrap();
         for m in [2, 4, 10, 100, 300] {
-            let (a, b) = (theo1_var(&c, m), naive_theo1(&c, m));
+            let (a, b) = (theo1_var(&c, m, &NEVER), naive_theo1(&c, m));
             assert!((a - b).abs() <= 1e-12 * b, "m {m}: {a} vs {b}");
         }
     }

@@ -10,19 +10,26 @@
 //! at 9 + 3i (τ = 0.75·m·τ0), so each ratio measures Theo1's bias at one τ
 //! between 9τ0 and 10 % of the record; κ is their mean.
 //!
-//! Cost. κ needs Theo1 at n + 1 ≈ N/30 averaging factors up to ≈ 0.13·N: with
-//! the direct sum that is Σ_i (N − m_i)·m_i/2 ≈ N³/900 steps; with the kernel's
-//! O(N log² m) expansion from m = `theo1::FFT_FROM` (256) on it is
-//! ≈ N²/30·log²(m), the dominant cost of ThêoBR for long records all the same. The ratios are independent, so they
-//! are computed in parallel (one task per i, each kernel parallel inside) and
-//! summed in order with compensation, so κ does not depend on the thread count.
-//! [`estimated_seconds`] turns that work into a time, for a warning before long runs.
+//! Cost. κ needs Theo1 at n + 1 ≈ N/30 averaging factors up to M ≈ 0.13·N:
+//! factor by factor that is Σ_i (N − m_i)·m_i/2 ≈ N³/900 steps directly, or
+//! ≈ N²/30·log²(m) with the kernel's O(N log² m) expansion. Instead, all of
+//! them come from one exact sweep (`fast::theo1_sweep`): an O(N log N)
+//! autocorrelation, then O(M²) integer pair products, ≈ 0.02·N² in all, and
+//! the AVARs from the same autocorrelation in O(m) each. The sweep is checked
+//! against the per-factor estimators at the first and the middle ratio; should
+//! they differ by more than 1e-9 the ratios are computed factor by factor
+//! (in parallel, one task per i) as before. The ratios are summed in order with
+//! compensation, so κ does not depend on the thread count. [`estimated_seconds`]
+//! turns the work into a time, for a warning before long runs.
 
 use rayon::prelude::*;
 
 use super::difference::oavar;
 use super::theo1::{self, theo1_var, theo1_work};
+use crate::allan::fast::exact_phase::ExactPhase;
+use crate::allan::fast::theo1_sweep::theo1_sums;
 use crate::allan::sum::Neumaier;
+use crate::interrupt::Interrupt;
 
 /// Fewest phase points for which the bias ratio is defined (n ≥ 0).
 pub const MIN_PHASE_POINTS: usize = 90;
@@ -55,12 +62,9 @@ pub fn ratio_factors(i: usize) -> (usize, usize) {
     (9 + 3 * i, 12 + 4 * i)
 }
 
-/// One ratio AVAR(9 + 3i)/Theo1(12 + 4i). Theo1 vanishes only for a linear
-/// phase, where AVAR vanishes too; that 0/0 counts as no bias (ratio 1).
-fn ratio(c: &[f64], i: usize) -> f64 {
-    let (ma, mt) = ratio_factors(i);
-    let avar = oavar(c, ma);
-    let theo = theo1_var(c, mt);
+/// AVAR/Theo1 with the 0/0 of a linear phase (Theo1 vanishes only there, and
+/// AVAR with it) counted as no bias (ratio 1).
+fn ratio_of(avar: f64, theo: f64) -> f64 {
     if theo == 0.0 {
         1.0
     } else {
@@ -68,60 +72,176 @@ fn ratio(c: &[f64], i: usize) -> f64 {
     }
 }
 
-/// The bias ratio κ of each phase (all of the same length), or `None` when the
-/// phases are shorter than [`MIN_PHASE_POINTS`]. Work is spread over
-/// (phase, i) pairs.
-pub fn bias_ratios(phases: &[&[f64]]) -> Option<Vec<f64>> {
+/// One ratio AVAR(9 + 3i)/Theo1(12 + 4i), each by its own estimator.
+fn ratio(c: &[f64], i: usize, stop: &Interrupt) -> f64 {
+    let (ma, mt) = ratio_factors(i);
+    ratio_of(oavar(c, ma), theo1_var(c, mt, stop))
+}
+
+/// Largest relative difference allowed between the sweep and the per-factor
+/// estimators at the factors checked.
+const CHECK_TOLERANCE: f64 = 1e-9;
+
+/// κ and Theo1 of one phase.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BiasRatio {
+    pub kappa: f64,
+    /// (m, Theo1 variance) for the requested factors the sweep reached, by m.
+    pub theo1: Vec<(usize, f64)>,
+}
+
+impl BiasRatio {
+    /// Theo1 at m from the sweep, else by its own estimator.
+    pub fn theo1_var(&self, c: &[f64], m: usize, stop: &Interrupt) -> f64 {
+        match self.theo1.binary_search_by_key(&m, |&(k, _)| k) {
+            Ok(i) => self.theo1[i].1,
+            Err(_) => theo1_var(c, m, stop),
+        }
+    }
+}
+
+/// The n + 1 ratios of one phase and (m, Theo1) at the extra factors swept.
+type Swept = (Vec<f64>, Vec<(usize, f64)>);
+
+/// The n + 1 ratios of one phase from the exact all-factor sweep
+/// (`fast::theo1_sweep`), with Theo1 at the factors of `extra` it passes on the
+/// way; `None` if it could not run or disagrees with the per-factor estimators
+/// at the first and the middle ratio.
+fn swept_ratios(c: &[f64], n: usize, extra: &[usize], stop: &Interrupt) -> Option<Swept> {
+    let n_phase = c.len();
+    let (avar_ms, theo_ms): (Vec<usize>, Vec<usize>) = (0..=n).map(ratio_factors).unzip();
+    let max_lag = 2 * avar_ms[n];
+    let exact = ExactPhase::new(c, max_lag)?;
+    let top = theo_ms[n];
+    let mut swept_ms: Vec<usize> = theo_ms
+        .iter()
+        .chain(extra.iter().filter(|&&m| m % 2 == 0 && m >= 2 && m <= top))
+        .copied()
+        .collect();
+    swept_ms.sort_unstable();
+    swept_ms.dedup();
+    let sums = theo1_sums(&exact, &swept_ms, stop)?;
+    let theo_at: Vec<(usize, f64)> = swept_ms
+        .iter()
+        .zip(&sums)
+        .map(|(&m, s)| (m, s / (0.75 * (n_phase - m) as f64 * (m * m) as f64)))
+        .collect();
+    let find = |m: usize| {
+        theo_at[theo_at.binary_search_by_key(&m, |&(k, _)| k).ok()?]
+            .1
+            .into()
+    };
+    let theo: Vec<f64> = theo_ms.iter().map(|&m| find(m)).collect::<Option<_>>()?;
+    let avar: Vec<f64> = avar_ms
+        .par_iter()
+        .map(|&m| {
+            if stop.raised() {
+                return f64::NAN;
+            }
+            exact.allan_sum(m) / (2.0 * (m * m) as f64 * (n_phase - 2 * m) as f64)
+        })
+        .collect();
+    let agrees = |got: f64, want: f64| (got - want).abs() <= CHECK_TOLERANCE * want.abs();
+    for i in [0, n / 2] {
+        let (ma, mt) = ratio_factors(i);
+        if !agrees(theo[i], theo1_var(c, mt, stop)) || !agrees(avar[i], oavar(c, ma)) {
+            return None;
+        }
+    }
+    let extras = theo_at
+        .into_iter()
+        .filter(|(m, _)| extra.contains(m))
+        .collect();
+    Some((
+        avar.iter()
+            .zip(&theo)
+            .map(|(&a, &t)| ratio_of(a, t))
+            .collect(),
+        extras,
+    ))
+}
+
+/// The bias ratio κ of each phase (all of the same length) with Theo1 at the
+/// factors of `ms` the sweep reached, or `None` when the phases are shorter
+/// than [`MIN_PHASE_POINTS`]. Each phase's ratios come from the exact sweep,
+/// or, if that fails its check, factor by factor. The values are meaningless
+/// once `stop` is raised (the caller checks it).
+pub fn bias_ratios(phases: &[&[f64]], ms: &[usize], stop: &Interrupt) -> Option<Vec<BiasRatio>> {
     let n_phase = phases.first()?.len();
     let n = ratio_count(n_phase)?;
     if phases.iter().any(|c| c.len() != n_phase) {
         return None;
     }
-    let terms = n + 1;
-    let ratios: Vec<f64> = (0..phases.len() * terms)
-        .into_par_iter()
-        .map(|k| ratio(phases[k / terms], k % terms))
+    let per_phase: Vec<Swept> = phases
+        .par_iter()
+        .map(|c| match swept_ratios(c, n, ms, stop) {
+            Some(found) => found,
+            None if stop.raised() => (vec![f64::NAN], Vec::new()),
+            None => (
+                (0..=n)
+                    .into_par_iter()
+                    .map(|i| {
+                        if stop.raised() {
+                            f64::NAN
+                        } else {
+                            ratio(c, i, stop)
+                        }
+                    })
+                    .collect(),
+                Vec::new(),
+            ),
+        })
         .collect();
     Some(
-        ratios
-            .chunks(terms)
-            .map(|chunk| chunk.iter().sum::<Neumaier>().value() / terms as f64)
+        per_phase
+            .into_iter()
+            .map(|(r, theo1)| BiasRatio {
+                kappa: r.iter().sum::<Neumaier>().value() / r.len() as f64,
+                theo1,
+            })
             .collect(),
     )
 }
 
 /// The bias ratio κ of one phase (see [`bias_ratios`]).
-pub fn bias_ratio(c: &[f64]) -> Option<f64> {
-    bias_ratios(&[c]).map(|v| v[0])
+pub fn bias_ratio(c: &[f64], stop: &Interrupt) -> Option<f64> {
+    bias_ratios(&[c], &[], stop).map(|v| v[0].kappa)
 }
 
-/// Work of the bias ratio of one phase of `n_phase` points plus Theo1 at `ms`,
-/// as (direct steps, fast units) (see [`theo1_work`]); the ratio's part is 0
-/// when it is not defined.
-pub fn theobr_work(n_phase: usize, ms: &[usize]) -> (f64, f64) {
-    let ratio_ms = ratio_count(n_phase)
-        .map(|n| (0..=n).map(|i| ratio_factors(i).1).collect::<Vec<_>>())
-        .unwrap_or_default();
-    ratio_ms
+/// Work of ThêoBR on one phase of `n_phase` points at `ms`, as (direct steps,
+/// fast units) of Theo1 at `ms` (see [`theo1_work`]) and the sweep's pair
+/// products for the bias ratio: M² + Σ_i m_i/2 (both ends' pair triangles, then
+/// the terms of each ratio's factor), 0 when the ratio is not defined.
+pub fn theobr_work(n_phase: usize, ms: &[usize]) -> (f64, f64, f64) {
+    let sweep = ratio_count(n_phase).map_or(0.0, |n| {
+        let top = ratio_factors(n).1 as f64;
+        let terms: f64 = (0..=n).map(|i| (ratio_factors(i).1 / 2) as f64).sum();
+        top * top + terms
+    });
+    let (direct, fast) = ms
         .iter()
-        .chain(ms)
         .map(|&m| theo1_work(n_phase, m))
-        .fold((0.0, 0.0), |(a, b), (c, d)| (a + c, b + d))
+        .fold((0.0, 0.0), |(a, b), (c, d)| (a + c, b + d));
+    (direct, fast, sweep)
 }
 
-/// Theo1 kernel rates, measured on the release build on the development machine
+/// Kernel rates, measured on the release build on the development machine
 /// (2 shared cores; `benches/bench_theo.py` prints them next to real timings):
-/// direct multiply-adds per second below `theo1::FFT_FROM`, and N·log₂(m)² units
-/// per second of the expansion above. They only decide whether a warning says a
-/// run will be long, so a machine twice as fast or slow changes nothing else.
+/// direct multiply-adds per second below `theo1::FFT_FROM`, N·log₂(m)² units
+/// per second of the expansion above, and the sweep's pair products per second.
+/// They only decide whether a warning says a run will be long, so a machine
+/// twice as fast or slow changes nothing else.
 const DIRECT_STEPS_PER_SECOND: f64 = 1.2e9;
 const FAST_UNITS_PER_SECOND: f64 = 1.1e9;
+const SWEEP_PRODUCTS_PER_SECOND: f64 = 1.0e9;
 
 /// Seconds ThêoBR at `ms` takes on one phase of `n_phase` points, from
 /// [`theobr_work`] and the measured kernel rates.
 pub fn estimated_seconds(n_phase: usize, ms: &[usize]) -> f64 {
-    let (direct, fast) = theobr_work(n_phase, ms);
-    direct / DIRECT_STEPS_PER_SECOND + fast / FAST_UNITS_PER_SECOND
+    let (direct, fast, sweep) = theobr_work(n_phase, ms);
+    direct / DIRECT_STEPS_PER_SECOND
+        + fast / FAST_UNITS_PER_SECOND
+        + sweep / SWEEP_PRODUCTS_PER_SECOND
 }
 
 #[cfg(test)]
@@ -129,6 +249,7 @@ mod tests {
     use super::*;
     use crate::allan::phase::cumulative_phase;
     use crate::allan::test_signals::naive_theo1;
+    use crate::interrupt::NEVER;
 
     /// Direct transcriptions of the definitions on phase values.
     fn naive_oavar(x: &[f64], m: usize) -> f64 {
@@ -179,7 +300,7 @@ mod tests {
                 .map(|i| naive_oavar(&c, 9 + 3 * i) / naive_theo1(&c, 12 + 4 * i))
                 .sum::<f64>()
                 / (n + 1) as f64;
-            let got = bias_ratio(&c).unwrap();
+            let got = bias_ratio(&c, &NEVER).unwrap();
             assert!((got - want).abs() <= 1e-12 * want, "{got} vs {want}");
             // Random-walk FM: Theo1 underestimates AVAR, so κ > 1.
             assert!(got > 1.0, "{got}");
@@ -188,43 +309,64 @@ mod tests {
 
     #[test]
     fn too_short_and_degenerate_phases() {
-        assert_eq!(bias_ratio(&sample(88)), None);
-        assert_eq!(bias_ratio(&[]), None);
+        assert_eq!(bias_ratio(&sample(88), &NEVER), None);
+        assert_eq!(bias_ratio(&[], &NEVER), None);
         let flat = vec![0.0; 200];
-        assert_eq!(bias_ratio(&flat), Some(1.0));
+        assert_eq!(bias_ratio(&flat, &NEVER), Some(1.0));
         let a = sample(200);
         let b = sample(201);
-        assert_eq!(bias_ratios(&[&a, &b]), None);
+        assert_eq!(bias_ratios(&[&a, &b], &[], &NEVER), None);
     }
 
     #[test]
     fn several_phases_give_their_own_ratios() {
         let a = sample(300);
         let b: Vec<f64> = (0..301).map(|k| ((k * 37) % 17) as f64).collect();
-        let both = bias_ratios(&[&a, &b]).unwrap();
-        assert_eq!(both, vec![bias_ratio(&a).unwrap(), bias_ratio(&b).unwrap()]);
+        let both = bias_ratios(&[&a, &b], &[], &NEVER).unwrap();
+        let kappas: Vec<f64> = both.iter().map(|r| r.kappa).collect();
+        let alone = [&a, &b].map(|c| bias_ratio(c, &NEVER).unwrap());
+        assert_eq!(kappas, alone);
     }
 
     #[test]
-    fn work_counts_the_theo1_regimes() {
-        assert_eq!(theobr_work(50, &[]), (0.0, 0.0));
-        // N = 90: one ratio, Theo1 at m = 12: (90 − 12)·6 direct steps.
-        assert_eq!(theobr_work(90, &[]), (78.0 * 6.0, 0.0));
-        assert_eq!(theobr_work(90, &[20]), (78.0 * 6.0 + 70.0 * 10.0, 0.0));
-        // N = 10001: ratios at m = 12, 16, …, 1332; 1024 adds N·log2(1024)² fast units.
-        let (direct, fast) = theobr_work(10_001, &[]);
-        let want: f64 = (12..256)
-            .step_by(4)
-            .map(|m| (10_001 - m) as f64 * (m / 2) as f64)
-            .sum();
-        assert_eq!(direct, want);
-        let (_, with_tau) = theobr_work(10_001, &[1024]);
-        assert!((with_tau - fast - 10_001.0 * 100.0).abs() < 1e-6 * fast);
+    fn the_sweep_passes_its_check_and_gives_theo1_on_the_way() {
+        // The four noise types; the sweep's values are the definition's.
+        for order in 0..4 {
+            let mut c = crate::allan::test_signals::integrated_noise(1501, 11, order);
+            if order == 0 {
+                c = c.windows(2).map(|w| w[1] - w[0]).collect(); // white PM
+            }
+            let n = ratio_count(c.len()).unwrap();
+            let (ratios, theo1) = swept_ratios(&c, n, &[10, 100, 198, 600], &NEVER).unwrap();
+            assert_eq!(ratios.len(), n + 1);
+            let ms: Vec<usize> = theo1.iter().map(|t| t.0).collect();
+            assert_eq!(ms, vec![10, 100, 198]);
+            for (m, var) in theo1 {
+                let want = naive_theo1(&c, m);
+                assert!((var - want).abs() <= 1e-10 * want, "m {m}: {var} vs {want}");
+            }
+        }
+    }
+
+    #[test]
+    fn work_counts_the_theo1_regimes_and_the_sweep() {
+        assert_eq!(theobr_work(50, &[]), (0.0, 0.0, 0.0));
+        // N = 90: one ratio at m = 12: a 12² triangle and 6 terms; Theo1 at m = 20
+        // directly: (90 − 20)·10 steps.
+        assert_eq!(theobr_work(90, &[]), (0.0, 0.0, 144.0 + 6.0));
+        assert_eq!(theobr_work(90, &[20]), (70.0 * 10.0, 0.0, 150.0));
+        // N = 10001: 1024 adds N·log2(1024)² fast units.
+        let (_, fast, sweep) = theobr_work(10_001, &[1024]);
+        assert_eq!(fast, 10_001.0 * 100.0);
+        assert_eq!(
+            sweep,
+            1332.0 * 1332.0 + (6..=666).step_by(2).sum::<usize>() as f64
+        );
         assert_eq!(theo1_work(100, 100), (0.0, 0.0));
         let seconds = estimated_seconds(10_001, &[1024]);
         assert_eq!(
             seconds,
-            direct / DIRECT_STEPS_PER_SECOND + with_tau / FAST_UNITS_PER_SECOND
+            fast / FAST_UNITS_PER_SECOND + sweep / SWEEP_PRODUCTS_PER_SECOND
         );
     }
 }

@@ -151,7 +151,7 @@ mod tests {
         ] {
             let sums = sums_of_squares(&c, &ms, difference);
             for (j, &m) in ms.iter().enumerate() {
-                let one = statistic.estimate(&c, m);
+                let one = statistic.estimate(&c, m, &crate::interrupt::NEVER);
                 let blocked = sums[j] / (divisor * (m * m) as f64 * one.terms as f64);
                 assert!(
                     (blocked / one.var - 1.0).abs() < 1e-13,

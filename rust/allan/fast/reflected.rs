@@ -34,6 +34,7 @@ use rayon::prelude::*;
 
 use crate::allan::phase::least_squares_line;
 use crate::allan::sum::{blocked_sum, Neumaier};
+use crate::interrupt::Interrupt;
 
 /// Subsequences per block, in units of m: the block's values span (this + 3)·m,
 /// so the expansion's terms stay within ~ (span / m)^5 of the result even for
@@ -225,8 +226,9 @@ fn class_sum(
 }
 
 /// Σ_i Σ_{j<6m} D_j(i)² over the `len − 3m + 1` subsequences of `values(k)`,
-/// k < len. Needs m ≥ 1 and 3m ≤ len.
-pub fn reflected_sum<V>(values: V, len: usize, m: usize) -> f64
+/// k < len. Needs m ≥ 1 and 3m ≤ len. Blocks started after `stop` is raised
+/// are skipped (the sum is then meaningless).
+pub fn reflected_sum<V>(values: V, len: usize, m: usize, stop: &Interrupt) -> f64
 where
     V: Fn(usize) -> f64 + Sync,
 {
@@ -249,6 +251,9 @@ where
     let parts: Vec<f64> = (0..blocks)
         .into_par_iter()
         .map(|bk| {
+            if stop.raised() {
+                return 0.0;
+            }
             let i0 = bk * block;
             let b = block.min(windows - i0);
             // P(i0 + t) of v minus the block's least-squares line, t ≤ b − 1 + l.
@@ -295,6 +300,7 @@ mod tests {
     use crate::allan::test_signals::{
         detrended_reflection, integrate, kernel_case, noise, offset_pair,
     };
+    use crate::interrupt::NEVER;
 
     /// The definition, transcribed: detrend, reflect, sum D².
     fn direct(v: &[f64], m: usize) -> f64 {
@@ -318,7 +324,7 @@ mod tests {
         let walk2 = integrate(&walk);
         for v in [&white, &walk, &walk2] {
             for m in [1, 2, 3, 4, 5, 7, 10, 16, 33, 60, 133] {
-                let (fast, slow) = (reflected_sum(|k| v[k], v.len(), m), direct(v, m));
+                let (fast, slow) = (reflected_sum(|k| v[k], v.len(), m, &NEVER), direct(v, m));
                 assert!(
                     (fast - slow).abs() <= 1e-10 * slow,
                     "m {m}: {fast} vs {slow}"
@@ -339,7 +345,7 @@ mod tests {
         for (v, offset) in [(&phase, 1e7), (&white, 9.81e3)] {
             let (shifted, v) = offset_pair(v, offset);
             for m in [16, 100, 250, 499] {
-                let fast = reflected_sum(|k| shifted[k], v.len(), m);
+                let fast = reflected_sum(|k| shifted[k], v.len(), m, &NEVER);
                 let slow = direct(&v, m);
                 assert!(
                     (fast - slow).abs() <= 1e-11 * slow,
@@ -357,7 +363,7 @@ mod tests {
         ) {
             let n = v.len();
             let m = 1 + (m_pick * (n / 3 - 1) as f64) as usize;
-            let (fast, slow) = (reflected_sum(|k| shifted[k], n, m), direct(&v, m));
+            let (fast, slow) = (reflected_sum(|k| shifted[k], n, m, &NEVER), direct(&v, m));
             proptest::prop_assert!((fast - slow).abs() <= 1e-10 * slow + 1e-300, "n {} m {}: {} vs {}", n, m, fast, slow);
         }
     }

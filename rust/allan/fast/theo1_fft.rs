@@ -24,6 +24,7 @@ use rayon::prelude::*;
 use super::sliding::sliding_dot;
 use crate::allan::phase::least_squares_line;
 use crate::allan::sum::Neumaier;
+use crate::interrupt::Interrupt;
 
 /// Start points per block, in units of m.
 const BLOCK_IN_M: usize = 4;
@@ -180,8 +181,9 @@ fn block_sum(f: &[f64], b: usize, m: usize, w: &[f64], harmonic: &[f64]) -> f64 
 }
 
 /// Σ_{i<N−m} Σ_{k=1}^{m/2} (1/k)·(c_i + c_{i+m} − c_{i+k} − c_{i+m−k})² for even
-/// m ≥ 2, N = c.len() > m.
-pub fn theo1_sum(c: &[f64], m: usize) -> f64 {
+/// m ≥ 2, N = c.len() > m. Blocks started after `stop` is raised are skipped
+/// (the sum is then meaningless).
+pub fn theo1_sum(c: &[f64], m: usize, stop: &Interrupt) -> f64 {
     let h = m / 2;
     let starts = c.len() - m;
     let w: Vec<f64> = (1..=h).map(|k| 1.0 / k as f64).collect();
@@ -196,6 +198,9 @@ pub fn theo1_sum(c: &[f64], m: usize) -> f64 {
     let parts: Vec<f64> = (0..blocks)
         .into_par_iter()
         .map(|bk| {
+            if stop.raised() {
+                return 0.0;
+            }
             let i0 = bk * block;
             let b = block.min(starts - i0);
             let span = b + m;
@@ -221,6 +226,7 @@ fn local_phase(c: &[f64]) -> Vec<f64> {
 mod tests {
     use super::*;
     use crate::allan::test_signals::{integrate, kernel_case, noise, offset_pair};
+    use crate::interrupt::NEVER;
 
     fn direct(c: &[f64], m: usize) -> f64 {
         let h = m / 2;
@@ -245,7 +251,7 @@ mod tests {
         for c in [&white, &walk, &walk2] {
             let (shifted, c) = offset_pair(c, 1e6);
             for m in [2, 4, 10, 64, 98, 200, 400, 600, 800, 1000, 1198] {
-                let (fast, slow) = (theo1_sum(&shifted, m), direct(&c, m));
+                let (fast, slow) = (theo1_sum(&shifted, m, &NEVER), direct(&c, m));
                 assert!(
                     (fast - slow).abs() <= 1e-12 * slow,
                     "m {m}: {fast} vs {slow} ({:e})",
@@ -264,7 +270,7 @@ mod tests {
             // Even m from 2 to n − 1.
             let n = c.len();
             let m = 2 * (1 + (m_pick * ((n - 1) / 2 - 1) as f64) as usize);
-            let (fast, slow) = (theo1_sum(&shifted, m), direct(&c, m));
+            let (fast, slow) = (theo1_sum(&shifted, m, &NEVER), direct(&c, m));
             proptest::prop_assert!((fast - slow).abs() <= 1e-10 * slow + 1e-300, "n {} m {}: {} vs {}", n, m, fast, slow);
         }
     }
