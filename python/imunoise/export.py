@@ -53,10 +53,20 @@ __all__ = [
     "kalibr_yaml",
     "openvins_yaml",
     "model_json",
+    "write_atomic",
     "write_kalibr",
     "write_openvins",
     "write_json",
 ]
+
+
+def write_atomic(path, text: str) -> Path:
+    """Deprecated (0.2): every writer of imunoise writes atomically; to write text of
+    your own atomically use :func:`write_json` / :func:`write_kalibr` or your own code.
+    Writes ``text`` to ``path`` through the one atomic-write helper."""
+    _warn.warn("imunoise.export.write_atomic is deprecated and will be removed in 0.3; "
+               "the export.write_* functions write atomically", DeprecationWarning)
+    return _atomic.write_text(path, text)
 
 
 def _combine(model, term: str, combine: str, sensor: str, input_unit) -> float:

@@ -163,3 +163,10 @@ def test_a_curve_still_falling_at_its_end_has_no_read_off_floor():
     x = imunoise.simulate(100_000, FS, N=1e-3, seed=9)
     m = quiet_fit(imunoise.adev(x, FS, taus=10))
     assert np.isnan(m.readoff["B"]["value"]) and not m.supported["B"]
+
+
+def test_export_write_atomic_still_writes_and_warns(tmp_path):
+    target = tmp_path / "x.txt"
+    with pytest.warns(DeprecationWarning, match="write_atomic is deprecated"):
+        export.write_atomic(target, "hello\n")
+    assert target.read_text() == "hello\n"
