@@ -429,6 +429,13 @@ def _model_curves(model: NoiseModel, grid: np.ndarray, channel: int) -> dict[str
     return out
 
 
+def _data_floor(model: NoiseModel, channel: int) -> tuple[float, float] | None:
+    """(τ, B) of the data's own read-off floor, or None where the curve has none."""
+    tau = float(np.ravel(model.readoff["B"]["tau"])[channel])
+    value = float(np.ravel(model.readoff["B"]["value"])[channel])
+    return (tau, value) if np.isfinite(tau) and np.isfinite(value) else None
+
+
 def _readoff_points(model: NoiseModel, channel: int) -> dict[str, float]:
     """The model's datasheet values N (τ = 1 s), K (τ = 3 s), B for the marks."""
     return {t: float(model.value(t)[channel]) for t in ("N", "K", "B")}
@@ -544,10 +551,20 @@ def allan(
                     ax.plot([3.0], [marks["K"]], marker="^", color="purple", ms=5,
                             linestyle="none", label="K at τ=3 s")
                 if marks.get("B", 0.0) > 0:
-                    imin = int(np.argmin(curves["total"]))
+                    # where model.B is read: the model's minimum over the fitted taus
+                    # (beyond them a model without a walk keeps falling)
+                    fitted = (grid >= taus[0]) & (grid <= taus[-1]) if model is None else (
+                        (grid >= model.taus[0]) & (grid <= model.taus[-1]))
+                    total = np.where(fitted, curves["total"], np.inf)
+                    imin = int(np.argmin(total))
                     ax.plot([grid[imin]], [marks["B"] * FLICKER], marker="D",
                             color="darkgreen", ms=5, linestyle="none",
                             label="B·0.664 floor")
+                read = _data_floor(model, j) if model is not None else None
+                if read is not None:
+                    ax.plot([read[0]], [read[1] * FLICKER], marker="D", mfc="none",
+                            color="darkgreen", ms=7, linestyle="none",
+                            label="data's floor (read-off B)")
             ax.set_xscale("log")
             ax.set_yscale("log")
             if not show_res:

@@ -84,3 +84,19 @@ def test_missing_samples_leave_a_hole_and_are_shaded():
     shaded = [p for p in ax.patches if p.get_facecolor()[:3] == pytest.approx(
         tuple(int(plot.GAP_COLOR[i:i + 2], 16) / 255 for i in (1, 3, 5)))]
     assert len(shaded) == 1
+
+
+def test_b_marker_sits_where_model_b_is_read_and_the_data_floor_is_marked():
+    # N + B only: the model keeps falling past the fitted taus (the plot's grid runs
+    # beyond them), so its minimum over the plot grid lies outside the data.
+    x = imunoise.simulate(400_000, 40.0, N=1e-3, B=2e-4, seed=2)
+    r = imunoise.adev(x, 40.0, taus=10)
+    m = imunoise.fit(r, terms=["N", "B"], warn_coverage=False)
+    fig = plot.allan(r, model=m)
+    lines = {ln.get_label(): ln for ln in fig.axes[0].get_lines()}
+    tau_b = float(lines["B·0.664 floor"].get_xdata()[0])
+    assert m.taus[0] <= tau_b <= m.taus[-1]
+    assert float(lines["B·0.664 floor"].get_ydata()[0]) == pytest.approx(
+        float(m.B) * imunoise.noise.FLICKER)
+    tau_read = float(lines["data's floor (read-off B)"].get_xdata()[0])
+    assert tau_read == pytest.approx(float(m.readoff["B"]["tau"]))
