@@ -104,6 +104,9 @@ def _build_parser() -> argparse.ArgumentParser:
     f.add_argument("--plot", default=None, metavar="PNG",
                    help="also save the Allan deviation with the fitted model (one PNG per "
                    "sensor: NAME_gyro.png, NAME_accel.png when there are two)")
+    f.add_argument("--datasheet-units", action="store_true",
+                   help="print N, B, K in the units datasheets write (deg/s/sqrt(Hz), "
+                   "deg/h, ug/sqrt(Hz), ug) instead of deg/sqrt(h), mg/sqrt(Hz)")
 
     s = sub.add_parser("stats", help="print sample statistics and distribution fits",
                        description="Per channel mean, std, variance, min, max, drift per hour; "
@@ -371,7 +374,8 @@ def _cmd_fit(args) -> int:
                               seed=0)
         else:  # the sentences below say how well the model follows the curve
             model = noise.fit(result, warn_coverage=False)
-        head, rows = report.datasheet_rows(model, s)
+        head, rows = report.datasheet_rows(
+            model, s, units="datasheet" if args.datasheet_units else None)
         print(f"# {s}")
         _print_table(head, rows)
         for sentence in report.model_sentences(model, s):

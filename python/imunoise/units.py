@@ -40,6 +40,7 @@ __all__ = [
     "INPUT_UNITS",
     "UNITS",
     "DEFAULT_UNITS",
+    "DATASHEET_UNITS",
     "convert",
     "convert_back",
     "input_scale",
@@ -135,6 +136,41 @@ DEFAULT_UNITS: dict[str, dict[str, str]] = {
     },
 }
 """The datasheet unit used for each coefficient when none is asked for."""
+
+DATASHEET_UNITS: dict[str, dict[str, str]] = {
+    "gyro": {
+        "Q": "deg",
+        "N": "deg/s/sqrt(Hz)",
+        "B": "deg/h",
+        "K": "deg/h/sqrt(h)",
+        "R": "deg/h^2",
+    },
+    "accel": {
+        "Q": "m/s",
+        "N": "ug/sqrt(Hz)",
+        "B": "ug",
+        "K": "m/s^2/sqrt(s)",
+        "R": "m/s^3",
+    },
+}
+"""The units MEMS datasheets (the VN-100's among them) write: noise density per √Hz,
+bias stability in °/h and µg; ``units="datasheet"`` in :meth:`NoiseModel.table`."""
+
+
+def unit_choice(units, sensor: str) -> dict[str, str]:
+    """A ``units`` option of the tables as a dict: ``None`` (the defaults),
+    ``"datasheet"`` (:data:`DATASHEET_UNITS`) or ``{term: unit}``."""
+    _check_sensor(sensor)
+    if units is None:
+        return {}
+    if isinstance(units, str):
+        if units != "datasheet":
+            raise ValueError(f"units must be 'datasheet', a dict of term -> unit or None; "
+                             f"got {units!r}")
+        return dict(DATASHEET_UNITS[sensor])
+    if not isinstance(units, dict):
+        raise TypeError(f"units must be 'datasheet', a dict or None; got {type(units).__name__}")
+    return dict(units)
 
 _ALIASES = {
     "°": "deg",

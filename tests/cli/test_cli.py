@@ -336,3 +336,15 @@ def test_stats_has_attitude_and_plot_options(tmp_path, capsys, read):
                          "--plot", str(tmp_path / "f.png")], capsys)
     assert code == 0 and (tmp_path / "f.png").stat().st_size > 1000
     assert f"# figure: {tmp_path / 'f.png'}" in out
+
+
+def test_fit_prints_datasheet_units_when_asked(capsys):
+    from imunoise.cli import bundled_log
+
+    args = ["fit", str(bundled_log()), "--sensor", "gyro", "--fs", "40"]
+    code, out, err = _run([*args, "--datasheet-units"], capsys)
+    assert code == 0, err
+    n_row = next(ln for ln in out.splitlines() if " N " in f" {ln} ")
+    assert "deg/s/sqrt(Hz)" in n_row
+    code, out, err = _run(args, capsys)
+    assert "deg/sqrt(h)" in next(ln for ln in out.splitlines() if " N " in f" {ln} ")

@@ -170,3 +170,15 @@ def test_export_write_atomic_still_writes_and_warns(tmp_path):
     with pytest.warns(DeprecationWarning, match="write_atomic is deprecated"):
         export.write_atomic(target, "hello\n")
     assert target.read_text() == "hello\n"
+
+
+def test_datasheet_units_are_what_datasheets_write(fast_gm_model):
+    m = fast_gm_model
+    rows = {r["term"]: r for r in m.table("gyro", units="datasheet")}
+    assert rows["N"]["unit"] == "deg/s/sqrt(Hz)" and rows["B"]["unit"] == "deg/h"
+    assert rows["N"]["X"] == pytest.approx(float(m.N[0]) * 180 / math.pi, rel=1e-12)
+    assert "°/s/√Hz" in m.table_text("gyro", units="datasheet")
+    accel = {r["term"]: r for r in m.table("accel", units="datasheet")}
+    assert accel["N"]["unit"] == "ug/sqrt(Hz)" and accel["B"]["unit"] == "ug"
+    with pytest.raises(ValueError, match="units must be 'datasheet'"):
+        m.table("gyro", units="lab")

@@ -206,16 +206,18 @@ class NoiseModel(PerTerm):
 
     # -- units and tables ---------------------------------------------------
     @old_call_forms(keyword_only=("units", "input_unit"))
-    def in_units(self, sensor: str = "gyro", *, units: dict[str, str] | None = None,
+    def in_units(self, sensor: str = "gyro", *, units: dict[str, str] | str | None = None,
                  input_unit: str | None = None) -> dict[str, dict]:
         """The datasheet values in datasheet units.
 
         Parameters
         ----------
         sensor : {"gyro", "accel"}
-        units : dict, optional
+        units : dict or "datasheet", optional
             Target unit per term, e.g. ``{"N": "deg/s/sqrt(Hz)"}``; missing terms
-            use :data:`imunoise.units.DEFAULT_UNITS`.
+            use :data:`imunoise.units.DEFAULT_UNITS`. ``"datasheet"``: the units MEMS
+            datasheets write (:data:`imunoise.units.DATASHEET_UNITS`: °/s/√Hz, °/h,
+            µg/√Hz, µg).
         input_unit : str, optional
             Unit of the rate data the model was fitted to (``"rad/s"`` default
             for gyros, ``"m/s^2"`` for accelerometers; also ``"deg/s"``, ``"g"``).
@@ -226,7 +228,7 @@ class NoiseModel(PerTerm):
             ``{term: {"value", "std", "unit", "label", "supported"}}`` with arrays
             shaped like the model's values.
         """
-        units = dict(units or {})
+        units = _units.unit_choice(units, sensor)
         unknown = set(units) - set(TERMS)
         if unknown:
             raise ValueError(f"units keys must be among {TERMS}; got {sorted(unknown)}")
@@ -247,7 +249,7 @@ class NoiseModel(PerTerm):
         return out
 
     @old_call_forms(keyword_only=("units", "input_unit", "axes", "terms"))
-    def table(self, sensor: str = "gyro", *, units: dict[str, str] | None = None,
+    def table(self, sensor: str = "gyro", *, units: dict[str, str] | str | None = None,
               input_unit: str | None = None, axes: Sequence[str] | None = None,
               terms: Sequence[str] = ("N", "B", "K", "Q", "R")) -> list[dict]:
         """Per-axis table in datasheet units: one row per datasheet value, then the
@@ -260,7 +262,8 @@ class NoiseModel(PerTerm):
         ``missing`` (the text of an axis without the value: ``not resolved`` for
         a datasheet value, ``—`` for a component the axis's model does not have)
         and, per axis name (default X, Y, Z…), the value, ``<axis>_std`` and
-        ``<axis>_supported``. Render it with :func:`format_table`.
+        ``<axis>_supported``. Render it with :func:`format_table`. ``units`` as
+        for :meth:`in_units` (``"datasheet"``: °/s/√Hz, °/h, µg/√Hz, µg).
         """
         axes = _schema.axis_names(self.channels, axes)
         conv = self.in_units(sensor, units=units, input_unit=input_unit)
@@ -276,7 +279,7 @@ class NoiseModel(PerTerm):
                 row[ax + "_std"] = float(stds[i])
                 row[ax + "_supported"] = bool(sup[i])
             rows.append(row)
-        rate = _units.unit_info("B", (units or {}).get("B"), sensor)
+        rate = _units.unit_info("B", _units.unit_choice(units, sensor).get("B"), sensor)
 
         def to_rate(v):
             return _units.convert(v, "B", rate.name, sensor=sensor, input_unit=input_unit)

@@ -20,17 +20,19 @@ __all__ = ["comparison_rows", "datasheet_rows", "model_sentences"]
 POOR_COVERAGE = 0.8
 
 
-def datasheet_rows(model: NoiseModel, sensor: str) -> tuple[list[str], list[list[str]]]:
+def datasheet_rows(model: NoiseModel, sensor: str,
+                   units: str | dict | None = None) -> tuple[list[str], list[list[str]]]:
     """Noise coefficients per axis in datasheet units, as text.
 
     Returns the header (``quantity, term, unit``, then one column per axis) and
     one row per term of :meth:`NoiseModel.table`; a cell is ``value ± std``,
     ``not resolved`` where the data do not resolve the coefficient, or ``—``
-    where the axis's model has no such term.
+    where the axis's model has no such term. ``units`` as for
+    :meth:`NoiseModel.table` (``"datasheet"``: °/s/√Hz, °/h, µg/√Hz, µg).
     """
     axes = axis_names(model.channels)
     out = []
-    for r in model.table(sensor, axes=axes):
+    for r in model.table(sensor, axes=axes, units=units):
         cells = [r["quantity"], r["term"], r["unit"]]
         for a in axes:
             if not r[f"{a}_supported"]:
