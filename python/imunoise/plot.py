@@ -429,6 +429,25 @@ def _model_curves(model: NoiseModel, grid: np.ndarray, channel: int) -> dict[str
     return out
 
 
+def _tone_envelope(model: NoiseModel, grid: np.ndarray, channel: int,
+                   curve: np.ndarray) -> np.ndarray:
+    """The tone's Allan deviation up to its first peak, its upper envelope beyond:
+    the sampled form 2·(A²/2)·sin⁴(πνm)/(m² sin²πν) with sin⁴ → 1, A/(m·|sin πν|),
+    ν = f0/fs, m = τ·fs. The curve itself is a comb of zeros at whole periods, which
+    drew spikes across the panel."""
+    tones = model.components.sine(channel)
+    if not tones:
+        return curve
+    amplitude, f0 = tones[0]
+    fs = float(model.fs)
+    envelope = amplitude / (grid * fs * abs(np.sin(np.pi * f0 / fs)))
+    first = grid <= 1.0 / f0  # the first peak lies below one period (≈ 0.37/f0)
+    if not first.any():
+        return envelope
+    peak = int(np.argmax(np.where(first, curve, -np.inf)))
+    return np.where(np.arange(grid.size) <= peak, curve, np.minimum(envelope, curve[peak]))
+
+
 def _data_floor(model: NoiseModel, channel: int) -> tuple[float, float] | None:
     """(τ, B) of the data's own read-off floor, or None where the curve has none."""
     tau = float(np.ravel(model.readoff["B"]["tau"])[channel])
@@ -538,9 +557,12 @@ def allan(
                         ax.plot(grid, curves[g], color="tab:brown", linestyle=ls,
                                 linewidth=0.9, label="Gauss–Markov bias")
                 if "sine" in curves and np.any(curves["sine"] > 0):
-                    # Zeros at whole periods: masked on the log axis.
-                    tone = np.where(curves["sine"] > 0, curves["sine"], np.nan)
-                    ax.plot(grid, tone, color="tab:olive", linewidth=0.9, label="tone")
+                    if model is not None:
+                        tone = _tone_envelope(model, grid, j, curves["sine"])
+                        label = "tone (envelope)"
+                    else:  # zeros at whole periods: masked on the log axis
+                        tone, label = np.where(curves["sine"] > 0, curves["sine"], np.nan), "tone"
+                    ax.plot(grid, tone, color="tab:olive", linewidth=0.9, label=label)
                 if "resonance" in curves and np.any(curves["resonance"] > 0):
                     band = np.where(curves["resonance"] > 0, curves["resonance"], np.nan)
                     ax.plot(grid, band, color="tab:cyan", linewidth=0.9, label="resonance")

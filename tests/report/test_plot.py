@@ -100,3 +100,16 @@ def test_b_marker_sits_where_model_b_is_read_and_the_data_floor_is_marked():
         float(m.B) * imunoise.noise.FLICKER)
     tau_read = float(lines["data's floor (read-off B)"].get_xdata()[0])
     assert tau_read == pytest.approx(float(m.readoff["B"]["tau"]))
+
+
+def test_tone_is_drawn_as_its_envelope_not_a_comb():
+    x = imunoise.simulate(200_000, 40.0, N=1e-4, channels=1, seed=3, sinusoid=(5e-4, 7.3))
+    r = imunoise.adev(x, 40.0, taus=20)
+    m = imunoise.fit(r, terms=["N", "sine"], warn_coverage=False)
+    assert m.components.sine(0)
+    fig = plot.allan(r, model=m)
+    line = next(ln for ln in fig.axes[0].get_lines() if ln.get_label() == "tone (envelope)")
+    y = np.asarray(line.get_ydata(), dtype=float)
+    assert np.all(np.isfinite(y) & (y > 0))  # no masked zeros at whole periods
+    after = y[int(np.argmax(y)):]
+    assert np.all(np.diff(after) <= 1e-12 * after[:-1])  # falls monotonically past the peak
