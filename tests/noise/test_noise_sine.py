@@ -109,7 +109,7 @@ def test_tone_in_prediction_dict_repr_and_plot(toned):
     assert "tone" in model._repr_html_()
     fig = imunoise.plot.allan(r, model=model)
     labels = [ln.get_label() for ln in fig.axes[0].get_lines()]
-    assert "tone" in labels
+    assert "tone (envelope)" in labels
 
 
 def test_explicit_sine_terms_are_checked(toned):
