@@ -47,6 +47,12 @@ variance is the real part of the AR1 form continued to z = ρe^(iθ).
     N at τ = 1 s (slope −½), K at τ = 3 s (slope +½), Q at τ = √3 s (slope −1),
     R at τ = √2 s (slope +1), and B = σ_flat/√(2 ln2/π) at the point of slope 0.
 
+What a user reads, ``model.N``, ``B``, ``K``, ``Q``, ``R``, are the datasheet values of
+the whole fitted model (``_datasheet``): a Gauss–Markov term faster than 1 s counts in
+N, a slower one's +½ slope in K, B is the model's flat minimum / 0.6643; every view
+prints these. The fit's own parameters are :attr:`NoiseModel.components`
+(``_components``).
+
 Whatever the method, :attr:`NoiseModel.readoff` holds the datasheet read-offs
 of the data (N at 1 s, K at 3 s, B = σ_min/0.6643) next to the model, and
 :attr:`NoiseModel.coverage` says how well the model follows the curve.
