@@ -260,9 +260,9 @@ class Components(PerTerm):
         for term in TERMS:
             d[term] = {
                 "value": self.value(term).tolist(),
-                "std": [_finite_or_none(v) for v in self.std(term)],
+                "std": finite_list(self.std(term)),
                 "supported": np.atleast_1d(self.supported[term]).tolist(),
-                "tau_range": [[_finite_or_none(v) for v in pair]
+                "tau_range": [finite_list(pair)
                               for pair in np.reshape(self.tau_range[term], (-1, 2))],
             }
         channels = range(self.channels)
@@ -282,5 +282,6 @@ class Components(PerTerm):
                               axes)
 
 
-def _finite_or_none(v) -> float | None:
-    return float(v) if np.isfinite(v) else None
+def finite_list(values) -> list[float | None]:
+    """``values`` as a list of floats, ``None`` where not finite (JSON has no NaN)."""
+    return [float(v) if np.isfinite(v) else None for v in np.atleast_1d(values)]

@@ -195,13 +195,13 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
             raise TypeError(f"replicates must be an integer; got {replicates!r}")
         if replicates < 5:
             raise ValueError(f"replicates must be >= 5; got {replicates}")
-        n = _record_length(result)
-        if replicates * n > MAX_BOOTSTRAP_SAMPLES:
-            most = MAX_BOOTSTRAP_SAMPLES // n
+        n_record = _record_length(result)  # the length of every simulated replicate
+        if replicates * n_record > MAX_BOOTSTRAP_SAMPLES:
+            most = MAX_BOOTSTRAP_SAMPLES // n_record
             raise ValueError(
-                (f"replicates must be at most {most:,} for a record of {n:,} samples"
+                (f"replicates must be at most {most:,} for a record of {n_record:,} samples"
                  if most >= 5 else
-                 f"a record of {n:,} samples is too long for a bootstrap (use "
+                 f"a record of {n_record:,} samples is too long for a bootstrap (use "
                  f"uncertainty='independent')")
                 + f" (the simulated records, replicates x samples, are held at once: at most "
                 f"{MAX_BOOTSTRAP_SAMPLES:,}); got replicates={replicates:,}"
@@ -271,7 +271,8 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
                                                  *["resonance"] * len(oscs)],
                            tau_range=tau_range)
             std[c], gm_std[c], sine_std[c], osc_std[c], sheet_std[c] = _bootstrap_std(
-                result, coef[c], markov, (tones, oscs), int(replicates), generator, options)
+                result, n_record, coef[c], markov, (tones, oscs), int(replicates), generator,
+                options)
     std[~sup] = np.nan
 
     def shaped(a):
@@ -354,16 +355,16 @@ def _record_length(result) -> int:
     return n0 + 2 * m0 - 1 if overlapping else (n0 + 1) * m0
 
 
-def _bootstrap_std(result, coef, markov, oscillators, replicates, rng, options):
+def _bootstrap_std(result, n, coef, markov, oscillators, replicates, rng, options):
     """Standard deviation of each coefficient (and Gauss–Markov σ, τc, tone A, f0,
     resonance σ, f_r, τr, and the datasheet values Q…R) over fits to records simulated
     from the model with
-    the length, rate and taus of ``result``; ``oscillators`` is (tones, resonances)."""
+    the rate and taus of ``result`` and its length ``n``; ``oscillators`` is (tones,
+    resonances)."""
     from imunoise._simulate import simulate
     from imunoise.allan import adev
 
     tones, oscs = oscillators
-    n = _record_length(result)
     sims = simulate(n, result.fs, *coef, channels=replicates, seed=rng, gm=markov,
                     sinusoid=tones[0] if tones else None,
                     resonance=oscs[0] if oscs else None)

@@ -13,7 +13,13 @@ from imunoise import _schema, _summary, _warn
 from imunoise import numbers as _numbers
 from imunoise import units as _units
 from imunoise._deprecation import old_call_forms
-from imunoise.noise._components import Components, PerTerm, Prediction, check_term
+from imunoise.noise._components import (
+    Components,
+    PerTerm,
+    Prediction,
+    check_term,
+    finite_list,
+)
 from imunoise.noise._terms import NAMES, SENSOR_NAMES, TERMS
 
 if TYPE_CHECKING:
@@ -279,16 +285,16 @@ class NoiseModel(PerTerm):
                 row[ax + "_std"] = float(stds[i])
                 row[ax + "_supported"] = bool(sup[i])
             rows.append(row)
-        rate = _units.unit_info("B", _units.unit_choice(units, sensor).get("B"), sensor)
+        rate, rate_label = conv["B"]["unit"], conv["B"]["label"]  # σ and A: in B's unit
 
         def to_rate(v):
-            return _units.convert(v, "B", rate.name, sensor=sensor, input_unit=input_unit)
+            return _units.convert(v, "B", rate, sensor=sensor, input_unit=input_unit)
 
         for term, quantity, unit, values, stds in self.components.other_terms():
             rate_valued = unit is None
             row = {"term": term, "quantity": "component: " + quantity, "missing": "—",
-                   "unit": rate.name if rate_valued else unit,
-                   "label": rate.label if rate_valued else unit}
+                   "unit": rate if rate_valued else unit,
+                   "label": rate_label if rate_valued else unit}
             for i, ax in enumerate(axes):
                 v, e = float(values[i]), float(stds[i])
                 row[ax] = float(to_rate(v)) if rate_valued and np.isfinite(v) else v
@@ -321,19 +327,16 @@ class NoiseModel(PerTerm):
         """Plain-Python view of the model (lists and floats), e.g. for JSON: the
         datasheet values under their names, the fitted components under
         ``"components"``."""
-        def finite(values):
-            return [float(v) if np.isfinite(v) else None for v in np.atleast_1d(values)]
-
         d = {"method": self.method, "kind": self.kind, "fs": self.fs,
              "overlapping": self.overlapping, "channels": self.channels,
              "taus": self.taus.tolist(), "units": dict(_INPUT_UNITS)}
         for term in TERMS:
-            d[term] = {"value": self.value(term).tolist(), "std": finite(self.std(term)),
+            d[term] = {"value": self.value(term).tolist(), "std": finite_list(self.std(term)),
                        "supported": self.resolved(term).tolist()}
         d["components"] = self.components.to_dict()
         d["coverage"] = np.atleast_1d(self.coverage).tolist()
         d["discrepancy"] = np.atleast_1d(self.discrepancy).tolist()
-        d["readoff"] = {term: {k: finite(a) for k, a in parts.items()}
+        d["readoff"] = {term: {k: finite_list(a) for k, a in parts.items()}
                         for term, parts in self.readoff.items()}
         return d
 
