@@ -9,6 +9,9 @@ from __future__ import annotations
 
 import datetime as _dt
 import os
+import resource
+import shutil
+import time
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from functools import cached_property
@@ -16,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-from imunoise import _atomic, _schema, export, noise, plot, stats
+from imunoise import _atomic, _schema, _stream, export, noise, plot, stats
 from imunoise import allan as _allan
 from imunoise._core import __version__
 from imunoise._events import Events, events
@@ -28,7 +31,7 @@ from imunoise.readers.log import ImuLog
 from imunoise.report import folder, sections
 from imunoise.report.document import Doc
 from imunoise.report.formatting import format_duration
-from imunoise.report.inputs import read_log
+from imunoise.report.inputs import read_log, streams
 
 __all__ = ["SECTIONS", "TAUS_PER_DECADE", "TITLE", "Context", "Report", "Section", "build"]
 
@@ -53,6 +56,13 @@ class Context:
     untrimmed: ImuLog | None = None
     #: What ``--trim auto`` cut, in words ("" when nothing was cut).
     trim_note: str = ""
+    #: True when the logs are memory maps read a block or a channel at a time
+    #: (:mod:`imunoise._stream`): the analyses then hold one channel, not the log.
+    streamed: bool = False
+    #: Rows per block of the streamed path.
+    block: int = _stream.BLOCK_ROWS
+    #: (stage, seconds, peak RSS in MiB so far) of each stage, for the appendix.
+    timings: list[tuple[str, float, float]] = field(default_factory=list)
 
     @property
     def logs(self) -> list[tuple[str, ImuLog]]:
@@ -64,6 +74,8 @@ class Context:
     @cached_property
     def description(self) -> stats.Description:
         """Sample statistics of the short log."""
+        if self.streamed:
+            return _stream.describe(self.short, self.block)
         return stats.describe(self.short)
 
     @cached_property
@@ -73,8 +85,9 @@ class Context:
         for sensor in SAMPLE_SENSORS:
             y = getattr(self.short, sensor)
             if y is not None:
-                out[sensor] = {sensor_label(sensor, j, y.shape[1]): stats.distribution(y[:, j])
-                               for j in range(y.shape[1])}
+                out[sensor] = {sensor_label(sensor, j, y.shape[1]): stats.distribution(
+                    _stream.column(y, j, self.block) if self.streamed else y[:, j])
+                    for j in range(y.shape[1])}
         return out
 
     @cached_property
@@ -82,9 +95,17 @@ class Context:
         """``{"yaw": …, "pitch": …, "roll": …}`` (degrees) of the short log, yaw
         unwrapped about its circular mean so that a heading near ±180° stays in
         one piece; None when the log has no attitude."""
-        if self.short.ypr is None or not np.any(np.isfinite(self.short.ypr)):
+        ypr = self.short.ypr
+        if ypr is None:
             return None
-        return stats.attitude_angles(self.short.ypr)
+        if not self.streamed:
+            return stats.attitude_angles(ypr) if np.any(np.isfinite(ypr)) else None
+        if not any(np.isfinite(rows).any() for _a, rows in _stream.blocks(ypr, self.block)):
+            return None
+        angles = {name: _stream.column(ypr, j, self.block)
+                  for j, name in enumerate(_schema.ATTITUDE_NAMES)}
+        angles["yaw"] = stats.unwrap_about_circular_mean(angles["yaw"])
+        return angles
 
     @cached_property
     def attitude_distributions(self) -> dict[str, stats.Distribution]:
@@ -151,6 +172,14 @@ class Context:
         fit = thermal(log)
         lo, hi = fit.temperature_range
         return fit if hi - lo >= sections.THERMAL_MIN_RANGE else None
+
+    def stage(self, name: str, start: float) -> None:
+        """Record a stage that began at ``start`` (``time.perf_counter()``); on the
+        streamed path, give the memory maps' pages back after it."""
+        if self.streamed:
+            for log in (self.short, self.long, self.untrimmed):
+                _stream.release_log(log)
+        self.timings.append((name, time.perf_counter() - start, _peak_mib()))
 
     def add_figure(self, doc: Doc, fig, name: str, caption: str) -> None:
         """Save ``fig`` as ``figures/<name>.png`` and ``.svg`` and show it in ``doc``."""
@@ -248,6 +277,7 @@ def build(
     read_options: Mapping[str, object] | None = None,
     trim: str | None = None,
     force: bool = False,
+    stream: bool | None = None,
 ) -> Report:
     """Analyse the logs and write the report directory.
 
@@ -280,21 +310,62 @@ def build(
     force : bool
         Write into an existing folder that is not a report (default False: refused
         with a ``ValueError``).
+    stream : bool or None
+        Bounded memory for logs larger than memory (:mod:`imunoise._stream`): each
+        log file is parsed once into memory maps (a temporary folder beside
+        ``out_dir``, removed at the end) and every analysis reads them a block or a
+        channel at a time. None (default): for VN logs larger than
+        ``imunoise._stream.STREAM_BYTES`` (256 MiB). The numbers are those of the
+        in-memory path (to rounding; the report's digits agree).
     """
     if trim not in (None, "auto"):
         raise ValueError(f"trim must be None or 'auto'; got {trim!r}")
+    if stream not in (None, True, False):
+        raise ValueError(f"stream must be None, True or False; got {stream!r}")
     out = Path(out_dir)
     inputs = [p for p in (short, long) if isinstance(p, str | os.PathLike)]
     previous = folder.claim(out, force=force, inputs=inputs)
     options = dict(read_options or {})
-    short_log = read_log(short, "short", fs=fs, progress=wanted(progress), **options)
-    long_log = short_log if long is None else read_log(long, "long", fs=fs,
-                                                       progress=wanted(progress), **options)
+    streamed = stream if stream is not None else any(
+        streams(p, options) for p in (short, long) if p is not None)
+    workdirs: list[Path] = []
+    try:
+        return _build(short, long, out, previous, inputs, options, workdirs, spec=spec,
+                      fs=fs, progress=progress, trim=trim, streamed=streamed)
+    finally:
+        for w in workdirs:
+            shutil.rmtree(w, ignore_errors=True)
+
+
+def _build(short, long, out: Path, previous, inputs, options, workdirs: list[Path], *,
+           spec, fs, progress, trim, streamed: bool) -> Report:
+    """:func:`build` once the folder is claimed; ``workdirs`` collects the folders of
+    the streamed path's memory maps (the caller removes them)."""
+    timings: list[tuple[str, float, float]] = []
+
+    def read(source, label: str) -> ImuLog:
+        start = time.perf_counter()
+        workdir = None
+        if streamed and isinstance(source, str | os.PathLike) and streams(source, options,
+                                                                          forced=True):
+            workdir = _stream.workdir_for(out)
+            workdirs.append(workdir)
+        log = read_log(source, label, fs=fs, progress=wanted(progress), workdir=workdir,
+                       **options)
+        timings.append((f"reading the {label} log" + (" into memory maps" if workdir else ""),
+                        time.perf_counter() - start, _peak_mib()))
+        return log
+
+    short_log = read(short, "short")
+    long_log = short_log if long is None else read(long, "long")
     folder.mark(out, previous)
     (out / "figures").mkdir(parents=True, exist_ok=True)
-    ctx = Context(short=short_log, long=long_log, one_log=long is None, spec=spec, out_dir=out)
+    ctx = Context(short=short_log, long=long_log, one_log=long is None, spec=spec, out_dir=out,
+                  streamed=streamed, block=_stream.BLOCK_ROWS, timings=timings)
     if trim == "auto":
+        start = time.perf_counter()
         _trim_warmup(ctx)
+        ctx.stage("warm-up of the long log (--trim auto)", start)
     doc = Doc()
     doc.h(1, TITLE)
     stamp = _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
@@ -302,14 +373,21 @@ def build(
     if ctx.trim_note:
         doc.p(f"**Trim**: {ctx.trim_note}")
     # the sections that apply, known before the bar starts: its total never changes
+    start = time.perf_counter()
     present = [s for s in SECTIONS if s.applies(ctx)]
+    ctx.stage("finding the sections that apply (events, warm-up, temperature)", start)
     with Progress(progress, total=len(present) + 1) as bar:
         for number, section in enumerate(present, start=1):
             bar.step(section.title)
+            start = time.perf_counter()
             doc.h(2, f"{number}. {section.title}")
             section.write(ctx, doc)
+            ctx.stage(section.title, start)
         bar.step("writing")
+        start = time.perf_counter()
         model_files = _write_model_files(ctx.models, out, long_log.fs)
+        ctx.stage("writing the model files", start)
+        _timings_appendix(doc, ctx)
         md_path, html_path = out / "report.md", out / "report.html"
         _atomic.write_text(md_path, doc.markdown(out))
         _atomic.write_text(html_path, doc.html(TITLE))
@@ -328,6 +406,25 @@ def build(
         logs=tuple(log for _label, log in ctx.logs),
         attitude=ctx.attitude_distributions,
     )
+
+
+def _peak_mib() -> float:
+    """Peak resident memory of this process so far, MiB (ru_maxrss: KiB on Linux)."""
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+
+
+def _timings_appendix(doc: Doc, ctx: Context) -> None:
+    """The appendix: how long each stage took and the peak memory after it."""
+    doc.h(2, "Appendix: stage timings")
+    doc.p(("Streamed: the logs were parsed once into memory maps and analysed a block or "
+           "a channel at a time" if ctx.streamed else "In memory: the logs were read whole")
+          + "; an analysis is timed in the first stage that uses it. Peak memory is the "
+          "process's largest resident set so far (memory-mapped pages included).")
+    doc.table(["stage", "time [s]", "peak memory [MiB]"],
+              [[name, f"{sec:.2f}", f"{peak:.0f}"] for name, sec, peak in ctx.timings]
+              + [["total", f"{sum(sec for _n, sec, _p in ctx.timings):.2f}",
+                  f"{_peak_mib():.0f}"]],
+              caption="Wall time and peak resident memory per stage")
 
 
 def _trim_warmup(ctx: Context) -> None:

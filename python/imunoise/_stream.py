@@ -1,0 +1,231 @@
+"""Bounded memory for logs larger than memory: parse once into memory maps, then
+read them a block or a column at a time and give the mapped pages back.
+
+The report's streamed path (``imunoise report --stream``, automatic for VN logs
+above :data:`STREAM_BYTES`) parses the log once with :func:`imunoise.scale.convert`
+into a folder of ``.npy`` files (memory bounded by its pieces) and opens them as
+memory maps (:func:`open_mapped`). A memory map costs no anonymous memory, but every
+page it has touched counts in the process's resident set until the kernel needs it
+back; :func:`release` hands them back (``madvise(MADV_DONTNEED)``: the pages stay in
+the page cache, a later read maps them again), and :func:`column` and :func:`blocks`
+read a channel a block at a time and release behind them. The statistics of the
+whole log that need no more than running sums (:func:`describe`) come from one
+pass over the blocks; the others take one channel (a column) at a time.
+"""
+
+from __future__ import annotations
+
+import mmap
+import os
+from collections.abc import Iterator
+from pathlib import Path
+
+import numpy as np
+
+from imunoise import _schema
+from imunoise.readers.log import ImuLog
+
+__all__ = ["BLOCK_ROWS", "PARSE_BYTES", "STREAM_BYTES", "blocks", "column", "describe",
+           "is_mapped", "open_mapped", "release", "release_log", "workdir_for"]
+
+#: VN logs larger than this are streamed by default (parsed once into memory maps).
+STREAM_BYTES = 256 << 20
+#: Rows read at once from a memory map.
+BLOCK_ROWS = 1 << 20
+#: Bytes :func:`open_mapped` parses at a time (None: ``imunoise.scale.convert``'s default).
+PARSE_BYTES: int | None = None
+
+
+def open_mapped(source, workdir: Path, *, fs: float | None = None,
+                chunk_bytes: int | None = None, progress=None) -> ImuLog:
+    """Parse ``source`` once into ``workdir`` (``.npy`` per channel) and open it as
+    an :class:`ImuLog` of read-only memory maps; the same arrays, rate, gaps and
+    issues as :func:`imunoise.read` (:func:`imunoise.scale.convert`'s contract)."""
+    from imunoise.scale import convert, load
+    from imunoise.scale.convert import CHUNK_BYTES
+
+    convert(source, workdir, fs=fs, chunk_bytes=chunk_bytes or PARSE_BYTES or CHUNK_BYTES,
+            progress=progress)
+    return load(workdir)  # named by its source, as convert records it
+
+
+def _mapping(arr) -> mmap.mmap | None:
+    """The memory map under ``arr`` (a memmap or a view of one), or None."""
+    while arr is not None:
+        m = getattr(arr, "_mmap", None)
+        if isinstance(m, mmap.mmap):
+            return m
+        if isinstance(arr, mmap.mmap):
+            return arr
+        arr = getattr(arr, "base", None)
+    return None
+
+
+def is_mapped(arr) -> bool:
+    """True when ``arr`` reads a memory-mapped file."""
+    return _mapping(arr) is not None
+
+
+def release(*arrays) -> None:
+    """Give the resident pages of the memory maps under ``arrays`` back to the kernel
+    (no-op for in-memory arrays and where ``madvise`` is not available)."""
+    for arr in arrays:
+        m = _mapping(arr)
+        if m is not None and hasattr(m, "madvise") and not m.closed:
+            try:
+                m.madvise(mmap.MADV_DONTNEED)
+            except (OSError, ValueError):  # pragma: no cover - not on this platform
+                pass
+
+
+def release_log(log: ImuLog | None) -> None:
+    """:func:`release` every channel of ``log``."""
+    if log is not None:
+        release(*(getattr(log, ch) for ch in (*log.channels, "time")
+                  if getattr(log, ch, None) is not None))
+
+
+def blocks(arr: np.ndarray, block: int = BLOCK_ROWS) -> Iterator[tuple[int, np.ndarray]]:
+    """``(start, rows)`` of ``arr`` ``block`` rows at a time, as float64 copies,
+    releasing a memory map's pages behind each block."""
+    mapped = is_mapped(arr)
+    for a in range(0, len(arr), block):
+        rows = np.array(arr[a:a + block], dtype=np.float64)
+        if mapped:
+            release(arr)
+        yield a, rows
+
+
+def column(arr: np.ndarray, j: int | None = None, block: int = BLOCK_ROWS) -> np.ndarray:
+    """Column ``j`` of ``arr`` (the whole of a 1-D ``arr``) as a contiguous float64
+    array in memory, read ``block`` rows at a time (a memory map's pages released
+    behind each block): one channel in memory, never the whole sensor's map."""
+    if not is_mapped(arr):
+        v = arr if j is None else arr[:, j]
+        return np.ascontiguousarray(v, dtype=np.float64)
+    out = np.empty(len(arr), dtype=np.float64)
+    for a, rows in blocks(arr, block):
+        out[a:a + len(rows)] = rows if j is None else rows[:, j]
+    return out
+
+
+class _Moments:
+    """Per column of one sensor: count, sums, extremes and missing samples (first
+    pass), then the centred sums of squares and of the cross product with time
+    (second pass)."""
+
+    def __init__(self, k: int) -> None:
+        self.n = np.zeros(k, dtype=np.int64)
+        self.sx, self.st = np.zeros(k), np.zeros(k)
+        self.lo, self.hi = np.full(k, np.inf), np.full(k, -np.inf)
+        self.sxx, self.stt, self.stx = np.zeros(k), np.zeros(k), np.zeros(k)
+
+    def first(self, v: np.ndarray, t: np.ndarray) -> None:
+        ok = ~np.isnan(v)
+        if ok.all():
+            self.n += len(v)
+            self.sx += v.sum(axis=0)
+            self.st += t.sum()
+            self.lo = np.minimum(self.lo, v.min(axis=0))
+            self.hi = np.maximum(self.hi, v.max(axis=0))
+            return
+        for j in range(v.shape[1]):
+            w = v[ok[:, j], j]
+            if w.size:
+                self.n[j] += w.size
+                self.sx[j] += w.sum()
+                self.st[j] += t[ok[:, j]].sum()
+                self.lo[j], self.hi[j] = min(self.lo[j], w.min()), max(self.hi[j], w.max())
+
+    def second(self, v: np.ndarray, t: np.ndarray) -> None:
+        with np.errstate(invalid="ignore"):
+            mean, tmean = self.sx / self.n, self.st / self.n
+        d = v - mean
+        tc = t[:, None] - tmean
+        ok = ~np.isnan(d)
+        if not ok.all():
+            d = np.where(ok, d, 0.0)
+            tc = np.where(ok, tc, 0.0)
+        self.sxx += np.einsum("ij,ij->j", d, d)
+        self.stt += np.einsum("ij,ij->j", tc, tc)
+        self.stx += np.einsum("ij,ij->j", tc, d)
+
+
+def _yaw_centre(ypr: np.ndarray, block: int) -> float | None:
+    """Circular mean of the yaw column (degrees), None when it has no finite value."""
+    s = c = 0.0
+    count = 0
+    for _a, rows in blocks(ypr, block):
+        r = rows[:, 0]
+        r = np.radians(r[np.isfinite(r)])
+        s += float(np.sum(np.sin(r)))
+        c += float(np.sum(np.cos(r)))
+        count += r.size
+    return float(np.degrees(np.arctan2(s / count, c / count))) if count else None
+
+
+def describe(log: ImuLog, block: int = BLOCK_ROWS):
+    """:func:`imunoise.describe` of a log in two passes over blocks of ``block``
+    rows: memory of one block whatever the log's length. The same statistics to
+    rounding (sums of blocks instead of numpy's pairwise sums over the whole
+    channel: 1e-13 relative, the report's six digits agree)."""
+    from imunoise import stats
+
+    if len(log) < 2:
+        return stats.describe(log)  # its error for a log too short
+    fs = float(log.fs)
+    names, sensors, units, parts = [], [], [], []
+    for sensor in _schema.STATISTICS_CHANNELS:
+        arr = getattr(log, sensor)
+        if arr is None:
+            continue
+        centre = None
+        if sensor == "ypr":
+            centre = _yaw_centre(arr, block)
+            if centre is None:  # as describe: a ypr channel with no finite value is left out
+                continue
+            labels = list(_schema.ATTITUDE_NAMES)
+        else:
+            k = 1 if arr.ndim == 1 else arr.shape[1]
+            labels = [_schema.sensor_label(sensor, j, k) for j in range(k)]
+        names += labels
+        sensors += [sensor] * len(labels)
+        units += [_schema.CHANNELS[sensor][1]] * len(labels)
+        parts.append((arr, centre, _Moments(len(labels))))
+    if not parts:
+        return stats.describe(log)  # its error for a log without these channels
+    for pass_ in (1, 2):
+        for arr, centre, mo in parts:
+            for a, rows in blocks(arr, block):
+                rows = rows.reshape(len(rows), -1)
+                if centre is not None:  # yaw about its circular mean, as attitude_angles
+                    rows[:, 0] = centre + (rows[:, 0] - centre + 180.0) % 360.0 - 180.0
+                t = np.arange(a, a + len(rows), dtype=np.float64) / fs
+                if pass_ == 1:
+                    mo.first(rows, t)
+                else:
+                    mo.second(rows, t)
+    n_valid = np.concatenate([mo.n for _a, _c, mo in parts])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        mean = np.concatenate([mo.sx for _a, _c, mo in parts]) / n_valid
+        var = np.where(n_valid > 1, np.concatenate([mo.sxx for _a, _c, mo in parts])
+                       / (n_valid - 1), np.nan)
+        drift = np.where(n_valid > 1, np.concatenate([mo.stx / mo.stt for _a, _c, mo in parts])
+                         * 3600.0, np.nan)
+    lo = np.where(n_valid > 0, np.concatenate([mo.lo for _a, _c, mo in parts]), np.nan)
+    hi = np.where(n_valid > 0, np.concatenate([mo.hi for _a, _c, mo in parts]), np.nan)
+    if "yaw" in names:
+        mean[names.index("yaw")] = stats.heading(mean[names.index("yaw")])
+    return stats.Description(
+        names=tuple(names), sensors=tuple(sensors), units=tuple(units), n=len(log), fs=fs,
+        mean=mean, std=np.sqrt(var), var=var, min=lo, max=hi, drift_per_hour=drift,
+        missing=(len(log) - n_valid).astype(np.int64))
+
+
+def workdir_for(out_dir: Path) -> Path:
+    """A fresh folder beside ``out_dir`` for the parsed log (removed after the report)."""
+    import tempfile
+
+    parent = Path(os.path.abspath(out_dir)).parent
+    parent.mkdir(parents=True, exist_ok=True)
+    return Path(tempfile.mkdtemp(prefix=".imunoise-stream-", dir=parent))
