@@ -10,23 +10,65 @@ from imunoise._validate import sample_rate
 from imunoise.readers.log import ImuLog
 
 
+class Columns:
+    """The rate channels of a log one column at a time: ``len(cols)`` channels of
+    ``cols.n`` samples, ``cols[j]`` a contiguous float64 copy of channel ``j`` (read a
+    block at a time from a memory-mapped log, so one channel is in memory, never the
+    whole log: :mod:`imunoise._stream`)."""
+
+    def __init__(self, parts: list[tuple[np.ndarray, int | None]], n: int) -> None:
+        self._parts = parts
+        self.n = n
+
+    def __len__(self) -> int:
+        return len(self._parts)
+
+    def __getitem__(self, j: int) -> np.ndarray:
+        from imunoise import _stream
+
+        arr, col = self._parts[j]
+        return _stream.column(arr, col)
+
+
+def rate_columns(data, fs, channels) -> tuple[Columns, float, tuple[str, ...]]:
+    """:func:`rate_channels` a column at a time: the same checks, names and rate, the
+    samples as :class:`Columns` (nothing copied until a column is asked for)."""
+    if isinstance(data, ImuLog):
+        wanted = _wanted(data, channels)
+        parts, names = [], []
+        for c in wanted:
+            arr = getattr(data, c)
+            k = 1 if arr.ndim == 1 else arr.shape[1]
+            parts += [(arr, None if arr.ndim == 1 else j) for j in range(k)]
+            names += [_schema.sensor_label(c, j, k) for j in range(k)]
+        return Columns(parts, len(data)), sample_rate(data.fs if fs is None else fs), \
+            tuple(names)
+    x, fs, names = rate_channels(data, fs, channels)
+    return Columns([(x, j) for j in range(x.shape[1])], len(x)), fs, names
+
+
+def _wanted(data: ImuLog, channels) -> list[str]:
+    """The log channels asked for (default: gyro and accel, those the log has)."""
+    wanted = [c for c in _schema.ALLAN_SENSORS if getattr(data, c) is not None]
+    if channels is not None:
+        wanted = [channels] if isinstance(channels, str) else list(channels)
+        missing = [c for c in wanted if c not in data.channels]
+        if missing:
+            raise ValueError(
+                f"channels {missing} are not in the log; it has {list(data.channels)}"
+            )
+    if not wanted:
+        raise ValueError(f"data has no gyro or accel channel; got {list(data.channels)}")
+    return wanted
+
+
 def rate_channels(data, fs, channels) -> tuple[np.ndarray, float, tuple[str, ...]]:
     """(n, k) float samples, the rate and the channel names (``"gyro X"`` …) of a log's
     ``channels`` (default: its gyro and accel) or of an array (``fs`` required)."""
     if isinstance(data, ImuLog):
         fs = data.fs if fs is None else fs
-        wanted = [c for c in _schema.ALLAN_SENSORS if getattr(data, c) is not None]
-        if channels is not None:
-            wanted = [channels] if isinstance(channels, str) else list(channels)
-            missing = [c for c in wanted if c not in data.channels]
-            if missing:
-                raise ValueError(
-                    f"channels {missing} are not in the log; it has {list(data.channels)}"
-                )
-        if not wanted:
-            raise ValueError(f"data has no gyro or accel channel; got {list(data.channels)}")
         blocks, names = [], []
-        for c in wanted:
+        for c in _wanted(data, channels):
             arr = np.asarray(getattr(data, c), dtype=np.float64)
             arr = arr.reshape(len(arr), -1)
             blocks.append(arr)

@@ -60,7 +60,7 @@ from scipy import signal as _signal
 from scipy import stats as _sstats
 
 from imunoise import _summary
-from imunoise._channels import rate_channels
+from imunoise._channels import rate_columns
 from imunoise._runs import true_runs
 from imunoise._validate import positive_finite
 from imunoise.readers.log import ImuLog
@@ -324,7 +324,7 @@ def events(
     whole channel: a log whose noise level changes (a sensor switched to a
     different filter) needs to be split first.
     """
-    x, fs, names = rate_channels(data, fs, channels)
+    cols, fs, names = rate_columns(data, fs, channels)
     if isinstance(false_alarm, bool) or not (0 < float(false_alarm) < 0.01):
         raise ValueError(f"false_alarm must be in (0, 0.01) per sample; got {false_alarm!r}")
     false_alarm = float(false_alarm)
@@ -332,7 +332,7 @@ def events(
     baseline = positive_finite(baseline, "baseline", unit="s")
     if isinstance(merge, bool) or not (np.isfinite(merge) and merge >= 0):
         raise ValueError(f"merge must be >= 0 and finite (s); got {merge!r}")
-    n = x.shape[0]
+    n = cols.n
     w = max(MIN_WINDOW, int(round(window * fs)))
     if n < 2 * w:
         raise ValueError(f"data needs at least 2·window = {2 * w} samples; got {n}")
@@ -347,9 +347,9 @@ def events(
     gap = int(round(merge * fs))
 
     per_channel = []
-    sigma = np.empty(x.shape[1])
-    for j in range(x.shape[1]):
-        r, mad_sigma = _standardise(x[:, j], block)
+    sigma = np.empty(len(cols))
+    for j in range(len(cols)):
+        r, mad_sigma = _standardise(cols[j], block)
         # first pass with the noise law of the whole channel, then once more with
         # the law of its quiet part: a record with vibration of its own (the VN-100
         # live capture, 20 % of it) otherwise sets thresholds for quiet noise from
@@ -379,9 +379,13 @@ def events(
         # found by itself is then inside the vibration it was joined to
         inner = _inner_bursts(z, [(a, b, kind) for a, b, kind, _c in joined], windows, p_v,
                               k_spike, isolated)
-        per_channel.append((joined, z, [(a, b, kind, {j}) for a, b, kind in inner]))
+        # z again when the events' peaks are read (_merge_channels), not kept: one
+        # channel's samples in memory at a time
+        per_channel.append((joined, (j, scale), [(a, b, kind, {j}) for a, b, kind in inner]))
+        del r, z, quiet, isolated
     return _merge_channels(
-        per_channel, names, fs, n, gap, touch, sigma,
+        per_channel, names, fs, n, gap, touch, sigma, lambda j, scale: _standardise(
+            cols[j], block)[0] / np.sqrt(scale),
         k_spike=k_spike,
         energy=float(_sstats.chi2.isf(p_window, w)) / w,
         window=w,
@@ -734,16 +738,23 @@ def _join_kind(spans: list[tuple], gap: int) -> list[list]:
     return out
 
 
-def _merge_channels(per_channel, names, fs, n, gap, touch, sigma, **thresholds) -> Events:
-    """One event per overlapping group of the channels' events."""
+def _merge_channels(per_channel, names, fs, n, gap, touch, sigma, standardised,
+                    **thresholds) -> Events:
+    """One event per overlapping group of the channels' events; a group's peak is the
+    largest |z| of its channels in it (``standardised(*key)``: a channel's z, from the
+    key each entry of ``per_channel`` holds)."""
     groups = _join([span for spans, _z, _in in per_channel for span in spans], gap, touch)
     nested = _join_kind(sorted((span for _s, _z, inner in per_channel for span in inner),
                                key=lambda span: span[:3]), gap)
     groups = sorted(groups + nested, key=lambda g: (g[0], g[1]))
-    peaks = [
-        max(_peak(per_channel[j][1][a:b]) for j in chans)
-        for a, b, _k, chans in groups
-    ]
+    per_group: list[dict[int, float]] = [{} for _g in groups]
+    for j in sorted({j for g in groups for j in g[3]}):
+        z = standardised(*per_channel[j][1])
+        for i, (a, b, _k, chans) in enumerate(groups):
+            if j in chans:
+                per_group[i][j] = _peak(z[a:b])
+        del z
+    peaks = [max(found[j] for j in g[3]) for g, found in zip(groups, per_group, strict=True)]
     return Events(
         fs=fs,
         n_samples=n,

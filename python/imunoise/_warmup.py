@@ -284,10 +284,9 @@ def warmup(
     temp = _temperature(data, temperature, n)
     fits = [_fit_exponential(t, bias[:, j], duration) for j in range(k)]
     final, amp, tau, amp_sd, tau_sd = (np.array(v) for v in zip(*fits, strict=True))
-    transient = _transient(amp, tau, n, fs)
     p = _null_p_values(x, fs, t, bias, duration, seed)
     significant = (p < alpha) & (tau < duration / 2)
-    tol = _tolerance(tolerance, x - transient, fs)
+    tol = _tolerance(tolerance, x, amp, tau, fs)
     ts, ts_sd = _settle_times(amp, tau, amp_sd, tau_sd, tol, significant)
     ts = np.minimum(ts, duration)
     t_fit = (np.nan, np.nan, np.nan)
@@ -441,6 +440,12 @@ def _transient(amp, tau, n, fs) -> np.ndarray:
     return np.where(finite, amp * np.exp(-t[:, None] / np.where(finite, tau, 1.0)), 0.0)
 
 
+def _residual(x, amp, tau, fs, j: int) -> np.ndarray:
+    """Channel ``j`` of ``x`` without its fitted transient (:func:`_transient`), one
+    channel in memory at a time."""
+    return x[:, j] - _transient(amp[j:j + 1], tau[j:j + 1], len(x), fs)[:, 0]
+
+
 def _fit_exponential(t, y, duration):
     """(final, A, τ, u(A), u(τ)) of c + A e^{-t/τ} fitted to y (NaN blocks left out)."""
     ok = np.isfinite(y)
@@ -473,19 +478,22 @@ def _fit_exponential(t, y, duration):
     return float(c), float(a), float(tau), float(sd[1]), float(sd[2])
 
 
-def _tolerance(tolerance, residual, fs) -> np.ndarray:
+def _tolerance(tolerance, x, amp, tau, fs) -> np.ndarray:
     """The given tolerance per channel, or the Allan-deviation floor of the samples
-    without their transient."""
-    k = residual.shape[1]
+    ``x`` without their transient (channel by channel: the Allan statistics of one
+    channel do not depend on the others)."""
+    k = x.shape[1]
     if tolerance is not None:
         tol = np.broadcast_to(np.asarray(tolerance, dtype=float), (k,)).copy()
         if not np.all(np.isfinite(tol) & (tol > 0)):
             raise ValueError(f"tolerance must be positive and finite; got {tolerance!r}")
         return tol
-    r = adev(residual, fs)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", RuntimeWarning)
-        floor = np.nanmin(np.asarray(r.dev).reshape(len(r.taus), -1), axis=0)
+    floor = np.empty(k)
+    for j in range(k):
+        r = adev(_residual(x, amp, tau, fs, j), fs)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)
+            floor[j] = np.nanmin(r.dev)
     # a constant channel has no floor: nothing in it ever needs to settle
     return np.where(np.isfinite(floor) & (floor > 0), floor, np.inf)
 
