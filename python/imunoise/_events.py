@@ -472,29 +472,45 @@ def _bursts(z: np.ndarray, w: int, p_window: float, dof: float, k_spike: float,
     prediction errors end before the shaking does."""
     n = len(z)
     valid = np.isfinite(z)
-    clipped = np.clip(z, -k_spike, k_spike)
-    z2 = np.where(valid, clipped * clipped, 0.0)
-    onset = np.where(valid & ~isolated, z2, np.nan)
-    tail = None if raw is None else np.where(
-        np.isfinite(raw) & ~isolated, np.clip(raw, -k_spike, k_spike) ** 2, np.nan)
-    csum = np.concatenate(([0.0], np.cumsum(z2)))
-    count = np.concatenate(([0], np.cumsum(valid)))
+    complete = bool(valid.all())
+    z2 = np.clip(z, -k_spike, k_spike)
+    z2 *= z2
+    if not complete:
+        z2[~valid] = 0.0
+    csum = np.empty(n + 1)
+    csum[0] = 0.0
+    np.cumsum(z2, out=csum[1:])
     energy = csum[w:] - csum[:-w]  # window j covers samples j .. j+w-1
-    used = count[w:] - count[:-w]
+    del csum
     # a window of m valid samples: energy·ν_m/m ~ χ²(ν_m), ν_m = ν·m/w
-    counts = [w] if valid.all() else np.unique(used).tolist()
-    limits = {m: _sstats.chi2.isf(p_window, dof * m / w) * w / dof for m in counts if m > 0}
-    limit = np.array([limits.get(m, np.inf) for m in used.tolist()]) if len(limits) > 1 \
-        else np.full(len(used), next(iter(limits.values()), np.inf))
-    hot = energy > limit
+    if complete:
+        hot = energy > _sstats.chi2.isf(p_window, dof * w / w) * w / dof  # m = w below
+    else:
+        count = np.concatenate(([0], np.cumsum(valid)))
+        used = count[w:] - count[:-w]
+        counts = np.unique(used).tolist()
+        limits = {m: _sstats.chi2.isf(p_window, dof * m / w) * w / dof for m in counts
+                  if m > 0}
+        limit = np.array([limits.get(m, np.inf) for m in used.tolist()]) if len(limits) > 1 \
+            else np.full(len(used), next(iter(limits.values()), np.inf))
+        hot = energy > limit
+    del energy
+
+    def onset(lo: int, hi: int) -> np.ndarray:
+        return np.where(valid[lo:hi] & ~isolated[lo:hi], z2[lo:hi], np.nan)
+
+    def tail(lo: int, hi: int) -> np.ndarray:
+        return np.where(np.isfinite(raw[lo:hi]) & ~isolated[lo:hi],
+                        np.clip(raw[lo:hi], -k_spike, k_spike) ** 2, np.nan)
+
     out = []
     # windows a .. b-1 flagged: samples a .. b+w-2 involved
     for a, b in zip(*true_runs(hot), strict=True):
         lo, hi = max(0, a - w // 2), min(n, b - 1 + w + w // 2)
-        start, end = _change_points(onset[lo:hi], tail_dof)
-        if tail is not None and end > start:
+        start, end = _change_points(onset(lo, hi), tail_dof)
+        if raw is not None and end > start:
             stop = min(n, hi + w)
-            raw_start, raw_end = _change_points(tail[lo + start:stop], tail_dof)
+            raw_start, raw_end = _change_points(tail(lo + start, stop), tail_dof)
             if raw_end > raw_start and raw_start <= w:
                 end = max(end, start + raw_end)
         if end > start:
