@@ -79,6 +79,7 @@ def _build_parser() -> argparse.ArgumentParser:
     r.add_argument("--trim", choices=["auto"], default=None,
                    help="'auto': analyse the long log from the end of its warm-up transient "
                    "(the report states what was cut)")
+    _stream_options(r)
 
     a = sub.add_parser("adev", help="print an Allan-family deviation table",
                        description="Print tau, deviation, confidence interval and number of "
@@ -213,6 +214,17 @@ def _build_parser() -> argparse.ArgumentParser:
     return p
 
 
+def _stream_options(p) -> None:
+    """``--stream`` / ``--no-stream`` of ``report``: bounded memory for large logs."""
+    g = p.add_mutually_exclusive_group()
+    g.add_argument("--stream", dest="stream", action="store_true", default=None,
+                   help="parse each log once into memory maps (a temporary folder beside "
+                   "the output) and analyse them a block or a channel at a time: bounded "
+                   "memory for logs larger than RAM (default: VN logs above 256 MiB)")
+    g.add_argument("--no-stream", dest="stream", action="store_false",
+                   help="read the logs whole into memory")
+
+
 def _shared_options(p, *, spec: bool = False, fs: bool = False, progress: bool = False,
                     layout: bool = False) -> None:
     """Add the options several commands share, each worded once."""
@@ -321,7 +333,7 @@ def _cmd_report(args) -> int:
     spec = None if args.spec.lower() == "none" else args.spec
     rep = report.build(args.short_log, args.long_log, args.output, spec=spec, fs=args.fs,
                        progress=args.progress, read_options=_read_options(args), trim=args.trim,
-                       force=args.force)
+                       force=args.force, stream=args.stream)
     for log in rep.logs:
         _note_gaps(log.source, log)
     print(f"report written to {rep.html}")

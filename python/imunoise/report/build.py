@@ -352,6 +352,8 @@ def _build(short, long, out: Path, previous, inputs, options, workdirs: list[Pat
             workdirs.append(workdir)
         log = read_log(source, label, fs=fs, progress=wanted(progress), workdir=workdir,
                        **options)
+        if streamed:
+            _stream.release_log(log)  # the reader's checks touched every page
         timings.append((f"reading the {label} log" + (" into memory maps" if workdir else ""),
                         time.perf_counter() - start, _peak_mib()))
         return log

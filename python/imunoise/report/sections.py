@@ -401,20 +401,20 @@ def events_section(ctx: Context, doc: Doc) -> None:
         caption=f"Events of the short log ({min(len(found), EVENT_ROWS)} largest of "
                 f"{len(found)})",
     )
-    cut = found.exclude(log)
     rows = []
     for sensor in ("gyro", "accel"):
-        y, z = getattr(log, sensor), getattr(cut, sensor)
+        y = getattr(log, sensor)
         if y is None:
             continue
+        z = found.exclude(y)  # one sensor copied at a time, not the whole log
         fig = plot.events(y, found, log.fs, title=f"{sensor} with events (short log)",
                           unit=CHANNELS[sensor][1])
         ctx.add_figure(doc, fig, f"events_{sensor}",
                        f"{sensor} of the short log, events shaded, peak in sigmas above")
         kept = []
         for j, axis in enumerate(axis_names(y.shape[1])):
-            with_, without = stats.distribution(y[:, j]), stats.distribution(
-                z[:, j][np.isfinite(z[:, j])])
+            with_ = list(ctx.sensor_distributions[sensor].values())[j]  # the same samples
+            without = stats.distribution(z[:, j][np.isfinite(z[:, j])])
             kept.append(without)
             rows.append([f"{sensor} {axis}", *(numbers.cell(v) for v in (
                 np.nanstd(y[:, j], ddof=1), np.nanstd(z[:, j], ddof=1), with_.excess_kurtosis,
@@ -451,7 +451,6 @@ def long_log_events(ctx: Context, doc: Doc) -> None:
     without them (as missing samples) at a few taus; which result the noise model
     used."""
     found, log = ctx.long_events, ctx.long
-    cut = found.exclude(log, pad=EVENT_PAD)
     kinds = (f"{found.kind.count('burst')} bursts, {found.kind.count('spike')} spikes")
     doc.p(f"The {'only' if ctx.one_log else 'long'} log holds {len(found)} "
           f"event{'' if len(found) == 1 else 's'} ({kinds}, "
@@ -465,7 +464,8 @@ def long_log_events(ctx: Context, doc: Doc) -> None:
         if not taus.size:
             continue
         both = _allan.adev(getattr(log, sensor), log.fs, taus=taus)
-        without = _allan.adev(getattr(cut, sensor), log.fs, taus=both.taus)
+        without = _allan.adev(found.exclude(getattr(log, sensor), pad=EVENT_PAD), log.fs,
+                              taus=both.taus)
         # the taus both have (the grid's own, whole samples; gaps may cost the longest)
         taus, a, b = np.intersect1d(both.taus, without.taus, return_indices=True)
         dev, lo, hi = (np.reshape(v, (len(both.taus), -1))[a] for v in (
