@@ -1,7 +1,8 @@
 """``imunoise report`` on a long 800 Hz VN-100 binary log: the in-memory path against
 the streamed one (#25: memory maps, a block or a channel at a time), in one run.
 
-Simulates the log with ``imunoise simulate --format vn-binary`` (or takes ``--log``),
+Simulates the log with ``imunoise simulate --format vn-binary`` (piece by piece
+beyond its 10⁷ samples, 3.47 h at 800 Hz) or takes ``--log``,
 then runs ``imunoise report LOG --no-stream`` and ``--stream`` in child processes and
 prints each one's wall time, CPU time and peak RSS (``os.wait4``: that child's own
 ``ru_maxrss``, memory-mapped pages included), the load average around the runs, and
@@ -25,6 +26,27 @@ import time
 from pathlib import Path
 
 CLI = [sys.executable, "-m", "imunoise.cli"]
+#: Hours per piece when the log is longer than ``imunoise simulate`` makes at once
+#: (10⁷ samples: 3.47 h at 800 Hz).
+PIECE_HOURS = 1.0
+
+
+def write_long_log(path: Path, hours: float, fs: float) -> None:
+    """A still VN-100 binary log of any length, simulated piece by piece (each piece
+    its own noise realisation; TimeStartup runs on across the pieces)."""
+    import numpy as np
+    from imunoise._simulate_log import still_log
+    from imunoise.writers.vn import write_vn_binary
+
+    done = 0
+    with open(path, "wb") as f:
+        for i in range(int(np.ceil(hours / PIECE_HOURS))):
+            log = still_log(min(PIECE_HOURS, hours - i * PIECE_HOURS), fs, seed=i)
+            n = len(log)
+            f.write(write_vn_binary({
+                "gyro": log.gyro, "accel": log.accel, "mag": np.ascontiguousarray(log.mag),
+                "ypr": np.ascontiguousarray(log.ypr), "time": (done + np.arange(n)) / fs}))
+            done += n
 
 
 def run(args: list[str]) -> dict:
@@ -53,11 +75,16 @@ def main() -> None:
     ap.add_argument("--fs", type=float, default=800.0)
     ap.add_argument("--log", type=Path, default=None,
                     help="an existing log (default: simulate one in a temporary folder)")
+    ap.add_argument("--write", type=Path, default=None,
+                    help="only simulate the log into this file and stop")
     ap.add_argument("--only", choices=["memory", "stream"], default=None,
                     help="run one path only (a 24 h log does not fit the in-memory one)")
     ap.add_argument("--keep", type=Path, default=None, help="keep the reports in this folder")
     opts = ap.parse_args()
 
+    if opts.write is not None:
+        write_long_log(opts.write, opts.hours, opts.fs)
+        return
     with tempfile.TemporaryDirectory(prefix="imunoise-report-scale-") as tmp:
         work = opts.keep or Path(tmp)
         work.mkdir(parents=True, exist_ok=True)
@@ -65,9 +92,12 @@ def main() -> None:
         if log is None:
             log = Path(tmp) / "big.bin"
             t = time.perf_counter()
-            subprocess.run([*CLI, "simulate", "-o", str(log), "--hours", str(opts.hours),
-                            "--fs", str(opts.fs), "--format", "vn-binary"], check=True,
-                           stdout=subprocess.DEVNULL)
+            if opts.hours * 3600 * opts.fs <= 1e7:
+                subprocess.run([*CLI, "simulate", "-o", str(log), "--hours", str(opts.hours),
+                                "--fs", str(opts.fs), "--format", "vn-binary"], check=True,
+                               stdout=subprocess.DEVNULL)
+            else:  # longer than simulate makes at once
+                write_long_log(log, opts.hours, opts.fs)
             print(f"simulated {opts.hours:g} h at {opts.fs:g} Hz: "
                   f"{log.stat().st_size / 1e6:.0f} MB in {time.perf_counter() - t:.0f} s")
         print(f"machine: {platform.processor() or platform.machine()}, "

@@ -306,13 +306,29 @@ def _positive_float(text: str) -> float:
 
 def _read(args):
     from imunoise.report import read_log
+    from imunoise.report.inputs import streams
 
+    options = _read_options(args)
+    workdir = _stream_workdir() if streams(args.log, options) else None
     try:
-        log = read_log(args.log, "input", fs=args.fs, **_read_options(args))
+        log = read_log(args.log, "input", fs=args.fs, workdir=workdir, **options)
     except ImportError as exc:  # e.g. a Parquet log without pyarrow
         _fail(str(exc))
     _note_gaps(log.source, log)
     return log
+
+
+def _stream_workdir():
+    """A temporary folder for a large log parsed once into memory maps (the commands'
+    bounded path, as ``report --stream``), removed when the command ends."""
+    import atexit
+    import shutil
+    import tempfile
+    from pathlib import Path
+
+    path = Path(tempfile.mkdtemp(prefix="imunoise-stream-"))
+    atexit.register(shutil.rmtree, path, ignore_errors=True)
+    return path
 
 
 def _note_gaps(source: str, done) -> None:
@@ -401,10 +417,10 @@ def _cmd_fit(args) -> int:
 
 
 def _cmd_stats(args) -> int:
-    from imunoise import numbers, stats
+    from imunoise import _stream, numbers, stats
 
     log = _read(args)
-    desc = stats.describe(log)
+    desc = _stream.describe(log) if _stream.is_mapped(log.gyro) else stats.describe(log)
     print(f"# {log.source}: {len(log)} samples at {log.fs:.6g} Hz, parse issues: {log.issues}")
     print(desc.table())
     print()
@@ -413,6 +429,7 @@ def _cmd_stats(args) -> int:
     figures = {}
     for sensor, columns in _distribution_columns(log).items():
         dists = {name: stats.distribution(v[np.isfinite(v)]) for name, v in columns.items()}
+        _stream.release_log(log)  # a memory-mapped log's pages, sensor by sensor
         figures[sensor] = dists
         for name, d in dists.items():
             rows.append([

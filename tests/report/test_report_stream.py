@@ -171,3 +171,16 @@ def test_auto_stream_says_so_in_the_appendix(both):
     assert "In memory: the logs were read whole" in memory.markdown.read_text(encoding="utf-8")
     assert "Streamed: the logs were parsed once" in streamed.markdown.read_text(
         encoding="utf-8")
+
+
+def test_commands_take_the_mapped_path_for_large_logs(vn_binary, monkeypatch, capsys):
+    assert main(["stats", str(vn_binary)]) == 0
+    whole = capsys.readouterr().out
+    monkeypatch.setattr(_stream, "STREAM_BYTES", 1024)  # "large": parsed into memory maps
+    monkeypatch.setattr(_stream, "BLOCK_ROWS", BLOCK)
+    seen = []
+    real = _stream.open_mapped
+    monkeypatch.setattr(_stream, "open_mapped", lambda *a, **k: seen.append(a[1]) or real(*a, **k))
+    assert main(["stats", str(vn_binary)]) == 0
+    assert capsys.readouterr().out == whole
+    assert seen  # the mapped path was taken (its folder is removed when the command ends)
