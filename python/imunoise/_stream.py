@@ -32,7 +32,8 @@ __all__ = ["BLOCK_ROWS", "PARSE_BYTES", "STREAM_BYTES", "blocks", "column", "des
 STREAM_BYTES = 256 << 20
 #: Rows read at once from a memory map.
 BLOCK_ROWS = 1 << 20
-#: Bytes :func:`open_mapped` parses at a time (16 MiB: the parse then costs ~0.2 GB above the interpreter; None: ``imunoise.scale.convert``'s 64 MiB).
+#: Bytes :func:`open_mapped` parses at a time (None: ``imunoise.scale.convert``'s 64 MiB,
+#: which set a 0.59 GB floor of the streamed report; 16 MiB costs ~0.2 GB less).
 PARSE_BYTES: int | None = 16 << 20
 
 
