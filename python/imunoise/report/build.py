@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import datetime as _dt
 import os
-import resource
 import shutil
 import time
 from collections.abc import Callable, Mapping
@@ -411,7 +410,12 @@ def _build(short, long, out: Path, previous, inputs, options, workdirs: list[Pat
 
 
 def _peak_mib() -> float:
-    """Peak resident memory of this process so far, MiB (ru_maxrss: KiB on Linux)."""
+    """Peak resident memory of this process so far, MiB (ru_maxrss: KiB on Linux);
+    NaN where the platform does not say (Windows has no ``resource``)."""
+    try:
+        import resource
+    except ImportError:  # pragma: no cover - not on Linux
+        return float("nan")
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
 
 
