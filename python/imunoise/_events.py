@@ -615,6 +615,10 @@ def _energy_law(z: np.ndarray, w: int) -> tuple[float, np.ndarray]:
     return (median / expected if median > 0 else 1.0), rho
 
 
+#: Bytes of block transforms :func:`_lag_products` holds at once.
+LAG_GROUP_BYTES = 32 << 20
+
+
 def _lag_products(a: np.ndarray, lags: int) -> np.ndarray:
     """Σ_i a_i·a_(i+k) for k = 0 … lags − 1, by FFT over blocks of 8·lags samples (at
     least 1024): n·log(lags) work, where one FFT of the whole record costs n·log(n)
@@ -627,8 +631,16 @@ def _lag_products(a: np.ndarray, lags: int) -> np.ndarray:
     padded[:n] = a
     heads = padded[: count * block].reshape(count, block)
     spans = np.lib.stride_tricks.sliding_window_view(padded, block + lags)[::block]
-    products = np.conj(np.fft.rfft(heads, size, axis=1)) * np.fft.rfft(spans, size, axis=1)
-    return np.fft.irfft(products, size, axis=1)[:, :lags].sum(axis=0)
+    # the blocks' transforms a group at a time (all at once they took 4 arrays of the
+    # record's length), their lag sums added block after block as a sum over axis 0 adds
+    total = np.zeros(lags)
+    rows = max(1, LAG_GROUP_BYTES // (16 * size))
+    for g in range(0, count, rows):
+        products = np.conj(np.fft.rfft(heads[g:g + rows], size, axis=1)) * np.fft.rfft(
+            spans[g:g + rows], size, axis=1)
+        for row in np.fft.irfft(products, size, axis=1)[:, :lags]:
+            total += row
+    return total
 
 
 def _dof(rho: np.ndarray, w: int) -> float:
