@@ -221,6 +221,10 @@ def _slice_log(log: ImuLog, start: int) -> ImuLog:
                   issues=type(log.issues).none(), time=time, messages=log.messages, **arrays)
 
 
+#: Rows of the log whose block means :func:`warmup` takes at once.
+BIAS_GROUP_ROWS = 1 << 20
+
+
 def warmup(
     data,
     fs: float | None = None,
@@ -279,7 +283,12 @@ def warmup(
     t = (np.arange(m) + 0.5) * size / fs
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN blocks stay NaN
-        bias = np.nanmean(x[: m * size].reshape(m, size, -1), axis=1)
+        # a group of blocks at a time: nanmean copies what it is given (NaN → 0) and
+        # each block's mean depends on its own samples only
+        group = max(1, BIAS_GROUP_ROWS // size)
+        bias = np.concatenate([
+            np.nanmean(x[g * size:min(g + group, m) * size].reshape(-1, size, x.shape[1]),
+                       axis=1) for g in range(0, m, group)])
     k = x.shape[1]
     temp = _temperature(data, temperature, n)
     fits = [_fit_exponential(t, bias[:, j], duration) for j in range(k)]
