@@ -216,7 +216,8 @@ def _ekf_axes(model, sensor: str, input_unit, min_samples: float) -> dict:
     for c, name in enumerate(names):
         white2 = float(parts.value("N")[c]) ** 2
         # A resonance (like a tone) is no bias state; what it adds to the white
-        # floor (its spectrum at zero frequency) is measurement noise.
+        # floor (its spectrum at zero frequency) is measurement noise. A bounded
+        # motion is the test mount's, not the sensor's: no state, no noise.
         for sigma, f_r, tau_r in parts.resonance(c):
             white2 += resonance_white_density(sigma, f_r, tau_r, model.fs)
         states = []

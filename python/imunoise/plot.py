@@ -566,6 +566,10 @@ def allan(
                 if "resonance" in curves and np.any(curves["resonance"] > 0):
                     band = np.where(curves["resonance"] > 0, curves["resonance"], np.nan)
                     ax.plot(grid, band, color="tab:cyan", linewidth=0.9, label="resonance")
+                if "motion" in curves and np.any(curves["motion"] > 0):
+                    rocking = np.where(curves["motion"] > 0, curves["motion"], np.nan)
+                    ax.plot(grid, rocking, color="tab:brown", linewidth=0.9, linestyle="-.",
+                            label="bounded motion (mount)")
                 if marks.get("N", 0.0) > 0:
                     ax.plot([1.0], [marks["N"]], marker="s", color="crimson", ms=5,
                             linestyle="none", label="N at τ=1 s")
@@ -573,13 +577,14 @@ def allan(
                     ax.plot([3.0], [marks["K"]], marker="^", color="purple", ms=5,
                             linestyle="none", label="K at τ=3 s")
                 if marks.get("B", 0.0) > 0:
-                    # where model.B is read: the model's minimum over the fitted taus
+                    # where model.B is read: the model's floor over the fitted taus
                     # (beyond them a model without a walk keeps falling)
                     fitted = (grid >= taus[0]) & (grid <= taus[-1]) if model is None else (
                         (grid >= model.taus[0]) & (grid <= model.taus[-1]))
-                    total = np.where(fitted, curves["total"], np.inf)
-                    imin = int(np.argmin(total))
-                    ax.plot([grid[imin]], [marks["B"] * FLICKER], marker="D",
+                    floor = model.floor(j) if model is not None else None
+                    at = floor[0] if floor is not None else grid[int(np.argmin(
+                        np.where(fitted, curves["total"], np.inf)))]
+                    ax.plot([at], [marks["B"] * FLICKER], marker="D",
                             color="darkgreen", ms=5, linestyle="none",
                             label="B·0.664 floor")
                 read = _data_floor(model, j) if model is not None else None

@@ -122,9 +122,20 @@ class NoiseModel(PerTerm):
         Returns the total curve σ(τ) and each component's own curve, e.g.
         ``terms["N"]`` = (fitted N)/√τ, ``terms["GM1"]`` for the first
         Gauss–Markov term, ``terms["sine"]`` for the tone and
-        ``terms["resonance"]`` for the resonance (when a channel has one).
+        ``terms["resonance"]`` for the resonance and ``terms["motion"]`` for a
+        bounded motion (when a channel has one).
         """
         return self.components.predict(self.taus if taus is None else taus)
+
+    def floor(self, channel: int = 0) -> tuple[float, float] | None:
+        """(τ, σ(τ)) of the model's floor over the fitted taus, where ``B`` is read
+        (B = σ/√(2 ln2/π)); None where the curve has none (B not resolved)."""
+        from imunoise.noise._datasheet import model_floor, parameters
+
+        if self.method != "wls":
+            return None
+        p = parameters(self.components, channel)
+        return model_floor(p, np.asarray(self.taus, float), float(self.fs))
 
     def plot(self, result: AllanResult, **kwargs) -> Figure:
         """The model over ``result``, the Allan result it was fitted to, with its terms,
@@ -178,6 +189,8 @@ class NoiseModel(PerTerm):
         extra = "".join(f", tone {_summary.number(f0)} Hz" for _, f0 in parts.sine(channel))
         extra += "".join(f", resonance {_summary.number(f)} Hz"
                          for _, f, _ in parts.resonance(channel))
+        extra += "".join(f", bounded motion τc {_summary.number(tc)} s"
+                         for _, tc in parts.motion(channel))
         return ((" ".join(terms) or "no term resolved") + (f", {gm} GM" if gm else "") + extra
                 + f", covers {100 * float(np.atleast_1d(self.coverage)[channel]):.3g} %")
 
@@ -261,8 +274,8 @@ class NoiseModel(PerTerm):
         """Per-axis table in datasheet units: one row per datasheet value, then the
         fitted components beyond the IEEE terms where any axis has them (``σ1``,
         ``τc1``, … per Gauss–Markov term, ``A``, ``f0`` of the tone, ``σr``,
-        ``f_r``, ``τr`` of the resonance; σ and A in the unit of B, times in s,
-        frequencies in Hz).
+        ``f_r``, ``τr`` of the resonance, ``σθ``, ``τm`` of a bounded motion; σ and A
+        in the unit of B, σθ in the unit of Q, times in s, frequencies in Hz).
 
         Each row is a dict with ``term``, ``quantity``, ``unit``, ``label``,
         ``missing`` (the text of an axis without the value: ``not resolved`` for
@@ -285,20 +298,24 @@ class NoiseModel(PerTerm):
                 row[ax + "_std"] = float(stds[i])
                 row[ax + "_supported"] = bool(sup[i])
             rows.append(row)
-        rate, rate_label = conv["B"]["unit"], conv["B"]["label"]  # σ and A: in B's unit
-
-        def to_rate(v):
-            return _units.convert(v, "B", rate, sensor=sensor, input_unit=input_unit)
-
+        # σ and A in B's unit (a rate), a motion's σθ in Q's (rate·s)
+        like = {None: "B", "Q": "Q"}
         for term, quantity, unit, values, stds in self.components.other_terms():
-            rate_valued = unit is None
+            as_term = like.get(unit)
+            shown = conv[as_term]["unit"] if as_term else unit
+
+            def scaled(v, as_term=as_term, shown=shown):
+                if as_term is None or not np.isfinite(v):
+                    return v
+                return float(_units.convert(v, as_term, shown, sensor=sensor,
+                                            input_unit=input_unit))
+
             row = {"term": term, "quantity": "component: " + quantity, "missing": "—",
-                   "unit": rate if rate_valued else unit,
-                   "label": rate_label if rate_valued else unit}
+                   "unit": shown, "label": conv[as_term]["label"] if as_term else unit}
             for i, ax in enumerate(axes):
                 v, e = float(values[i]), float(stds[i])
-                row[ax] = float(to_rate(v)) if rate_valued and np.isfinite(v) else v
-                row[ax + "_std"] = float(to_rate(e)) if rate_valued and np.isfinite(e) else e
+                row[ax] = scaled(v)
+                row[ax + "_std"] = scaled(e)
                 row[ax + "_supported"] = bool(np.isfinite(v))
             rows.append(row)
         return rows
