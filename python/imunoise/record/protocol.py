@@ -12,8 +12,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 __all__ = [
-    "ERROR_NAMES", "BAUD_RATES", "DeviceError", "Reply", "checksum8", "crc16", "error_name",
-    "parse_reply", "sentence",
+    "ADOF_RATES", "ADOR_MESSAGES", "BAUD_RATES", "ERROR_NAMES", "IMU_RATE", "DeviceError",
+    "Reply", "checksum8", "crc16", "error_name", "parse_reply", "sentence",
 ]
 
 #: ``$VNERR`` codes (§4) by number.
@@ -33,6 +33,14 @@ ERROR_NAMES = {
     0xFF: "error buffer overflow",
 }
 
+#: Asynchronous ASCII types (register 6) the recorder sets and the emulator streams:
+#: ADOR -> message.
+ADOR_MESSAGES = {1: "VNYPR", 2: "VNQTN", 8: "VNQMR", 10: "VNMAG", 11: "VNACC", 12: "VNGYR",
+                 13: "VNMAR", 14: "VNYMR", 19: "VNIMU"}
+#: Rates (Hz) register 7 accepts.
+ADOF_RATES = (1, 2, 4, 5, 10, 20, 25, 40, 50, 100, 200)
+#: The VN-100's IMU rate (Hz): binary outputs run at IMU_RATE / RateDivisor.
+IMU_RATE = 800
 #: Baud rates a VN-100 accepts (register 5), the factory one first.
 BAUD_RATES = (115200, 921600, 460800, 230400, 128000, 57600, 38400, 19200, 9600)
 
