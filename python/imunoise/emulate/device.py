@@ -30,7 +30,7 @@ import tty
 from dataclasses import dataclass, field
 
 from imunoise.emulate.outputs import SampleSource, check_selection, encode
-from imunoise.emulate.registers import IMU_RATE, Registers, RegisterError
+from imunoise.emulate.registers import IMU_RATE, RegisterError, Registers
 from imunoise.record.protocol import parse_reply, sentence
 
 __all__ = ["FAULT_KINDS", "Emulator", "Event", "Fault"]

@@ -11,17 +11,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from imunoise.record.protocol import BAUD_RATES
+from imunoise.record.protocol import ADOF_RATES, ADOR_MESSAGES, BAUD_RATES, IMU_RATE
 
-__all__ = ["ADOR_MESSAGES", "ADOF_RATES", "IMU_RATE", "RegisterError", "Registers"]
+__all__ = ["ADOF_RATES", "ADOR_MESSAGES", "IMU_RATE", "RegisterError", "Registers"]
 
-#: Asynchronous ASCII types (register 6) the emulator streams: ADOR -> message.
-ADOR_MESSAGES = {1: "VNYPR", 2: "VNQTN", 8: "VNQMR", 10: "VNMAG", 11: "VNACC", 12: "VNGYR",
-                 13: "VNMAR", 14: "VNYMR", 19: "VNIMU"}
-#: Rates (Hz) register 7 accepts.
-ADOF_RATES = (1, 2, 4, 5, 10, 20, 25, 40, 50, 100, 200)
-#: The VN-100's IMU rate (Hz): binary outputs run at IMU_RATE / RateDivisor.
-IMU_RATE = 800
 #: Group bits a VN-100 has (Common, Time, IMU, Attitude).
 _GROUP_BITS = (0, 1, 2, 4)
 

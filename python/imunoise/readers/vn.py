@@ -301,17 +301,17 @@ def read_vn(
     See :func:`read_vn_tables` for the arguments and the module docstring for how
     channels are chosen when the stream has several message types. A log written
     by ``imunoise record`` brings its side files (:mod:`imunoise.readers.recording`):
-    without timestamps, each port outage is a gap of its length at its place, at
-    ``fs`` or else the rate the recorder set.
+    ``fs`` defaults to the rate the recorder set, and without timestamps each port
+    outage is a gap of its length at its place.
     """
     if isinstance(source, (bytes, bytearray, memoryview)):
         return vn_log(read_vn_tables(source, strict=strict, progress=progress), fs=fs,
                       source="<bytes>")
     name = os.fspath(source)
     tables = read_vn_tables(source, strict=strict, progress=progress)
+    fs = fs if fs is not None else recording.recorded_fs(name)
     cut = recording.outages(name)
     if cut:
-        fs = fs if fs is not None else recording.recorded_fs(name)
         tables = _with_outages(tables, name, cut, fs)
     return vn_log(tables, fs=fs, source=name)
 
