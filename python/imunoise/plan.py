@@ -31,12 +31,14 @@ from imunoise._core import allan as _core_allan
 from imunoise._validate import sample_rate
 from imunoise.noise._terms import FLICKER, model_variance
 
-__all__ = ["PLAN_TERMS", "Plan", "TermPlan", "plan", "relative_uncertainty"]
+__all__ = ["PLAN_TERMS", "Plan", "TermPlan", "fit_line", "plan", "relative_uncertainty"]
 
 #: Terms the planner answers for, with the power-law noise type (α) of each.
 PLAN_TERMS = {"N": 0, "B": -1, "K": -2}
 #: A term is read where it is this many times the other terms' variance.
 _DOMINANT = 3.0
+#: Record lengths beyond this (s) are printed as "> 1000 h".
+_LONGEST = 3.6e6
 #: Longest record the planner considers (samples).
 _MAX_SAMPLES = 1e13
 
@@ -104,12 +106,13 @@ class Plan:
         """One line: what each term needs, and (given a record length) what it has."""
         from imunoise.numbers import duration
 
-        need = ", ".join(f"{k} {duration(t.seconds) if math.isfinite(t.seconds) else 'never'}"
-                         for k, t in self.terms.items())
+        need = ", ".join(f"{k} {_length(t.seconds)}" for k, t in self.terms.items())
         text = (f"plan{' ' + self.label if self.label else ''}: ±{100 * self.target:g} % "
                 f"({100 * self.confidence:g} % confidence) needs {need}")
         if seconds is not None:
-            have = ", ".join(f"{k} ±{_percent(u)}" for k, u in self.uncertainty(seconds).items())
+            have = ", ".join(f"{k} ±{100 * u:.2g} %" if math.isfinite(u) and u < 10
+                             else f"{k} not yet (its τ is beyond the record)"
+                             for k, u in self.uncertainty(seconds).items())
             text += f"; this record ({duration(seconds)}) resolves {have}"
         return text
 
@@ -117,8 +120,10 @@ class Plan:
         return self.line()
 
 
-def _percent(u: float) -> str:
-    return f"{100 * u:.2g} %" if math.isfinite(u) and u < 10 else "—"
+def _length(seconds: float) -> str:
+    from imunoise.numbers import duration
+
+    return duration(seconds) if seconds <= _LONGEST else f"> {duration(_LONGEST)}"
 
 
 def _edf(n: int, fs: float, tau: float, alpha: int) -> float:
@@ -218,3 +223,13 @@ def plan(source="vn100", *, fs: float = 40.0, target: float = 0.2, confidence: f
              for k, tau in taus.items()}
     return Plan(fs=fs, target=float(target), confidence=float(confidence), terms=terms,
                 coefficients=coefficients, label=label)
+
+
+def fit_line(model, fs: float, seconds: float, *, target: float = 0.2,
+             confidence: float = 0.95) -> str:
+    """One line for a fitted model: what ``seconds`` of record at ``fs`` resolve and
+    what ``target`` needs (``imunoise fit`` prints it; the report may)."""
+    try:
+        return plan(model, fs=fs, target=target, confidence=confidence).line(seconds)
+    except ValueError as exc:
+        return f"plan: not available ({exc})"
