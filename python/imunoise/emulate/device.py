@@ -8,7 +8,8 @@ emulator waits instead of dropping bytes, so every byte it sent (``sent``) is on
 the reader could have read. A client whose baud rate (termios) is not the
 sensor's register 5 reads garbage, as on a real port.
 
-Faults on demand (:class:`Fault`), at a time on the sensor's clock:
+Faults on demand (:class:`Fault`), after so many seconds of output from the
+first ``$VNASY,1`` (which ``imunoise record`` sends when its record starts):
 ``corrupt`` flips one byte inside the next record; ``pause`` stops the output
 for ``seconds`` (the clock runs on: a gap in ``TimeStartup``); ``vanish`` removes
 the port for ``seconds`` (the reader's fd hangs up; the pty comes back at the
@@ -46,7 +47,9 @@ _CORRUPT_AT = 10
 
 @dataclass(frozen=True)
 class Fault:
-    """A fault at ``at`` seconds of sensor time; ``seconds`` for pause/vanish."""
+    """A fault after ``at`` seconds of output: sensor time while the output is on,
+    counted from the first ``$VNASY,1`` (the start of a recorder's record: the
+    faults wait for it); ``seconds`` of sensor time for pause/vanish."""
 
     kind: str
     at: float
@@ -64,8 +67,9 @@ class Fault:
 @dataclass(frozen=True)
 class Event:
     """Something the emulator did: a fault or a ``$VNASY`` (``kind`` "asy0"/"asy1"),
-    at ``offset`` in ``sent`` (a corrupt fault: the flipped byte; an ASY: just
-    after its echo) and IMU tick ``tick``."""
+    at ``offset`` in ``sent`` (a fault: the first record it touches, for ``corrupt``
+    the damaged one; an ASY: just after its echo) and IMU tick ``tick`` (the first
+    tick the fault touches)."""
 
     kind: str
     offset: int
@@ -82,6 +86,8 @@ class _State:
     registers: Registers = field(default_factory=Registers)
     streaming: bool = True
     tick: int = 0  # next IMU tick to send
+    streamed: int = 0  # ticks passed while the output was on (the faults' clock)
+    resumed: bool = False  # a client sent $VNASY,1 (the faults' clock restarted then)
     clock_zero: int = 0  # tick of the last reset
     silent_until: int = -1  # pause / vanish: no output before this tick
 
@@ -100,9 +106,12 @@ class Emulator:
     faults : sequence of Fault
     keep_sent : bool
         Keep every byte sent in ``sent`` (tests); off for long demos.
+    baud : int
+        The sensor's baud rate (register 5); a client at another rate reads garbage.
     """
 
-    def __init__(self, path, *, speed: float = 1.0, seed=None, faults=(), keep_sent=True):
+    def __init__(self, path, *, speed: float = 1.0, seed=None, faults=(), keep_sent=True,
+                 baud: int = 115200):
         if not speed > 0:
             raise ValueError(f"speed must be > 0; got {speed!r}")
         self.path = os.fspath(path)
@@ -115,6 +124,7 @@ class Emulator:
         self.events: list[Event] = []
         self._keep = keep_sent
         self._state = _State()
+        self._state.registers.write(5, (str(baud),))
         self._source = SampleSource(seed)
         self._out = bytearray()
         self._inbox = bytearray()
@@ -223,6 +233,8 @@ class Emulator:
                 self._reply(f"VNWRG,{reg:02d},{echo}")
             elif head == "VNASY" and fields in (("0",), ("1",)):
                 state.streaming = fields[0] == "1"
+                if state.streaming and not state.resumed:
+                    state.resumed, state.streamed = True, 0
                 offset = self._reply(f"VNASY,{fields[0]}")
                 end = offset + len(sentence(f"VNASY,{fields[0]}", crc=regs.crc))
                 self._log(Event(f"asy{fields[0]}", end, state.tick))
@@ -255,7 +267,7 @@ class Emulator:
     def _due_tick(self) -> int:
         return int((time.monotonic() - self._started) * self.speed * IMU_RATE)
 
-    def _fault(self, fault: Fault, records: list[bytes]) -> list[bytes]:
+    def _fault(self, fault: Fault, records: list[bytes], start: int, stop: int) -> list[bytes]:
         state = self._state
         offset = self.bytes_sent + len(self._out)
         if fault.kind == "corrupt" and records:
@@ -263,15 +275,13 @@ class Emulator:
             at = min(_CORRUPT_AT, len(rec) - 3)
             rec[at] ^= 0x01
             records = [bytes(rec), *records[1:]]
-            offset += at
         elif fault.kind in ("pause", "vanish"):
-            state.silent_until = state.tick + round(fault.seconds * IMU_RATE)
+            state.silent_until = start + round(fault.seconds * IMU_RATE)
             records = []
         elif fault.kind == "reset":
-            state.clock_zero = state.tick
-            records = encode(state.registers, self._source, state.tick, state.tick + 1,
-                             state.clock_zero) + records[1:]
-        self._log(Event(fault.kind, offset, state.tick, fault.seconds))
+            state.clock_zero = start
+            records = encode(state.registers, self._source, start, stop, state.clock_zero)
+        self._log(Event(fault.kind, offset, start, fault.seconds))
         if fault.kind == "vanish":
             self._vanish(fault.seconds)
         return records
@@ -279,8 +289,15 @@ class Emulator:
     def _vanish(self, seconds: float) -> None:
         while self._out and not self._stop.is_set():
             self._flush(0.05)
-        deadline = time.monotonic() + 2.0  # let the client read what it was sent
-        while self._pending_for_client() and time.monotonic() < deadline:
+        # Let the client read what it was sent: bytes written to the master reach the
+        # slave's queue a moment later, so the queue must stay empty for a while.
+        deadline = time.monotonic() + 2.0
+        empty_since = time.monotonic()
+        while time.monotonic() < deadline:
+            if self._pending_for_client():
+                empty_since = time.monotonic()
+            elif time.monotonic() - empty_since > 0.1:
+                break
             time.sleep(0.005)
         self._close_pty()
         self._stop.wait(seconds / self.speed)
@@ -289,24 +306,30 @@ class Emulator:
 
     def _step(self) -> None:
         state = self._state
+        if not state.streaming:  # the clock runs on while the output is paused
+            state.tick = max(state.tick, self._due_tick())
+            return
         stop = min(self._due_tick(), state.tick + round(_STEP * IMU_RATE))
         if stop <= state.tick or len(self._out) >= _QUEUE:
             return
         start, state.tick = state.tick, stop
         if start < state.silent_until:
             start = min(state.silent_until, stop)
-        if not state.streaming or start >= stop:
+        if start >= stop:
             return
         records = encode(state.registers, self._source, start, stop, state.clock_zero)
-        while self.faults and self.faults[0].at * IMU_RATE < stop:
-            records = self._fault(self.faults.pop(0), records)
+        state.streamed += stop - start
+        while state.resumed and self.faults and self.faults[0].at * IMU_RATE < state.streamed:
+            records = self._fault(self.faults.pop(0), records, start, stop)
             if self._master < 0:
                 return
         self._queue(b"".join(records))
 
     def _run(self) -> None:
-        while not self._stop.is_set():
+        while not self._stop.is_set() and self._master >= 0:
             self._step()
+            if self._master < 0:  # the port vanished and the emulator was stopped meanwhile
+                break
             wait = 0.0 if self._out else min(0.01, 1 / (self.speed * IMU_RATE) + 0.002)
             readable, _, _ = select.select([self._master], [], [], wait)
             if readable:
@@ -314,6 +337,17 @@ class Emulator:
             self._flush(0.0 if readable else 0.005)
 
     # --- lifetime ----------------------------------------------------------------------
+
+    @property
+    def registers(self) -> dict[int, tuple]:
+        """A copy of the register file (what the sensor is set to now)."""
+        with self._lock:
+            return dict(self._state.registers.values)
+
+    @property
+    def tick(self) -> int:
+        """The next IMU tick the sensor will send (800 per sensor second)."""
+        return self._state.tick
 
     def sent_bytes(self) -> bytes:
         """A copy of every byte sent so far."""

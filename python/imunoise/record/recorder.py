@@ -97,7 +97,13 @@ class _Recorder:
                 self.identity = config.read_identity(session)
                 self.previous = config.read_outputs(session)
                 self.wanted = config.wanted_outputs(self.previous, **self.options)
-            config.apply(session, self.wanted)
+            try:
+                config.apply(session, self.wanted)
+            except DeviceError:  # leave the sensor as it was, streaming
+                if first:
+                    config.restore(session, self.previous, self.wanted)
+                    session.command("VNASY,1")
+                raise
             session.command("VNASY,1")
         except BaseException:
             serial.close()
@@ -137,7 +143,7 @@ class _Recorder:
             except Exception:  # the port is not back yet, or not answering yet
                 time.sleep(RETRY_EVERY)
                 continue
-            outage = Outage(self.writer.size, start, time.time())
+            outage = Outage(self.writer.size, round(start, 6), round(time.time(), 6))  # as kept
             self.writer.outage(outage.start, outage.end)
             self.outages.append(outage)
             if self.live is not None:
