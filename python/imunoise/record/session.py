@@ -63,7 +63,9 @@ class Session:
         self.serial.write(sentence(body, crc=self.crc))
         buf = bytearray(self.rest)
         self.rest = b""
-        deadline = time.monotonic() + timeout
+        started = time.monotonic()
+        deadline = started + timeout
+        resent = False
         searched = 0
         while True:
             found = _find_reply(buf, key, searched)
@@ -77,6 +79,11 @@ class Session:
             searched = max(0, len(buf) - 400)  # a reply may straddle two reads
             if time.monotonic() > deadline:
                 raise DeviceError(f"no reply to ${body} within {timeout:g} s")
+            if not resent and time.monotonic() > started + timeout / 2:
+                # a command can be lost (line noise, a sensor still starting): once more;
+                # every command the recorder sends may be repeated without harm
+                self.serial.write(sentence(body, crc=self.crc))
+                resent = True
             buf += self.serial.read(_CHUNK)
 
 
