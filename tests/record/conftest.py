@@ -12,6 +12,7 @@ if not sys.platform.startswith("linux"):
 
 from imunoise.emulate import Emulator  # noqa: E402
 
+
 @pytest.fixture
 def emulator(tmp_path):
     """``emulator(**options)`` starts one at tmp_path/port; all are closed after the test."""

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import pytest
-
 from imunoise.record.protocol import crc16, error_name, parse_reply, sentence
 from imunoise.record.session import Session, open_port
 

@@ -9,9 +9,8 @@ import sys
 import time
 from pathlib import Path
 
-from helpers.emulator import FULL
-
 import imunoise
+from helpers.emulator import FULL
 
 ROOT = Path(__file__).resolve().parents[2]
 RATE = 200  # Hz of the binary output

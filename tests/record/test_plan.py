@@ -2,10 +2,9 @@
 
 from __future__ import annotations
 
+import imunoise
 import numpy as np
 import pytest
-
-import imunoise
 from imunoise.noise._terms import model_variance
 from imunoise.plan import plan
 

@@ -4,11 +4,10 @@ from __future__ import annotations
 
 import io
 
+import imunoise
 import numpy as np
 import pytest
 from helpers.emulator import FULL, record_slice
-
-import imunoise
 from imunoise.emulate import Fault
 from imunoise.readers.recording import outages
 from imunoise.record import DeviceError, binary_output, record
