@@ -28,10 +28,10 @@ FIELDS = "common=TimeStartup+YawPitchRoll+Quaternion+AngularRate+Accel+MagPres+I
 PACKET = 1 + 1 + 2 + 8 + 12 + 16 + 12 + 12 + 20 + 24 + 2
 CHILD = """
 import json, os, resource, sys, time
-from imunoise.record import binary_output, record
+from imunoise.recording import binary_output, record
 port, out, seconds, live = sys.argv[1], sys.argv[2], float(sys.argv[3]), sys.argv[4] == "1"
 done = {}
-import imunoise.record.recorder as rr
+import imunoise.recording.recorder as rr
 original = rr._Recorder.connect
 def connect(self, first):
     data = original(self, first)

@@ -451,7 +451,7 @@ def _cmd_fit(args) -> int:
 
 def _plan_line(model, log, sensor: str) -> str:
     """The planner's answer for this log, one line (end of ``fit``)."""
-    from imunoise.plan import fit_line
+    from imunoise.planner import fit_line
 
     return fit_line(model, log.fs, log.duration).replace("plan:", f"plan {sensor}:")
 
@@ -734,7 +734,7 @@ def _cmd_thermal(args) -> int:
 
 
 def _cmd_record(args) -> int:
-    from imunoise.record import binary_output, record
+    from imunoise.recording import binary_output, record
 
     seconds = (args.hours * 3600 if args.hours else args.minutes * 60 if args.minutes
                else args.seconds)
@@ -786,7 +786,7 @@ def _cmd_emulate(args) -> int:
 
 
 def _cmd_plan(args) -> int:
-    from imunoise.plan import plan
+    from imunoise.planner import plan
 
     sensors = [args.sensor] if args.sensor else list(ALLAN_SENSORS)
     if args.log is None:

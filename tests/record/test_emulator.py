@@ -3,8 +3,8 @@
 from __future__ import annotations
 
 import pytest
-from imunoise.record.protocol import crc16, error_name, parse_reply, sentence
-from imunoise.record.session import Session, open_port
+from imunoise.recording.protocol import crc16, error_name, parse_reply, sentence
+from imunoise.recording.session import Session, open_port
 
 
 def test_checksums_match_the_protocol_vectors():

@@ -6,7 +6,7 @@ import imunoise
 import numpy as np
 import pytest
 from imunoise.noise._terms import model_variance
-from imunoise.plan import plan
+from imunoise.planner import plan
 
 SIMULATIONS = 40
 

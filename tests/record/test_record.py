@@ -10,7 +10,7 @@ import pytest
 from helpers.emulator import FULL, record_slice
 from imunoise.emulate import Fault
 from imunoise.readers.recording import outages
-from imunoise.record import DeviceError, binary_output, record
+from imunoise.recording import DeviceError, binary_output, record
 
 IMU_RATE = 800
 

@@ -32,7 +32,7 @@ from dataclasses import dataclass, field
 
 from imunoise.emulate.outputs import SampleSource, check_selection, encode
 from imunoise.emulate.registers import IMU_RATE, RegisterError, Registers
-from imunoise.record.protocol import parse_reply, sentence
+from imunoise.recording.protocol import parse_reply, sentence
 
 __all__ = ["FAULT_KINDS", "Emulator", "Event", "Fault"]
 
@@ -146,11 +146,7 @@ class Emulator:
         termios.tcsetattr(slave, termios.TCSANOW, attrs)
         fcntl.fcntl(master, fcntl.F_SETFL, fcntl.fcntl(master, fcntl.F_GETFL) | os.O_NONBLOCK)
         self._master, self._slave = master, slave
-        tmp = self.path + ".new"
-        with contextlib.suppress(FileNotFoundError):
-            os.unlink(tmp)
-        os.symlink(os.ttyname(slave), tmp)
-        os.replace(tmp, self.path)
+        os.symlink(os.ttyname(slave), self.path)  # the port appears (it was removed)
 
     def _close_pty(self) -> None:
         with contextlib.suppress(FileNotFoundError):

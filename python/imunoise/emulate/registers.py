@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from imunoise.record.protocol import ADOF_RATES, ADOR_MESSAGES, BAUD_RATES, IMU_RATE
+from imunoise.recording.protocol import ADOF_RATES, ADOR_MESSAGES, BAUD_RATES, IMU_RATE
 
 __all__ = ["ADOF_RATES", "ADOR_MESSAGES", "IMU_RATE", "RegisterError", "Registers"]
 

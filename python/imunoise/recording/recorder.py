@@ -5,7 +5,7 @@ VN-100 rates at which the sensor answers), pause its asynchronous output
 (``$VNASY,0``), read its identity (registers 1–4) and output settings, write and
 verify the settings asked for, resume (``$VNASY,1``): the record starts with the
 first byte after that echo. Every byte then goes to the log as received
-(:mod:`imunoise.record.writer`); the record ends with the echo of the final
+(:mod:`imunoise.recording.writer`); the record ends with the echo of the final
 ``$VNASY,0``, after which the previous settings are restored (unless
 ``keep_config``) and the output resumed. A port that disappears is reopened
 until it returns (the settings written again, as a replugged sensor may have
@@ -22,11 +22,11 @@ import time
 from dataclasses import dataclass, field
 
 from imunoise.readers.recording import Outage
-from imunoise.record import config
-from imunoise.record.live import LiveView, Snapshot
-from imunoise.record.protocol import ADOR_MESSAGES, IMU_RATE, DeviceError
-from imunoise.record.session import Session, find_baud, open_port
-from imunoise.record.writer import RawWriter
+from imunoise.recording import config
+from imunoise.recording.live import LiveView, Snapshot
+from imunoise.recording.protocol import ADOR_MESSAGES, IMU_RATE, DeviceError
+from imunoise.recording.session import Session, find_baud, open_port
+from imunoise.recording.writer import RawWriter
 
 __all__ = ["Recording", "record"]
 
@@ -191,7 +191,7 @@ def record(port, output, *, seconds: float | None = None, baud: int | str = 1152
     ascii, rate : optional
         Asynchronous ASCII type (``"VNYMR"``, ``"off"``) and rate (Hz, register 7).
     binary : sequence, optional
-        Binary outputs, each as :func:`imunoise.record.config.binary_output` makes them.
+        Binary outputs, each as :func:`imunoise.recording.config.binary_output` makes them.
     crc : bool, optional
         CRC-16 (True) or XOR-8 (False) on the sensor's sentences.
     keep_config : bool

@@ -9,8 +9,8 @@ settings read before (:func:`read_outputs`) back the same way.
 
 from __future__ import annotations
 
-from imunoise.record.protocol import ADOF_RATES, ADOR_MESSAGES, IMU_RATE, DeviceError
-from imunoise.record.session import Session
+from imunoise.recording.protocol import ADOF_RATES, ADOR_MESSAGES, IMU_RATE, DeviceError
+from imunoise.recording.session import Session
 
 __all__ = ["IDENTITY", "OUTPUT_REGISTERS", "ascii_type", "apply", "binary_output",
            "read_identity", "read_outputs", "restore", "wanted_outputs"]

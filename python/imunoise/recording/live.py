@@ -25,7 +25,7 @@ from imunoise._simulate_log import DEFAULT_K
 from imunoise.allan import AllanResult, adev
 from imunoise.noise._terms import FLICKER
 from imunoise.numbers import duration
-from imunoise.plan import plan as make_plan
+from imunoise.planner import plan as make_plan
 from imunoise.readers.log import DEFAULT_FS
 from imunoise.readers.vn import richest_table, table_channels
 

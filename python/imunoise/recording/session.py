@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import time
 
-from imunoise.record.protocol import (
+from imunoise.recording.protocol import (
     BAUD_RATES,
     DeviceError,
     Reply,
