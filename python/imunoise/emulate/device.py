@@ -39,7 +39,7 @@ __all__ = ["FAULT_KINDS", "Emulator", "Event", "Fault"]
 FAULT_KINDS = ("corrupt", "pause", "vanish", "reset")
 #: Output bytes queued before the emulator waits for the reader.
 _QUEUE = 1 << 16
-#: Longest sensor time generated per step (s).
+#: Longest sensor time generated per step (s) at real time (x speed / 2 when faster).
 _STEP = 0.02
 #: Byte of a record flipped by a ``corrupt`` fault (inside the fields / payload).
 _CORRUPT_AT = 10
@@ -305,7 +305,8 @@ class Emulator:
         if not state.streaming:  # the clock runs on while the output is paused
             state.tick = max(state.tick, self._due_tick())
             return
-        stop = min(self._due_tick(), state.tick + round(_STEP * IMU_RATE))
+        longest = round(max(_STEP, _STEP * self.speed / 2) * IMU_RATE)  # fewer, longer steps
+        stop = min(self._due_tick(), state.tick + longest)
         if stop <= state.tick or len(self._out) >= _QUEUE:
             return
         start, state.tick = state.tick, stop
