@@ -38,6 +38,11 @@ def test_ten_minutes_recorded_byte_identical_and_settings_restored(emulator, tmp
     snap = rec.snapshot
     np.testing.assert_array_equal(snap.gyro, log.gyro)
     np.testing.assert_array_equal(snap.adev.dev, imunoise.adev(log.gyro, log.fs).dev)
+    assert snap.dropped == 0
+    # the host receive times: one line per chunk, offsets increasing from 0 within the log
+    times = np.loadtxt(f"{out}.times", dtype=np.int64, ndmin=2)
+    assert times[0, 0] == 0 and np.all(np.diff(times[:, 0]) > 0) and times[-1, 0] < len(raw)
+    assert np.all(np.diff(times[:, 1]) >= 0)
 
 
 def test_injected_faults_appear_in_issues_and_gaps_at_their_place(emulator, tmp_path):
@@ -70,7 +75,8 @@ def test_injected_faults_appear_in_issues_and_gaps_at_their_place(emulator, tmp_
 def test_vanishing_port_is_one_gap_of_its_length(emulator, tmp_path):
     emu = emulator(speed=10, seed=3, faults=[Fault("vanish", 1.0, 2.0)])
     out = tmp_path / "vanish.vn"
-    rec = record(emu.path, out, seconds=2.5, ascii="off", binary=[binary_output(200, FULL)])
+    rec = record(emu.path, out, seconds=2.5, ascii="off", binary=[binary_output(200, FULL)],
+                 live=True, live_stream=io.StringIO())
     assert len(rec.outages) == 1 and outages(out) == list(rec.outages)
     assert rec.outages[0].offset > 0
     log = imunoise.read(out)
@@ -83,6 +89,7 @@ def test_vanishing_port_is_one_gap_of_its_length(emulator, tmp_path):
     expected = (-(-back // step) - -(-gone // step))  # samples of ticks [gone, back)
     assert log.gaps.samples[0] == pytest.approx(expected, abs=1)
     assert log.gaps.samples[0] >= 2 * 200
+    assert rec.snapshot.outages == 1 and rec.snapshot.dropped == log.gaps.total
 
 
 def test_outage_of_an_ascii_log_without_timestamps_comes_from_the_side_file(tmp_path):

@@ -39,13 +39,15 @@ REFRESH = 1.0
 class Snapshot:
     """What the live view knows: ``gyro`` (n, 3) samples of the main message type
     so far, its rate, the ADEV of those samples (``None`` before 16), damaged
-    records and outages."""
+    records, outages and ``dropped`` samples (steps of the timestamps, when the
+    output has them)."""
 
     gyro: np.ndarray
     fs: float
     adev: AllanResult | None
     damaged: int
     outages: int
+    dropped: int = 0
 
 
 class _Table:
@@ -127,11 +129,17 @@ class LiveView:
             damaged = sum(t.damaged for t in self._tables.values())
         kind = "ascii" if name and name.startswith("VN") else "binary"
         fs = self.rates.get(kind) or next(iter(self.rates.values()), DEFAULT_FS)
+        dropped = 0
         if stamps is not None and len(stamps) > 2:
-            step = np.median(np.diff(stamps))
-            fs = 1.0 / step if step > 0 else fs
+            steps = np.diff(stamps)
+            step = np.median(steps)
+            if step > 0:
+                fs = 1.0 / step
+                # samples missing between stamps (a clock reset's backward step counts none)
+                dropped = int(np.sum(np.maximum(np.round(steps / step) - 1, 0)))
         result = adev(gyro, fs) if len(gyro) >= 16 else None
-        return Snapshot(gyro=gyro, fs=fs, adev=result, damaged=damaged, outages=self.outages)
+        return Snapshot(gyro=gyro, fs=fs, adev=result, damaged=damaged, outages=self.outages,
+                        dropped=dropped)
 
     def _render(self, snap: Snapshot) -> None:
         elapsed = time.monotonic() - self.started
@@ -139,7 +147,7 @@ class LiveView:
         head = (f"recording {duration(elapsed)}"
                 + (f" / {duration(self.target)}" if self.target else "")
                 + f"  samples {n} at {snap.fs:.4g} Hz  damaged {snap.damaged}"
-                + f"  outages {snap.outages}")
+                + f"  dropped {snap.dropped}  outages {snap.outages}")
         lines = [head]
         if n:
             mean, std = np.nanmean(snap.gyro, axis=0), np.nanstd(snap.gyro, axis=0)
