@@ -21,6 +21,7 @@ def test_errors_are_one_line_with_status_2(argv, message, capsys, tmp_path, monk
     assert main(argv) == 2
     err = capsys.readouterr().err.strip()
     assert err.startswith("imunoise: error: ") and "\n" not in err and message in err
+    assert list(tmp_path.iterdir()) == []  # no log begun for a port that is not there
 
 
 def test_record_from_the_emulator_and_plan(emulator, tmp_path, capsys):

@@ -78,7 +78,9 @@ class _Recorder:
         self.baud = baud
         self.options = wanted_options
         self.keep_config = keep_config
-        self.writer = RawWriter(output)
+        self.output = os.fspath(output)
+        RawWriter.refuse_existing(self.output)  # before the sensor is touched
+        self.writer: RawWriter | None = None  # created once the sensor answers
         self.live = live
         self.session: Session | None = None
         self.identity: dict = {}
@@ -223,9 +225,10 @@ def record(port, output, *, seconds: float | None = None, baud: int | str = 1152
         return stop_event.is_set() or (seconds is not None
                                        and time.monotonic() - started >= seconds)
 
-    snapshot, restored = None, False
+    snapshot, restored, signalled = None, False, None
+    first = rec.connect(first=True)
     try:
-        first = rec.connect(first=True)
+        rec.writer = RawWriter(output)
         settings = {**rec.previous, **rec.wanted}
         rec.writer.write_meta(rec.meta(started=time.time()))
         if live:
@@ -240,15 +243,22 @@ def record(port, output, *, seconds: float | None = None, baud: int | str = 1152
                         break
         except KeyboardInterrupt:
             pass  # Ctrl-C: end the record cleanly
+        except SystemExit as exc:  # SIGTERM (the CLI): end cleanly too, then exit
+            signalled = exc
         with contextlib.suppress(OSError, DeviceError, *_serial_errors()):
             restored = rec.finish()
     finally:
         if rec.live is not None:
             snapshot = rec.live.close()
-        rec.writer.close()
+        if rec.writer is not None:
+            rec.writer.close()
+        elif rec.session is not None:
+            rec.session.serial.close()
     elapsed = time.monotonic() - started
     rec.writer.write_meta(rec.meta(seconds=elapsed, bytes=rec.writer.size,
                                    outages=len(rec.outages), restored=restored))
+    if signalled is not None:
+        raise signalled
     return Recording(path=rec.writer.path, bytes=rec.writer.size, seconds=elapsed,
                      outages=tuple(rec.outages), identity=rec.identity,
                      settings={**rec.previous, **rec.wanted}, previous=rec.previous,

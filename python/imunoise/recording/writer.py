@@ -15,6 +15,7 @@ record cut at the end. The metadata, rewritten whole, goes through
 
 from __future__ import annotations
 
+import errno
 import json
 import os
 import time
@@ -37,11 +38,16 @@ class RawWriter:
     """Append-only writer of ``path`` (the raw log) and ``path.times`` /
     ``path.gaps``; refuses an existing log (a record is never overwritten)."""
 
+    @staticmethod
+    def refuse_existing(path) -> None:
+        """``FileExistsError`` when ``path`` exists: a recording is never overwritten."""
+        if os.path.lexists(path):
+            raise FileExistsError(errno.EEXIST, "exists: a recording is never overwritten; "
+                                  "choose another output", os.fspath(path))
+
     def __init__(self, path) -> None:
         self.path = os.fspath(path)
-        if os.path.exists(self.path):
-            raise FileExistsError(17, "exists: a recording is never overwritten; choose "
-                                      "another output", self.path)
+        self.refuse_existing(self.path)
         self._raw = os.open(self.path, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_APPEND
                             | getattr(os, "O_BINARY", 0), 0o666)
         self._times = _append(self.path + TIMES)
