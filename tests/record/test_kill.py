@@ -10,7 +10,7 @@ import time
 from pathlib import Path
 
 import imunoise
-from helpers.emulator import FULL
+from helpers.emulator import FULL, record_slice
 
 ROOT = Path(__file__).resolve().parents[2]
 RATE = 200  # Hz of the binary output
@@ -46,3 +46,29 @@ def test_kill_9_loses_at_most_one_second(emulator, tmp_path):
     assert log.issues.total <= 1  # at most the packet the kill cut
     lost = killed_at / 800 - (log.time[-1] + 1 / RATE)
     assert lost <= 1.0, f"lost {lost:.3f} s of record"
+
+
+def test_sigterm_ends_the_record_cleanly_and_restores(emulator, tmp_path):
+    emu = emulator(speed=5, seed=8)
+    before = emu.registers
+    out = tmp_path / "terminated.vn"
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(
+        [str(ROOT / "python"), os.environ.get("PYTHONPATH", "")])}
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "imunoise.cli", "record", emu.path, "-o", str(out),
+         "--ascii", "VNIMU", "--rate", "50"],
+        env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    try:
+        for _ in range(600):
+            if any(e.kind == "asy1" for e in emu.events) and out.exists() \
+                    and out.stat().st_size > 10_000:
+                break
+            time.sleep(0.05)
+        proc.send_signal(signal.SIGTERM)
+        assert proc.wait(timeout=30) == 143
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert emu.registers == before  # restored on the way out
+    raw = out.read_bytes()
+    assert raw == record_slice(emu) and raw.endswith(b"$VNASY,0*4F\r\n")

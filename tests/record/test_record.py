@@ -143,3 +143,21 @@ def test_an_existing_output_is_refused(emulator, tmp_path):
     with pytest.raises(FileExistsError):
         record(emu.path, out, seconds=1)
     assert out.read_bytes() == b"keep me"
+
+
+def test_ctrl_c_ends_the_record_cleanly_without_losing_a_byte(emulator, tmp_path):
+    import os
+    import signal
+    import threading
+
+    emu = emulator(speed=20, seed=10)
+    out = tmp_path / "interrupted.vn"
+
+    def interrupt() -> None:
+        while not out.exists() or out.stat().st_size < 50_000:
+            threading.Event().wait(0.02)
+        os.kill(os.getpid(), signal.SIGINT)
+
+    threading.Thread(target=interrupt, daemon=True).start()
+    rec = record(emu.path, out, binary=[binary_output(800, FULL)])
+    assert rec.restored and out.read_bytes() == record_slice(emu)

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import contextlib
 import os
+import signal
 import sys
 import threading
 import time
@@ -225,7 +226,7 @@ def record(port, output, *, seconds: float | None = None, baud: int | str = 1152
         return stop_event.is_set() or (seconds is not None
                                        and time.monotonic() - started >= seconds)
 
-    snapshot, restored, signalled = None, False, None
+    snapshot, restored, signalled = None, False, []
     first = rec.connect(first=True)
     try:
         rec.writer = RawWriter(output)
@@ -234,19 +235,15 @@ def record(port, output, *, seconds: float | None = None, baud: int | str = 1152
         if live:
             rec.live = LiveView(rates=output_rates(settings), target=seconds, stream=stream)
         rec.write(first)
-        try:
+        with _signals_stop(stop_event) as signalled:
             while not done():
                 try:
                     rec.write(rec.session.read())
                 except (OSError, DeviceError) + _serial_errors():
                     if not rec.reconnect(done):
                         break
-        except KeyboardInterrupt:
-            pass  # Ctrl-C: end the record cleanly
-        except SystemExit as exc:  # SIGTERM (the CLI): end cleanly too, then exit
-            signalled = exc
-        with contextlib.suppress(OSError, DeviceError, *_serial_errors()):
-            restored = rec.finish()
+            with contextlib.suppress(OSError, DeviceError, *_serial_errors()):
+                restored = rec.finish()
     finally:
         if rec.live is not None:
             snapshot = rec.live.close()
@@ -257,12 +254,35 @@ def record(port, output, *, seconds: float | None = None, baud: int | str = 1152
     elapsed = time.monotonic() - started
     rec.writer.write_meta(rec.meta(seconds=elapsed, bytes=rec.writer.size,
                                    outages=len(rec.outages), restored=restored))
-    if signalled is not None:
-        raise signalled
+    if signalled:  # SIGTERM: now that the record is complete, as it would have
+        signal.raise_signal(signalled[0])
     return Recording(path=rec.writer.path, bytes=rec.writer.size, seconds=elapsed,
                      outages=tuple(rec.outages), identity=rec.identity,
                      settings={**rec.previous, **rec.wanted}, previous=rec.previous,
                      restored=restored, snapshot=snapshot)
+
+
+@contextlib.contextmanager
+def _signals_stop(stop: threading.Event):
+    """While recording, Ctrl-C and SIGTERM set ``stop`` instead of raising wherever
+    the code happens to be (an exception inside a read would lose the bytes it had
+    read). Yields a list that receives SIGTERM's number; restores the handlers."""
+    received: list[int] = []
+    if threading.current_thread() is not threading.main_thread():
+        yield received
+        return
+
+    def handler(signum, frame) -> None:
+        if signum == signal.SIGTERM:
+            received.append(signum)
+        stop.set()
+
+    old = {sig: signal.signal(sig, handler) for sig in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        yield received
+    finally:
+        for sig, previous in old.items():
+            signal.signal(sig, previous)
 
 
 def _serial_errors() -> tuple[type[BaseException], ...]:
