@@ -13,6 +13,7 @@ from imunoise.cli import main
      "800 Hz divided by a whole number"),
     (["record", "p", "-o", "x.vn", "--binary", "800:common=Bogus"], "'Bogus' is not in group"),
     (["record", "p", "-o", "x.vn", "--baud", "fast"], "--baud must be a number or 'auto'"),
+    (["record", "p", "-o", "x.vn", "--rate", "33"], "rate must be one of"),
     (["plan", "--target", "2"], "target must be a relative uncertainty in (0, 1)"),
     (["emulate", "p", "--fault", "melt@1"], "fault kind must be one of"),
 ])

@@ -115,6 +115,15 @@ def test_errors_of_the_sensor_are_named_and_nothing_is_left_changed(emulator, tm
     assert emu.registers == before
 
 
+def test_settings_that_silence_the_sensor_are_refused_and_it_streams_on(emulator, tmp_path):
+    emu = emulator(speed=5, seed=11)
+    before = emu.registers
+    with pytest.raises(ValueError, match="nothing to record"):
+        record(emu.path, tmp_path / "silent.vn", seconds=1, ascii="off")
+    assert emu.registers == before and emu.events[-1].kind == "asy1"  # resumed
+    assert not (tmp_path / "silent.vn").exists()
+
+
 def test_keep_config_leaves_the_settings_and_baud_auto_finds_the_rate(emulator, tmp_path):
     emu = emulator(speed=5, seed=5, baud=57600)
     rec = record(emu.path, tmp_path / "k.vn", seconds=0.5, baud="auto", ascii="VNIMU",

@@ -96,24 +96,29 @@ class _Recorder:
         try:
             session = Session(serial)
             session.command("VNASY,0")
-            if first:
-                self.identity = config.read_identity(session)
-                self.previous = config.read_outputs(session)
-                self.wanted = config.wanted_outputs(self.previous, **self.options)
             try:
-                config.apply(session, self.wanted)
-            except DeviceError:  # leave the sensor as it was, streaming
                 if first:
-                    config.restore(session, self.previous, self.wanted)
-                    session.command("VNASY,1")
+                    self.identity = config.read_identity(session)
+                    self.previous = config.read_outputs(session)
+                    self.wanted = config.wanted_outputs(self.previous, **self.options)
+                    if not output_rates({**self.previous, **self.wanted}):
+                        raise ValueError("with these settings the sensor sends nothing "
+                                         "(ASCII output off, no binary output): nothing to "
+                                         "record")
+                config.apply(session, self.wanted)
+            except BaseException:
+                if first:  # leave the sensor as it was, streaming
+                    with contextlib.suppress(Exception):
+                        config.restore(session, self.previous, self.wanted)
+                        session.command("VNASY,1")
                 raise
             session.command("VNASY,1")
         except BaseException:
             serial.close()
             raise
         self.session = session
-        first, session.rest = session.rest, b""
-        return first
+        head, session.rest = session.rest, b""
+        return head
 
     def meta(self, **extra) -> dict:
         settings = {**self.previous, **self.wanted}
@@ -218,6 +223,7 @@ def record(port, output, *, seconds: float | None = None, baud: int | str = 1152
     elif not isinstance(baud, int) or baud <= 0:
         raise ValueError(f"baud must be a positive integer or 'auto'; got {baud!r}")
     options = {"ascii": ascii, "rate": rate, "binary": tuple(binary), "crc": crc}
+    config.wanted_outputs({}, **options)  # bad options fail before the port is opened
     rec = _Recorder(port, output, baud, options, keep_config, None)
     stop_event = stop or threading.Event()
     started = time.monotonic()
