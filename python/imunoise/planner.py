@@ -16,7 +16,7 @@ them). The uncertainty promised at ``confidence`` is the half-width x with
 P(|σ̂/σ − 1| ≤ x) = confidence, and the record length the least n whose x is
 at most the target. This is the statistical uncertainty alone: a model that
 does not follow the sensor (a Gauss–Markov bump, temperature drift) adds its own.
-Checked by simulation in ``tests/record/test_plan.py``. ``imunoise.plan`` is :func:`plan`.
+Checked by simulation in ``tests/record/test_planner.py``. ``imunoise.plan`` is :func:`plan`.
 """
 
 from __future__ import annotations
