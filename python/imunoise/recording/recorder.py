@@ -237,7 +237,8 @@ def record(port, output, *, seconds: float | None = None, baud: int | str = 1152
     try:
         rec.writer = RawWriter(output)
         settings = {**rec.previous, **rec.wanted}
-        rec.writer.write_meta(rec.meta(started=time.time()))
+        began = time.time()
+        rec.writer.write_meta(rec.meta(started=began))
         if live:
             rec.live = LiveView(rates=output_rates(settings), target=seconds, stream=stream)
         rec.write(first)
@@ -258,7 +259,7 @@ def record(port, output, *, seconds: float | None = None, baud: int | str = 1152
         elif rec.session is not None:
             rec.session.serial.close()
     elapsed = time.monotonic() - started
-    rec.writer.write_meta(rec.meta(seconds=elapsed, bytes=rec.writer.size,
+    rec.writer.write_meta(rec.meta(started=began, seconds=elapsed, bytes=rec.writer.size,
                                    outages=len(rec.outages), restored=restored))
     if signalled:  # SIGTERM: now that the record is complete, as it would have
         signal.raise_signal(signalled[0])
