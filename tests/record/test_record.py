@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from helpers.emulator import FULL, record_slice, stop_after
 from imunoise.emulate import Fault
-from imunoise.readers.recording import outages
+from imunoise.readers.recording import host_times, outages
 from imunoise.recording import DeviceError, binary_output, record
 
 IMU_RATE = 800
@@ -40,9 +40,9 @@ def test_ten_minutes_recorded_byte_identical_and_settings_restored(emulator, tmp
     np.testing.assert_array_equal(snap.adev.dev, imunoise.adev(log.gyro, log.fs).dev)
     assert snap.dropped == 0
     # the host receive times: one line per chunk, offsets increasing from 0 within the log
-    times = np.loadtxt(f"{out}.times", dtype=np.int64, ndmin=2)
-    assert times[0, 0] == 0 and np.all(np.diff(times[:, 0]) > 0) and times[-1, 0] < len(raw)
-    assert np.all(np.diff(times[:, 1]) >= 0)
+    offsets, seconds = host_times(out)
+    assert offsets[0] == 0 and np.all(np.diff(offsets) > 0) and offsets[-1] < len(raw)
+    assert np.all(np.diff(seconds) >= 0) and len(seconds) == len(offsets)
 
 
 def test_injected_faults_appear_in_issues_and_gaps_at_their_place(emulator, tmp_path):

@@ -20,7 +20,9 @@ import json
 import os
 from dataclasses import dataclass
 
-__all__ = ["GAPS", "META", "TIMES", "Outage", "outages", "recorded_fs"]
+import numpy as np
+
+__all__ = ["GAPS", "META", "TIMES", "Outage", "host_times", "outages", "recorded_fs"]
 
 TIMES = ".times"
 GAPS = ".gaps"
@@ -58,6 +60,27 @@ def outages(path) -> list[Outage]:
         except (ValueError, IndexError):
             continue
     return found
+
+
+def host_times(path) -> tuple[np.ndarray, np.ndarray]:
+    """``(offsets, seconds)``: byte offset of each chunk received and its host time
+    (Unix s), from ``LOG.times`` (empty arrays without one; a line cut by a kill is
+    left out)."""
+    offsets, seconds = [], []
+    try:
+        with open(os.fspath(path) + TIMES, encoding="ascii", errors="replace") as f:
+            for line in f:
+                parts = line.split()
+                if len(parts) == 2 and line.endswith("\n"):
+                    try:
+                        offset, ns = int(parts[0]), int(parts[1])
+                    except ValueError:
+                        continue
+                    offsets.append(offset)
+                    seconds.append(ns / 1e9)
+    except (FileNotFoundError, IsADirectoryError):
+        pass
+    return np.asarray(offsets, dtype=np.int64), np.asarray(seconds, dtype=np.float64)
 
 
 def recorded_fs(path) -> float | None:
