@@ -23,7 +23,7 @@ from imunoise.recording.protocol import (
 __all__ = ["Session", "find_baud", "open_port"]
 
 #: Seconds to wait for a reply.
-REPLY_TIMEOUT = 1.0
+REPLY_TIMEOUT = 2.0
 #: Seconds a read waits for the first byte (also how fast a vanished port is seen).
 READ_TIMEOUT = 0.02
 _CHUNK = 1 << 16
@@ -115,7 +115,7 @@ def find_baud(port: str, rates=BAUD_RATES) -> int:
             tried.append(baud)
             continue
         try:
-            Session(serial).command("VNRRG,01", timeout=0.3)
+            Session(serial).command("VNRRG,01", timeout=0.5)
             return baud
         except DeviceError:
             tried.append(baud)
