@@ -106,6 +106,8 @@ class Plan:
         """One line: what each term needs, and (given a record length) what it has."""
         from imunoise.numbers import duration
 
+        if not self.terms:
+            return f"plan{' ' + self.label if self.label else ''}: no N, B or K to plan for"
         need = ", ".join(f"{k} {_length(t.seconds)}" for k, t in self.terms.items())
         text = (f"plan{' ' + self.label if self.label else ''}: ±{100 * self.target:g} % "
                 f"({100 * self.confidence:g} % confidence) needs {need}")

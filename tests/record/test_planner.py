@@ -49,6 +49,7 @@ def test_plan_numbers_and_errors():
         < p.terms["K"].seconds == p.seconds
     assert "needs N" in p.line() and "resolves" in p.line(3600)
     assert plan({"N": 1e-4, "B": 0.0, "K": 0.0}).terms.keys() == {"N"}
+    assert "no N, B or K" in plan({}).line(60)
     with pytest.raises(ValueError, match="target"):
         plan("vn100", target=0)
     with pytest.raises(ValueError, match="coefficients must be finite"):
