@@ -85,6 +85,11 @@ CHANGE_POINT_DOF = 10.0
 BURST_SCALES = 3
 #: Smallest energy window, samples (fewer makes the χ² test a spike test).
 MIN_WINDOW = 4
+#: Significance at which a burst's raw (unwhitened) energy over its span must exceed
+#: the quiet noise's: the whitened test also answers to a change of the noise's
+#: spectral shape (the VN-100 live capture's 15–20 Hz band), which adds no power a
+#: person could see (18.4 and 222.5 s there: RMS ×1.05 and ×1.11 of the quiet level).
+CONFIRM_P = 1e-3
 #: Most coefficients of the whitening predictor of the burst test (fewer when the
 #: energy window is shorter): 8 and 16 found the same bursts in the VN-100 live
 #: capture (its 13.5 Hz line and 15–20 Hz band), docs/events.md.
@@ -374,6 +379,7 @@ def events(
             if spans:
                 quiet = ~_span_mask(spans, n, pad=w)
         sigma[j] = mad_sigma * np.sqrt(scale)
+        spans = [sp for sp in spans if sp[2] != "burst" or _raised(z[sp[0]:sp[1]], rho)]
         joined = _join([(a, b, kind, {j}) for a, b, kind in spans], gap, touch)
         # searched once the channel's spans are joined: a shock that the burst test
         # found by itself is then inside the vibration it was joined to
@@ -416,6 +422,18 @@ def _standardise(col: np.ndarray, block: int) -> tuple[np.ndarray, float]:
     if sigma == 0:
         return np.where(valid, 0.0, np.nan), 0.0
     return r / sigma, sigma
+
+
+def _raised(seg: np.ndarray, rho: np.ndarray) -> bool:
+    """Whether the mean z² of ``seg`` (the raw standardised record over a burst, NaN
+    = missing) exceeds the quiet noise's at :data:`CONFIRM_P`: Satterthwaite's
+    χ²(ν)/ν for its length, ν from ``rho`` (w lags; a longer span adds ν in proportion)."""
+    v = seg[np.isfinite(seg)]
+    if v.size < 2:
+        return True  # nothing to judge by: the burst test's word stands
+    w = len(rho)
+    dof = _dof(rho, v.size) if v.size <= w else _dof(rho, w) * v.size / w
+    return float(np.mean(v * v)) > float(_sstats.chi2.isf(CONFIRM_P, dof)) / dof
 
 
 def _isolated(z: np.ndarray, k_spike: float, half: int, level: float) -> np.ndarray:
