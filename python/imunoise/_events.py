@@ -240,6 +240,43 @@ class Events:
         arr[mask] = np.nan
         return arr
 
+    def rms_ratio(self, data, *, baseline: float = 10.0) -> np.ndarray:
+        """How much louder each event is than the quiet record: per event and channel,
+        the RMS over the event over the RMS outside every event, both about the
+        detector's median baseline (``baseline``-second blocks, as :func:`events`).
+
+        Parameters
+        ----------
+        data : ImuLog or array_like
+            The record the events were found in (the same channels).
+
+        Returns
+        -------
+        ndarray, shape (events, channels)
+            1 for an event no louder than the quiet noise; NaN where a channel has
+            no valid sample in the event.
+        """
+        x, _fs, names = rate_channels(data, None if isinstance(data, ImuLog) else self.fs,
+                                      None)
+        if x.shape[0] != self.n_samples or names != self.names:
+            raise ValueError(f"data must be the record of the events ({self.n_samples} "
+                             f"samples of {', '.join(self.names)}); got {x.shape[0]} samples "
+                             f"of {', '.join(names)}")
+        baseline = positive_finite(baseline, "baseline", unit="s")
+        block = max(2 * self.window, int(round(baseline * self.fs)))
+        quiet = ~self.mask
+        out = np.full((len(self), x.shape[1]), np.nan)
+        for j in range(x.shape[1]):
+            r, _sigma = _standardise(x[:, j], block)
+            sq = np.where(np.isfinite(r), r * r, np.nan)
+            with np.errstate(invalid="ignore", divide="ignore"):
+                level = np.sqrt(np.nanmean(sq[quiet])) if quiet.any() else np.nan
+                for i, (a, b) in enumerate(zip(self.start_index, self.end_index, strict=True)):
+                    inside = sq[a:b]
+                    if np.isfinite(inside).any():
+                        out[i, j] = np.sqrt(np.nanmean(inside)) / level
+        return out
+
     def rows(self) -> list[dict]:
         """One dict per event: start, end, duration (s), kind, channels, peak (sigmas),
         within (index of the longer event it lies inside, or None)."""

@@ -7,13 +7,14 @@ computes each analysis once, on first use) and adds its figures through it.
 
 from __future__ import annotations
 
+from functools import partial
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from imunoise import allan as _allan
-from imunoise import noise, numbers, plot, stats
+from imunoise import noise, numbers, plot, stats, units
 from imunoise._schema import CHANNELS, SAMPLE_SENSORS, axis_names
 from imunoise.numbers import format_value
 from imunoise.report.formatting import (
@@ -22,7 +23,12 @@ from imunoise.report.formatting import (
     missing_text,
     terms_used,
 )
-from imunoise.report.model_text import comparison_rows, datasheet_rows, model_sentences
+from imunoise.report.model_text import (
+    comparison_rows,
+    datasheet_rows,
+    lab_rows,
+    model_sentences,
+)
 
 if TYPE_CHECKING:
     from imunoise.report.build import Context
@@ -221,7 +227,7 @@ def allan_deviation(ctx: Context, doc: Doc) -> None:
         header = ["τ [s]", "n"]
         for a in axis_names(r.dev.shape[1]):
             header += [f"σ {a} [{unit}]", f"CI {a}"]
-        doc.table(header, rows, caption=f"Allan deviation of {sensor}")
+        doc.table(header, rows, caption=f"Allan deviation of {sensor}: every τ", collapsed=True)
 
 
 def noise_coefficients(ctx: Context, doc: Doc) -> None:
@@ -231,10 +237,14 @@ def noise_coefficients(ctx: Context, doc: Doc) -> None:
           "IEEE 952 Annex C) and a resonance (a damped oscillator), on ln σ², each octave of τ "
           "weighted alike, the terms chosen by BIC; standard uncertainties from the fit "
           "(docs/noise.md). Read-offs: N on the −½ line at τ = 1 s, B = σ_min/0.664.")
+    if ctx.models:
+        header, rows = lab_rows(ctx.models, ctx.spec, ctx.units)
+        doc.table(header, rows, caption="Lab table: N, B and K per axis"
+                  + (f" beside the datasheet ({ctx.spec}), in one unit" if ctx.spec else ""))
     for sensor, m in ctx.models.items():
-        header, rows = datasheet_rows(m, sensor)
+        header, rows = datasheet_rows(m, sensor, ctx.units, symbols=True)
         doc.table(header, rows, caption=f"{sensor} noise coefficients per axis")
-        for sentence in model_sentences(m, sensor):
+        for sentence in model_sentences(m, sensor, ctx.units):
             doc.p(sentence)
 
 
@@ -243,7 +253,7 @@ def datasheet_comparison(ctx: Context, doc: Doc) -> None:
     if ctx.spec is None:
         doc.p("No datasheet given (`--spec`).")
         return
-    header, rows = comparison_rows(ctx.models, ctx.spec)
+    header, rows = comparison_rows(ctx.models, ctx.spec, ctx.units)
     doc.table(header, rows, caption=f"Measured vs datasheet ({ctx.spec})")
 
 
@@ -314,16 +324,19 @@ def power_spectral_density(ctx: Context, doc: Doc) -> None:
                   else np.full(s.channels, np.nan))
         n, n_std = np.atleast_1d(s.N), np.atleast_1d(s.N_std)
         band = np.reshape(s.band, (-1, 2))
+        # N in the unit of every other table of the report
+        n_unit = units.unit_info("N", units.unit_choice(ctx.units, sensor).get("N"), sensor)
+        in_n_unit = partial(units.convert, term="N", unit=n_unit.name, sensor=sensor)
         rows = []
         for j, a in enumerate(axis_names(s.channels)):
             with np.errstate(divide="ignore", invalid="ignore"):
                 ratio = n[j] / fitted[j] if fitted[j] > 0 else np.nan
-            rows.append([a, format_value(n[j], n_std[j]),
+            rows.append([a, format_value(in_n_unit(n[j]), in_n_unit(n_std[j])),
                          f"{band[j, 0]:.3g} – {band[j, 1]:.3g}",
-                         format_value(fitted[j]), f"{ratio:.3g}",
+                         format_value(in_n_unit(fitted[j])), f"{ratio:.3g}",
                          _n_remark(s, j, ratio)])
-        doc.table(["axis", f"N PSD [{unit}/√Hz]", "white band [Hz]", "N ADEV fit",
-                   "PSD/ADEV", "remark"], rows,
+        doc.table(["axis", f"N PSD [{n_unit.label}]", "white band [Hz]",
+                   f"N ADEV fit [{n_unit.label}]", "PSD/ADEV", "remark"], rows,
                   caption=f"{sensor}: noise density from the spectrum and from the Allan fit"
                   + (f" ({s.segments_skipped} of {s.segments + s.segments_skipped} Welch "
                      "segments hold a missing sample and are left out)"
@@ -393,10 +406,26 @@ def events_section(ctx: Context, doc: Doc) -> None:
         return found.kind[i] if j < 0 else (
             f"{found.kind[i]} inside the event from {format_number(found.start[j] + offset)} s")
 
+    loud = found.rms_ratio(log)
+    column = {name: j for j, name in enumerate(found.names)}
+
+    def loudest(i: int) -> str:
+        """RMS ratio of the event's loudest channel, and which."""
+        ratios = {c: loud[i, column[c]] for c in found.channels[i]}
+        c = max(ratios, key=lambda k: np.nan_to_num(ratios[k]))
+        return f"{ratios[c]:.2g} ({c})"
+
+    doc.p("The evidence per event: its peak in sigmas of the quiet noise, its length, and "
+          "how much louder it is than the quiet record (RMS over the event ÷ RMS outside "
+          "every event, on its loudest channel; 1 = no louder; energy is the square). A "
+          "burst is flagged only where its energy is significantly above the quiet "
+          "noise's.")
     doc.table(
-        ["start [s]", "end [s]", "kind", "channels", "peak [σ]"],
+        ["start [s]", "end [s]", "duration [s]", "kind", "channels", "peak [σ]",
+         "RMS ÷ quiet RMS"],
         [[format_number(found.start[i] + offset), format_number(found.end[i] + offset),
-          kind(i), ", ".join(found.channels[i]), f"{found.peak[i]:.3g}"]
+          numbers.cell(found.duration[i], digits=3), kind(i), ", ".join(found.channels[i]),
+          f"{found.peak[i]:.3g}", loudest(i)]
          for i in sorted(order)],
         caption=f"Events of the short log ({min(len(found), EVENT_ROWS)} largest of "
                 f"{len(found)})",
