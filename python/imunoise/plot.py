@@ -353,9 +353,9 @@ def histograms(
                     ax.text(xpos, 0.98, text.format(count), transform=ax.transAxes,
                             ha=align, va="top", fontsize=7, color="0.3")
             ax.set_xlabel(_label(names[j], unit))
+            ax.set_ylabel(_label("density", _per(unit)))  # each panel has its own scale
             ax.grid(False)
-        axes[0].set_ylabel(_label("density", _per(unit)))
-        _margins(fig, left=0.6, bottom=0.45, top=0.55, wspace=0.3, title=bool(title))
+        _margins(fig, left=0.7, bottom=0.45, top=0.55, wspace=0.4, title=bool(title))
         if title:
             fig.suptitle(title)
         _readable_ticks(fig, axes)

@@ -129,7 +129,7 @@ padding:.05rem .3rem;border-radius:3px}
 .tw{overflow-x:auto;margin:.6rem 0 1.2rem}
 table{border-collapse:collapse;font-size:13px;font-variant-numeric:tabular-nums}
 caption{caption-side:top;text-align:left;color:var(--mut);font-style:italic;padding:.2rem 0}
-th,td{border:1px solid var(--bd);padding:.3rem .6rem;text-align:right;white-space:nowrap}
+th,td{border:1px solid var(--bd);padding:.3rem .45rem;text-align:right;white-space:nowrap}
 th{white-space:normal;vertical-align:bottom}
 details{margin:.4rem 0 1rem}
 summary{cursor:pointer;color:var(--mut);font-style:italic}

@@ -133,28 +133,30 @@ def distribution_fits(ctx: Context, doc: Doc) -> None:
           "some of the printed grid), centred on the levels. With this many samples any "
           "real sensor fails a normality test: read KS D, A², skewness and excess kurtosis "
           "as sizes of the departure from normal.")
-    rows = []
+    rows, bins = [], []
     for sensor, per_axis in ctx.sensor_distributions.items():
         unit = CHANNELS[sensor][1]
         for name, d in per_axis.items():
             rows.append([
-                name, unit, format_number(d.step) if d.step else "—",
-                format_number(d.level_spacing) if d.level_spacing else "—",
-                str(len(d.counts)), format_number(d.mu, d.mu_std),
-                format_number(d.sigma, d.sigma_std), *(numbers.cell(v) for v in (
-                    d.ks_statistic, d.ks_pvalue, d.ad_statistic, d.skewness,
-                    d.excess_kurtosis)),
+                name, unit, format_number(d.mu, d.mu_std), format_number(d.sigma, d.sigma_std),
+                *(numbers.cell(v) for v in (d.ks_statistic, d.ks_pvalue, d.ad_statistic,
+                                            d.skewness, d.excess_kurtosis)),
             ])
+            bins.append([name, unit, format_number(d.step) if d.step else "—",
+                         format_number(d.level_spacing) if d.level_spacing else "—",
+                         str(len(d.counts))])
         fig = plot.histograms(list(per_axis.values()),
                               title=f"{sensor} distribution (short log)", unit=unit)
         ctx.add_figure(doc, fig, f"hist_{sensor}",
                        f"Histogram of {sensor} with the fitted normal density")
     doc.table(
-        ["channel", "unit", "quantization step", "level spacing", "bins", "μ", "σ", "KS D",
-         "KS p", "AD A²", "skewness", "excess kurtosis"],
+        ["channel", "unit", "μ", "σ", "KS D", "KS p", "AD A²", "skewness", "excess kurtosis"],
         rows,
         caption="Distribution fits (short log)",
     )
+    doc.table(["channel", "unit", "quantization step", "level spacing", "bins"], bins,
+              caption="Histogram bins (short log): the sensor's quantization step and the "
+                      "spacing of the levels it uses")
 
 
 def attitude(ctx: Context, doc: Doc) -> None:
