@@ -204,3 +204,109 @@ def test_no_table_is_wider_than_its_column_in_chromium(reports):
         assert len(widths) >= 8, widths
         wide = [w for w in widths if w[1] > w[2]]
         assert not wide, (name, wide)
+
+
+# -- tables: the lab table first, one unit per quantity ----------------------------------
+
+
+def _md_tables(md: str) -> dict[str, list[list[str]]]:
+    """Every Markdown table by its caption (``*caption*`` or a collapsed table's
+    ``<summary>``), rows with the header first."""
+    out, caption, rows = {}, None, []
+    for line in [*md.splitlines(), ""]:
+        if line.startswith("|"):
+            if not set(line) <= set("|-"):
+                rows.append([c.strip() for c in line.strip("|").split("|")])
+            continue
+        if rows:
+            out[caption] = rows
+            rows = []
+        if line.startswith("*") and line.endswith("*") and len(line) > 2:
+            caption = line.strip("*")
+        elif line.startswith("<summary>"):
+            caption = re.sub(r" \(\d+ rows\)</summary>$", "", line[len("<summary>"):])
+    return out
+
+
+def test_lab_table_is_the_first_table_of_the_noise_section(reports):
+    rep, _figs = reports["bundled"]
+    md = rep.markdown.read_text(encoding="utf-8")
+    section = md.split(". Noise coefficients\n")[1].split("\n## ")[0]
+    first = next(line for line in section.splitlines() if line.startswith("*"))
+    assert first.startswith("*Lab table: N, B and K per axis beside the datasheet (vn100)")
+    rows = _md_tables(section)[first.strip("*")]
+    assert rows[0] == ["sensor", "quantity", "unit", "X", "Y", "Z", "datasheet", "as printed"]
+    by = {(r[0], r[1]): r for r in rows[1:]}
+    # datasheet units (--units datasheet): the VN-100's 0.0035 °/s/√Hz and 0.14 mg/√Hz
+    gyro_n = by[("gyro", "angle random walk (N)")]
+    assert gyro_n[2] == "°/s/√Hz" and float(gyro_n[6]) == pytest.approx(0.0035)
+    accel_n = by[("accel", "velocity random walk (N)")]
+    assert accel_n[2] == "µg/√Hz" and float(accel_n[6]) == pytest.approx(140)
+    assert accel_n[7] == "0.14 mg/√Hz typ."
+    assert [r[1] for r in rows[1:4]] == ["angle random walk (N)", "bias instability (B)",
+                                        "rate random walk (K)"]
+
+
+def _units_by_quantity(md: str) -> dict[tuple[str, str], set[str]]:
+    """(sensor, term) -> the units the report's tables write it in."""
+    tables = _md_tables(md)
+    seen: dict[tuple[str, str], set[str]] = {}
+    for caption, rows in tables.items():
+        if caption is None:
+            continue
+        header = rows[0]
+        if caption.startswith("Lab table") or caption.startswith("Measured vs datasheet"):
+            q, u = header.index("quantity"), header.index("unit")
+            for r in rows[1:]:
+                term = re.search(r"\((\w)\)$", r[q]).group(1)
+                seen.setdefault((r[0], term), set()).add(r[u])
+        elif caption.endswith("noise coefficients per axis"):
+            sensor = caption.split()[0]
+            for r in rows[1:]:
+                seen.setdefault((sensor, r[1]), set()).add(r[2])
+        elif "noise density from the spectrum" in caption:
+            sensor = caption.split(":")[0]
+            for h in header:
+                if h.startswith("N "):
+                    seen.setdefault((sensor, "N"), set()).add(h[h.index("[") + 1:-1])
+    return seen
+
+
+def test_one_unit_per_quantity_across_the_tables(reports):
+    for name, (rep, _figs) in reports.items():
+        seen = _units_by_quantity(rep.markdown.read_text(encoding="utf-8"))
+        assert ("accel", "B") in seen and ("gyro", "N") in seen, seen
+        for key, units in seen.items():
+            assert len(units) == 1, (name, key, units)
+    bundled = _units_by_quantity(reports["bundled"][0].markdown.read_text(encoding="utf-8"))
+    simulated = _units_by_quantity(reports["simulated"][0].markdown.read_text(encoding="utf-8"))
+    assert bundled[("gyro", "N")] == {"°/s/√Hz"} and bundled[("accel", "B")] == {"µg"}
+    assert simulated[("gyro", "N")] == {"°/√h"} and simulated[("accel", "N")] == {"mg/√Hz"}
+
+
+def test_lab_table_text_and_its_units():
+    import imunoise
+
+    y = imunoise.simulate(200_000, 40.0, N=1e-4, B=2e-5, K=1e-6, channels=3, seed=2)
+    model = imunoise.fit(imunoise.adev(y, 40.0, taus=10), warn_coverage=False)
+    text = model.table_text("lab", sensor="gyro", spec="vn100", units="datasheet")
+    lines = text.splitlines()
+    assert lines[0].split()[-3:] == ["datasheet", "as", "printed"]
+    n_line = next(line for line in lines if line.startswith("N "))
+    assert "°/s/√Hz" in n_line and "0.0035 °/s/√Hz typ." in n_line
+    assert len([line for line in lines[2:] if line.strip()]) == 3  # N, B, K only
+    rows = {r["term"]: r for r in model.lab_table("gyro", spec="vn100")}
+    # the datasheet's 10 °/h, in the default unit of B (°/h), beside the measured values
+    assert rows["B"]["spec"] == pytest.approx(10.0) and rows["B"]["spec_text"] == "< 10 °/h"
+    assert rows["K"]["spec_text"] == "—" and np.isnan(rows["K"]["spec"])
+    assert rows["N"]["spec"] == pytest.approx(0.0035 * 60)  # °/s/√Hz -> °/√h
+    with pytest.raises(ValueError, match="sensor once"):
+        model.table_text("accel", sensor="gyro")
+
+
+def test_cli_report_units_datasheet_is_parsed_beside_the_layout_units():
+    from imunoise.cli import _TABLE_UNITS, _build_parser
+
+    args = _build_parser().parse_args(["report", "x.txt", "--units", "datasheet",
+                                       "--units", "gyro=deg/s"])
+    assert _TABLE_UNITS in args.units and ("gyro", "deg/s") in args.units

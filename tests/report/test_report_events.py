@@ -129,7 +129,7 @@ def test_long_log_events_with_and_without_in_the_allan_analysis(trimmed):
     assert f"holds {len(found)} event" in text
     # the "without events" column is the gap-aware ADEV of the log with them left out
     cut = found.exclude(analysed, pad=0.2)
-    row = re.search(r"\| gyro X \| 10(?:\.0)? s \| ([^|]+) \| ([^|]+) \|", text)
+    row = re.search(r"\| gyro X \| rad/s \| 10(?:\.0)? s \| ([^|]+) \| ([^|]+) \|", text)
     assert row, text
     want = imunoise.adev(cut.gyro[:, 0], FS, taus=[10.0]).dev[0]
     assert float(row.group(2)) == pytest.approx(want, rel=0.01)

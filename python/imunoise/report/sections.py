@@ -60,6 +60,12 @@ GAP_ROWS = 10
 GAP_SHADE = plot.SHADED_GAPS
 
 
+def _unit_of(channel: str) -> str:
+    """Unit of a channel named like ``"gyro X"``; "" for a name that is no log channel's."""
+    sensor = channel.split(" ")[0]
+    return CHANNELS[sensor][1] if sensor in CHANNELS else ""
+
+
 def _which(label: str) -> str:
     """How the text names a log: "the log" (one log for both) or "the short log"."""
     return "the log" if label == "both" else f"the {label} log"
@@ -507,12 +513,12 @@ def long_log_events(ctx: Context, doc: Doc) -> None:
                 outside = not lo[i, j] <= dev_out[i, j] <= hi[i, j]
                 if outside:
                     changed.append(f"{sensor} {axis} at {format_duration(tau)}")
-                rows.append([f"{sensor} {axis}", format_duration(tau),
+                rows.append([f"{sensor} {axis}", CHANNELS[sensor][1], format_duration(tau),
                              numbers.cell(dev[i, j]), numbers.cell(dev_out[i, j]),
                              f"{dev_out[i, j] / dev[i, j]:.3g}" if dev[i, j] > 0 else "—",
                              "yes" if outside else "no"])
     level = f"{100 * next(iter(ctx.allan.values())).confidence:.3g} %"
-    doc.table(["channel", "τ", "ADEV", "without events", "ratio",
+    doc.table(["channel", "unit", "τ", "ADEV", "without events", "ratio",
                f"outside the {level} interval"], rows,
               caption=f"Allan deviation of the {'only' if ctx.one_log else 'long'} log with "
                       "and without its events")
@@ -539,8 +545,8 @@ def warmup_section(ctx: Context, doc: Doc) -> None:
           "and has settled when what is left of it is below "
           "the channel's Allan-deviation floor (docs/events.md).")
     doc.table(
-        ["channel", "A", "τ", "p", "tolerance", "settled after"],
-        [[r["name"],
+        ["channel", "unit of A and tolerance", "A", "τ", "p", "tolerance", "settled after"],
+        [[r["name"], _unit_of(r["name"]),
           format_number(r["amplitude"], r["amplitude_std"]) if r["significant"] else "—",
           format_duration(r["tau"]) if r["significant"] else "—", f"{r['p_value']:.2g}",
           numbers.cell(r["tolerance"]),
