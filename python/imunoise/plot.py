@@ -642,7 +642,7 @@ def allan(
             ax.text(0.02, 0.06, f"follows {cover:.0%} of taus", transform=ax.transAxes,
                     fontsize=7)
             if j == 0:
-                ax.set_ylabel("data/model [ratio]")
+                ax.set_ylabel("data/model\n[ratio]")
             axes[j].tick_params(labelbottom=False)
         if spans:
             span = min(max(spans), 0.9)  # shared by the residual panels
