@@ -61,3 +61,17 @@ def test_live_capture_events_are_louder_than_its_quiet_noise():
         assert not np.any((found.start <= t + 0.5) & (found.end >= t)), found.rows()
     for t in (79.0, 94.0, 137.0, 400.0, 742.0):  # visible bursts and the 324–477 s vibration
         assert np.any((found.start <= t) & (found.end >= t)), t
+
+
+def test_rms_ratio_is_the_burst_against_the_quiet_noise():
+    fs, start, length = 100.0, 30_000, 200
+    rng = np.random.default_rng(4)
+    x = rng.standard_normal(60_000)
+    x[start:start + length] += 3.0 * rng.standard_normal(length)  # RMS √10 of the quiet 1
+    found = imunoise.events(x, fs)
+    (ratio,) = found.rms_ratio(x)[:, 0]
+    assert ratio == pytest.approx(np.sqrt(10), rel=0.15)
+    with pytest.raises(ValueError, match=r"\(60000 samples of x\); got 100 samples"):
+        found.rms_ratio(x[:100])
+    with pytest.raises(ValueError, match="baseline must be"):
+        found.rms_ratio(x, baseline=-1.0)
