@@ -716,6 +716,7 @@ def spectrum(
     bands = np.reshape(result.band, (k, 2))
     terms = model_psd_terms(model, s.f) if model is not None else {}
     names = list(names) if names is not None else axis_names(k)
+    unit = unit or INPUT_UNIT
     level_unit = f"{unit}/√Hz" if amplitude else f"({unit})²/Hz"
     with style():
         fig = new_figure(figsize=(min(3.6 * k, 14.0), 3.4))
@@ -726,7 +727,7 @@ def spectrum(
             ax.loglog(s.f, p[:, j], color=color, label="PSD" if not amplitude else "ASD")
             ax.axvspan(*bands[j], color="0.85", alpha=0.5, linewidth=0, label="white band")
             level = (2 * white_n[j] ** 2) ** power
-            value = f"N = {format_value(white_n[j], white_std[j])} {unit}/√Hz".replace("  ", " ")
+            value = f"N = {format_value(white_n[j], white_std[j])} {unit}/√Hz"
             ax.plot(bands[j], [level, level], color="k", linewidth=1.6,
                     label="N read-off (level 2N²)")
             ax.text(0.03, 0.04, value, transform=ax.transAxes, fontsize=7,
