@@ -76,9 +76,17 @@ class Doc:
             elif b[0] == "table":
                 _, header, rows, caption, collapsed = b
                 cap = f"<caption>{e(caption)}</caption>" if caption and not collapsed else ""
-                th = "".join(f"<th>{e(h)}</th>" for h in header)
+                # columns of words (quantity, verdict, remark) read left-aligned,
+                # columns of numbers right-aligned
+                cells = [[r[i] for r in rows if i < len(r) and r[i] not in _NEUTRAL]
+                         for i in range(len(header))]
+                left = [i > 0 and bool(c) and not any(_NUMERIC.match(v) for v in c)
+                        for i, c in enumerate(cells)]
+                cls = [' class="l"' if flag else "" for flag in left]
+                th = "".join(f"<th{cls[i]}>{e(h)}</th>" for i, h in enumerate(header))
                 trs = "".join(
-                    "<tr>" + "".join(f"<td>{e(c)}</td>" for c in r) + "</tr>" for r in rows
+                    "<tr>" + "".join(f"<td{cls[i] if i < len(cls) else ''}>{e(c)}</td>"
+                                     for i, c in enumerate(r)) + "</tr>" for r in rows
                 )
                 # A short table is kept on one printed page; a long one flows
                 # across pages with its header repeated.
@@ -97,6 +105,12 @@ class Doc:
                 )
         return _HTML.format(title=e(title), css=_CSS, body="\n".join(body))
 
+
+#: A cell that reads as a number: "1.2", "(3.4 ± 0.1)e-3", "−5", "< 10", "typ. 0.2".
+_NUMERIC = re.compile(r"^(typ\.\s*)?[(<>~−-]?\s*[\d.]")
+
+#: Cells that say nothing about their column's kind.
+_NEUTRAL = frozenset({"", "—", "not resolved"})
 
 #: Tables with at most this many rows are not split across printed pages.
 _KEEP_TOGETHER_ROWS = 20
@@ -134,7 +148,7 @@ th{white-space:normal;vertical-align:bottom}
 details{margin:.4rem 0 1rem}
 summary{cursor:pointer;color:var(--mut);font-style:italic}
 th{background:var(--hd);font-weight:600}
-td:first-child,th:first-child{text-align:left}
+td:first-child,th:first-child,td.l,th.l{text-align:left}
 tbody tr:nth-child(even){background:#fafbfd}
 figure{margin:1rem 0 1.6rem}
 img{max-width:100%;height:auto;border:1px solid var(--bd);border-radius:4px}
