@@ -334,3 +334,17 @@ def test_cli_report_units_datasheet_is_parsed_beside_the_layout_units():
     args = _build_parser().parse_args(["report", "x.txt", "--units", "datasheet",
                                        "--units", "gyro=deg/s"])
     assert _TABLE_UNITS in args.units and ("gyro", "deg/s") in args.units
+
+
+def test_columns_of_words_are_left_aligned_and_long_tables_collapse():
+    from imunoise.report.document import Doc
+
+    doc = Doc()
+    doc.table(["channel", "value", "verdict", "Z"],
+              [["gyro X", "(1.2 ± 0.1)e-3", "pass", "not resolved"],
+               ["gyro Y", "< 10", "fail (2× typical)", "—"]], caption="t")
+    doc.table(["τ [s]", "σ"], [["0.1", "2"]] * 40, caption="long", collapsed=True)
+    html = doc.html("x")
+    assert '<td class="l">pass</td>' in html and '<td>(1.2 ± 0.1)e-3</td>' in html
+    assert '<td>not resolved</td>' in html  # a column without a word or a number: as is
+    assert "<details><summary>long (40 rows)</summary>" in html
