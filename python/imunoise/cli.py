@@ -79,6 +79,7 @@ def _build_parser() -> argparse.ArgumentParser:
     r.add_argument("--trim", choices=["auto"], default=None,
                    help="'auto': analyse the long log from the end of its warm-up transient "
                    "(the report states what was cut)")
+    _report_units_option(r)
 
     a = sub.add_parser("adev", help="print an Allan-family deviation table",
                        description="Print tau, deviation, confidence interval and number of "
@@ -375,13 +376,35 @@ def _note_gaps(source: str, done) -> None:
 # --- commands ------------------------------------------------------------------------
 
 
+#: ``--units datasheet`` of ``report``, told apart from the layout's ``CHANNEL=UNIT``.
+_TABLE_UNITS = ("tables", "datasheet")
+
+
+def _report_units_option(parser) -> None:
+    """``report --units datasheet``: the units of the report's tables, on the same
+    option as the layout's ``--units CHANNEL=UNIT`` (a value without ``=``)."""
+    action = next(a for a in parser._actions if "--units" in a.option_strings)
+    layout = action.type
+
+    def units_value(text: str) -> tuple[str, str]:
+        return _TABLE_UNITS if text.strip() == "datasheet" else layout(text)
+
+    action.type = units_value
+    action.metavar = "CHANNEL=UNIT|datasheet"
+    action.help += ("; 'datasheet': every table of the report gives N, B, K in the units "
+                    "datasheets write (deg/s/sqrt(Hz), deg/h, ug/sqrt(Hz), ug) instead of "
+                    "deg/sqrt(h), mg/sqrt(Hz)")
+
+
 def _cmd_report(args) -> int:
     from imunoise import report
 
     spec = None if args.spec.lower() == "none" else args.spec
+    table_units = "datasheet" if _TABLE_UNITS in args.units else None
+    args.units = [u for u in args.units if u != _TABLE_UNITS]
     rep = report.build(args.short_log, args.long_log, args.output, spec=spec, fs=args.fs,
                        progress=args.progress, read_options=_read_options(args), trim=args.trim,
-                       force=args.force)
+                       force=args.force, units=table_units)
     for log in rep.logs:
         _note_gaps(log.source, log)
     print(f"report written to {rep.html}")
@@ -438,7 +461,8 @@ def _cmd_fit(args) -> int:
             model, s, units="datasheet" if args.datasheet_units else None)
         print(f"# {s}")
         _print_table(head, rows)
-        for sentence in report.model_sentences(model, s):
+        for sentence in report.model_sentences(
+                model, s, units="datasheet" if args.datasheet_units else None):
             print(sentence.replace("**", ""))
         print(_plan_line(model, log, s))
         if args.plot:

@@ -320,10 +320,58 @@ class NoiseModel(PerTerm):
             rows.append(row)
         return rows
 
-    def table_text(self, sensor: str = "gyro", **kwargs) -> str:
-        """Text rendering of :meth:`table`."""
-        rows = self.table(sensor, **kwargs)
-        return format_table(rows, _schema.axis_names(self.channels, kwargs.get("axes")))
+    def lab_table(self, sensor: str = "gyro", *, spec="vn100",
+                  units: dict[str, str] | str | None = None, input_unit: str | None = None,
+                  axes: Sequence[str] | None = None) -> list[dict]:
+        """The lab report's table: N, B and K per axis beside the datasheet's value.
+
+        The rows of :meth:`table` for N, B and K (same keys, same ``units``), each
+        with ``spec`` (the datasheet's value in the row's unit, NaN when the
+        datasheet does not give it), ``spec_text`` (as the datasheet prints it:
+        ``"< 10 °/h"``, ``"0.0035 °/s/√Hz typ."``, ``"—"``) and ``spec_quantity``.
+
+        Parameters
+        ----------
+        spec : str, path, :class:`imunoise.datasheet.Spec` or None
+            The datasheet (:func:`imunoise.datasheet.load_spec`; default the VN-100's);
+            None: no datasheet values.
+        """
+        from imunoise import datasheet
+
+        items = datasheet.load_spec(spec).items if spec is not None else ()
+        given = {item.term: item for item in items if item.sensor == sensor}
+        rows = [r for r in self.table(sensor, units=units, input_unit=input_unit, axes=axes,
+                                      terms=LAB_TERMS) if r["term"] in LAB_TERMS]
+        for row in rows:
+            item = given.get(row["term"])
+            row["spec"], row["spec_text"], row["spec_quantity"] = float("nan"), "—", ""
+            if item is None:
+                continue
+            label = _units.unit_info(row["term"], item.unit, sensor).label
+            row["spec"] = float(_units.convert(
+                _units.convert_back(item.value, row["term"], item.unit, sensor=sensor,
+                                    input_unit=input_unit),
+                row["term"], row["unit"], sensor=sensor, input_unit=input_unit))
+            bound = {"max": "< ", "min": "> "}.get(item.limit, "")
+            row["spec_text"] = (f"{bound}{item.value:g} {label}"
+                                + (" typ." if item.limit == "typical" else ""))
+            row["spec_quantity"] = item.quantity
+        return rows
+
+    def table_text(self, which: str = "gyro", /, **kwargs) -> str:
+        """Text rendering of :meth:`table` (``which`` is the sensor, ``"gyro"`` or
+        ``"accel"``), or with ``which="lab"`` of :meth:`lab_table` (pass
+        ``sensor=``, default ``"gyro"``, and ``spec=``): N, B, K per axis beside the
+        datasheet's values, in one unit."""
+        axes = _schema.axis_names(self.channels, kwargs.get("axes"))
+        if which == "lab":
+            rows = self.lab_table(kwargs.pop("sensor", "gyro"), **kwargs)
+            return format_table(rows, axes, datasheet=True)
+        sensor = kwargs.pop("sensor", which)
+        if which not in ("gyro", sensor):
+            raise ValueError(f"table_text takes the sensor once; got {which!r} and "
+                             f"sensor={sensor!r}")
+        return format_table(self.table(sensor, **kwargs), axes)
 
     # -- exports ------------------------------------------------------------
     @old_call_forms(keyword_only=("accel", "path"))
@@ -371,13 +419,19 @@ _MOVED_FIELDS = frozenset({
 })
 
 
-def format_table(rows: list[dict], axes: Sequence[str]) -> str:
+#: The terms of the lab table (:meth:`NoiseModel.lab_table`): what a lab report asks for.
+LAB_TERMS = ("N", "B", "K")
+
+
+def format_table(rows: list[dict], axes: Sequence[str], *, datasheet: bool = False) -> str:
     """Render :meth:`NoiseModel.table` rows as fixed-width text.
 
     Terms the data do not resolve print as ``not resolved`` (the report's and
     ``imunoise fit``'s wording too), a component an axis's model does not have
     as ``—``; values carry ``± std``, rounded to it
-    (:func:`imunoise.numbers.format_value`).
+    (:func:`imunoise.numbers.format_value`). With ``datasheet`` (rows of
+    :meth:`NoiseModel.lab_table`), two more columns: the datasheet's value in the
+    row's unit and as the datasheet prints it.
     """
     def cell(row, ax):
         if not row[ax + "_supported"]:
@@ -387,6 +441,10 @@ def format_table(rows: list[dict], axes: Sequence[str]) -> str:
     header = ["coefficient", "unit", *axes]
     body = [[f"{r['term']} {r['quantity']}", r["label"], *(cell(r, a) for a in axes)]
             for r in rows]
+    if datasheet:
+        header += ["datasheet", "as printed"]
+        for line, r in zip(body, rows, strict=True):
+            line += [_numbers.cell(r["spec"], digits=3), r["spec_text"]]
     widths = [max(len(str(x[i])) for x in [header, *body]) for i in range(len(header))]
     lines = ["  ".join(str(x).ljust(w) for x, w in zip(line, widths, strict=True)).rstrip()
              for line in [header, *body]]

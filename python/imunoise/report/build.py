@@ -53,6 +53,9 @@ class Context:
     untrimmed: ImuLog | None = None
     #: What ``--trim auto`` cut, in words ("" when nothing was cut).
     trim_note: str = ""
+    #: Units of the noise coefficients in every table (None: the defaults, or
+    #: "datasheet"; :meth:`imunoise.noise.NoiseModel.table`).
+    units: str | None = None
 
     @property
     def logs(self) -> list[tuple[str, ImuLog]]:
@@ -248,6 +251,7 @@ def build(
     read_options: Mapping[str, object] | None = None,
     trim: str | None = None,
     force: bool = False,
+    units: str | None = None,
 ) -> Report:
     """Analyse the logs and write the report directory.
 
@@ -280,9 +284,15 @@ def build(
     force : bool
         Write into an existing folder that is not a report (default False: refused
         with a ``ValueError``).
+    units : {None, "datasheet"}
+        Units of N, B, K, Q, R in every table of the report (one unit per quantity):
+        None the defaults (°/√h, °/h, mg/√Hz, µg, …), ``"datasheet"`` the units MEMS
+        datasheets write (°/s/√Hz, °/h, µg/√Hz, µg; :data:`imunoise.units.DATASHEET_UNITS`).
     """
     if trim not in (None, "auto"):
         raise ValueError(f"trim must be None or 'auto'; got {trim!r}")
+    if units not in (None, "datasheet"):
+        raise ValueError(f"units must be None or 'datasheet'; got {units!r}")
     out = Path(out_dir)
     inputs = [p for p in (short, long) if isinstance(p, str | os.PathLike)]
     previous = folder.claim(out, force=force, inputs=inputs)
@@ -292,7 +302,8 @@ def build(
                                                        progress=wanted(progress), **options)
     folder.mark(out, previous)
     (out / "figures").mkdir(parents=True, exist_ok=True)
-    ctx = Context(short=short_log, long=long_log, one_log=long is None, spec=spec, out_dir=out)
+    ctx = Context(short=short_log, long=long_log, one_log=long is None, spec=spec, out_dir=out,
+                  units=units)
     if trim == "auto":
         _trim_warmup(ctx)
     doc = Doc()
