@@ -96,7 +96,8 @@ def main(argv: list[str]) -> int:
         work.mkdir()
         run([python, "-m", "pip", "install", "--quiet", str(wheel)], env=env, cwd=work)
         run([python, "-c", SMOKE], env=env, cwd=work)
-        version = subprocess.run([str(venv / "bin" / "imunoise"), "--version"], env=env, cwd=work, check=True,
+        imunoise = str(venv / "bin" / "imunoise")
+        version = subprocess.run([imunoise, "--version"], env=env, cwd=work, check=True,
                                  capture_output=True, text=True).stdout.strip()
         meta = subprocess.run([python, "-c", "import imunoise; print(imunoise.__version__)"],
                               env=env, cwd=work, check=True, capture_output=True,
@@ -105,7 +106,7 @@ def main(argv: list[str]) -> int:
             raise SystemExit(f"check_wheel: versions differ: {version!r}, __version__ "
                              f"{meta!r}, wheel {wheel.name}")
         print(f"versions agree: {version}, {wheel.name}")
-        run([str(venv / "bin" / "imunoise"), "demo", "-o", str(tmp / "demo"), "--no-progress"], env=env, cwd=work)
+        run([imunoise, "demo", "-o", str(tmp / "demo"), "--no-progress"], env=env, cwd=work)
         if not (tmp / "demo" / "report.html").exists():
             raise SystemExit("check_wheel: imunoise demo wrote no report.html")
         print(f"wheel ok: {wheel.name}")

@@ -89,7 +89,8 @@ def api_index(objects: dict[str, object]) -> str:
         out.append(f"{heading}\n{'-' * len(heading)}\n")
         out.append(".. list-table::\n   :widths: 30 70\n")
         for n in names:
-            text = _escape(summary(objects[n])) if kind != "data" else "The version string."
+            # the first paragraph of a docstring is reST already (roles kept)
+            text = summary(objects[n]) if kind != "data" else "The version string."
             out.append(f"   * - :doc:`imunoise.{n} <{page_name(n)}>`\n     - {text}")
         out.append("")
         out.append(".. toctree::\n   :hidden:\n")
@@ -166,7 +167,8 @@ def cli_page(prog: str, parser: argparse.ArgumentParser, help_text: str) -> str:
         for action in actions:
             out.append(f".. option:: {_option_signature(parser, action)}\n")
             text = _option_help(parser, action)
-            if action.choices is not None and not isinstance(action.choices, dict):
+            if action.choices is not None and action.metavar is not None:
+                # the metavar hides the choices the signature would otherwise show
                 choices = ", ".join(str(c) for c in action.choices)
                 text = f"{text} (one of: {choices})" if text else f"One of: {choices}."
             if text:
