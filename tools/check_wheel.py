@@ -27,9 +27,11 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 RUST_TOOLS = ("cargo", "rustc", "rustup")
+#: Where a venv keeps its programs.
+BIN = "Scripts" if os.name == "nt" else "bin"
 #: Variables the venv's commands keep: certificates, proxies, pip's settings, locale.
 KEPT = ("HOME", "LANG", "LC_ALL", "TMPDIR", "SSL_CERT_FILE", "SSL_CERT_DIR",
-        "REQUESTS_CA_BUNDLE", "CURL_CA_BUNDLE")
+        "REQUESTS_CA_BUNDLE", "CURL_CA_BUNDLE", "SYSTEMROOT", "TEMP", "TMP", "USERPROFILE")
 KEPT_PREFIXES = ("PIP_", "HTTP_PROXY", "HTTPS_PROXY", "NO_PROXY", "http_proxy", "https_proxy",
                  "no_proxy")
 
@@ -65,9 +67,9 @@ def build(out: Path) -> Path:
 
 def without_rust(venv: Path) -> dict[str, str]:
     """The environment of the venv's commands: no Rust tool reachable."""
-    folders = [str(venv / "bin")] + [
+    folders = [str(venv / BIN)] + [
         d for d in os.environ.get("PATH", "").split(os.pathsep)
-        if d and not any((Path(d) / tool).exists() for tool in RUST_TOOLS)
+        if d and not any(shutil.which(tool, path=d) for tool in RUST_TOOLS)
     ]
     env = {k: v for k, v in os.environ.items()
            if k in KEPT or k.startswith(KEPT_PREFIXES)}
@@ -91,12 +93,12 @@ def main(argv: list[str]) -> int:
         venv = tmp / "venv"
         run([sys.executable, "-m", "venv", str(venv)])
         env = without_rust(venv)
-        python = str(venv / "bin" / "python")
+        python = str(venv / BIN / "python")
         work = tmp / "work"  # outside the source tree: nothing imports from python/
         work.mkdir()
         run([python, "-m", "pip", "install", "--quiet", str(wheel)], env=env, cwd=work)
         run([python, "-c", SMOKE], env=env, cwd=work)
-        imunoise = str(venv / "bin" / "imunoise")
+        imunoise = str(venv / BIN / "imunoise")
         version = subprocess.run([imunoise, "--version"], env=env, cwd=work, check=True,
                                  capture_output=True, text=True).stdout.strip()
         meta = subprocess.run([python, "-c", "import imunoise; print(imunoise.__version__)"],

@@ -42,4 +42,8 @@ dyn
 
 # %%
 fig = plot.dynamic(dyn, title="gyro dynamic Allan deviation")
-print(dyn.stationarity)
+
+# %%
+# The departures, each to within one step: the louder ten minutes, found on every axis
+# with the ratio of its deviation to the record's.
+dyn.stationarity
