@@ -33,7 +33,18 @@ def expected_pages() -> list[Path]:
     return pages
 
 
+#: The modules the docs extra installs (pyproject.toml).
+NEEDED = ("sphinx", "numpydoc", "pydata_sphinx_theme", "myst_parser", "sphinx_gallery")
+
+
 def main() -> int:
+    import importlib.util
+
+    missing_modules = [m for m in NEEDED if importlib.util.find_spec(m) is None]
+    if missing_modules:
+        print(f"check_docs: {', '.join(missing_modules)} not installed; "
+              "install the docs extra: python3 -m pip install -e '.[docs]'", file=sys.stderr)
+        return 2
     command = [sys.executable, "-m", "sphinx", "-W", "--keep-going", "-q", "-b", "html",
                str(DOCS), str(HTML)]
     print(f"$ {' '.join(command)}", flush=True)

@@ -47,8 +47,8 @@ assert imunoise.__version__ == meta, (imunoise.__version__, meta)
 x = imunoise.simulate(20_000, 100.0, N=1e-3, seed=0)
 r = imunoise.adev(x, 100.0)
 model = imunoise.fit(r, terms=["N"])
-assert abs(model.N[0] / 1e-3 - 1) < 0.1, model.N
-print(f"smoke: imunoise {meta} from {imunoise.__file__}; N = {model.N[0]:.4g}")
+assert abs(float(model.N) / 1e-3 - 1) < 0.1, model.N
+print(f"smoke: imunoise {meta} from {imunoise.__file__}; N = {float(model.N):.4g}")
 """
 
 
