@@ -54,7 +54,12 @@ def main() -> int:
     missing = [p for p in expected_pages() if not p.exists()]
     for page in missing:
         print(f"check_docs: no page {page.relative_to(ROOT)}", file=sys.stderr)
-    if missing:
+    # every gallery example draws: a page without a figure lost its scraper
+    blank = [p for p in (HTML / "auto_examples").glob("plot_*.html")
+             if (DOCS / "gallery" / f"{p.stem}.py").exists() and "<img" not in p.read_text()]
+    for page in blank:
+        print(f"check_docs: no figure on {page.relative_to(ROOT)}", file=sys.stderr)
+    if missing or blank:
         return 1
     print(f"docs: {HTML.relative_to(ROOT) / 'index.html'}")
     return 0
