@@ -316,7 +316,7 @@ class Events:
     def _repr_html_(self) -> str:
         rows = [
             [_summary.number(r["start"]), _summary.number(r["end"]), r["kind"], r["channels"],
-             _summary.number(r["peak"])]
+             f"{r['peak']:.3g}"]  # as the repr and the report print it
             for r in self.rows()[: _summary.HTML_ROWS]
         ]
         caption = "Events: " + ", ".join(self._facts()[:2])

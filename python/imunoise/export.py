@@ -3,14 +3,14 @@
 Kalibr's IMU model (``imu.yaml``) and OpenVINS' ``kalibr_imu_chain.yaml`` take
 continuous-time densities in SI units:
 
-=============================  =======================  ====================
-key                            noise-model coefficient  unit
-=============================  =======================  ====================
-``gyroscope_noise_density``    N of the gyro            rad/s/√Hz
-``gyroscope_random_walk``      K of the gyro            rad/s²/√Hz
-``accelerometer_noise_density`` N of the accelerometer  m/s²/√Hz
-``accelerometer_random_walk``  K of the accelerometer   m/s³/√Hz
-=============================  =======================  ====================
+===============================  =======================  ====================
+key                              noise-model coefficient  unit
+===============================  =======================  ====================
+``gyroscope_noise_density``      N of the gyro            rad/s/√Hz
+``gyroscope_random_walk``        K of the gyro            rad/s²/√Hz
+``accelerometer_noise_density``  N of the accelerometer   m/s²/√Hz
+``accelerometer_random_walk``    K of the accelerometer   m/s³/√Hz
+===============================  =======================  ====================
 
 (N in rad/√s is numerically rad/s/√Hz, K in rad/s/√s is rad/s²/√Hz.) Kalibr's
 model has no Gauss–Markov state, so the values written are the model's

@@ -315,6 +315,17 @@ class Components(PerTerm):
         return _summary.lines(f"Components({_summary.plural(self.channels, 'channel')}",
                               axes)
 
+    def _repr_html_(self) -> str:
+        """One row per axis: the fitted IEEE coefficients ± their uncertainty (— where
+        not in the structure) and the structure in words."""
+        rows = [[name, *(_summary.estimate(self.value(t)[c], self.std(t)[c])
+                         if np.atleast_1d(self.supported[t])[c] else "—" for t in TERMS),
+                 self.structure(c)]
+                for c, name in enumerate(_schema.axis_names(self.channels))]
+        return _summary.html_table(
+            ["axis", *TERMS, "structure"], rows,
+            caption=f"Components: {_summary.plural(self.channels, 'channel')}")
+
 
 def finite_list(values) -> list[float | None]:
     """``values`` as a list of floats, ``None`` where not finite (JSON has no NaN)."""

@@ -206,16 +206,16 @@ class NoiseModel(PerTerm):
 
     def _repr_html_(self) -> str:
         """One row per axis: each datasheet value ± standard uncertainty in the
-        input's units (``not resolved`` where the data do not resolve it), the
-        fitted components and the coverage."""
+        input's units, rounded to it as in the repr (``not resolved`` where the data
+        do not resolve it), the fitted components and the coverage."""
         units = _INPUT_UNITS
         rows = []
         for c, name in enumerate(_schema.axis_names(self.channels)):
             row: list[object] = [name]
             for t in TERMS:
                 v, e = self.value(t)[c], self.std(t)[c]
-                row.append(_numbers.NOT_RESOLVED if not self.resolved(t)[c]
-                           else _summary.number(v) + (f" ± {e:.2g}" if np.isfinite(e) else ""))
+                row.append(_summary.estimate(v, e) if self.resolved(t)[c]
+                           else _numbers.NOT_RESOLVED)
             row.append(self.components.structure(c))
             row.append(f"{100 * float(np.atleast_1d(self.coverage)[c]):.3g} %")
             rows.append(row)

@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from imunoise import _atomic, _schema, export, noise, plot, stats
+from imunoise import _atomic, _schema, _summary, export, noise, plot, stats
 from imunoise import allan as _allan
 from imunoise._core import __version__
 from imunoise._events import Events, events
@@ -238,6 +238,22 @@ class Report:
     models: dict
     logs: tuple = ()
     attitude: dict = field(default_factory=dict)
+
+    def _facts(self) -> list[str]:
+        return [_summary.plural(len(self.logs), "log"),
+                _summary.plural(len(self.figures), "figure file"),
+                "models " + (" ".join(self.models) or "none")]
+
+    def __repr__(self) -> str:
+        return _summary.lines(f"Report({str(self.out_dir)!r}", self._facts(), sep=", ")
+
+    def _repr_html_(self) -> str:
+        """What the report wrote, one file kind a row."""
+        rows = [["report", self.html.name], ["Markdown", self.markdown.name],
+                ["figures", _summary.plural(len(self.figures), "file")],
+                ["model files", ", ".join(p.name for p in self.model_files) or "—"]]
+        return _summary.html_table(["", str(self.out_dir)], rows,
+                                   caption="Report: " + ", ".join(self._facts()))
 
 
 def build(

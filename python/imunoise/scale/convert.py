@@ -43,7 +43,7 @@ from pathlib import Path
 
 import numpy as np
 
-from imunoise import _atomic
+from imunoise import _atomic, _summary
 from imunoise._core import vn as _core_vn
 from imunoise._schema import CHANNELS, column_names
 from imunoise.readers import registry
@@ -69,7 +69,7 @@ CHUNK_BYTES = 64 << 20
 MAX_STREAM_PIECE = 1 << 30
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class Conversion:
     """What :func:`convert` wrote.
 
@@ -101,6 +101,24 @@ class Conversion:
     issues: ParseIssues
     bytes_read: int
     gaps: Gaps
+
+    def _facts(self) -> list[str]:
+        return [f"{self.samples} samples at {_summary.number(self.fs)} Hz = "
+                f"{_summary.duration(self.samples / self.fs)}",
+                "channels " + " ".join(self.channels),
+                f"{_summary.plural(len(self.files), 'file')}, {self.bytes_read} bytes read",
+                str(self.gaps), f"issues: {self.issues}" if self.issues.total else "no issues"]
+
+    def __repr__(self) -> str:
+        return _summary.lines(f"Conversion({_summary.source_name(str(self.out))!r}",
+                              self._facts(), sep=", ")
+
+    def _repr_html_(self) -> str:
+        """The output, what it holds and what the reader skipped, one fact a row."""
+        return _summary.html_table(
+            ["output", "samples", "channels", "files", "gaps", "issues"],
+            [[str(self.out), *self._facts()]],
+            caption=f"Conversion: {_summary.source_name(str(self.out))}")
 
 
 def _width(channel: str) -> int:
