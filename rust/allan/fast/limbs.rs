@@ -161,6 +161,16 @@ pub struct LimbSlice<'a> {
     pub l2: &'a [i64],
 }
 
+impl<'a> LimbSlice<'a> {
+    pub fn range(&self, range: std::ops::Range<usize>) -> LimbSlice<'a> {
+        LimbSlice {
+            l0: &self.l0[range.clone()],
+            l1: &self.l1[range.clone()],
+            l2: &self.l2[range],
+        }
+    }
+}
+
 impl Limbs {
     pub fn slice(&self, range: std::ops::Range<usize>) -> LimbSlice<'_> {
         LimbSlice {
@@ -243,7 +253,8 @@ fn ifma() -> bool {
 
 #[cfg(target_arch = "x86_64")]
 fn avx512() -> bool {
-    std::arch::is_x86_feature_detected!("avx512f") && std::arch::is_x86_feature_detected!("avx512dq")
+    std::arch::is_x86_feature_detected!("avx512f")
+        && std::arch::is_x86_feature_detected!("avx512dq")
 }
 
 #[cfg(target_arch = "x86_64")]
@@ -360,7 +371,10 @@ mod x86 {
         // One limb of eight terms: f + a[u..] + reversed b[v..] − 2·c[u..].
         macro_rules! limb {
             ($k:expr, $sa:expr, $sb:expr, $sc:expr, $u:expr, $v:expr) => {{
-                let bv = _mm512_permutexvar_epi64(reverse, _mm512_loadu_si512($sb.as_ptr().add($v).cast()));
+                let bv = _mm512_permutexvar_epi64(
+                    reverse,
+                    _mm512_loadu_si512($sb.as_ptr().add($v).cast()),
+                );
                 let av = _mm512_loadu_si512($sa.as_ptr().add($u).cast());
                 let cv = _mm512_loadu_si512($sc.as_ptr().add($u).cast());
                 _mm512_sub_epi64(
@@ -405,7 +419,9 @@ mod tests {
         let mut s = seed;
         (0..n)
             .map(|_| {
-                s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+                s = s
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
                 ((s >> 11) & ((1 << bits) - 1)) as i64
             })
             .collect()
@@ -434,9 +450,34 @@ mod tests {
         add_scaled_rows(
             &mut limbs.l0,
             &mut limbs.l1,
-            [(s[0], &x[0][..]), (s[1], &x[1]), (s[2], &x[2]), (s[3], &x[3])],
+            [
+                (s[0], &x[0][..]),
+                (s[1], &x[1]),
+                (s[2], &x[2]),
+                (s[3], &x[3]),
+            ],
         );
         add_pair_products(&mut limbs.l0, &mut limbs.l1, [(&x[0][..], &x[1][..])]);
+        // The portable kernels (what a CPU without IFMA runs) give the same limbs.
+        let mut portable = Limbs::from_values(start.iter().copied());
+        scaled_rows_scalar(
+            &mut portable.l0,
+            &mut portable.l1,
+            [
+                (s[0], &x[0][..]),
+                (s[1], &x[1]),
+                (s[2], &x[2]),
+                (s[3], &x[3]),
+            ],
+            0,
+        );
+        pair_products_scalar(
+            &mut portable.l0,
+            &mut portable.l1,
+            [(&x[0][..], &x[1][..])],
+            0,
+        );
+        assert_eq!((&portable.l0, &portable.l1), (&limbs.l0, &limbs.l1));
         limbs.normalise();
         for i in 0..n {
             let want = start[i]
@@ -452,6 +493,7 @@ mod tests {
             let (a, b) = (pseudo(n, 5, 51), pseudo(n + 3, 6, 51));
             let want: i128 = a.iter().zip(&b).map(|(&x, &y)| x as i128 * y as i128).sum();
             assert_eq!(dot(&a, &b), want, "n {n}");
+            assert_eq!(dot_scalar(&a, &b[..n], 0), want, "n {n}");
         }
     }
 
@@ -482,11 +524,23 @@ mod tests {
             .map(|u| (f + a[u] + b[h - 1 - u] - 2 * c[u]) as f64 * w[h - 1 - u])
             .sum();
         assert!((got - want).abs() <= 1e-14 * want, "{got} vs {want}");
+        let (sa, sb, sc) = (la.slice(0..h), lb.slice(0..h), lc.slice(0..h));
+        let portable = weighted_terms_scalar(split(f), sa, sb, sc, &w, 0, 0.0);
+        assert!(
+            (portable - want).abs() <= 1e-14 * want,
+            "{portable} vs {want}"
+        );
         // A negative term is a failed computation.
         let mut c2 = c.clone();
         c2[5] += 1 << 30;
         let lc2 = Limbs::from_values(c2.iter().copied());
-        let neg = weighted_terms(split(f), la.slice(0..h), lb.slice(0..h), lc2.slice(0..h), &w);
+        let neg = weighted_terms(
+            split(f),
+            la.slice(0..h),
+            lb.slice(0..h),
+            lc2.slice(0..h),
+            &w,
+        );
         assert!(neg.is_nan(), "{neg}");
     }
 }

@@ -22,8 +22,74 @@
 //! before it is weighted by 1/k in double precision.
 
 use super::exact_phase::ExactPhase;
-use super::limbs::{self, Limbs};
+use super::limbs::{self, LimbSlice, Limbs};
 use crate::interrupt::Interrupt;
+
+/// Lanes from which a kernel call is split in two halves for two threads (the
+/// halves are fixed, so the result does not depend on the thread count).
+const SPLIT_FROM: usize = 1 << 14;
+
+/// [`limbs::add_scaled_rows`], in two halves on two threads when long.
+fn scaled_rows<const R: usize>(lo: &mut [i64], hi: &mut [i64], rows: [(i64, &[i64]); R]) {
+    if lo.len() < SPLIT_FROM {
+        return limbs::add_scaled_rows(lo, hi, rows);
+    }
+    let mid = lo.len() / 16 * 8;
+    let (lo_a, lo_b) = lo.split_at_mut(mid);
+    let (hi_a, hi_b) = hi.split_at_mut(mid);
+    let rows_b = rows.map(|(s, x)| (s, &x[mid..]));
+    rayon::join(
+        || limbs::add_scaled_rows(lo_a, hi_a, rows),
+        || limbs::add_scaled_rows(lo_b, hi_b, rows_b),
+    );
+}
+
+/// [`limbs::add_pair_products`], in two halves on two threads when long.
+fn pair_products<const R: usize>(lo: &mut [i64], hi: &mut [i64], pairs: [(&[i64], &[i64]); R]) {
+    if lo.len() < SPLIT_FROM {
+        return limbs::add_pair_products(lo, hi, pairs);
+    }
+    let mid = lo.len() / 16 * 8;
+    let (lo_a, lo_b) = lo.split_at_mut(mid);
+    let (hi_a, hi_b) = hi.split_at_mut(mid);
+    let pairs_b = pairs.map(|(a, b)| (&a[mid..], &b[mid..]));
+    rayon::join(
+        || limbs::add_pair_products(lo_a, hi_a, pairs),
+        || limbs::add_pair_products(lo_b, hi_b, pairs_b),
+    );
+}
+
+/// [`limbs::weighted_terms`], the terms in two halves on two threads when many
+/// (the two partial sums added in a fixed order).
+fn weighted_terms(f: [i64; 3], a: LimbSlice, b: LimbSlice, c: LimbSlice, w: &[f64]) -> f64 {
+    let h = w.len();
+    if h < SPLIT_FROM {
+        return limbs::weighted_terms(f, a, b, c, w);
+    }
+    // Terms u < mid read a, c at u and b, w at h − 1 − u (their last mid lanes).
+    let mid = h / 16 * 8;
+    let (first, second) = rayon::join(
+        || {
+            limbs::weighted_terms(
+                f,
+                a.range(0..mid),
+                b.range(h - mid..h),
+                c.range(0..mid),
+                &w[h - mid..],
+            )
+        },
+        || {
+            limbs::weighted_terms(
+                f,
+                a.range(mid..h),
+                b.range(0..h - mid),
+                c.range(mid..h),
+                &w[..h - mid],
+            )
+        },
+    );
+    first + second
+}
 
 /// Four-row steps between normalisations of the limbs: each step adds at most
 /// eight products (< 2⁵² per limb) to a lane, so limbs stay below 2⁶⁰ and a
@@ -104,7 +170,7 @@ impl<'a> Sweep<'a> {
         let (q, qr) = (self.q, &self.qr[..]);
         let b = self.max_m - l;
         let m = self.max_m;
-        limbs::add_scaled_rows(
+        scaled_rows(
             &mut self.w.l0[b..m],
             &mut self.w.l1[b..m],
             [(2 * q[l], &q[..l]), (2 * qr[l], &qr[..l])],
@@ -121,15 +187,15 @@ impl<'a> Sweep<'a> {
         let m = self.max_m;
         let b = m - l;
         // Index x ≥ b gets all four rows: W[x] += Σ_t 2q_{l+t} q_{x−b+t}.
-        limbs::add_scaled_rows(
+        scaled_rows(
             &mut self.w.l0[b..m],
             &mut self.w.l1[b..m],
             [
-                (2 * q[l], &q[..]),
+                (2 * q[l], q),
                 (2 * q[l + 1], &q[1..]),
                 (2 * q[l + 2], &q[2..]),
                 (2 * q[l + 3], &q[3..]),
-                (2 * qr[l], &qr[..]),
+                (2 * qr[l], qr),
                 (2 * qr[l + 1], &qr[1..]),
                 (2 * qr[l + 2], &qr[2..]),
                 (2 * qr[l + 3], &qr[3..]),
@@ -154,11 +220,11 @@ impl<'a> Sweep<'a> {
         let (back, back_r) = (&qr[n - 1 - c..], &q[n - 1 - c..]);
         let (lo, hi) = (&mut self.z.l0[..=c], &mut self.z.l1[..=c]);
         if ROWS == 2 {
-            limbs::add_pair_products(lo, hi, [(back, &q[c..]), (back_r, &qr[c..])]);
+            pair_products(lo, hi, [(back, &q[c..]), (back_r, &qr[c..])]);
             return;
         }
         let (next, next_r) = (&qr[n - 2 - c..], &q[n - 2 - c..]);
-        limbs::add_pair_products(
+        pair_products(
             lo,
             hi,
             [
@@ -184,7 +250,7 @@ impl<'a> Sweep<'a> {
             .wrapping_add(p.r[m].wrapping_mul(2));
         // W(k) for k = h … 1 (index top − h … top − 1), W(m − k) for k = 1 … h
         // read backwards, Z((m − 2k)/2) = Z(h − k) for k = h … 1.
-        limbs::weighted_terms(
+        weighted_terms(
             limbs::split(f),
             self.w.slice(top - h..top),
             self.w.slice(top + 1 - m..top + 1 - m + h),
