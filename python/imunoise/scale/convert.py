@@ -4,9 +4,11 @@
 the file is read in pieces of ``chunk_bytes`` and fed to one streaming parser
 (:class:`imunoise._core.vn.VnStream`), which hands back the rows of the records
 each piece completes (a record cut by the end of a piece waits for the next), and
-those rows are appended to the output.
-Memory stays about three pieces (the bytes, their decoded columns, the rows being
-written) whatever the size of the log. :func:`load` opens the result as an
+those rows are appended to the output. Three things overlap: the next piece is read
+(into one of two reused buffers) while one is parsed, and a piece's rows are written by a
+thread while the next is parsed. Memory stays about five pieces (two buffers, the
+columns being decoded, those being written, their growth) whatever the size of the log:
+about 400 MB at the default 64 MiB. :func:`load` opens the result as an
 :class:`~imunoise.readers.log.ImuLog` whose channels are memory-mapped ``.npy``
 arrays, which :func:`imunoise.adev` reads in place (the Allan core takes arrays of
 any strides without copying them), so ``convert → load → adev → fit`` analyses a

@@ -19,7 +19,8 @@
 //! anti-diagonal to C, so all even m up to M cost O(M²) products in all and
 //! each requested m O(m) more: O(N log N + M²) instead of O(N·M) per factor.
 //! Every quantity is an exact integer, so the sum of T_k over i is exact
-//! before it is weighted by 1/k in double precision.
+//! before it is weighted by 1/k in double precision. The sums live in 52-bit
+//! limbs (`limbs`), whose products AVX-512 IFMA adds eight at a time.
 
 use super::exact_phase::ExactPhase;
 use super::limbs::{self, LimbSlice, Limbs};
