@@ -5,7 +5,8 @@ use std::collections::BTreeMap;
 use std::path::PathBuf;
 
 use numpy::{IntoPyArray, PyReadonlyArray1};
-use pyo3::exceptions::PyValueError;
+use pyo3::buffer::PyBuffer;
+use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict, PyList, PySlice};
 
@@ -148,8 +149,32 @@ impl VnStream {
         }
     }
 
-    fn feed<'py>(&mut self, py: Python<'py>, data: &Bound<'py, PyBytes>) -> PyResult<VnRows> {
-        let slice: &[u8] = data.as_bytes();
+    /// `data`: bytes, or any C-contiguous buffer of bytes (a reused `bytearray`,
+    /// a read-only `mmap`), parsed in place; the caller must not change it during
+    /// the call.
+    fn feed<'py>(&mut self, py: Python<'py>, data: &Bound<'py, PyAny>) -> PyResult<VnRows> {
+        let buffer;
+        let slice: &[u8] = if let Ok(bytes) = data.cast::<PyBytes>() {
+            bytes.as_bytes()
+        } else {
+            buffer = PyBuffer::<u8>::get(data).map_err(|_| {
+                PyTypeError::new_err(format!(
+                    "data must be bytes or a buffer of bytes; got {}",
+                    data.get_type()
+                        .name()
+                        .map(|n| n.to_string())
+                        .unwrap_or_default()
+                ))
+            })?;
+            if !buffer.is_c_contiguous() {
+                return Err(PyValueError::new_err(
+                    "data must be a C-contiguous buffer of bytes",
+                ));
+            }
+            // SAFETY: the buffer is held (exported) until the end of this call,
+            // is C-contiguous and holds len_bytes() bytes of u8.
+            unsafe { std::slice::from_raw_parts(buffer.buf_ptr() as *const u8, buffer.len_bytes()) }
+        };
         let pieces = self.pieces()?;
         let tables = py.detach(|| pieces.feed(slice))?;
         let (tables, missing) = tables_to_py(py, tables)?;
