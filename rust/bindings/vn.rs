@@ -5,7 +5,6 @@ use std::collections::BTreeMap;
 use std::path::PathBuf;
 
 use numpy::{IntoPyArray, PyReadonlyArray1};
-use pyo3::buffer::PyBuffer;
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict, PyList, PySlice};
@@ -153,27 +152,32 @@ impl VnStream {
     /// a read-only `mmap`), parsed in place; the caller must not change it during
     /// the call.
     fn feed<'py>(&mut self, py: Python<'py>, data: &Bound<'py, PyAny>) -> PyResult<VnRows> {
-        let buffer;
+        // bytes as they are; any other buffer of bytes (bytearray, memoryview, a
+        // uint8 array) through numpy.frombuffer, without a copy. (pyo3's own
+        // buffer protocol is not in the stable ABI of CPython 3.10, abi3-py310.)
+        let viewed;
         let slice: &[u8] = if let Ok(bytes) = data.cast::<PyBytes>() {
             bytes.as_bytes()
         } else {
-            buffer = PyBuffer::<u8>::get(data).map_err(|_| {
+            let not_bytes = || {
                 PyTypeError::new_err(format!(
-                    "data must be bytes or a buffer of bytes; got {}",
+                    "data must be bytes or a C-contiguous buffer of bytes; got {}",
                     data.get_type()
                         .name()
                         .map(|n| n.to_string())
                         .unwrap_or_default()
                 ))
-            })?;
-            if !buffer.is_c_contiguous() {
-                return Err(PyValueError::new_err(
-                    "data must be a C-contiguous buffer of bytes",
-                ));
-            }
-            // SAFETY: the buffer is held (exported) until the end of this call,
-            // is C-contiguous and holds len_bytes() bytes of u8.
-            unsafe { std::slice::from_raw_parts(buffer.buf_ptr() as *const u8, buffer.len_bytes()) }
+            };
+            let array = py
+                .import("numpy")?
+                .call_method1("frombuffer", (data, "u1"))
+                .map_err(|_| not_bytes())?;
+            viewed = array
+                .extract::<PyReadonlyArray1<'py, u8>>()
+                .map_err(|_| not_bytes())?;
+            viewed
+                .as_slice()
+                .map_err(|_| PyValueError::new_err("data must be a C-contiguous buffer of bytes"))?
         };
         let pieces = self.pieces()?;
         let tables = py.detach(|| pieces.feed(slice))?;
