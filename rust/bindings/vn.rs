@@ -159,25 +159,29 @@ impl VnStream {
         let slice: &[u8] = if let Ok(bytes) = data.cast::<PyBytes>() {
             bytes.as_bytes()
         } else {
-            let not_bytes = || {
-                PyTypeError::new_err(format!(
-                    "data must be bytes or a C-contiguous buffer of bytes; got {}",
-                    data.get_type()
-                        .name()
-                        .map(|n| n.to_string())
-                        .unwrap_or_default()
-                ))
-            };
-            let array = py
+            let view = py
+                .import("builtins")?
+                .getattr("memoryview")?
+                .call1((data,))
+                .map_err(|_| {
+                    PyTypeError::new_err(format!(
+                        "data must be bytes or a buffer of bytes; got {}",
+                        data.get_type()
+                            .name()
+                            .map(|n| n.to_string())
+                            .unwrap_or_default()
+                    ))
+                })?;
+            if !view.getattr("c_contiguous")?.extract::<bool>()? {
+                return Err(PyValueError::new_err(
+                    "data must be a C-contiguous buffer of bytes",
+                ));
+            }
+            viewed = py
                 .import("numpy")?
-                .call_method1("frombuffer", (data, "u1"))
-                .map_err(|_| not_bytes())?;
-            viewed = array
-                .extract::<PyReadonlyArray1<'py, u8>>()
-                .map_err(|_| not_bytes())?;
-            viewed
-                .as_slice()
-                .map_err(|_| PyValueError::new_err("data must be a C-contiguous buffer of bytes"))?
+                .call_method1("frombuffer", (view, "u1"))?
+                .extract::<PyReadonlyArray1<'py, u8>>()?;
+            viewed.as_slice()?
         };
         let pieces = self.pieces()?;
         let tables = py.detach(|| pieces.feed(slice))?;
