@@ -258,6 +258,10 @@ def test_lab_table_is_the_first_table_of_the_noise_section(reports):
     section = md.split(". Noise coefficients\n")[1].split("\n## ")[0]
     first = next(line for line in section.splitlines() if line.startswith("*"))
     assert first.startswith("*Lab table: N, B and K per axis beside the datasheet (vn100)")
+    # and after each sensor's sentences, how long to record for N, B, K (imunoise plan)
+    plans = [line for line in section.splitlines() if line.startswith("Plan (")]
+    assert [p.split(")")[0] for p in plans] == ["Plan (gyro", "Plan (accel"]
+    assert all("needs N" in p and "this record" in p for p in plans)
     rows = _md_tables(section)[first.strip("*")]
     assert rows[0] == ["sensor", "quantity", "unit", "X", "Y", "Z", "datasheet", "as printed"]
     by = {(r[0], r[1]): r for r in rows[1:]}

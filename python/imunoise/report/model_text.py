@@ -112,27 +112,27 @@ def model_sentences(model: NoiseModel, sensor: str,
                          f"{format_number(f_r, stds[1])} Hz, damping time "
                          f"{format_number(tau_r, stds[2])} s (quality factor "
                          f"{math.pi * f_r * tau_r:.2g})")
-        parts += _motion_sentence(model, c, sensor, n_unit)
+        parts += _motion_sentence(model, c, sensor, n_unit,
+                                  _units.unit_info("Q", chosen.get("Q"), sensor))
         for term, unit in (("N", n_unit), ("B", b_unit)):
             parts += _readoff_agreement(model, c, term, unit, sensor)
         out.append("; ".join(parts) + ".")
     return out
 
 
-def _motion_sentence(model: NoiseModel, c: int, sensor: str, n_unit) -> list[str]:
+def _motion_sentence(model: NoiseModel, c: int, sensor: str, n_unit, q_unit) -> list[str]:
     """What a bounded motion of the mount means for channel ``c``: its size and time,
     and that N leaves it out (an upper bound on N where N is not resolved)."""
     parts_of = model.components
     out = []
-    q_unit = units.unit_info("Q", None, sensor)
     for sigma, tau_c in parts_of.motion(c):
         sigma_std, tau_std = (float(np.atleast_1d(a)[c]) for a in
                               (parts_of.motion_sigma_std, parts_of.motion_tau_std))
-        value, value_std = units.convert(np.array([sigma, sigma_std]), "Q", q_unit.name,
-                                         sensor=sensor)
+        value, value_std = _units.convert(np.array([sigma, sigma_std]), "Q", q_unit.name,
+                                          sensor=sensor)
         white = math.sqrt(2.0 * sigma**2 / tau_c)  # its density below τc
         n_now = float(model.value("N")[c])
-        bound = units.convert(math.hypot(n_now, white), "N", n_unit.name, sensor=sensor)
+        bound = _units.convert(math.hypot(n_now, white), "N", n_unit.name, sensor=sensor)
         text = (f"**a bounded motion of the mount** (the platform's angle wanders by "
                 f"σ = {format_number(value, value_std)} {q_unit.label} over "
                 f"τc = {format_number(tau_c, tau_std)} s and comes back: white below τc, "

@@ -17,6 +17,7 @@ from imunoise import allan as _allan
 from imunoise import noise, numbers, plot, stats, units
 from imunoise._schema import CHANNELS, SAMPLE_SENSORS, axis_names
 from imunoise.numbers import format_value
+from imunoise.planner import fit_line
 from imunoise.report.formatting import (
     format_duration,
     format_number,
@@ -254,6 +255,9 @@ def noise_coefficients(ctx: Context, doc: Doc) -> None:
         doc.table(header, rows, caption=f"{sensor} noise coefficients per axis")
         for sentence in model_sentences(m, sensor, ctx.units):
             doc.p(sentence)
+        r = ctx.allan.get(sensor)
+        if r is not None:  # how long to record for the coefficients (imunoise plan)
+            doc.p(fit_line(m, r.fs, r.n_samples / r.fs).replace("plan:", f"Plan ({sensor}):"))
 
 
 def datasheet_comparison(ctx: Context, doc: Doc) -> None:
