@@ -14,6 +14,12 @@ largest relative difference of the deviations.
 Part 2 (``--peer-size``, 0 to skip): allantools (2024.06) has no ThêoBR; its oadev
 and theo1 at the bias ratio's averaging factors plus theo1 at the octave taus give
 the same numbers (checked), timed once.
+Part 3 (``--fast-size``, 0 to skip): the fast ThêoBR (``ratio_block=b``) against the exact
+bias ratio on white PM, white FM, flicker FM and random-walk FM (``--fast-seeds`` records
+each): median and largest |ThêoBR_b / ThêoBR − 1| (the same at every tau: κ_b/κ) and
+the time of each.
+Part 4 (``--ladder-size``, 0 to skip): the "sp1065" ladder (n = ⌊N/6⌋ − 3) against the
+default one: time and κ ratio.
 Prints Markdown tables.
 """
 
@@ -88,6 +94,61 @@ def peer_theobr(y, fs, m):
     return np.sqrt(np.mean(ad**2 / th**2)) * dev
 
 
+def noise_type(kind: str, n: int, rng: np.random.Generator) -> np.ndarray:
+    """Rate samples of white PM, white FM, flicker FM or random-walk FM."""
+    if kind == "white PM":
+        return np.diff(rng.normal(size=n + 1))
+    if kind == "white FM":
+        return rng.normal(size=n)
+    if kind == "flicker FM":
+        spectrum = np.fft.rfft(rng.normal(size=n))
+        f = np.arange(spectrum.size, dtype=float)
+        f[0] = 1.0
+        return np.fft.irfft(spectrum / np.sqrt(f), n)
+    return np.cumsum(rng.normal(size=n))
+
+
+def fast_error(size: int, seeds: int, blocks: list[int]) -> None:
+    print(f"\nFast ThêoBR against exact, {size} samples, {seeds} records per noise type "
+          f"(load {os.getloadavg()[0]:.1f}):\n")
+    print("| noise | exact (s) | " + " | ".join(f"b = {b}: median / max error, s" for b in blocks)
+          + " |\n|---|---|" + "---|" * len(blocks))
+    for kind in ("white PM", "white FM", "flicker FM", "random-walk FM"):
+        errors = {b: [] for b in blocks}
+        times = {b: [] for b in [1, *blocks]}
+        for seed in range(seeds):
+            y = noise_type(kind, size, np.random.default_rng(100 + seed))
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                t, exact = timed(imunoise.theobr, y, 1.0)
+                times[1].append(t)
+                for b in blocks:
+                    t, fast = timed(lambda y=y, b=b: imunoise.theobr(y, 1.0, ratio_block=b))
+                    times[b].append(t)
+                    errors[b].append(float(np.max(np.abs(fast.dev / exact.dev - 1))))
+        cells = [f"{np.median(errors[b]) * 100:.1f} % / {np.max(errors[b]) * 100:.1f} %, "
+                 f"{np.median(times[b]):.2g}" for b in blocks]
+        print(f"| {kind} | {np.median(times[1]):.2g} | " + " | ".join(cells) + " |", flush=True)
+
+
+def ladder_cost(size: int) -> None:
+    y = np.random.default_rng(5).normal(size=size)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        t_default, c_default, default = timed_cpu(imunoise.theobr, y, 1.0)
+        t_sp, c_sp, sp = timed_cpu(lambda: imunoise.theobr(y, 1.0, ratio_ladder="sp1065"))
+    predicted = [_core_allan.theobr_seconds(size + 1, [int(m) for m in default.m],
+                                            ratio_ladder=ladder)
+                 for ladder in ("taylor-howe", "sp1065")]
+    print(f"\nRatio ladders, {size} samples, white FM (load {os.getloadavg()[0]:.1f}):\n\n"
+          "| ladder | wall / CPU (s) | predicted (s) | κ relative to taylor-howe |\n"
+          "|---|---|---|---|\n"
+          f"| taylor-howe, n = ⌊N/30⌋ − 3 | {t_default:.3g} / {c_default:.3g} "
+          f"| {predicted[0]:.3g} | 1 |\n"
+          f"| sp1065, n = ⌊N/6⌋ − 3 | {t_sp:.3g} / {c_sp:.3g} | {predicted[1]:.3g} "
+          f"| {float(np.mean(sp.var / default.var)):.4f} |")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--sizes", type=int, nargs="+", default=[10_000, 100_000, 720_000])
@@ -96,7 +157,19 @@ def main() -> None:
     parser.add_argument("--baseline", help="another tree's python folder to time theobr against")
     parser.add_argument("--baseline-sizes", type=int, nargs="+", default=[20_000, 50_000])
     parser.add_argument("--peer-size", type=int, default=2000)
+    parser.add_argument("--fast-size", type=int, default=100_000)
+    parser.add_argument("--fast-seeds", type=int, default=8)
+    parser.add_argument("--fast-blocks", type=int, nargs="+", default=[2, 4, 8, 16])
+    parser.add_argument("--ladder-size", type=int, default=100_000)
+    parser.add_argument("--only-options", action="store_true",
+                        help="parts 3 and 4 only")
     args = parser.parse_args()
+    if args.only_options:
+        if args.fast_size:
+            fast_error(args.fast_size, args.fast_seeds, args.fast_blocks)
+        if args.ladder_size:
+            ladder_cost(args.ladder_size)
+        return
     print(
         f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
         f"Python {platform.python_version()}, numpy {np.__version__}, "
@@ -143,6 +216,10 @@ def main() -> None:
             "ratio | max rel. diff |\n|---|---|---|---|---|\n"
             f"| theobr | {t_ours:.3g} | {t_peer:.3g} | {t_peer / t_ours:.0f}× | {worst:.1e} |"
         )
+    if args.fast_size:
+        fast_error(args.fast_size, args.fast_seeds, args.fast_blocks)
+    if args.ladder_size:
+        ladder_cost(args.ladder_size)
 
 
 if __name__ == "__main__":

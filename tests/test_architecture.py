@@ -147,6 +147,8 @@ _OWN_WRITES = {
     "imunoise._atomic": "the helper itself",
     "imunoise.scale.convert": "appends to its staging files, themselves _atomic temporaries",
     "imunoise.readers.rosbag_reader": "bytes given as a bag go to a scratch TemporaryDirectory",
+    "imunoise.recording.writer": "a recording is an append stream fsync-ed every second: it must "
+                              "survive kill -9 with at most 1 s lost (its metadata is atomic)",
 }
 _WRITERS = {"write_text", "write_bytes", "savefig", "savetxt", "save", "savez",
             "savez_compressed", "to_csv", "to_parquet", "replace", "rename", "mkstemp"}

@@ -30,8 +30,10 @@ from imunoise.datasheet import compare
 from imunoise.dynamic import DynamicAllan, dynamic_adev
 from imunoise.errors import ParseError
 from imunoise.noise import NoiseModel, fit
+from imunoise.planner import plan
 from imunoise.readers import Gaps, ImuLog, ParseIssues
 from imunoise.readers.read import read
+from imunoise.recording import record
 from imunoise.scale import batch
 from imunoise.spectrum import Spectrum, psd
 from imunoise.stats import describe, distribution
@@ -64,8 +66,10 @@ __all__ = [
     "mdev",
     "mtotdev",
     "plot",
+    "plan",
     "psd",
     "read",
+    "record",
     "report",
     "scale",
     "simulate",

@@ -109,7 +109,8 @@ def simulate(n_samples: int, fs: float, Q: float = 0.0, N: float = 0.0, B: float
              K: float = 0.0, R: float = 0.0, *, channels: int = 1, seed=None,
              gm: Sequence[tuple[float, float]] = (),
              sinusoid: tuple[float, float] | None = None,
-             resonance: tuple[float, float, float] | None = None) -> np.ndarray:
+             resonance: tuple[float, float, float] | None = None,
+             motion: tuple[float, float] | None = None) -> np.ndarray:
     """Rate noise with the given IEEE 952 coefficients.
 
     Parameters
@@ -141,6 +142,12 @@ def simulate(n_samples: int, fs: float, Q: float = 0.0, N: float = 0.0, B: float
         sigma²·ρ^|h|·cos(θh): standard deviation ``sigma`` (rate), centre
         frequency ``f_r`` (Hz, at most fs/2) and damping time ``tau_r`` (s) —
         the process of the ``"resonance"`` term of :func:`imunoise.fit`.
+    motion : (sigma, tau_c), optional
+        A bounded motion of the mount: the rate (θ[t] − θ[t−1])·fs of an angle
+        (velocity, for an accelerometer) θ that is a stationary AR1 of standard
+        deviation ``sigma`` (rate·s) and correlation time ``tau_c`` (s) — a
+        parked vehicle rocking; the process of the ``"motion"`` term of
+        :func:`imunoise.fit`.
 
     Returns
     -------
@@ -162,6 +169,7 @@ def simulate(n_samples: int, fs: float, Q: float = 0.0, N: float = 0.0, B: float
     markov = _check_gm(gm)
     tone = _check_sinusoid(sinusoid)
     oscillator = _check_resonance(resonance, fs)
+    moving = _check_motion(motion)
     rng = np.random.default_rng(seed)
     out = np.zeros((n, channels))
     sqfs = math.sqrt(fs)
@@ -198,6 +206,8 @@ def simulate(n_samples: int, fs: float, Q: float = 0.0, N: float = 0.0, B: float
             col += amplitude * np.sin(2 * math.pi * f0 / fs * np.arange(n) + phase)
         if oscillator is not None and oscillator[0] > 0:
             col += damped_oscillator(n, fs, *oscillator, rng)
+        if moving is not None and moving[0] > 0:
+            col += np.diff(gauss_markov(n + 1, fs, *moving, rng)) * fs
     return out[:, 0].copy() if channels == 1 else out
 
 
@@ -214,6 +224,20 @@ def _check_sinusoid(sinusoid) -> tuple[float, float] | None:
     if not (math.isfinite(f0) and f0 > 0):
         raise ValueError(f"sinusoid f0 must be finite and > 0 Hz; got {f0!r}")
     return amplitude, f0
+
+
+def _check_motion(motion) -> tuple[float, float] | None:
+    if motion is None:
+        return None
+    try:
+        sigma, tau_c = (float(v) for v in motion)
+    except (TypeError, ValueError):
+        raise TypeError(f"motion must be a (sigma, tau_c) pair or None; got {motion!r}") from None
+    if not (math.isfinite(sigma) and sigma >= 0):
+        raise ValueError(f"motion sigma must be finite and >= 0; got {sigma!r}")
+    if not (math.isfinite(tau_c) and tau_c > 0):
+        raise ValueError(f"motion tau_c must be finite and > 0 s; got {tau_c!r}")
+    return sigma, tau_c
 
 
 def _check_resonance(resonance, fs: float) -> tuple[float, float, float] | None:

@@ -76,7 +76,8 @@ class Thermal:
     r_squared : ndarray
         Share of the block means' variance the fit explains.
     time_correlation : float
-        |Pearson r| between block temperature and time (1: fully confounded).
+        Absolute Pearson correlation of block temperature and time (1: fully
+        confounded).
     compensated : ndarray, (n, k)
         The samples with the fitted temperature dependence removed.
     """

@@ -205,12 +205,15 @@ class Warmup:
         return _summary.lines("Warmup(", self._facts(), sep=", ")
 
     def _repr_html_(self) -> str:
-        rows = [[r["name"], _summary.number(r["amplitude"]), _summary.number(r["tau"]),
+        rows = [[r["name"], _summary.number(r["amplitude"]), _summary.duration(r["tau"]),
                  f"{r['p_value']:.2g}", _summary.number(r["tolerance"]),
-                 _summary.number(r["settle_time"])] for r in self.rows()]
+                 _summary.duration(r["settle_time"])] for r in self.rows()]
+        facts = self._facts()
+        # the log's facts, and the temperature's when it has one (the axes are rows)
+        caption = facts[:2] + (facts[-1:] if self.temperature is not None else [])
         return _summary.html_table(
-            ["channel", "A", "τ [s]", "p", "tolerance", "t_s [s]"], rows,
-            caption="Warmup: " + ", ".join(self._facts()[:2]),
+            ["channel", "A", "τ", "p", "tolerance", "t_s"], rows,
+            caption="Warmup: " + ", ".join(caption),
         )
 
 

@@ -86,7 +86,7 @@ from scipy import stats as _stats
 from imunoise import _schema, _summary, _warn
 from imunoise._core import allan as _core_allan
 from imunoise._runs import true_runs
-from imunoise._validate import confidence_level, sample_rate, samples
+from imunoise._validate import confidence_level, integer, sample_rate, samples
 from imunoise.taus import averaging_factors, keep_estimable
 
 if TYPE_CHECKING:
@@ -484,7 +484,8 @@ def theo1(x: npt.ArrayLike, fs: float, *, taus: TauSpec = "octave",
 
 
 def theobr(x: npt.ArrayLike, fs: float, *, taus: TauSpec = "octave",
-           confidence: float = ONE_SIGMA, gaps: str = "skip") -> AllanResult:
+           confidence: float = ONE_SIGMA, gaps: str = "skip",
+           ratio_ladder: str = "taylor-howe", ratio_block: int = 1) -> AllanResult:
     r"""ThêoBR deviation: Theo1 with its bias relative to the Allan variance removed
     by the data's own AVAR/Theo1 ratio (Howe & Tasset 2004; Howe 2006; SP 1065
     §5.2.15). An estimate of the Allan deviation out to τ ≈ 0.75·T (T the record
@@ -516,18 +517,28 @@ def theobr(x: npt.ArrayLike, fs: float, *, taus: TauSpec = "octave",
     use Theo1's EDF alone, whose 68 % intervals then hold the true white-FM
     deviation in only 30–60 % of records at short taus.
 
-    Cost: the bias ratio needs Theo1 at n + 1 ≈ N/30 factors up to ≈ 0.13·N,
-    whatever taus are asked for; one exact sweep gives them all in about 0.02·N²
-    integer multiply-adds: 0.5 s at 10⁵ samples, about 19 s of CPU at 720,000, minutes
-    beyond 2·10⁶ (a warning says so beforehand). Ctrl-C stops it. For much longer
-    records average blocks of samples first (NIST's advice for ThêoBR: the bias ratio
-    barely changes).
+    Cost: the bias ratio needs Theo1 at n + 1 ≈ N/30 factors up to M ≈ 0.13·N,
+    whatever taus are asked for; one exact sweep gives them all in about 1.25·M²
+    integer products (eight at a time with AVX-512 IFMA, where the CPU has it): a few
+    seconds at 720,000 samples, minutes beyond 5·10⁶ (a warning says so beforehand).
+    Ctrl-C stops it. Channels run in parallel. For much longer records use
+    ``ratio_block`` (docs/total.md gives its error).
 
     Parameters
     ----------
     x, fs, taus, confidence, gaps
         As for :func:`adev` (taus: see the tau convention above); cannot skip gaps
         (``gaps="longest"`` or ``"splice"`` for data with NaN).
+    ratio_ladder : {"taylor-howe", "sp1065"}
+        The ratios averaged: ``"taylor-howe"``, n = ⌊0.1·N/3⌋ − 3 (Taylor & Howe
+        2010, Stable32); ``"sp1065"``, n = ⌊N/6⌋ − 3 as SP 1065 eq. 33 prints it
+        (ratios out to half the record; the sweep reaches ≈ 2N/3, about 25 times
+        the work, and the ladder stops at the last AVAR with a term).
+    ratio_block : int
+        1 (default): the exact bias ratio. b > 1: the "fast ThêoBR": the ratio from
+        the record averaged in blocks of b samples (b² less work; Theo1 at the taus
+        still from every sample); needs n/b ≥ 89. Its error against the exact ratio
+        by noise type is in docs/total.md.
 
     Returns
     -------
@@ -540,8 +551,9 @@ def theobr(x: npt.ArrayLike, fs: float, *, taus: TauSpec = "octave",
     m = _keep_theobr(m, n, fs, user_given, "theobr", lower=0.0)
     if m.size == 0:
         raise ValueError(f"none of the taus is in range for theobr; got {taus!r}")
-    _warn_theobr_cost("theobr", n, m, data.shape[1])
-    core = _core_allan.analyse(data, "theobr", m.astype(np.uint64))
+    ratio = _ratio_options(ratio_ladder, ratio_block, n)
+    _warn_theobr_cost("theobr", n, m, data.shape[1], ratio)
+    core = _core_allan.analyse(data, "theobr", m.astype(np.uint64), **ratio)
     return _assemble(
         "theobr", True, 0.75 * m / fs, m, core.var, core.terms, core.alpha,
         core.alpha_identified, core.edf, fs=fs, confidence=confidence, one_d=one_d,
@@ -550,7 +562,8 @@ def theobr(x: npt.ArrayLike, fs: float, *, taus: TauSpec = "octave",
 
 
 def theoh(x: npt.ArrayLike, fs: float, *, taus: TauSpec = "octave",
-          confidence: float = ONE_SIGMA, gaps: str = "skip") -> AllanResult:
+          confidence: float = ONE_SIGMA, gaps: str = "skip",
+          ratio_ladder: str = "taylor-howe", ratio_block: int = 1) -> AllanResult:
     r"""ThêoH deviation: the overlapping Allan deviation at short taus and ThêoBR
     (:func:`theobr`) at long ones (Howe, "ThêoH: a hybrid, high-confidence
     statistic that improves on the Allan deviation", Metrologia 43, 2006; SP 1065
@@ -581,7 +594,8 @@ def theoh(x: npt.ArrayLike, fs: float, *, taus: TauSpec = "octave",
     ones, as elsewhere). Needs at least 89 samples; cost: that of :func:`theobr`
     (the bias ratio), which a warning announces when it is long.
 
-    Parameters and result as for :func:`theobr`, with ``kind == "theoh"``.
+    Parameters (``ratio_ladder``, ``ratio_block`` included) and result as for
+    :func:`theobr`, with ``kind == "theoh"``.
     """
     data, one_d, missing, fs, confidence = _theo_input(x, fs, confidence, gaps, "theoh")
     n = data.shape[0]
@@ -607,12 +621,13 @@ def theoh(x: npt.ArrayLike, fs: float, *, taus: TauSpec = "octave",
     m_theo = _keep_theobr(m_theo, n, fs, user_given, "theoh", lower=k)
     if m_avar.size + m_theo.size == 0:
         raise ValueError(f"none of the taus is in range for theoh; got {taus!r}")
-    _warn_theobr_cost("theoh", n, m_theo, data.shape[1])
+    ratio = _ratio_options(ratio_ladder, ratio_block, n)
+    _warn_theobr_cost("theoh", n, m_theo, data.shape[1], ratio)
     m = np.concatenate([m_avar, m_theo]).astype(np.int64)
     kind = _REGISTRY["theoh"]
     below_k = kind.short_taus or kind.statistic
     statistics = [below_k] * m_avar.size + [kind.statistic] * m_theo.size
-    core = _core_allan.analyse_plan(data, statistics, m.astype(np.uint64))
+    core = _core_allan.analyse_plan(data, statistics, m.astype(np.uint64), **ratio)
     tau = np.concatenate([m_avar / fs, 0.75 * m_theo / fs])
     return _assemble(
         "theoh", True, tau, m, core.var, core.terms, core.alpha, core.alpha_identified,
@@ -811,17 +826,36 @@ def _keep_theobr(m, n: int, fs: float, user_given: bool, kind: str, lower: float
     return np.unique(m[keep])
 
 
-def _warn_theobr_cost(kind: str, n: int, m: np.ndarray, channels: int) -> None:
+#: ThêoBR's bias-ratio ladders (see :func:`theobr`).
+RATIO_LADDERS = ("taylor-howe", "sp1065")
+
+
+def _ratio_options(ladder, block, n: int) -> dict:
+    """The checked ``ratio_ladder`` and ``ratio_block`` as the core's keywords."""
+    if not isinstance(ladder, str) or ladder not in RATIO_LADDERS:
+        raise ValueError(f"ratio_ladder must be one of {RATIO_LADDERS}; got {ladder!r}")
+    block = integer(block, "ratio_block", 1)
+    need = _core_allan.THEOBR_MIN_SAMPLES
+    if n // block < need:
+        raise ValueError(
+            f"ratio_block must leave at least {need} block averages of the {n} samples "
+            f"(ratio_block <= {n // need}); got {block}"
+        )
+    return {"ratio_ladder": ladder, "ratio_block": block}
+
+
+def _warn_theobr_cost(kind: str, n: int, m: np.ndarray, channels: int, ratio: dict) -> None:
     """The bias ratio needs Theo1 at N/30 averaging factors: say so up front when
     that is long."""
     if m.size == 0:
         return
-    seconds = channels * _core_allan.theobr_seconds(n + 1, [int(v) for v in m])
+    seconds = channels * _core_allan.theobr_seconds(n + 1, [int(v) for v in m], **ratio)
     if seconds > 60:
+        per = 30 if ratio["ratio_ladder"] == "taylor-howe" else 6
         _warn.warn(
-            f"{kind}'s bias ratio needs Theo1 at N/30 averaging factors (cost ~N²): "
-            f"{n} samples will take roughly {seconds / 60:.0f} minutes; average blocks of "
-            "samples first (x.reshape(-1, b).mean(axis=1) at fs/b) to shorten it"
+            f"{kind}'s bias ratio needs Theo1 at N/{per} averaging factors (cost ~N²): "
+            f"{n} samples will take roughly {seconds / 60:.0f} minutes; ratio_block=b "
+            "(the fast ThêoBR) computes the ratio on averages of b samples in ~1/b² the time"
         )
 
 

@@ -79,6 +79,7 @@ def _build_parser() -> argparse.ArgumentParser:
     r.add_argument("--trim", choices=["auto"], default=None,
                    help="'auto': analyse the long log from the end of its warm-up transient "
                    "(the report states what was cut)")
+    _report_units_option(r)
     _stream_options(r)
 
     a = sub.add_parser("adev", help="print an Allan-family deviation table",
@@ -211,6 +212,7 @@ def _build_parser() -> argparse.ArgumentParser:
                    help="length of the simulated long log (default: %(default)s)")
     d.add_argument("--seed", type=int, default=1)
     _shared_options(d, progress=True)
+    _add_recording_commands(sub)
     return p
 
 
@@ -223,6 +225,65 @@ def _stream_options(p) -> None:
                    "memory for logs larger than RAM (default: VN logs above 256 MiB)")
     g.add_argument("--no-stream", dest="stream", action="store_false",
                    help="read the logs whole into memory")
+
+
+def _add_recording_commands(sub) -> None:
+    """``record``, ``emulate`` and ``plan`` (#27)."""
+    rc = sub.add_parser("record", help="record a VN-100 on a serial port (lossless, live view)",
+                        description="Record the raw byte stream of a VN-100 into OUTPUT (fsync "
+                        "every second; side files OUTPUT.times, OUTPUT.gaps, OUTPUT.meta.json), "
+                        "setting the outputs asked for and restoring the previous ones on exit. "
+                        "Ctrl-C ends the record cleanly.")
+    rc.add_argument("port", metavar="PORT", help="serial port, e.g. /dev/ttyUSB0")
+    rc.add_argument("-o", "--output", required=True, metavar="OUTPUT")
+    rc.add_argument("--baud", default="115200",
+                    help="baud rate, or 'auto' to try the nine VN-100 rates (default: "
+                    "%(default)s)")
+    length = rc.add_mutually_exclusive_group()
+    length.add_argument("--hours", type=_positive_float, default=None)
+    length.add_argument("--minutes", type=_positive_float, default=None)
+    length.add_argument("--seconds", type=_positive_float, default=None)
+    rc.add_argument("--ascii", default=None, metavar="TYPE",
+                    help="asynchronous ASCII output: VNYMR, VNIMU, ... or 'off'")
+    rc.add_argument("--rate", type=_positive_float, default=None, metavar="HZ",
+                    help="asynchronous ASCII rate (1 ... 200 Hz)")
+    rc.add_argument("--binary", action="append", default=[], metavar="HZ:FIELDS",
+                    help="a binary output, e.g. 800:common=TimeStartup+AngularRate+Accel"
+                    "[,imu=Temp]; repeat for up to three")
+    check = rc.add_mutually_exclusive_group()
+    check.add_argument("--crc", dest="crc", action="store_true", default=None,
+                       help="CRC-16 on the sensor's sentences")
+    check.add_argument("--checksum", dest="crc", action="store_false",
+                       help="8-bit checksum on the sensor's sentences")
+    rc.add_argument("--keep-config", action="store_true",
+                    help="leave the settings on the sensor (default: restore the previous ones)")
+
+    em = sub.add_parser("emulate", help="a VN-100 emulator on a pseudo-terminal (tests, demos)",
+                        description="Serve an emulated VN-100 at PATH (a symlink to a "
+                        "pseudo-terminal) streaming simulated still data, until Ctrl-C.")
+    em.add_argument("path", metavar="PATH")
+    em.add_argument("--speed", type=_positive_float, default=1.0,
+                    help="sensor seconds per wall second (default: %(default)s)")
+    em.add_argument("--seed", type=int, default=None)
+    em.add_argument("--seconds", type=_positive_float, default=None,
+                    help="stop after this many wall seconds")
+    em.add_argument("--fault", action="append", default=[], metavar="KIND@T[:SECONDS]",
+                    help="corrupt@T, pause@T:S, vanish@T:S or reset@T (sensor seconds); repeat")
+
+    pl = sub.add_parser("plan", help="how long to record for N, B and K to a target uncertainty",
+                        description="Record length that resolves N, B and K to --target, from "
+                        "a datasheet (--spec) or the noise model fitted to a short LOG.")
+    pl.add_argument("log", metavar="LOG", nargs="?", default=None)
+    pl.add_argument("--spec", default="vn100", help="datasheet when no LOG (default: "
+                    "%(default)s)")
+    pl.add_argument("--sensor", choices=ALLAN_SENSORS, default=None,
+                    help="one sensor (default: gyro and accel)")
+    pl.add_argument("--fs", type=_positive_float, default=None, metavar="HZ",
+                    help="sample rate to plan for (default: the log's, else 40 Hz)")
+    pl.add_argument("--target", type=_positive_float, default=0.2,
+                    help="relative uncertainty wanted (default: %(default)s = ±20 %%)")
+    pl.add_argument("--confidence", type=_positive_float, default=0.95,
+                    help="probability of being within it (default: %(default)s)")
 
 
 def _shared_options(p, *, spec: bool = False, fs: bool = False, progress: bool = False,
@@ -343,13 +404,35 @@ def _note_gaps(source: str, done) -> None:
 # --- commands ------------------------------------------------------------------------
 
 
+#: ``--units datasheet`` of ``report``, told apart from the layout's ``CHANNEL=UNIT``.
+_TABLE_UNITS = ("tables", "datasheet")
+
+
+def _report_units_option(parser) -> None:
+    """``report --units datasheet``: the units of the report's tables, on the same
+    option as the layout's ``--units CHANNEL=UNIT`` (a value without ``=``)."""
+    action = next(a for a in parser._actions if "--units" in a.option_strings)
+    layout = action.type
+
+    def units_value(text: str) -> tuple[str, str]:
+        return _TABLE_UNITS if text.strip() == "datasheet" else layout(text)
+
+    action.type = units_value
+    action.metavar = "CHANNEL=UNIT|datasheet"
+    action.help += ("; 'datasheet': every table of the report gives N, B, K in the units "
+                    "datasheets write (deg/s/sqrt(Hz), deg/h, ug/sqrt(Hz), ug) instead of "
+                    "deg/sqrt(h), mg/sqrt(Hz)")
+
+
 def _cmd_report(args) -> int:
     from imunoise import report
 
     spec = None if args.spec.lower() == "none" else args.spec
+    table_units = "datasheet" if _TABLE_UNITS in args.units else None
+    args.units = [u for u in args.units if u != _TABLE_UNITS]
     rep = report.build(args.short_log, args.long_log, args.output, spec=spec, fs=args.fs,
                        progress=args.progress, read_options=_read_options(args), trim=args.trim,
-                       force=args.force, stream=args.stream)
+                       force=args.force, units=table_units, stream=args.stream)
     for log in rep.logs:
         _note_gaps(log.source, log)
     print(f"report written to {rep.html}")
@@ -406,14 +489,23 @@ def _cmd_fit(args) -> int:
             model, s, units="datasheet" if args.datasheet_units else None)
         print(f"# {s}")
         _print_table(head, rows)
-        for sentence in report.model_sentences(model, s):
+        for sentence in report.model_sentences(
+                model, s, units="datasheet" if args.datasheet_units else None):
             print(sentence.replace("**", ""))
+        print(_plan_line(model, log, s))
         if args.plot:
             from imunoise import plot
 
             _save_plot(plot.allan(result, model, title=f"{s} Allan deviation and model",
                                   unit=CHANNELS[s][1]), _plot_path(args.plot, s, len(sensors)))
     return 0
+
+
+def _plan_line(model, log, sensor: str) -> str:
+    """The planner's answer for this log, one line (end of ``fit``)."""
+    from imunoise.planner import fit_line
+
+    return fit_line(model, log.fs, log.duration).replace("plan:", f"plan {sensor}:")
 
 
 def _cmd_stats(args) -> int:
@@ -694,6 +786,80 @@ def _cmd_thermal(args) -> int:
     return 0
 
 
+def _cmd_record(args) -> int:
+    from imunoise.recording import binary_output, record
+
+    seconds = (args.hours * 3600 if args.hours else args.minutes * 60 if args.minutes
+               else args.seconds)
+    baud = args.baud
+    if baud != "auto":
+        try:
+            baud = int(baud)
+        except ValueError:
+            _fail(f"--baud must be a number or 'auto'; got {args.baud!r}")
+    binary = []
+    for text in args.binary:
+        rate, sep, fields = text.partition(":")
+        if not sep:
+            _fail(f"--binary must be HZ:FIELDS; got {text!r}")
+        try:
+            binary.append(binary_output(float(rate), fields))
+        except ValueError as exc:
+            _fail(f"--binary {text}: {exc}")
+    rec = record(args.port, args.output, seconds=seconds, baud=baud, ascii=args.ascii,
+                 rate=args.rate, binary=binary, crc=args.crc, keep_config=args.keep_config)
+    print(f"recorded {rec.bytes} bytes in {duration(rec.seconds)} to {rec.path}"
+          + (f"; {len(rec.outages)} port outage(s)" if rec.outages else "")
+          + ("; previous settings restored" if rec.restored else ""))
+    return 0
+
+
+def _cmd_emulate(args) -> int:
+    import os
+    import time
+
+    from imunoise.emulate import Emulator, Fault
+
+    faults = []
+    for text in args.fault:
+        kind, _, when = text.partition("@")
+        at, _, length = when.partition(":")
+        try:
+            faults.append(Fault(kind, float(at), float(length or 0)))
+        except ValueError as exc:
+            _fail(f"--fault {text}: {exc}")
+    with Emulator(args.path, speed=args.speed, seed=args.seed, faults=faults,
+                  keep_sent=False) as emu:
+        print(f"VN-100 emulator on {emu.path} -> {os.path.realpath(emu.path)}; Ctrl-C to stop",
+              flush=True)
+        started = time.monotonic()
+        while args.seconds is None or time.monotonic() - started < args.seconds:
+            time.sleep(0.1)
+    return 0
+
+
+def _cmd_plan(args) -> int:
+    from imunoise.planner import plan
+
+    sensors = [args.sensor] if args.sensor else list(ALLAN_SENSORS)
+    if args.log is None:
+        for s in sensors:
+            print(plan(args.spec, fs=args.fs or 40.0, target=args.target,
+                       confidence=args.confidence, sensor=s).line())
+        return 0
+    from imunoise import allan, noise, report
+
+    log = _read(args)
+    for s in sensors:
+        if getattr(log, s) is None:
+            continue
+        model = noise.fit(allan.adev(getattr(log, s), log.fs, taus=report.TAUS_PER_DECADE),
+                          warn_coverage=False)
+        p = plan(model, fs=args.fs or log.fs, target=args.target, confidence=args.confidence)
+        print(p.line(log.duration).replace("plan:", f"plan {s}:"))
+    return 0
+
+
 def _print_table(head, rows) -> None:
     widths = [max(len(str(x)) for x in col) for col in zip(head, *rows, strict=True)]
     for line in [head, *rows]:
@@ -713,6 +879,9 @@ _COMMANDS = {
     "demo": _cmd_demo,
     "psd": _cmd_psd,
     "dadev": _cmd_dadev,
+    "record": _cmd_record,
+    "emulate": _cmd_emulate,
+    "plan": _cmd_plan,
 }
 
 

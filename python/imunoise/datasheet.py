@@ -164,7 +164,8 @@ class Comparison:
                          _numbers.cell(r["ratio"], r["ratio_std"]), r["verdict"]])
         return _summary.html_table(
             ["sensor", "quantity", "axis", "measured", "spec", "ratio", "verdict"], body,
-            caption=f"Comparison with {self.spec.name}: {self._verdicts()}")
+            caption=f"Comparison with {self.spec.name}, "
+                    f"{_summary.plural(len(self.rows), 'row')}: {self._verdicts()}")
 
     @property
     def passed(self) -> bool:

@@ -159,6 +159,19 @@ class Stationarity:
             f"departures {found}{more}",
         ], sep=", ")
 
+    def _repr_html_(self) -> str:
+        """The departures (the first :data:`~imunoise._summary.HTML_ROWS`), ratio
+        rounded to its uncertainty as in the repr."""
+        rows = [[_summary.number(d.start), _summary.number(d.end), d.channel,
+                 _numbers.rounded(d.ratio, d.ratio_std)]
+                for d in self.intervals[:_summary.HTML_ROWS]]
+        caption = (f"Stationarity: outside {_summary.number(np.max(self.outside))} (expected "
+                   f"{_summary.number(self.expected_outside)}), max |z| "
+                   f"{_summary.number(np.max(self.worst_z))}, "
+                   f"{_summary.plural(len(self.intervals), 'departure')}")
+        return _summary.html_table(["start [s]", "end [s]", "channel", "ratio"],
+                                   rows or [["—", "—", "—", "none"]], caption=caption)
+
 
 @dataclass(frozen=True, repr=False)
 class DynamicAllan:

@@ -3,14 +3,14 @@
 Kalibr's IMU model (``imu.yaml``) and OpenVINS' ``kalibr_imu_chain.yaml`` take
 continuous-time densities in SI units:
 
-=============================  =======================  ====================
-key                            noise-model coefficient  unit
-=============================  =======================  ====================
-``gyroscope_noise_density``    N of the gyro            rad/s/√Hz
-``gyroscope_random_walk``      K of the gyro            rad/s²/√Hz
-``accelerometer_noise_density`` N of the accelerometer  m/s²/√Hz
-``accelerometer_random_walk``  K of the accelerometer   m/s³/√Hz
-=============================  =======================  ====================
+===============================  =======================  ====================
+key                              noise-model coefficient  unit
+===============================  =======================  ====================
+``gyroscope_noise_density``      N of the gyro            rad/s/√Hz
+``gyroscope_random_walk``        K of the gyro            rad/s²/√Hz
+``accelerometer_noise_density``  N of the accelerometer   m/s²/√Hz
+``accelerometer_random_walk``    K of the accelerometer   m/s³/√Hz
+===============================  =======================  ====================
 
 (N in rad/√s is numerically rad/s/√Hz, K in rad/s/√s is rad/s²/√Hz.) Kalibr's
 model has no Gauss–Markov state, so the values written are the model's
@@ -216,7 +216,8 @@ def _ekf_axes(model, sensor: str, input_unit, min_samples: float) -> dict:
     for c, name in enumerate(names):
         white2 = float(parts.value("N")[c]) ** 2
         # A resonance (like a tone) is no bias state; what it adds to the white
-        # floor (its spectrum at zero frequency) is measurement noise.
+        # floor (its spectrum at zero frequency) is measurement noise. A bounded
+        # motion is the test mount's, not the sensor's: no state, no noise.
         for sigma, f_r, tau_r in parts.resonance(c):
             white2 += resonance_white_density(sigma, f_r, tau_r, model.fs)
         states = []

@@ -31,19 +31,26 @@ def _plain(x: float) -> bool:
     return x == 0 or 1e-2 <= abs(x) < 1e5
 
 
+#: Relative uncertainty below which a value prints without it: beyond what a double's
+#: 15–16 digits carry.
+RESOLUTION = 1e-13
+
+
 def format_value(value, std=None, *, unit: str | None = None, digits: int = 4,
                  missing: str = NOT_RESOLVED) -> str:
     """``value ± std`` rounded GUM style, or ``value`` to ``digits`` significant digits.
 
-    ``std`` None, NaN, inf or ≤ 0 means no usable uncertainty. A non-finite or None
-    ``value`` gives ``missing``. ``unit`` is appended after a space.
+    ``std`` None, NaN, inf or ≤ 0 means no usable uncertainty, and so does one below
+    :data:`RESOLUTION` of the value (rounding error of a constant's mean: its
+    digits would run to the end of the float). A non-finite or None ``value``
+    gives ``missing``. ``unit`` is appended after a space.
     """
     if not isinstance(digits, int) or digits < 1:
         raise ValueError(f"digits must be a positive integer; got {digits!r}")
     if not _finite(value):
         return missing
     value = float(value)
-    if _finite(std) and float(std) > 0:
+    if _finite(std) and float(std) > RESOLUTION * abs(value):
         text = _with_uncertainty(value, float(std))
     else:
         text = _significant(value, digits)

@@ -85,6 +85,28 @@ _RC = {
 }
 
 
+#: The unit an axis label gives when the caller did not say the data's: results are
+#: in the input's units (``docs``: rate data in, deviations in the same units).
+INPUT_UNIT = "input unit"
+
+
+def _label(quantity: str, unit: str) -> str:
+    """``"σ(τ) [rad/s]"``; ``"σ(τ) [input unit]"`` when the unit is not known."""
+    return f"{quantity} [{unit or INPUT_UNIT}]"
+
+
+def _per(unit: str) -> str:
+    """The unit of a density over ``unit``: ``"1/deg"``, ``"1/(rad/s)"``."""
+    u = unit or INPUT_UNIT
+    return f"1/({u})" if any(c in u for c in "/ ·*^") else f"1/{u}"
+
+
+def _channel_unit(name: str) -> str:
+    """Unit of a channel named ``"gyro X"`` (or ``"gyro"``); "" when not a log's."""
+    sensor = name.split(" ")[0]
+    return CHANNELS[sensor][1] if sensor in CHANNELS else ""
+
+
 def _plt():
     import matplotlib
 
@@ -263,7 +285,7 @@ def _series_figure(blocks, fs: float, title: str, columns: int, gaps) -> Figure:
                     width = max(length, duration / columns) / scale
                     ax.axvspan(start / scale, start / scale + width, color=GAP_COLOR,
                                alpha=0.35, linewidth=0)
-                ax.set_ylabel(names[j] if head or not unit else f"{names[j]} [{unit}]")
+                ax.set_ylabel(_label(names[j], unit))
                 ax.margins(x=0)
             if head:
                 grid[0, b].set_title(f"{head} [{unit}]" if unit else head)
@@ -330,10 +352,10 @@ def histograms(
                 if count:
                     ax.text(xpos, 0.98, text.format(count), transform=ax.transAxes,
                             ha=align, va="top", fontsize=7, color="0.3")
-            ax.set_xlabel(unit)
+            ax.set_xlabel(_label(names[j], unit))
+            ax.set_ylabel(_label("density", _per(unit)))  # each panel has its own scale
             ax.grid(False)
-        axes[0].set_ylabel("density")
-        _margins(fig, left=0.6, bottom=0.45, top=0.55, wspace=0.3, title=bool(title))
+        _margins(fig, left=0.7, bottom=0.45, top=0.55, wspace=0.4, title=bool(title))
         if title:
             fig.suptitle(title)
         _readable_ticks(fig, axes)
@@ -566,6 +588,10 @@ def allan(
                 if "resonance" in curves and np.any(curves["resonance"] > 0):
                     band = np.where(curves["resonance"] > 0, curves["resonance"], np.nan)
                     ax.plot(grid, band, color="tab:cyan", linewidth=0.9, label="resonance")
+                if "motion" in curves and np.any(curves["motion"] > 0):
+                    rocking = np.where(curves["motion"] > 0, curves["motion"], np.nan)
+                    ax.plot(grid, rocking, color="tab:brown", linewidth=0.9, linestyle="-.",
+                            label="bounded motion (mount)")
                 if marks.get("N", 0.0) > 0:
                     ax.plot([1.0], [marks["N"]], marker="s", color="crimson", ms=5,
                             linestyle="none", label="N at τ=1 s")
@@ -573,13 +599,14 @@ def allan(
                     ax.plot([3.0], [marks["K"]], marker="^", color="purple", ms=5,
                             linestyle="none", label="K at τ=3 s")
                 if marks.get("B", 0.0) > 0:
-                    # where model.B is read: the model's minimum over the fitted taus
+                    # where model.B is read: the model's floor over the fitted taus
                     # (beyond them a model without a walk keeps falling)
                     fitted = (grid >= taus[0]) & (grid <= taus[-1]) if model is None else (
                         (grid >= model.taus[0]) & (grid <= model.taus[-1]))
-                    total = np.where(fitted, curves["total"], np.inf)
-                    imin = int(np.argmin(total))
-                    ax.plot([grid[imin]], [marks["B"] * FLICKER], marker="D",
+                    floor = model.floor(j) if model is not None else None
+                    at = floor[0] if floor is not None else grid[int(np.argmin(
+                        np.where(fitted, curves["total"], np.inf)))]
+                    ax.plot([at], [marks["B"] * FLICKER], marker="D",
                             color="darkgreen", ms=5, linestyle="none",
                             label="B·0.664 floor")
                 read = _data_floor(model, j) if model is not None else None
@@ -620,7 +647,7 @@ def allan(
             ax.text(0.02, 0.06, f"follows {cover:.0%} of taus", transform=ax.transAxes,
                     fontsize=7)
             if j == 0:
-                ax.set_ylabel("data/model")
+                ax.set_ylabel("data/model\n[ratio]")
             axes[j].tick_params(labelbottom=False)
         if spans:
             span = min(max(spans), 0.9)  # shared by the residual panels
@@ -629,7 +656,7 @@ def allan(
         ymax = np.nanmax([b for _, b in lims])
         if np.isfinite(ymin) and np.isfinite(ymax) and ymin > 0:
             axes[0].set_ylim(ymin / 1.5, ymax * 1.5)  # shared by all panels
-        axes[0].set_ylabel(f"σ(τ) [{unit}]" if unit else "σ(τ)")
+        axes[0].set_ylabel(_label("σ(τ)", unit))
         seen: dict[str, object] = {}
         for ax in axes:
             for h, lab in zip(*ax.get_legend_handles_labels(), strict=True):
@@ -694,6 +721,7 @@ def spectrum(
     bands = np.reshape(result.band, (k, 2))
     terms = model_psd_terms(model, s.f) if model is not None else {}
     names = list(names) if names is not None else axis_names(k)
+    unit = unit or INPUT_UNIT
     level_unit = f"{unit}/√Hz" if amplitude else f"({unit})²/Hz"
     with style():
         fig = new_figure(figsize=(min(3.6 * k, 14.0), 3.4))
@@ -704,8 +732,11 @@ def spectrum(
             ax.loglog(s.f, p[:, j], color=color, label="PSD" if not amplitude else "ASD")
             ax.axvspan(*bands[j], color="0.85", alpha=0.5, linewidth=0, label="white band")
             level = (2 * white_n[j] ** 2) ** power
-            label = f"N = {format_value(white_n[j], white_std[j])} {unit}/√Hz".replace("  ", " ")
-            ax.plot(bands[j], [level, level], color="k", linewidth=1.6, label=label)
+            value = f"N = {format_value(white_n[j], white_std[j])} {unit}/√Hz"
+            ax.plot(bands[j], [level, level], color="k", linewidth=1.6,
+                    label="N read-off (level 2N²)")
+            ax.text(0.03, 0.04, value, transform=ax.transAxes, fontsize=7,
+                    bbox={"facecolor": "white", "alpha": 0.8, "linewidth": 0, "pad": 1})
             for k, line in enumerate(result.lines[j]):
                 ax.axvline(line, color="0.3", linestyle=":", linewidth=0.8,
                            label="line (left out)" if k == 0 else None)
@@ -717,16 +748,35 @@ def spectrum(
                     text, dash = TERM_STYLES.get(name, (name, (0, (2, 2))))
                     ax.loglog(s.f, np.reshape(values, shape)[:, j] ** power, color="0.4",
                               linestyle=dash, linewidth=0.8, label=text)
-                ax.set_ylim(np.nanmin(lo[:, j]) / 3, np.nanmax(hi[:, j]) * 3)
             ax.set_title(names[j])
             ax.set_xlabel("frequency [Hz]")
-            if j == 0:
-                ax.legend(loc="best", fontsize=6.5)
+        # the panels share y: one range holding every panel's spectrum and band (a
+        # line's peak included; the model's terms may leave it below)
+        shown = np.concatenate([lo[lo > 0], hi[np.isfinite(hi)], p[np.isfinite(p)]])
+        if shown.size:
+            axes[0].set_ylim(np.min(shown) / 3, np.max(shown) * 3)
         axes[0].set_ylabel(("ASD " if amplitude else "PSD ") + f"[{level_unit}]")
         if title:
             fig.suptitle(title)
-        _margins(fig, title=bool(title))
+        rows = _shared_legend(fig, axes, per_row=4)
+        fig.set_size_inches(fig.get_size_inches()[0], 3.0 + 0.2 * rows)
+        _margins(fig, bottom=0.5 + 0.2 * rows, title=bool(title))
     return fig
+
+
+def _shared_legend(fig, axes, *, per_row: int) -> int:
+    """One legend for the figure, below its panels: each label once (the first panel
+    to draw it gives its handle), ``per_row`` to a row. Returns the rows it takes.
+    A legend inside a small panel covers its data."""
+    seen: dict[str, object] = {}
+    for ax in axes:
+        for h, lab in zip(*ax.get_legend_handles_labels(), strict=True):
+            seen.setdefault(lab, h)
+    if not seen:
+        return 0
+    fig.legend(list(seen.values()), list(seen), loc="lower center",
+               ncol=min(len(seen), per_row), bbox_to_anchor=(0.5, 0.0))
+    return -(-len(seen) // per_row)
 
 
 def dynamic(
@@ -740,6 +790,7 @@ def dynamic(
     across, tau up, colour the window's ADEV over the whole-record ADEV on a log scale
     (1 white, noisier red, quieter blue, clipped at ``limit`` and 1/``limit``); the
     stationarity summary's departures are marked above each panel."""
+    import matplotlib
     from matplotlib.colors import LogNorm
 
     from imunoise.dynamic import DynamicAllan
@@ -766,28 +817,39 @@ def dynamic(
         fig = new_figure(figsize=(min(3.8 * k, 14.0), 3.2))
         axes = np.atleast_1d(fig.subplots(1, k, sharey=True))
         norm = LogNorm(vmin=1 / limit, vmax=limit)
+        cmap = matplotlib.colormaps["RdBu_r"].with_extremes(bad=NO_ESTIMATE)
         for j, ax in enumerate(axes):
             mesh = ax.pcolormesh(t_edges, tau_edges, np.clip(ratio[:, :, j], 1 / limit, limit).T,
-                                 cmap="RdBu_r", norm=norm, shading="flat")
+                                 cmap=cmap, norm=norm, shading="flat")
+            if not np.isfinite(ratio[:, :, j]).all():  # a proxy: the legend names the grey
+                ax.fill_between([], [], color=NO_ESTIMATE,
+                                label="no estimate (too few terms in the window)")
             ax.set_yscale("log")
             ax.grid(False)
             for d in departures:
-                if d.channel == j:
-                    ax.axvspan(d.start / scale, d.end / scale, ymin=0.97, ymax=1.0,
-                               color="k", linewidth=0)
+                if d.channel == j:  # a bar above the map, not a cell of it
+                    ax.axvspan(d.start / scale, d.end / scale, ymin=1.02, ymax=1.07,
+                               color="k", linewidth=0, clip_on=False,
+                               label="departs from its typical level (bar above the map)")
             ax.set_xlim(0, result.n_samples / result.fs / scale)  # the record's time
-            ax.set_title(names[j])
+            ax.set_title(names[j], pad=14)
             ax.set_xlabel(f"window centre [{tunit}]")
         axes[0].set_ylabel("τ [s]")
-        _margins(fig, right=0.9, title=bool(title))
+        rows = _shared_legend(fig, axes, per_row=1)
+        fig.set_size_inches(fig.get_size_inches()[0], 3.2 + 0.2 * rows)
+        _margins(fig, right=0.9, bottom=0.5 + 0.2 * rows, top=0.45, title=bool(title))
         bar = fig.colorbar(mesh, ax=list(axes), pad=0.02, fraction=0.04)
-        bar.set_label("ADEV / whole-record ADEV")
+        bar.set_label("ADEV / whole-record ADEV [ratio]")
         ticks = [v for v in (0.25, 0.5, 1.0, 2.0, 4.0, 8.0) if 1 / limit <= v <= limit]
         bar.set_ticks(ticks, labels=[f"{v:g}" for v in ticks])
         bar.minorticks_off()
         if title:
             fig.suptitle(title)
     return fig
+
+
+#: Colour of a dynamic-ADEV cell without an estimate (white would read as ratio 1).
+NO_ESTIMATE = "0.72"
 
 
 def _edges(centres: np.ndarray, step: float) -> np.ndarray:
@@ -828,12 +890,32 @@ def events(y, found, fs: float | None = None, *, title: str = "", unit: str = ""
         for a, b in zip(found.start, found.end, strict=True):
             ax.axvspan(a / scale, (a + max(b - a, width)) / scale, color=EVENT_COLOR,
                        alpha=0.3, linewidth=0)
-    top = fig.axes[0]
-    for i in np.argsort(found.peak)[::-1][:EVENT_LABELS]:  # the largest, inside the panel
-        top.annotate(f"{found.peak[i]:.0f}σ", (found.start[i] / scale, 0.97),
-                     xycoords=("data", "axes fraction"), fontsize=6, color=EVENT_COLOR,
-                     va="top", ha="center")
+    _peak_labels(fig, fig.axes[0], found, scale)
     return fig
+
+
+def _peak_labels(fig, ax, found, scale: float) -> None:
+    """The peak (σ) of the :data:`EVENT_LABELS` largest events at their start, inside
+    ``ax``; a label that would touch one already written (a larger event's) is left
+    out: the report's events table gives every peak."""
+    renderer = _renderer(fig)
+    placed = []
+    for i in np.argsort(found.peak)[::-1]:
+        if len(placed) == EVENT_LABELS:
+            break
+        x = found.start[i] / scale
+        lo, hi = ax.get_xlim()
+        # written from the event's start, rightwards (leftwards near the right edge)
+        text = ax.annotate(f"{found.peak[i]:.0f}σ", (x, 0.97),
+                           xycoords=("data", "axes fraction"), fontsize=6,
+                           color=EVENT_COLOR, va="top",
+                           ha="right" if x > lo + 0.93 * (hi - lo) else "left")
+        x0, y0, x1, y1 = text.get_window_extent(renderer).extents
+        box = (x0 - TICK_GAP_PX, x1 + TICK_GAP_PX)
+        if any(box[0] < b and a < box[1] for a, b in placed):
+            text.remove()
+        else:
+            placed.append(box)
 
 
 def warmup(result, *, title: str = "", unit: str = "") -> Figure:
@@ -857,7 +939,7 @@ def warmup(result, *, title: str = "", unit: str = "") -> Figure:
                 ax.plot(t, fitted[:, j], color="k", linewidth=0.8, linestyle="--",
                         label=f"τ {_summary.duration(result.tau[j])}")
                 ax.legend(loc="upper right")
-            ax.set_ylabel(f"{name}" + (f" [{unit}]" if unit else ""))
+            ax.set_ylabel(_label(name, unit or _channel_unit(name)))
         if result.temperature is not None:
             axes[-1].plot(t, result.temperature, color="#d62728", linewidth=0.9)
             axes[-1].set_ylabel("temperature [°C]")
@@ -896,6 +978,7 @@ def thermal(result, *, title: str = "") -> Figure:
                     label=f"{slope[j]:.3g} ± {slope_std[j]:.2g} {units[j]}")
             ax.set_title(name)
             ax.set_xlabel("temperature [°C]")
+            ax.set_ylabel(_label("bias", _channel_unit(name)))
             ax.legend(loc="best")
         for j in range(k, rows * cols):
             axes[j // cols, j % cols].set_visible(False)
@@ -920,7 +1003,7 @@ def compensation(before: AllanResult, after: AllanResult, *, title: str = "",
             ax.loglog(before.taus, b[:, j], color=color, label=f"{name} before")
             ax.loglog(after.taus, a[:, j], color=color, linestyle="--", label=f"{name} after")
         ax.set_xlabel("τ [s]")
-        ax.set_ylabel(f"σ(τ) [{unit}]" if unit else "σ(τ)")
+        ax.set_ylabel(_label("σ(τ)", unit))
         ax.legend(ncol=2)
         fig.suptitle(title or "Allan deviation before and after compensation")
         _margins(fig, left=0.9, bottom=0.5, title=True)

@@ -30,6 +30,7 @@ use rayon::prelude::*;
 
 use crate::error::{CoreError, CoreResult};
 use crate::interrupt::{Interrupt, NEVER};
+pub use estimators::theobr::{Ladder, RatioOptions};
 pub use estimators::Estimate;
 pub use phase::{column_phases, row_major_phases, Gaps, Phase};
 pub use statistic::Statistic;
@@ -73,8 +74,25 @@ pub fn analyse_plan(
     plan: &[(Statistic, usize)],
     stop: &Interrupt,
 ) -> CoreResult<Analysis> {
+    analyse_plan_with(phases, plan, RatioOptions::default(), stop)
+}
+
+/// [`analyse_plan`] with ThêoBR's bias ratio computed as `ratio` says (its
+/// ladder, or the fast ThêoBR's block).
+pub fn analyse_plan_with(
+    phases: &[Phase],
+    plan: &[(Statistic, usize)],
+    ratio: RatioOptions,
+    stop: &Interrupt,
+) -> CoreResult<Analysis> {
     let n_phase = check_phases(phases, plan)?;
-    let job = Job::new(phases, plan, n_phase)?;
+    if ratio.block == 0 {
+        return Err(CoreError::InvalidArgument(
+            "the bias ratio's block must be at least 1; got 0".into(),
+        ));
+    }
+    let mut job = Job::new(phases, plan, n_phase)?;
+    job.ratio = ratio;
     let swept = job.sweep_blocked();
     stop.check()?;
     let estimates = job.estimate_pairs(&swept, stop);
@@ -140,6 +158,8 @@ struct Job<'a> {
     runs: Vec<Option<BTreeMap<usize, usize>>>,
     /// Terms per pair.
     terms: Vec<usize>,
+    /// How ThêoBR's bias ratio is computed.
+    ratio: RatioOptions,
 }
 
 impl<'a> Job<'a> {
@@ -184,6 +204,7 @@ impl<'a> Job<'a> {
             pairs,
             runs,
             terms,
+            ratio: RatioOptions::default(),
         })
     }
 
@@ -246,7 +267,7 @@ impl<'a> Job<'a> {
             None
         } else {
             let refs: Vec<&[f64]> = self.phases.iter().map(|p| p.c.as_slice()).collect();
-            estimators::theobr::bias_ratios(&refs, &theobr_ms, stop)
+            estimators::theobr::bias_ratios_with(&refs, &theobr_ms, self.ratio, stop)
         };
         self.pairs
             .par_iter()

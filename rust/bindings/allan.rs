@@ -12,7 +12,7 @@ use pyo3::types::PyTuple;
 
 use super::interrupt::run_interruptible;
 use crate::allan::estimators::theobr;
-use crate::allan::{self, Statistic};
+use crate::allan::{self, Ladder, RatioOptions, Statistic};
 
 /// The arrays of one analysis; 2-D arrays are (taus, channels).
 #[pyclass(name = "Analysis", module = "imunoise._core.allan", frozen, get_all)]
@@ -39,32 +39,55 @@ fn parse_statistic(name: &str) -> PyResult<Statistic> {
 ///
 /// `x` is a float64 array (n, channels) in any memory order, NaN where a sample
 /// is missing; `ms` the averaging factors. 2-D outputs have shape (len(ms),
-/// channels); `missing` counts the NaN of each channel.
+/// channels); `missing` counts the NaN of each channel. `ratio_ladder`
+/// ("taylor-howe" or "sp1065") and `ratio_block` (≥ 1) choose how ThêoBR's bias
+/// ratio is computed (`allan::RatioOptions`).
 #[pyfunction]
+#[pyo3(signature = (x, statistic, ms, ratio_ladder="taylor-howe", ratio_block=1))]
 fn analyse<'py>(
     py: Python<'py>,
     x: PyReadonlyArray2<'py, f64>,
     statistic: &str,
     ms: PyReadonlyArray1<'py, u64>,
+    ratio_ladder: &str,
+    ratio_block: usize,
 ) -> PyResult<AnalysisArrays> {
+    let ratio = ratio_options(ratio_ladder, ratio_block)?;
     let statistic = parse_statistic(statistic)?;
     let plan: Vec<(Statistic, usize)> = ms
         .as_array()
         .iter()
         .map(|&m| (statistic, m as usize))
         .collect();
-    run_plan(py, x, plan)
+    run_plan(py, x, plan, ratio)
+}
+
+/// The bias ratio's options from their Python names.
+fn ratio_options(ladder: &str, block: usize) -> PyResult<RatioOptions> {
+    if block == 0 {
+        return Err(PyValueError::new_err(
+            "ratio_block must be at least 1; got 0",
+        ));
+    }
+    Ok(RatioOptions {
+        ladder: ladder.parse::<Ladder>()?,
+        block,
+    })
 }
 
 /// analyse_plan(x, statistics, ms) -> as `analyse`, with one statistic per tau
 /// (`statistics[t]` at `ms[t]`; ThêoH is oadev then theobr, ordered by tau).
 #[pyfunction]
+#[pyo3(signature = (x, statistics, ms, ratio_ladder="taylor-howe", ratio_block=1))]
 fn analyse_plan<'py>(
     py: Python<'py>,
     x: PyReadonlyArray2<'py, f64>,
     statistics: Vec<String>,
     ms: PyReadonlyArray1<'py, u64>,
+    ratio_ladder: &str,
+    ratio_block: usize,
 ) -> PyResult<AnalysisArrays> {
+    let ratio = ratio_options(ratio_ladder, ratio_block)?;
     let ms = ms.as_array();
     if statistics.len() != ms.len() {
         return Err(PyValueError::new_err(format!(
@@ -78,13 +101,14 @@ fn analyse_plan<'py>(
         .zip(ms.iter())
         .map(|(s, &m)| Ok((parse_statistic(s)?, m as usize)))
         .collect::<PyResult<Vec<_>>>()?;
-    run_plan(py, x, plan)
+    run_plan(py, x, plan, ratio)
 }
 
 fn run_plan<'py>(
     py: Python<'py>,
     x: PyReadonlyArray2<'py, f64>,
     plan: Vec<(Statistic, usize)>,
+    ratio: RatioOptions,
 ) -> PyResult<AnalysisArrays> {
     let view = x.as_array();
     let result = run_interruptible(py, |stop| {
@@ -103,7 +127,7 @@ fn run_plan<'py>(
                 allan::column_phases(columns)?
             }
         };
-        allan::analyse_plan(&phases, &plan, stop)
+        allan::analyse_plan_with(&phases, &plan, ratio, stop)
     })?;
     let shape = (plan.len(), result.channels);
     let as_u64 = |v: &[usize]| v.iter().map(|&t| t as u64).collect::<Vec<u64>>();
@@ -128,11 +152,19 @@ fn table<T: Element>(
     Ok(array.into_pyarray(py).unbind())
 }
 
-/// theobr_seconds(n_phase, ms) -> rough seconds of ThêoBR's bias ratio plus Theo1 at
-/// `ms` on one channel (see `allan::estimators::theobr::estimated_seconds`)
+/// theobr_seconds(n_phase, ms, ratio_ladder="taylor-howe", ratio_block=1) -> rough
+/// seconds of ThêoBR's bias ratio plus Theo1 at `ms` on one channel (see
+/// `allan::estimators::theobr::estimated_seconds`)
 #[pyfunction]
-fn theobr_seconds(n_phase: usize, ms: Vec<usize>) -> f64 {
-    theobr::estimated_seconds(n_phase, &ms)
+#[pyo3(signature = (n_phase, ms, ratio_ladder="taylor-howe", ratio_block=1))]
+fn theobr_seconds(
+    n_phase: usize,
+    ms: Vec<usize>,
+    ratio_ladder: &str,
+    ratio_block: usize,
+) -> PyResult<f64> {
+    let ratio = ratio_options(ratio_ladder, ratio_block)?;
+    Ok(theobr::estimated_seconds(n_phase, &ms, ratio))
 }
 
 /// estimator_terms(statistic, n_phase, ms) -> terms per averaging factor (0: does not fit)

@@ -10,8 +10,8 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
 use crate::fit::{
-    self, Options, FLICKER_FACTOR, IEEE_TERMS, IEEE_TERM_NAMES, MAX_GM, PARAMETERS, RESONANCE_SLOT,
-    SINE_SLOT,
+    self, Options, FLICKER_FACTOR, IEEE_TERMS, IEEE_TERM_NAMES, MAX_GM, MOTION_SLOT, PARAMETERS,
+    RESONANCE_SLOT, SINE_SLOT,
 };
 
 /// The fit of one channel, as `_core.fit.NoiseFit`.
@@ -25,8 +25,11 @@ struct PyNoiseFit {
     sine: Py<PyArray2<f64>>,
     /// (k, 3) rows of (r², f_r, τr), k ≤ 1: the resonance.
     resonance: Py<PyArray2<f64>>,
+    /// (k, 2) rows of (σθ², τc), k ≤ 1: the bounded motion.
+    motion: Py<PyArray2<f64>>,
     /// PARAMETERS × PARAMETERS covariance of (Q²…R², then q², ln τc per slot,
-    /// then s², ln f₀, then r², ln f_r, ln τr; NaN variance of ln f_r at fs/2).
+    /// then s², ln f₀, then r², ln f_r, ln τr, then σθ², ln τc; NaN variance of
+    /// ln f_r at fs/2).
     cov: Py<PyArray2<f64>>,
     /// δ, the relative model discrepancy.
     discrepancy: f64,
@@ -58,10 +61,10 @@ fn to_matrix(rows: Vec<Vec<f64>>, cols: usize) -> PyResult<Array2<f64>> {
         .map_err(|e| PyValueError::new_err(e.to_string()))
 }
 
-/// fit_noise(taus, var, edf, fs, terms, gm, select, sine, resonance) -> NoiseFit
+/// fit_noise(taus, var, edf, fs, terms, gm, select, sine, resonance, motion) -> NoiseFit
 #[pyfunction]
 #[allow(clippy::too_many_arguments)] // mirrors the Python keyword arguments
-#[pyo3(signature = (taus, var, edf, fs, terms, gm=3, select=true, sine=true, resonance=true))]
+#[pyo3(signature = (taus, var, edf, fs, terms, gm=3, select=true, sine=true, resonance=true, motion=true))]
 fn fit_noise<'py>(
     py: Python<'py>,
     taus: PyReadonlyArray1<'py, f64>,
@@ -73,12 +76,14 @@ fn fit_noise<'py>(
     select: bool,
     sine: bool,
     resonance: bool,
+    motion: bool,
 ) -> PyResult<PyNoiseFit> {
     let opts = Options {
         ieee: ieee_flags(&terms)?,
         gm,
         sine,
         resonance,
+        motion,
         select,
     };
     let taus = taus.as_array().to_vec();
@@ -88,11 +93,13 @@ fn fit_noise<'py>(
     let gm_rows: Vec<Vec<f64>> = r.gm.iter().map(|&(q2, tc)| vec![q2, tc]).collect();
     let sine_rows: Vec<Vec<f64>> = r.sine.iter().map(|&(s2, f0)| vec![s2, f0]).collect();
     let res_rows: Vec<Vec<f64>> = r.resonance.iter().map(|&(a, f, t)| vec![a, f, t]).collect();
+    let motion_rows: Vec<Vec<f64>> = r.motion.iter().map(|&(v, tc)| vec![v, tc]).collect();
     Ok(PyNoiseFit {
         ieee: r.ieee.to_vec().into_pyarray(py).unbind(),
         gm: to_matrix(gm_rows, 2)?.into_pyarray(py).unbind(),
         sine: to_matrix(sine_rows, 2)?.into_pyarray(py).unbind(),
         resonance: to_matrix(res_rows, 3)?.into_pyarray(py).unbind(),
+        motion: to_matrix(motion_rows, 2)?.into_pyarray(py).unbind(),
         cov: to_matrix(r.cov, PARAMETERS)?.into_pyarray(py).unbind(),
         discrepancy: r.discrepancy,
         chi2: r.chi2,
@@ -102,10 +109,11 @@ fn fit_noise<'py>(
     })
 }
 
-/// noise_terms(taus, fs, ieee, gm, sine, resonance) -> (len(taus), 5 + k + j + l) Allan
-/// variance of each term
+/// noise_terms(taus, fs, ieee, gm, sine, resonance, motion) -> (len(taus), 5 + k + j + l + n)
+/// Allan variance of each term
 #[pyfunction]
-#[pyo3(signature = (taus, fs, ieee, gm, sine=Vec::new(), resonance=Vec::new()))]
+#[allow(clippy::too_many_arguments)] // mirrors the Python keyword arguments
+#[pyo3(signature = (taus, fs, ieee, gm, sine=Vec::new(), resonance=Vec::new(), motion=Vec::new()))]
 fn noise_terms<'py>(
     py: Python<'py>,
     taus: PyReadonlyArray1<'py, f64>,
@@ -114,6 +122,7 @@ fn noise_terms<'py>(
     gm: Vec<(f64, f64)>,
     sine: Vec<(f64, f64)>,
     resonance: Vec<(f64, f64, f64)>,
+    motion: Vec<(f64, f64)>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     if ieee.len() != IEEE_TERMS {
         return Err(PyValueError::new_err(format!(
@@ -141,9 +150,14 @@ fn noise_terms<'py>(
             "resonance frequency and damping time must be finite and > 0; got {f} Hz, {t} s"
         )));
     }
-    let cols = IEEE_TERMS + gm.len() + sine.len() + resonance.len();
+    if let Some(&(_, t)) = motion.iter().find(|m| !(m.1.is_finite() && m.1 > 0.0)) {
+        return Err(PyValueError::new_err(format!(
+            "motion correlation times must be finite and > 0 s; got {t}"
+        )));
+    }
+    let cols = IEEE_TERMS + gm.len() + sine.len() + resonance.len() + motion.len();
     let taus = taus.as_array().to_vec();
-    let rows = fit::terms(&taus, fs, &coef, &gm, (&sine, &resonance));
+    let rows = fit::terms(&taus, fs, &coef, &gm, (&sine, &resonance, &motion));
     Ok(to_matrix(rows, cols)?.into_pyarray(py))
 }
 
@@ -153,6 +167,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("PARAMETERS", PARAMETERS)?;
     m.add("SINE_SLOT", SINE_SLOT)?;
     m.add("RESONANCE_SLOT", RESONANCE_SLOT)?;
+    m.add("MOTION_SLOT", MOTION_SLOT)?;
     m.add("FLICKER_FACTOR", FLICKER_FACTOR)?;
     m.add_class::<PyNoiseFit>()?;
     m.add_function(wrap_pyfunction!(fit_noise, m)?)?;

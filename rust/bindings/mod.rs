@@ -77,8 +77,38 @@ fn add_submodule(
     Ok(())
 }
 
+/// Loads NumPy's C API now, while `import imunoise._core` can still fail with
+/// a Python exception. rust-numpy loads it on the first array it touches and
+/// panics (`expect`) if that import raises: a Ctrl-C landing in it (NumPy's
+/// version check runs Python code) reached the CLI as a Rust panic, exit 1,
+/// instead of an interrupt (`benches/faults.py`, SIGINT 1.25 s into
+/// `convert`). Here the panic is caught and a KeyboardInterrupt raised again.
+fn load_numpy_api(py: Python<'_>) -> PyResult<()> {
+    let loaded = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        numpy::PyArray1::<f64>::zeros(py, 0, false);
+    }));
+    match loaded {
+        Ok(()) => Ok(()),
+        Err(payload) => {
+            let message = payload
+                .downcast_ref::<String>()
+                .cloned()
+                .or_else(|| payload.downcast_ref::<&str>().map(|s| s.to_string()))
+                .unwrap_or_default();
+            Err(if message.contains("KeyboardInterrupt") {
+                PyKeyboardInterrupt::new_err("interrupted while loading NumPy's C API")
+            } else {
+                pyo3::exceptions::PyImportError::new_err(format!(
+                    "cannot load NumPy's C API: {message}"
+                ))
+            })
+        }
+    }
+}
+
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    load_numpy_api(m.py())?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     add_submodule(m, "allan", allan::register)?;
     add_submodule(m, "vn", vn::register)?;

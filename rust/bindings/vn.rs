@@ -5,7 +5,7 @@ use std::collections::BTreeMap;
 use std::path::PathBuf;
 
 use numpy::{IntoPyArray, PyReadonlyArray1};
-use pyo3::exceptions::PyValueError;
+use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict, PyList, PySlice};
 
@@ -148,8 +148,41 @@ impl VnStream {
         }
     }
 
-    fn feed<'py>(&mut self, py: Python<'py>, data: &Bound<'py, PyBytes>) -> PyResult<VnRows> {
-        let slice: &[u8] = data.as_bytes();
+    /// `data`: bytes, or any C-contiguous buffer of bytes (a reused `bytearray`,
+    /// a read-only `mmap`), parsed in place; the caller must not change it during
+    /// the call.
+    fn feed<'py>(&mut self, py: Python<'py>, data: &Bound<'py, PyAny>) -> PyResult<VnRows> {
+        // bytes as they are; any other buffer of bytes (bytearray, memoryview, a
+        // uint8 array) through numpy.frombuffer, without a copy. (pyo3's own
+        // buffer protocol is not in the stable ABI of CPython 3.10, abi3-py310.)
+        let viewed;
+        let slice: &[u8] = if let Ok(bytes) = data.cast::<PyBytes>() {
+            bytes.as_bytes()
+        } else {
+            let view = py
+                .import("builtins")?
+                .getattr("memoryview")?
+                .call1((data,))
+                .map_err(|_| {
+                    PyTypeError::new_err(format!(
+                        "data must be bytes or a buffer of bytes; got {}",
+                        data.get_type()
+                            .name()
+                            .map(|n| n.to_string())
+                            .unwrap_or_default()
+                    ))
+                })?;
+            if !view.getattr("c_contiguous")?.extract::<bool>()? {
+                return Err(PyValueError::new_err(
+                    "data must be a C-contiguous buffer of bytes",
+                ));
+            }
+            viewed = py
+                .import("numpy")?
+                .call_method1("frombuffer", (view, "u1"))?
+                .extract::<PyReadonlyArray1<'py, u8>>()?;
+            viewed.as_slice()?
+        };
         let pieces = self.pieces()?;
         let tables = py.detach(|| pieces.feed(slice))?;
         let (tables, missing) = tables_to_py(py, tables)?;

@@ -53,6 +53,24 @@ pub fn gauss_markov(m: f64, u: f64) -> f64 {
     (numerator / (m * m * d * d)).max(0.0)
 }
 
+/// Allan variance at cluster size `m`, τ = m·τ₀, of the rate of a bounded
+/// motion: the increments xₖ = (θₖ − θₖ₋₁)/τ₀ of a unit-variance sampled AR1
+/// θ with φ = e^(−u), u = τ₀/τc (a mount whose angle, or velocity, wanders and
+/// comes back). The cluster mean of m rates is (θ_{k+m} − θₖ)/τ, so
+///
+/// ```text
+/// σ²(τ) = (3 − 4φᵐ + φ²ᵐ)/τ²
+/// ```
+///
+/// per unit of θ's variance: white rate noise of density 2/τc below τc (the
+/// −½ slope), the quantization form 3/τ² beyond it (the −1 slope: the angle
+/// stays bounded, so its rate averages away as 1/τ). Written with expm1, the
+/// numerator −4(φᵐ − 1) + (φ²ᵐ − 1) loses at most a factor 2 to cancellation.
+pub fn motion(tau: f64, m: f64, u: f64) -> f64 {
+    let x = m * u;
+    ((-2.0 * x).exp_m1() - 4.0 * (-x).exp_m1()) / (tau * tau)
+}
+
 /// Allan variance at cluster size `m` of a unit-variance sinusoid of random
 /// phase at `nu` = f₀/fs cycles per sample (autocovariance γ(h) = cos 2πνh):
 ///
@@ -289,6 +307,32 @@ mod tests {
             let want = 1e-6 * (2.0 * m * m + 1.0) / (3.0 * m);
             assert!((gauss_markov(m, 1e-6) / want - 1.0).abs() < 1e-4, "m {m}");
         }
+    }
+
+    #[test]
+    fn motion_matches_the_autocovariance_sum() {
+        // Increments of a unit AR1 at τ₀ = 1: γ(0) = 2(1 − φ), γ(h ≥ 1) =
+        // −φ^(h−1)(1 − φ)².
+        for &phi in &[0.0f64, 0.3, 0.9, 0.99, 0.9999] {
+            let u = -f64::ln(phi.max(1e-300));
+            let g0 = 2.0 * (1.0 - phi);
+            let g = |h: usize| -phi.powi(h as i32 - 1) * (1.0 - phi).powi(2) / g0;
+            for &m in &[1usize, 2, 3, 10, 64, 300, 2000] {
+                let want = g0 * direct_from(m, g);
+                let got = motion(m as f64, m as f64, u);
+                assert!(
+                    (got - want).abs() <= 1e-9 * want.abs() + 1e-15,
+                    "phi {phi} m {m}: {got} vs {want}"
+                );
+            }
+        }
+        // Limits: white of density 2/τc well below τc, 3/τ² well beyond.
+        let (tau_c, fs) = (50.0, 100.0);
+        let u = 1.0 / (fs * tau_c);
+        let short = motion(0.1, 0.1 * fs, u) * 0.1;
+        assert!((short / (2.0 / tau_c) - 1.0).abs() < 2e-3, "{short}");
+        let long = motion(1e5, 1e5 * fs, u) * 1e10;
+        assert!((long / 3.0 - 1.0).abs() < 1e-9, "{long}");
     }
 
     #[test]

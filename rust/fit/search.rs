@@ -32,6 +32,13 @@
 //! It is tried on the best structure found without it (tone or not), and a tone
 //! is then searched again on top of it: a line and a band next to each other
 //! (the VN-100 gyro's 13.5 Hz line and its 15–20 Hz band) are two terms.
+//!
+//! A bounded motion (`basis::motion`: the mount's angle wandering and coming
+//! back, a parked vehicle's rocking) is one more column, linear in the angle's
+//! variance for a fixed correlation time, searched last on the grid of
+//! correlation times and refined like them; it competes by BIC with two
+//! parameters. White below its correlation time and falling as 1/τ beyond, it
+//! is what no other term draws: a −½ slope that steepens to −1.
 
 use faer::Mat;
 
@@ -99,18 +106,23 @@ pub type Resonance = (f64, f64);
 /// τ ≈ 0.37/f₀ stays more than a decade inside the curve).
 pub const SINE_PERIODS: f64 = 10.0;
 
+/// The tone's frequency, the resonance and the bounded motion's correlation
+/// time of a structure, each if it has one.
+pub type Extras = (Option<f64>, Option<Resonance>, Option<f64>);
+
+/// Columns of a structure beyond the IEEE terms and its Gauss–Markov times.
+fn extra_columns((sine, resonance, motion): Extras) -> usize {
+    usize::from(sine.is_some()) + usize::from(resonance.is_some()) + usize::from(motion.is_some())
+}
+
 /// The basis of a structure: IEEE columns, one column per GM time, then the
-/// tone if any, then the resonance if any.
-pub fn design(
-    data: &Data,
-    fs: f64,
-    gm_tau: &[f64],
-    sine: Option<f64>,
-    resonance: Option<Resonance>,
-) -> Mat<f64> {
+/// tone if any, then the resonance if any, then the bounded motion if any.
+pub fn design(data: &Data, fs: f64, gm_tau: &[f64], extras: Extras) -> Mat<f64> {
+    let (sine, resonance, motion) = extras;
     let g = gm_tau.len();
     let tone = IEEE_TERMS + g;
-    let k = tone + usize::from(sine.is_some()) + usize::from(resonance.is_some());
+    let osc = tone + usize::from(sine.is_some());
+    let k = tone + extra_columns(extras);
     let rates = resonance.map(|(f, t)| basis::resonance_rates(f, t, fs));
     Mat::from_fn(data.len(), k, |i, j| {
         if j < IEEE_TERMS {
@@ -119,9 +131,11 @@ pub fn design(
             basis::gauss_markov(data.m[i], basis::gm_rate(gm_tau[j - IEEE_TERMS], fs))
         } else if let (Some(f), true) = (sine, j == tone) {
             basis::sinusoid(data.m[i], f / fs)
-        } else {
-            let (u, theta) = rates.unwrap_or((1.0, 0.0));
+        } else if let (Some((u, theta)), true) = (rates, j == osc) {
             basis::resonance(data.m[i], u, theta)
+        } else {
+            let u = basis::gm_rate(motion.unwrap_or(1.0), fs);
+            basis::motion(data.taus[i], data.m[i], u)
         }
     })
 }
@@ -299,6 +313,9 @@ struct Searcher<'a> {
     sine: Option<f64>,
     /// The resonance, held fixed while the times and the tone are searched.
     resonance: Option<Resonance>,
+    /// The bounded motion's correlation time, held fixed while the times are
+    /// polished around it.
+    motion: Option<f64>,
 }
 
 impl Searcher<'_> {
@@ -314,8 +331,9 @@ impl Searcher<'_> {
 
     /// Loss of the best θ for these times, this tone and this resonance.
     fn loss_full(&self, times: &[f64], sine: Option<f64>, resonance: Option<Resonance>) -> f64 {
-        let basis = design(self.data, self.fs, times, sine, resonance);
-        let extra = times.len() + usize::from(sine.is_some()) + usize::from(resonance.is_some());
+        let extras = (sine, resonance, self.motion);
+        let basis = design(self.data, self.fs, times, extras);
+        let extra = times.len() + extra_columns(extras);
         let allowed = allowed_with(&self.ieee, extra);
         match estimate::solve_theta(
             estimate::Problem {
@@ -504,19 +522,22 @@ pub struct Candidate {
     pub sine: Option<f64>,
     /// The resonance, if the structure has one.
     pub resonance: Option<Resonance>,
+    /// The bounded motion's correlation time (s), if the structure has one.
+    pub motion: Option<f64>,
     pub ieee: [bool; IEEE_TERMS],
     pub solution: Solution,
     pub bic: f64,
 }
 
 /// Number of free parameters of a solution: non-zero variances, a time (or
-/// frequency) for every Gauss–Markov term (or tone) in use, and one more
-/// (frequency and damping) for a resonance in use, whose variance is the last
-/// of `theta` when `resonance`.
-pub fn parameters(theta: &[f64], resonance: bool) -> usize {
+/// frequency) for every Gauss–Markov term, tone or bounded motion in use, and one
+/// more (frequency and damping) for a resonance in use, whose variance is the
+/// last of `theta` when `resonance` (the one before last when `motion` too).
+pub fn parameters(theta: &[f64], resonance: bool, motion: bool) -> usize {
     let used = theta.iter().filter(|t| **t > 0.0).count();
     let times = theta[IEEE_TERMS..].iter().filter(|t| **t > 0.0).count();
-    let damping = usize::from(resonance && theta.last().is_some_and(|t| *t > 0.0));
+    let res_column = theta.len().wrapping_sub(1 + usize::from(motion));
+    let damping = usize::from(resonance && theta.get(res_column).is_some_and(|t| *t > 0.0));
     used + times + damping
 }
 
@@ -540,7 +561,7 @@ impl Candidate {
         let gm = (0..self.gm_tau.len())
             .filter(|k| theta[IEEE_TERMS + k] > 0.0)
             .count();
-        gm + usize::from(self.sine.is_some()) + usize::from(self.resonance.is_some())
+        gm + extra_columns((self.sine, self.resonance, self.motion))
     }
 
     /// What structure selection minimises: the BIC, with [`COMPONENT_EVIDENCE`]
@@ -556,11 +577,12 @@ pub fn candidate(
     fs: f64,
     ieee: [bool; IEEE_TERMS],
     gm_tau: Vec<f64>,
-    (sine, resonance): (Option<f64>, Option<Resonance>),
+    extras: Extras,
     d2: f64,
 ) -> CoreResult<Candidate> {
-    let basis = design(data, fs, &gm_tau, sine, resonance);
-    let extra = gm_tau.len() + usize::from(sine.is_some()) + usize::from(resonance.is_some());
+    let (sine, resonance, motion) = extras;
+    let basis = design(data, fs, &gm_tau, extras);
+    let extra = gm_tau.len() + extra_columns(extras);
     let allowed = allowed_with(&ieee, extra);
     let solution = estimate::solve_joint(
         estimate::Problem {
@@ -571,12 +593,13 @@ pub fn candidate(
         d2,
         None,
     )?;
-    let p = parameters(&solution.theta, resonance.is_some());
+    let p = parameters(&solution.theta, resonance.is_some(), motion.is_some());
     let bic = solution.loss + p as f64 * data.n_eff().max(2.0).ln();
     Ok(Candidate {
         gm_tau,
         sine,
         resonance,
+        motion,
         ieee,
         solution,
         bic,
@@ -600,9 +623,10 @@ pub fn fit_structure(
         d2,
         sine: None,
         resonance: None,
+        motion: None,
     };
     let times = searcher.times(gm, seed);
-    let first = candidate(data, fs, ieee, times, (None, None), d2)?;
+    let first = candidate(data, fs, ieee, times, (None, None, None), d2)?;
     let settled = first.solution.d2;
     if gm == 0 || (settled <= 2.0 * d2 && settled >= 0.5 * d2) {
         return Ok(first);
@@ -613,7 +637,7 @@ pub fn fit_structure(
         ..searcher
     };
     let times = again.times(gm, seed);
-    let second = candidate(data, fs, ieee, times, (None, None), first.solution.d2)?;
+    let second = candidate(data, fs, ieee, times, (None, None, None), first.solution.d2)?;
     Ok(if second.solution.loss < first.solution.loss {
         second
     } else {
@@ -645,11 +669,12 @@ pub fn with_sine(
             d2,
             sine: Some(f),
             resonance,
+            motion: None,
         };
         searcher.polish(&mut times, step);
         searcher.sine = None;
         let f = searcher.refine_frequency(&times, f);
-        candidate(data, fs, ieee, times, (Some(f), resonance), d2)
+        candidate(data, fs, ieee, times, (Some(f), resonance, None), d2)
     };
     let searcher = Searcher {
         data,
@@ -658,6 +683,7 @@ pub fn with_sine(
         d2,
         sine: None,
         resonance,
+        motion: None,
     };
     let Some((f, toned)) = searcher.coarse_frequency(gm_tau) else {
         return Ok(None);
@@ -682,7 +708,7 @@ pub fn with_sine(
     }))
 }
 
-/// Add a resonance to the structure of `base` (its times and tone): grid,
+/// Add a resonance to the Gauss–Markov times `gm_tau` and tone `sine`: grid,
 /// refinement, the times and the tone's frequency polished with it in place;
 /// refined again at the discrepancy the fit settles on when that moved by more
 /// than a factor of two. None when the curve is too short for one or, when
@@ -692,7 +718,7 @@ pub fn with_resonance(
     data: &Data,
     fs: f64,
     ieee: [bool; IEEE_TERMS],
-    base: &Candidate,
+    (gm_tau, sine): (&[f64], Option<f64>),
     d2: f64,
     gated: bool,
 ) -> CoreResult<Option<Candidate>> {
@@ -702,13 +728,14 @@ pub fn with_resonance(
         fs,
         ieee,
         d2,
-        sine: base.sine,
+        sine,
         resonance: None,
+        motion: None,
     };
-    let Some((res, loss)) = searcher.coarse_resonance(&base.gm_tau) else {
+    let Some((res, loss)) = searcher.coarse_resonance(gm_tau) else {
         return Ok(None);
     };
-    if gated && loss > searcher.loss(&base.gm_tau) - 0.75 * data.n_eff().max(2.0).ln() {
+    if gated && loss > searcher.loss(gm_tau) - 0.75 * data.n_eff().max(2.0).ln() {
         return Ok(None);
     }
     let polish = |d2: f64, mut times: Vec<f64>, sine: Option<f64>, res: Resonance| {
@@ -719,13 +746,14 @@ pub fn with_resonance(
             d2,
             sine,
             resonance: None,
+            motion: None,
         };
         let res = s.refine_resonance(&times, res);
         s.resonance = Some(res);
         s.polish(&mut times, step);
         s.sine = None;
         let sine = sine.map(|f| s.refine_frequency(&times, f));
-        candidate(data, fs, ieee, times, (sine, Some(res)), d2)
+        candidate(data, fs, ieee, times, (sine, Some(res), None), d2)
     };
     let on_bound = |c: &Candidate| {
         c.resonance.is_some_and(|(f, t)| {
@@ -733,7 +761,7 @@ pub fn with_resonance(
             q >= 0.99 * RES_Q_MAX || q <= 1.01 * RES_Q_MIN
         })
     };
-    let first = polish(d2, base.gm_tau.clone(), base.sine, res)?;
+    let first = polish(d2, gm_tau.to_vec(), sine, res)?;
     let settled = first.solution.d2;
     if settled <= 2.0 * d2 && settled >= 0.5 * d2 {
         return Ok((!(gated && on_bound(&first))).then_some(first));
@@ -808,23 +836,24 @@ fn rebuilt(
         fs,
         ieee,
         base.gm_tau.clone(),
-        (base.sine, base.resonance),
+        (base.sine, base.resonance, base.motion),
         base.solution.d2,
     )
 }
 
 /// Automatic selection over 0..=`max_gm` Gauss–Markov terms and the IEEE terms
 /// in `ieee`, each also with a tone when `sine`, then with a resonance when
-/// `resonance`.
+/// `resonance`, then with a bounded motion when `motion`.
 pub fn select(
     data: &Data,
     fs: f64,
     ieee: [bool; IEEE_TERMS],
     max_gm: usize,
-    (sine, resonance): (bool, bool),
+    (sine, resonance, motion): (bool, bool, bool),
 ) -> CoreResult<Candidate> {
     let base = fit_structure(data, fs, ieee, 0, 0.0, &[])?;
     let mut best = eliminate(data, fs, ieee, base.clone())?;
+    let ieee_only = best.clone();
     // The structure BIC alone prefers, without the evidence asked of components.
     let mut by_bic = best.clone();
     let mut seed: Vec<f64> = Vec::new();
@@ -837,6 +866,27 @@ pub fn select(
         }
         if reduced.score() < best.score() {
             best = reduced;
+        }
+    }
+    // A slow Gauss–Markov term in place of the walk. The times above are searched
+    // with K and R in the model, which take the rise past the floor first; a
+    // bounded wander that falls again at the longest taus (an ADIS16405 gyro X:
+    // a bump at 300 s) then never gets a term of its own, and which structure
+    // wins moved with the tau grid (B + K on octaves, K 4.5 standard
+    // uncertainties from the wander's walk rate on 5–50 per decade).
+    if best.solution.theta[WALK] > 0.0 && best.gm_tau.len() < max_gm {
+        let mut still = ieee;
+        still[WALK] = false;
+        still[RAMP] = false;
+        let gm = best.gm_tau.len() + 1;
+        if let Ok(wander) = fit_structure(data, fs, still, gm, base.solution.d2, &best.gm_tau) {
+            let reduced = eliminate(data, fs, ieee, wander)?;
+            if reduced.bic < by_bic.bic {
+                by_bic = reduced.clone();
+            }
+            if reduced.score() < best.score() {
+                best = reduced;
+            }
         }
     }
     let plain = best.clone();
@@ -865,6 +915,31 @@ pub fn select(
     }
     if resonance && misses_short_taus(data, &best) {
         best = add_resonance(data, fs, ieee, best, &plain, sine)?;
+    }
+    if motion {
+        // On the best structure, and on the IEEE terms alone: a fast
+        // Gauss–Markov term takes the motion's white part when the motion is
+        // not there to take it (a ring-laser gyro on a parked vehicle).
+        let bases = if best.components() > 0 {
+            vec![best.clone(), ieee_only]
+        } else {
+            vec![best.clone()]
+        };
+        for base in bases {
+            // Only the times in use: an unused slot the polish revives is one more
+            // component to pay for (a 15 s one beside the motion cost 6).
+            let times: Vec<f64> = (base.gm_tau.iter().enumerate())
+                .filter(|&(k, _)| base.solution.theta[IEEE_TERMS + k] > 0.0)
+                .map(|(_, &t)| t)
+                .collect();
+            let shape = (times.as_slice(), base.sine, base.resonance);
+            if let Some(moved) = with_motion(data, fs, ieee, shape, base.solution.d2, true)? {
+                let reduced = eliminate(data, fs, ieee, moved)?;
+                if reduced.score() < best.score() {
+                    best = reduced;
+                }
+            }
+        }
     }
     Ok(best)
 }
@@ -917,7 +992,7 @@ fn add_resonance(
         bases.push(plain.clone());
     }
     for base in &bases {
-        let Some(res) = with_resonance(data, fs, ieee, base, d2, true)? else {
+        let Some(res) = with_resonance(data, fs, ieee, (&base.gm_tau, base.sine), d2, true)? else {
             continue;
         };
         let reduced = eliminate(data, fs, ieee, res.clone())?;
@@ -936,6 +1011,93 @@ fn add_resonance(
     }
     Ok(best)
 }
+
+/// Shortest correlation time of a bounded motion, in samples: a faster one is
+/// the quantization form 3/τ² at every cluster size, Q's.
+const MOTION_FASTEST: f64 = 2.0;
+
+/// Shortest correlation time of a bounded motion, in seconds. What the term is
+/// for — a parked vehicle, a building, a bench settling — moves over seconds to
+/// minutes; faster, a mount's motion is a vibration, the tone's and the
+/// resonance's, and a motion there took N's place at the shortest taus, where
+/// the EDF is largest, on 2 of 48 clean N + B + K axes (τc 0.15 and 0.62 s).
+const MOTION_SHORTEST: f64 = 1.0;
+
+/// Add a bounded motion (`basis::motion`) to the Gauss–Markov times `gm_tau`,
+/// tone `sine` and `resonance`: correlation time by the grid of [`time_grid`]
+/// from [`MOTION_FASTEST`] samples and [`MOTION_SHORTEST`] to the longest tau
+/// (slower, it is white noise at every tau, N's), refined by golden section,
+/// the Gauss–Markov times polished and the tone searched again with it in
+/// place. None when no time fits or, when `gated`, the grid's best gains less
+/// than the BIC penalty of its two parameters (the refinement cannot then make
+/// up the evidence it must show; a quarter of it, the tone's gate, let the
+/// search run on most clean axes and tripled the fit's time) or its time is
+/// refined onto the lower bound.
+pub fn with_motion(
+    data: &Data,
+    fs: f64,
+    ieee: [bool; IEEE_TERMS],
+    (gm_tau, sine, resonance): (&[f64], Option<f64>, Option<Resonance>),
+    d2: f64,
+    gated: bool,
+) -> CoreResult<Option<Candidate>> {
+    let tau_max = data.taus[data.len() - 1];
+    let searcher = |motion: Option<f64>| Searcher {
+        data,
+        fs,
+        ieee,
+        d2,
+        sine,
+        resonance,
+        motion,
+    };
+    let loss = |t: f64| searcher(Some(t)).loss(gm_tau);
+    let shortest = (MOTION_FASTEST / fs).max(MOTION_SHORTEST);
+    let Some((coarse, best)) = time_grid(data, fs)
+        .into_iter()
+        .filter(|&t| t >= shortest && t <= tau_max)
+        .map(|t| (t, loss(t)))
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+    else {
+        return Ok(None);
+    };
+    if gated && best > searcher(None).loss(gm_tau) - 2.0 * data.n_eff().max(2.0).ln() {
+        return Ok(None);
+    }
+    let step = 10f64.powf(1.0 / PER_DECADE);
+    let lo = (coarse / step).max(shortest);
+    let tau_c = golden(lo, (coarse * step).min(tau_max), coarse, TIME_TOL, loss);
+    // On the lower bound it is a shape at the shortest taus the search cut off
+    // rather than a motion: (on the first half of the VN-100 accelerometer X, N +
+    // K + a motion at 1 s predicted the second half at 57 % of taus, N + K alone
+    // at 87 %).
+    if gated && tau_c <= shortest * (1.0 + TIME_TOL) {
+        return Ok(None);
+    }
+    let mut times = gm_tau.to_vec();
+    let mut moving = searcher(Some(tau_c));
+    moving.polish(&mut times, step);
+    // The tone searched again with the motion in place: the line found without
+    // it had also been bent to the motion's white part (on a simulated gyro with
+    // lines at 1.2 and 2.1 Hz on a rocking vehicle, 1.217 Hz refined to 1.25 Hz,
+    // and the structure with both scored 12 lower).
+    let sine = match sine {
+        Some(f) => {
+            moving.sine = None;
+            let coarse = moving.coarse_frequency(&times).map_or(f, |(g, _)| g);
+            let refined = moving.refine_frequency(&times, coarse);
+            moving.sine = Some(refined);
+            moving.polish(&mut times, step);
+            Some(refined)
+        }
+        None => None,
+    };
+    let extras = (sine, resonance, Some(tau_c));
+    candidate(data, fs, ieee, times, extras, d2).map(Some)
+}
+
+/// Slot of the rate random walk K among the IEEE terms.
+const WALK: usize = 3;
 
 /// Slot of the rate ramp R among the IEEE terms.
 const RAMP: usize = 4;
@@ -958,7 +1120,7 @@ pub fn prefer_random_walk(
     fs: f64,
     ieee: [bool; IEEE_TERMS],
     max_gm: usize,
-    kinds: (bool, bool),
+    kinds: (bool, bool, bool),
     best: Candidate,
 ) -> CoreResult<Candidate> {
     if best.solution.theta[RAMP] <= 0.0 {

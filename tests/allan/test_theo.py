@@ -159,6 +159,48 @@ def test_theobr_equals_the_definition_at_random_factors(kind):
     np.testing.assert_allclose(r.var[pick], want, rtol=1e-9)
 
 
+def test_the_sp1065_ladder_is_its_printed_definition():
+    # n = floor(N/6) - 3 ratios (SP 1065 eq. 33 as printed), stopping at the last AVAR
+    # with a term: N = 601 phase points give n = 97 (the last AVAR, m = 300, has 1).
+    y = _noise_type("rw_fm", 600, seed=5)
+    x = phase(y)
+    n = min(len(x) // 6 - 3, ((len(x) - 1) // 2 - 9) // 3)
+    assert n == 97
+    kappa = np.mean([naive_avar(x, 9 + 3 * i) / naive_theo1(x, 12 + 4 * i)
+                     for i in range(n + 1)])
+    r = imunoise.theobr(y, 1.0, taus=[30.0, 90.0], ratio_ladder="sp1065")
+    want = [kappa * naive_theo1(x, int(m)) for m in r.m]
+    np.testing.assert_allclose(r.var.ravel(), want, rtol=1e-9)
+    default = imunoise.theobr(y, 1.0, taus=[30.0, 90.0])
+    assert not np.allclose(r.var, default.var, rtol=1e-6)
+
+
+@pytest.mark.parametrize("fn", [imunoise.theobr, imunoise.theoh])
+def test_a_ratio_block_takes_the_ratio_from_block_averages(fn):
+    # The fast ThêoBR: kappa from every 4th phase point (the samples averaged in blocks
+    # of 4), Theo1 still from every sample.
+    y = _noise_type("flicker_fm", 1600, seed=9)
+    x = phase(y)
+    exact = fn(y, 1.0)
+    fast = fn(y, 1.0, ratio_block=4)
+    theo = exact.taus * 1.0 < exact.m  # ThêoBR points (all of theobr's)
+    ratio = fast.var[theo] / exact.var[theo]
+    np.testing.assert_allclose(ratio, naive_kappa(x[::4]) / naive_kappa(x), rtol=1e-9)
+    np.testing.assert_array_equal(fast.var[~theo], exact.var[~theo])
+
+
+def test_bad_ratio_options_name_the_argument():
+    y = np.random.default_rng(0).normal(size=500)
+    with pytest.raises(ValueError, match="ratio_ladder must be one of"):
+        imunoise.theobr(y, 1.0, ratio_ladder="stable32")
+    with pytest.raises(ValueError, match=r"ratio_block must be >= 1; got 0"):
+        imunoise.theoh(y, 1.0, ratio_block=0)
+    with pytest.raises(TypeError, match="ratio_block must be an integer"):
+        imunoise.theobr(y, 1.0, ratio_block=2.0)
+    with pytest.raises(ValueError, match=r"ratio_block <= 5\); got 6"):
+        imunoise.theobr(y, 1.0, ratio_block=6)
+
+
 _INTERRUPTED_CHILD = """
 import sys, time
 import numpy as np
@@ -397,6 +439,6 @@ def test_long_records_warn_before_a_slow_run(monkeypatch):
     monkeypatch.setattr(allan_module._core_allan, "analyse_plan", refuse)
     x = np.zeros(5_000_000)
     for fn in (imunoise.theobr, imunoise.theoh):
-        with pytest.warns(UserWarning, match=r"N/30 averaging factors.*minutes.*average blocks"):
+        with pytest.warns(UserWarning, match=r"N/30 averaging factors.*minutes.*ratio_block"):
             with pytest.raises(RuntimeError, match="kernel reached"):
                 fn(x, 40.0)

@@ -54,7 +54,7 @@ def test_explicit_terms_fit_exactly_those(white_plus_gm):
     _, r = white_plus_gm
     only = imunoise.fit(r, terms=["N", "GM"])
     assert all(len(only.components.gauss_markov(c)) == 1 for c in range(2))
-    assert not np.any(only.supported["B"])
+    assert not np.any(only.components.supported["B"])
     with pytest.raises(ValueError, match="terms must be 'auto' or"):
         imunoise.fit(r, terms=["N", "GM", "GM", "GM", "GM"])
     with pytest.raises(ValueError, match="terms must be 'auto' or"):

@@ -114,7 +114,7 @@ def test_tone_in_prediction_dict_repr_and_plot(toned):
 
 def test_explicit_sine_terms_are_checked(toned):
     _, r = toned
-    with pytest.raises(ValueError, match="'sine' at most once"):
+    with pytest.raises(ValueError, match="each of 'sine', 'resonance', 'motion' at most once"):
         imunoise.fit(r, terms=["N", "sine", "sine"])
     only = quiet_fit(r, terms=["N", "sine"])
     assert all(len(only.components.sine(c)) == 1 for c in range(2))

@@ -19,8 +19,11 @@ def _damaged() -> bytes:
     return bytes(ascii_part[:40_000]) + b"noise" + binary_part + bytes(ascii_part[40_000:-30])
 
 
-@pytest.mark.parametrize("piece", [1000, 4096 + 17, 1 << 20])
-def test_pieces_add_up_to_the_whole(piece):
+# Pieces shorter and longer than the 64 KiB that finish a cut record, each as bytes
+# and as a view of a reused buffer (how convert feeds them).
+@pytest.mark.parametrize("buffer", [bytes, lambda b: memoryview(bytearray(b))])
+@pytest.mark.parametrize("piece", [1000, 4096 + 17, 70_001, 150_000, 1 << 20])
+def test_pieces_add_up_to_the_whole(piece, buffer):
     data = _damaged()
     whole = _core_vn.parse_vn(data)
     stream = _core_vn.VnStream()
@@ -32,7 +35,7 @@ def test_pieces_add_up_to_the_whole(piece):
                 rows.setdefault(name, {}).setdefault(col, []).append(values)
 
     for start in range(0, len(data), piece):
-        take(stream.feed(data[start : start + piece]))
+        take(stream.feed(buffer(data[start : start + piece])))
     summary = stream.finish()
     take(summary)
     for name, cols in whole.tables.items():
@@ -57,6 +60,14 @@ def test_strict_stream_raises_parse_error_with_the_absolute_location():
         stream.finish()
     assert (raised.value.offset, raised.value.line) == want
     assert raised.value.kind == "bad_checksum"
+
+
+def test_feed_takes_bytes_or_a_contiguous_byte_buffer():
+    stream = _core_vn.VnStream()
+    with pytest.raises(TypeError, match="data must be bytes or a buffer of bytes; got str"):
+        stream.feed("$VNYMR")
+    with pytest.raises(ValueError, match="C-contiguous"):
+        stream.feed(memoryview(bytearray(b"$VNYMR,1,2*00\r\n" * 4))[::2])
 
 
 def test_finish_once():

@@ -42,7 +42,9 @@ def built(tmp_path_factory):
 def _md_table(md: str, caption: str) -> list[list[str]]:
     """Rows (header first) of the Markdown table that follows ``*caption*``."""
     lines = md.splitlines()
-    i = lines.index(f"*{caption}*")
+    # a long table is collapsed: <summary>caption (N rows)</summary>
+    i = next(k for k, line in enumerate(lines) if line == f"*{caption}*"
+             or line.startswith(f"<summary>{caption} ("))
     rows = []
     for line in lines[i + 2:]:
         if not line.startswith("|"):
@@ -92,22 +94,25 @@ def test_statistics_table_matches_describe(built):
 
 def test_distribution_table_matches_api(built):
     rep, short, _ = built
-    rows = _md_table(rep.markdown.read_text(), "Distribution fits (short log)")
-    header = rows[0]
-    assert header[:7] == ["channel", "unit", "quantization step", "level spacing", "bins", "μ",
-                          "σ"]
+    md = rep.markdown.read_text()
+    rows = _md_table(md, "Distribution fits (short log)")
+    assert rows[0][:4] == ["channel", "unit", "μ", "σ"]
     by_name = {r[0]: r for r in rows[1:]}
+    bins = _md_table(md, "Histogram bins (short log): the sensor's quantization step and the "
+                         "spacing of the levels it uses")
+    assert bins[0] == ["channel", "unit", "quantization step", "level spacing", "bins"]
+    bins_of = {r[0]: r for r in bins[1:]}
     for sensor, step in (("gyro", 1e-6), ("accel", 1e-3), ("mag", 1e-4)):
         for j, axis in enumerate("XYZ"):
-            r = by_name[f"{sensor} {axis}"]
+            r, b = by_name[f"{sensor} {axis}"], bins_of[f"{sensor} {axis}"]
             d = distribution(getattr(short, sensor)[:, j])
-            assert float(r[2]) == pytest.approx(step, rel=1e-4)
-            assert float(r[3]) == pytest.approx(d.level_spacing, rel=1e-5)
-            assert int(r[4]) == len(d.counts)
+            assert float(b[2]) == pytest.approx(step, rel=1e-4)
+            assert float(b[3]) == pytest.approx(d.level_spacing, rel=1e-5)
+            assert int(b[4]) == len(d.counts)
             # μ and σ rounded to their uncertainties (GUM), the statistics to 4 digits
-            assert r[5] == numbers.format_value(d.mu, d.mu_std)
-            assert r[6] == numbers.format_value(d.sigma, d.sigma_std)
-            got = [float(v) for v in (r[7], r[9], r[10], r[11])]
+            assert r[2] == numbers.format_value(d.mu, d.mu_std)
+            assert r[3] == numbers.format_value(d.sigma, d.sigma_std)
+            got = [float(v) for v in (r[4], r[6], r[7], r[8])]
             want = [d.ks_statistic, d.ad_statistic, d.skewness, d.excess_kurtosis]
             np.testing.assert_allclose(got, want, rtol=5e-4)
 
@@ -116,7 +121,7 @@ def test_allan_table_matches_adev(built):
     rep, _, long = built
     md = rep.markdown.read_text()
     for sensor in ("gyro", "accel"):
-        rows = _md_table(md, f"Allan deviation of {sensor}")
+        rows = _md_table(md, f"Allan deviation of {sensor}: every τ")
         r = imunoise.adev(getattr(long, sensor), long.fs, taus=report.TAUS_PER_DECADE)
         assert len(rows) - 1 == len(r.taus)
         taus = [float(x[0]) for x in rows[1:]]
@@ -206,7 +211,8 @@ def test_report_on_bundled_real_log(tmp_path):
     rep = report.build(bundled_log(), None, tmp_path, progress=False)
     md = rep.markdown.read_text()
     assert "vn100_stationary_5min.txt" in md
-    rows = _md_table(md, "Distribution fits (short log)")
+    rows = _md_table(md, "Histogram bins (short log): the sensor's quantization step and the "
+                         "spacing of the levels it uses")
     steps = {r[0]: r[2] for r in rows[1:]}
     assert float(steps["gyro X"]) == pytest.approx(1e-6, rel=1e-3)
     assert float(steps["accel X"]) == pytest.approx(1e-3, rel=1e-3)

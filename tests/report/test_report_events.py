@@ -66,7 +66,11 @@ def test_event_found_and_listed(trimmed):
     _rep, _log, md = trimmed
     # times are from the first sample of the recording, trimmed part included
     table = md.split("Events of the short log")[1].split("\n\n")[1]
-    assert re.search(r"\| 4000(\.\d+)? \| 400[12](\.\d+)? \| burst \| gyro X", table)
+    row = re.search(r"\| 4000(\.\d+)? \| 400[12](\.\d+)? \| [\d.]+ \| burst \| gyro X \| "
+                    r"[\d.]+ \| ([\d.]+) \(gyro X\) \|", table)
+    assert row, table
+    # the evidence: the burst against the quiet noise (RMS over the event ÷ quiet RMS)
+    assert float(row.group(3)) > 3
 
 
 def test_temperature_section_gives_datasheet_units_and_compensation(trimmed):
@@ -125,7 +129,7 @@ def test_long_log_events_with_and_without_in_the_allan_analysis(trimmed):
     assert f"holds {len(found)} event" in text
     # the "without events" column is the gap-aware ADEV of the log with them left out
     cut = found.exclude(analysed, pad=0.2)
-    row = re.search(r"\| gyro X \| 10(?:\.0)? s \| ([^|]+) \| ([^|]+) \|", text)
+    row = re.search(r"\| gyro X \| rad/s \| 10(?:\.0)? s \| ([^|]+) \| ([^|]+) \|", text)
     assert row, text
     want = imunoise.adev(cut.gyro[:, 0], FS, taus=[10.0]).dev[0]
     assert float(row.group(2)) == pytest.approx(want, rel=0.01)

@@ -159,7 +159,9 @@ def test_plot_methods_return_figures(objects):
     for fig in figures:
         assert isinstance(fig, Figure)
     assert len(figures[0].get_axes()) == 4 * 3  # gyro accel mag ypr, three axes each
-    assert [ax.get_ylabel() for ax in figures[0].get_axes()[3::4]] == ["yaw", "pitch", "roll"]
+    # every panel carries its unit, also below a column title that names it (#26)
+    assert [ax.get_ylabel() for ax in figures[0].get_axes()[3::4]] == [
+        "yaw [deg]", "pitch [deg]", "roll [deg]"]
     assert figures[1].get_axes()[0].get_ylabel() == "X [rad/s]"
     shaded = [p for p in figures[2].get_axes()[0].patches if p.get_facecolor()[0] > 0.8]
     assert len(shaded) == 2  # the damaged log's two gaps

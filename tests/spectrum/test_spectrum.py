@@ -304,7 +304,9 @@ def test_plot_with_model_and_asd():
     model = imunoise.fit(imunoise.adev(y, FS))
     fig = s.plot(model, unit="rad/s")
     assert len(fig.axes) == 2
-    assert any(line.get_label().startswith("N = ") for line in fig.axes[0].lines)
+    assert any(t.get_text().startswith("N = ") for t in fig.axes[0].texts)
+    # one legend for the figure, below the panels (none inside a panel over the data)
+    assert len(fig.legends) == 1 and all(ax.get_legend() is None for ax in fig.axes)
     fig = plot.spectrum(s, amplitude=True)
     assert "ASD" in fig.axes[0].get_ylabel()
     with pytest.raises(TypeError, match="Spectrum"):
@@ -320,3 +322,22 @@ def test_constant_and_tiny_channels_read_no_noise():
     assert tiny.N == pytest.approx(1e-147, rel=0.1)
     with pytest.raises(ValueError, match="too large for a spectrum"):
         imunoise.psd(1e200 * live, FS)
+
+
+def test_plot_range_holds_every_panels_line():
+    """The panels share y: a line that only one panel has (the 13.4 Hz line of the
+    VN-100 live capture in gyro Y) must fit in the range, whichever panel is last."""
+    from imunoise import plot
+
+    fs = 40.0
+    rng = np.random.default_rng(3)
+    y = rng.standard_normal((2**15, 3)) * 1e-3
+    t = np.arange(len(y)) / fs
+    y[:, 1] += 2e-2 * np.sin(2 * np.pi * 13.4 * t)  # a strong line in the middle panel only
+    s = imunoise.psd(y, fs)
+    model = imunoise.fit(imunoise.adev(y, fs))
+    fig = plot.spectrum(s, model, unit="rad/s")
+    top = fig.axes[0].get_ylim()[1]
+    highest = max(float(np.nanmax(line.get_ydata())) for ax in fig.axes[:3]
+                  for line in ax.lines if line.get_label() == "PSD")
+    assert highest < top, (highest, top)

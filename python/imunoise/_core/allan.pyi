@@ -40,23 +40,32 @@ def analyse(
     x: npt.NDArray[np.float64],
     statistic: str,
     ms: npt.NDArray[np.uint64],
+    ratio_ladder: str = "taylor-howe",
+    ratio_block: int = 1,
 ) -> Analysis:
     """The analysis of x (n, channels) at averaging factors ms. NaN marks a missing
     sample: adev, oadev, mdev, hdev and ohdev leave out the terms touching one
     (``terms`` counts those used; var and edf are NaN where none is left), the others
-    raise ValueError. statistic: one of :data:`STATISTICS`."""
+    raise ValueError. statistic: one of :data:`STATISTICS`. ThêoBR's bias ratio:
+    ``ratio_ladder`` "taylor-howe" (n = ⌊N/30⌋ − 3) or "sp1065" (n = ⌊N/6⌋ − 3);
+    ``ratio_block`` b ≥ 1 computes it on every b-th phase point (the fast ThêoBR)."""
 
 def analyse_plan(
     x: npt.NDArray[np.float64],
     statistics: list[str],
     ms: npt.NDArray[np.uint64],
+    ratio_ladder: str = "taylor-howe",
+    ratio_block: int = 1,
 ) -> Analysis:
     """As :func:`analyse` with one statistic per tau (``statistics[t]`` at ``ms[t]``,
     ordered by tau); ThêoH is oadev at its short taus, then theobr."""
 
-def theobr_seconds(n_phase: int, ms: list[int]) -> float:
-    """Rough seconds ThêoBR's bias ratio plus Theo1 at ms take on one channel, from the
-    kernel's work model and rates measured on the development machine."""
+def theobr_seconds(
+    n_phase: int, ms: list[int], ratio_ladder: str = "taylor-howe", ratio_block: int = 1
+) -> float:
+    """Rough seconds ThêoBR's bias ratio (as ``analyse`` computes it with these
+    options) plus Theo1 at ms take on one channel, from the kernel's work model and
+    rates measured on the development machine."""
 
 def estimator_terms(
     statistic: str, n_phase: int, ms: npt.NDArray[np.uint64]

@@ -11,11 +11,14 @@ MAX_GAUSS_MARKOV: int
 """Most first-order Gauss–Markov terms a model may have."""
 PARAMETERS: int
 """Slots of the covariance: Q²…R², then (q², ln τc) per Gauss–Markov term, then
-(s², ln f₀) of the tone, then (r², ln f_r, ln τr) of the resonance."""
+(s², ln f₀) of the tone, then (r², ln f_r, ln τr) of the resonance, then
+(σθ², ln τc) of the bounded motion."""
 SINE_SLOT: int
 """Slot of the tone's variance s² (its ln f₀ follows)."""
 RESONANCE_SLOT: int
 """Slot of the resonance's variance r² (its ln f_r, ln τr follow)."""
+MOTION_SLOT: int
+"""Slot of the bounded motion's variance σθ² (its ln τc follows)."""
 FLICKER_FACTOR: float
 """(2 ln 2)/π: the Allan variance of flicker rate noise per unit B²."""
 
@@ -36,9 +39,13 @@ class NoiseFit:
     def resonance(self) -> npt.NDArray[np.float64]:
         """(k, 3) rows of (r², f_r, τr), k ≤ 1: the resonance."""
     @property
+    def motion(self) -> npt.NDArray[np.float64]:
+        """(k, 2) rows of (σθ², τc), k ≤ 1: the bounded motion."""
+    @property
     def cov(self) -> npt.NDArray[np.float64]:
         """(PARAMETERS, PARAMETERS) covariance of (Q²…R², then q², ln τc per slot,
-        then s², ln f₀, then r², ln f_r, ln τr; NaN variance of ln f_r at fs/2)."""
+        then s², ln f₀, then r², ln f_r, ln τr, then σθ², ln τc; NaN variance of
+        ln f_r at fs/2)."""
     @property
     def discrepancy(self) -> float:
         """δ, the relative model discrepancy."""
@@ -65,10 +72,12 @@ def fit_noise(
     select: bool = True,
     sine: bool = True,
     resonance: bool = True,
+    motion: bool = True,
 ) -> NoiseFit:
     """Log-space, octave-weighted fit of the noise model (IEEE terms, up to
-    ``gm`` Gauss–Markov terms, with ``sine`` a tone and with ``resonance`` a
-    damped oscillator) to one channel; structure chosen by BIC when ``select``."""
+    ``gm`` Gauss–Markov terms, with ``sine`` a tone, with ``resonance`` a
+    damped oscillator and with ``motion`` a bounded motion of the mount) to one
+    channel; structure chosen by BIC when ``select``."""
 
 def noise_terms(
     taus: npt.NDArray[np.float64],
@@ -77,7 +86,8 @@ def noise_terms(
     gm: list[tuple[float, float]],
     sine: list[tuple[float, float]] = ...,
     resonance: list[tuple[float, float, float]] = ...,
+    motion: list[tuple[float, float]] = ...,
 ) -> npt.NDArray[np.float64]:
     """Allan variance of each model term at ``taus``: (len(taus), 5 + len(gm) +
-    len(sine) + len(resonance)), ``sine`` as (s², f₀) pairs, ``resonance`` as
-    (r², f_r, τr) triples."""
+    len(sine) + len(resonance) + len(motion)), ``sine`` as (s², f₀) pairs,
+    ``resonance`` as (r², f_r, τr) triples, ``motion`` as (σθ², τc) pairs."""

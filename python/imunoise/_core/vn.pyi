@@ -77,7 +77,9 @@ class VnStream:
     rows only). Counts, first locations and lines run on across pieces."""
 
     def __new__(cls, strict: bool = False) -> VnStream: ...
-    def feed(self, data: bytes) -> VnRows: ...
+    def feed(self, data: bytes | bytearray | memoryview) -> VnRows:
+        """The rows of the records the bytes so far complete. ``data``: bytes or any
+        C-contiguous buffer of bytes, parsed in place (do not change it meanwhile)."""
     def finish(self) -> VnResult: ...
 
 def parse_vn(

@@ -4,7 +4,8 @@ A :class:`~imunoise.noise.NoiseModel` speaks in datasheet values (``model.N`` is
 the white-noise density a datasheet quotes from the curve, whichever components
 produce it); its :attr:`~imunoise.noise.NoiseModel.components` are the pieces
 behind those values — the IEEE coefficients of the fit, the Gauss–Markov terms,
-the tone and the resonance — for simulation, Kalman-filter states and diagnosis.
+the tone, the resonance and a bounded motion of the mount — for simulation,
+Kalman-filter states and diagnosis.
 """
 
 from __future__ import annotations
@@ -137,11 +138,22 @@ class Components(PerTerm):
     resonance_sigma_std, resonance_freq_std, resonance_tau_std : ndarray
         Their standard uncertainties (the frequency's is NaN when it sits on the
         fs/2 bound of the search).
+    motion_sigma, motion_tau : ndarray
+        A bounded motion of the mount: its angle (velocity, for an accelerometer)
+        wanders as a Gauss–Markov process of standard deviation σθ (rate·s) and
+        correlation time τc (s) and comes back, and the sensor measures its rate —
+        a parked vehicle rocking, a building swaying. Its Allan variance
+        σθ²(3 − 4e^(−τ/τc) + e^(−2τ/τc))/τ² is white below τc (density 2σθ²/τc)
+        and falls as 1/τ beyond: the −½ slope that steepens to −1. NaN where a
+        channel has none. It is the platform's, not the sensor's: the datasheet
+        values leave it out of N and K.
+    motion_sigma_std, motion_tau_std : ndarray
+        Their standard uncertainties.
     cov : ndarray
         ``"wls"``: covariance of (Q², N², B², K², R², then σ², ln τc of each
         Gauss–Markov slot, then A²/2, ln f0 of the tone, then σ², ln f_r, ln τr
-        of the resonance), shape (16, 16) or (channels, 16, 16); NaN for
-        ``"slopes"``.
+        of the resonance, then σθ², ln τc of the motion), shape (18, 18) or
+        (channels, 18, 18); NaN for ``"slopes"``.
     fs : float
         Sample rate of the data (Hz): the terms' sampled forms depend on it.
     """
@@ -161,6 +173,10 @@ class Components(PerTerm):
     resonance_sigma_std: np.ndarray
     resonance_freq_std: np.ndarray
     resonance_tau_std: np.ndarray
+    motion_sigma: np.ndarray
+    motion_tau: np.ndarray
+    motion_sigma_std: np.ndarray
+    motion_tau_std: np.ndarray
     cov: np.ndarray
     fs: float
 
@@ -182,12 +198,18 @@ class Components(PerTerm):
                              (self.resonance_sigma, self.resonance_freq, self.resonance_tau))
         return [(sigma, f_r, tau_r)] if np.isfinite(sigma) else []
 
+    def motion(self, channel: int = 0) -> list[tuple[float, float]]:
+        """The (sigma, tau_c) of the bounded motion of ``channel``: one pair, or none."""
+        sigma, tau_c = (float(np.atleast_1d(a)[channel]) for a in
+                        (self.motion_sigma, self.motion_tau))
+        return [(sigma, tau_c)] if np.isfinite(sigma) else []
+
     def count(self, channel: int = 0) -> int:
         """Number of terms in the fitted structure of ``channel`` (IEEE
-        coefficients, Gauss–Markov terms, tone, resonance)."""
+        coefficients, Gauss–Markov terms, tone, resonance, bounded motion)."""
         ieee = sum(bool(np.atleast_1d(self.supported[t])[channel]) for t in TERMS)
         return (ieee + len(self.gauss_markov(channel)) + len(self.sine(channel))
-                + len(self.resonance(channel)))
+                + len(self.resonance(channel)) + len(self.motion(channel)))
 
     def structure(self, channel: int = 0) -> str:
         """The fitted structure of ``channel`` in words: ``"N + K + GM(0.05 s) +
@@ -196,29 +218,34 @@ class Components(PerTerm):
         parts += [f"GM({_summary.number(tc)} s)" for _, tc in self.gauss_markov(channel)]
         parts += [f"tone {_summary.number(f0)} Hz" for _, f0 in self.sine(channel)]
         parts += [f"resonance {_summary.number(f)} Hz" for _, f, _ in self.resonance(channel)]
+        parts += [f"motion({_summary.number(tc)} s)" for _, tc in self.motion(channel)]
         return " + ".join(parts) or "none"
 
     def predict(self, taus) -> Prediction:
         """Allan deviation of the components at ``taus``: the total curve and each
         term's own curve (``terms["N"]`` = N/√τ, ``terms["GM1"]``, ``terms["sine"]``,
-        ``terms["resonance"]``)."""
+        ``terms["resonance"]``, ``terms["motion"]``)."""
         t = np.asarray(taus, dtype=float)
         if t.ndim != 1 or t.size == 0 or not np.all(np.isfinite(t)) or np.any(t <= 0):
             raise ValueError(f"taus must be a non-empty 1-D array of finite values > 0; got {t!r}")
         gm_names = [f"GM{k + 1}" for k in range(GM_MAX)]
-        names = [*TERMS, *gm_names, "sine", "resonance"]
+        names = [*TERMS, *gm_names, "sine", "resonance", "motion"]
         parts = np.zeros((t.size, len(names), self.channels))
         for c in range(self.channels):
             markov, tone, osc = self.gauss_markov(c), self.sine(c), self.resonance(c)
-            var = term_variances(t, self.fs, [self.value(k)[c] for k in TERMS], markov, tone, osc)
+            moving = self.motion(c)
+            var = term_variances(t, self.fs, [self.value(k)[c] for k in TERMS], markov, tone, osc,
+                                 moving)
             cols = [*range(len(TERMS) + len(markov)), *([names.index("sine")] if tone else []),
-                    *([names.index("resonance")] if osc else [])]
+                    *([names.index("resonance")] if osc else []),
+                    *([names.index("motion")] if moving else [])]
             parts[:, cols, c] = var
         total = np.sqrt(parts.sum(axis=1))
         channels = range(self.channels)
         used = [*TERMS, *gm_names[: max(len(self.gauss_markov(c)) for c in channels)],
                 *(["sine"] if any(self.sine(c) for c in channels) else []),
-                *(["resonance"] if any(self.resonance(c) for c in channels) else [])]
+                *(["resonance"] if any(self.resonance(c) for c in channels) else []),
+                *(["motion"] if any(self.motion(c) for c in channels) else [])]
         terms = {k: np.sqrt(parts[:, names.index(k), :]) for k in used}
         if self.one_channel:
             total = total[:, 0]
@@ -226,8 +253,8 @@ class Components(PerTerm):
         return Prediction(taus=t, dev=total, terms=terms)
 
     def other_terms(self) -> list[tuple[str, str, str | None, np.ndarray, np.ndarray]]:
-        """(term, quantity, unit — None for a rate —, values, stds per channel) of
-        each row of the non-IEEE terms that any axis has."""
+        """(term, quantity, unit — None for a rate, ``"Q"`` for Q's unit (rate·s) —,
+        values, stds per channel) of each row of the non-IEEE terms that any axis has."""
         out = []
         sig = np.reshape(self.gm_sigma, (self.channels, GM_MAX))
         sig_std = np.reshape(self.gm_sigma_std, (self.channels, GM_MAX))
@@ -252,6 +279,11 @@ class Components(PerTerm):
                         one(self.resonance_freq_std)))
             out.append(("τr", "resonance damping time", "s", one(self.resonance_tau),
                         one(self.resonance_tau_std)))
+        if np.isfinite(one(self.motion_sigma)).any():
+            out.append(("σθ", "bounded motion (angle)", "Q", one(self.motion_sigma),
+                        one(self.motion_sigma_std)))
+            out.append(("τm", "bounded motion correlation time", "s", one(self.motion_tau),
+                        one(self.motion_tau_std)))
         return out
 
     def to_dict(self) -> dict:
@@ -272,6 +304,8 @@ class Components(PerTerm):
                      for c in channels]
         d["resonance"] = [[{"sigma": sg, "frequency": f, "tau_r": tr}
                            for sg, f, tr in self.resonance(c)] for c in channels]
+        d["motion"] = [[{"sigma": sg, "tau_c": tc} for sg, tc in self.motion(c)]
+                       for c in channels]
         return d
 
     def __repr__(self) -> str:
@@ -280,6 +314,17 @@ class Components(PerTerm):
                 for c in range(self.channels)]
         return _summary.lines(f"Components({_summary.plural(self.channels, 'channel')}",
                               axes)
+
+    def _repr_html_(self) -> str:
+        """One row per axis: the fitted IEEE coefficients ± their uncertainty (— where
+        not in the structure) and the structure in words."""
+        rows = [[name, *(_summary.estimate(self.value(t)[c], self.std(t)[c])
+                         if np.atleast_1d(self.supported[t])[c] else "—" for t in TERMS),
+                 self.structure(c)]
+                for c, name in enumerate(_schema.axis_names(self.channels))]
+        return _summary.html_table(
+            ["axis", *TERMS, "structure"], rows,
+            caption=f"Components: {_summary.plural(self.channels, 'channel')}")
 
 
 def finite_list(values) -> list[float | None]:

@@ -9,10 +9,15 @@ A datasheet quotes what the curve shows, not which components made it:
   filter's white-noise input should be.
 - ``K``, the rate random walk: the fitted K together with every slower
   Gauss–Markov term's short-τ random-walk rate √(2σ²/τc) (its +½ slope).
-- ``B``, the bias instability: the minimum of the model's deviation over the
-  fitted taus divided by √(2 ln2/π) ≈ 0.6643 — 0 when the curve still falls at
-  the longest tau with a log-log slope below −¼ (no flat part).
+- ``B``, the bias instability: the floor of the model's deviation over the
+  fitted taus divided by √(2 ln2/π) ≈ 0.6643 (:func:`model_floor`: the minimum,
+  or, where the curve falls again past a slow bump, the valley before it) — 0
+  when the curve never flattens (no part with a log-log slope above −¼).
 - ``Q`` and ``R`` are the fitted coefficients.
+
+A bounded motion of the mount (the platform's, not the sensor's) is part of the
+curve B is read from, but neither N nor K: under it a sensor's own white noise may
+not show at all, and N is then not resolved rather than the platform's rocking.
 
 With ``method="slopes"`` every value is the read-off coefficient. Uncertainties
 are propagated from the fit's covariance through a numerical gradient.
@@ -29,6 +34,7 @@ from imunoise.noise._terms import (
     FLAT_SLOPE,
     FLICKER,
     GM_MAX,
+    MOTION_SLOT,
     PARAMS,
     RES_SLOT,
     SINE_SLOT,
@@ -81,7 +87,8 @@ def _propagated(components, taus, term: str) -> tuple[np.ndarray, np.ndarray]:
 
 def parameters(components, channel: int) -> np.ndarray:
     """(Q², N², B², K², R², then σ², ln τc per Gauss–Markov slot, then A²/2,
-    ln f0 of the tone, then σ², ln f_r, ln τr of the resonance) of a channel."""
+    ln f0 of the tone, then σ², ln f_r, ln τr of the resonance, then σθ², ln τc of
+    the bounded motion) of a channel."""
     p = np.zeros(PARAMS)
     p[:5] = [float(components.value(t)[channel]) ** 2 for t in TERMS]
     for k, (sigma, tau_c) in enumerate(components.gauss_markov(channel)):
@@ -90,25 +97,56 @@ def parameters(components, channel: int) -> np.ndarray:
         p[SINE_SLOT], p[SINE_SLOT + 1] = amplitude**2 / 2, math.log(f0)
     for sigma, f_r, tau_r in components.resonance(channel):
         p[RES_SLOT], p[RES_SLOT + 1], p[RES_SLOT + 2] = sigma**2, math.log(f_r), math.log(tau_r)
+    for sigma, tau_c in components.motion(channel):
+        p[MOTION_SLOT], p[MOTION_SLOT + 1] = sigma**2, math.log(tau_c)
     return p
+
+
+def model_floor(p: np.ndarray, taus: np.ndarray, fs: float) -> tuple[float, float] | None:
+    """(τ, σ) of the floor of the model's deviation over the fitted taus, where B is
+    read; None where the curve has none.
+
+    The floor is the curve's minimum. Where that minimum is the last tau and the
+    curve still falls there (slope below −¼), it is the lowest valley of the curve
+    (where its slope turns from falling to rising), else the lowest point of its
+    flat parts (log-log slope ≥ −¼): a slow Gauss–Markov bump beyond a flat bottom
+    falls again past its peak, and the bottom before it is the bias floor a reader
+    sees. A curve that never flattens has none. The tone, the resonance and a
+    bounded motion are part of the curve whose floor B is read from; the tone and
+    the resonance are neither white nor a walk, so N and K leave them out.
+    """
+    gm = [(p[5 + 2 * k], math.exp(p[6 + 2 * k])) for k in range(GM_MAX) if p[5 + 2 * k] > 0]
+    tone = [(p[SINE_SLOT], math.exp(p[SINE_SLOT + 1]))] if p[SINE_SLOT] > 0 else []
+    osc = ([(p[RES_SLOT], math.exp(p[RES_SLOT + 1]), math.exp(p[RES_SLOT + 2]))]
+           if p[RES_SLOT] > 0 else [])
+    moving = [(p[MOTION_SLOT], math.exp(p[MOTION_SLOT + 1]))] if p[MOTION_SLOT] > 0 else []
+    grid = np.geomspace(taus[0], taus[-1], _B_GRID)
+    dev = np.sqrt(_core_fit.noise_terms(grid, fs, list(p[:5]), gm, tone, osc, moving)
+                  .sum(axis=1))
+    i = int(np.argmin(dev))
+    slope = np.log(dev[-1] / dev[-2]) / np.log(grid[-1] / grid[-2])
+    if i == grid.size - 1 and slope < FLAT_SLOPE:
+        # the curve without its oscillators: a tone's comb has a zero at every period
+        smooth = np.sqrt(_core_fit.noise_terms(grid, fs, list(p[:5]), gm, [], [], moving)
+                         .sum(axis=1))
+        slope = np.gradient(np.log(smooth), np.log(grid))
+        flat = slope >= FLAT_SLOPE
+        if not flat.any():
+            return None
+        # a valley (the slope turns from falling to rising) where the curve has
+        # one; else the lowest point of a shoulder
+        valley = np.zeros_like(flat)
+        valley[1:] = (slope[:-1] < 0) & (slope[1:] >= 0)
+        i = int(np.argmin(np.where(valley if valley.any() else flat, smooth, np.inf)))
+    return float(grid[i]), float(dev[i])
 
 
 def value_of(term: str, p: np.ndarray, taus: np.ndarray, fs: float) -> float:
     """The datasheet value of ``term`` for the parameter vector ``p``."""
     gm = [(p[5 + 2 * k], math.exp(p[6 + 2 * k])) for k in range(GM_MAX) if p[5 + 2 * k] > 0]
     if term == "B":
-        # The tone and the resonance are part of the curve whose floor B is
-        # read from; they are neither white nor a walk, so N and K leave them out.
-        tone = [(p[SINE_SLOT], math.exp(p[SINE_SLOT + 1]))] if p[SINE_SLOT] > 0 else []
-        osc = ([(p[RES_SLOT], math.exp(p[RES_SLOT + 1]), math.exp(p[RES_SLOT + 2]))]
-               if p[RES_SLOT] > 0 else [])
-        grid = np.geomspace(taus[0], taus[-1], _B_GRID)
-        dev = np.sqrt(_core_fit.noise_terms(grid, fs, list(p[:5]), gm, tone, osc).sum(axis=1))
-        i = int(np.argmin(dev))
-        slope = np.log(dev[-1] / dev[-2]) / np.log(grid[-1] / grid[-2])
-        if i == grid.size - 1 and slope < FLAT_SLOPE:  # still falling: no floor
-            return 0.0
-        return float(dev[i] / FLICKER)
+        floor = model_floor(p, taus, fs)
+        return 0.0 if floor is None else floor[1] / FLICKER
     total = p[1] if term == "N" else p[3]
     if term == "N" and p[RES_SLOT] > 0 and p[RES_SLOT + 2] <= 0.0:  # τr ≤ 1 s
         total += resonance_white_density(1.0, math.exp(p[RES_SLOT + 1]),

@@ -20,7 +20,15 @@ from imunoise.noise._components import Components
 from imunoise.noise._datasheet import datasheet_values
 from imunoise.noise._model import NoiseModel
 from imunoise.noise._readoff import coverage, fit_slopes, measured, readoffs
-from imunoise.noise._terms import GM_MAX, PARAMS, RES_SLOT, SINE_SLOT, TERMS, term_variances
+from imunoise.noise._terms import (
+    GM_MAX,
+    MOTION_SLOT,
+    PARAMS,
+    RES_SLOT,
+    SINE_SLOT,
+    TERMS,
+    term_variances,
+)
 
 #: Most simulated samples (replicates x record length) of ``fit(uncertainty=
 #: "bootstrap")``: they are held at once, 8 bytes each (1.6 GB at the bound).
@@ -106,22 +114,24 @@ def _edf_cap(result, taus):
     return np.where(np.isfinite(cap) & (cap > 1.0), cap, 1.0)
 
 
-def _parse_terms(terms) -> tuple[np.ndarray, int, tuple[bool, bool], bool]:
-    """``terms`` → (IEEE mask, Gauss–Markov count, (tone, resonance), select by BIC)."""
+def _parse_terms(terms) -> tuple[np.ndarray, int, tuple[bool, bool, bool], bool]:
+    """``terms`` → (IEEE mask, Gauss–Markov count, (tone, resonance, motion), select
+    by BIC)."""
     if isinstance(terms, str) and terms == "auto":
-        return np.ones(len(TERMS), dtype=bool), GM_MAX, (True, True), True
+        return np.ones(len(TERMS), dtype=bool), GM_MAX, (True, True, True), True
     names = tuple(terms) if not isinstance(terms, str) else tuple(terms)
-    allowed = (*TERMS, "GM", "sine", "resonance")
+    allowed = (*TERMS, "GM", "sine", "resonance", "motion")
     bad = [t for t in names if t not in allowed]
     gm = names.count("GM")
-    if (bad or not names or gm > GM_MAX or names.count("sine") > 1
-            or names.count("resonance") > 1):
+    if (bad or not names or gm > GM_MAX
+            or any(names.count(once) > 1 for once in ("sine", "resonance", "motion"))):
         raise ValueError(
             f"terms must be 'auto' or a non-empty sequence of {allowed} with 'GM' at most "
-            f"{GM_MAX} times, 'sine' at most once and 'resonance' at most once; got {terms!r}"
+            f"{GM_MAX} times and each of 'sine', 'resonance', 'motion' at most once; got "
+            f"{terms!r}"
         )
     mask = np.array([t in names for t in TERMS])
-    return mask, gm, ("sine" in names, "resonance" in names), False
+    return mask, gm, ("sine" in names, "resonance" in names, "motion" in names), False
 
 
 @old_call_forms(keyword_only=("method", "terms", "tau_range"))
@@ -139,13 +149,15 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
     method : {"wls", "slopes"}
         Log-space weighted least squares (default) or the IEEE 952 / MATLAB
         slope read-off (see the module docstring).
-    terms : "auto" or sequence of {"Q", "N", "B", "K", "R", "GM", "sine", "resonance"}
+    terms : "auto" or sequence of {"Q", "N", "B", "K", "R", "GM", "sine", "resonance", \
+"motion"}
         ``"auto"`` (default): the IEEE terms, up to three Gauss–Markov terms,
-        a tone and a resonance, the structure with the lowest BIC (the fewest
-        terms that describe the curve). A sequence fits exactly those terms
-        (``"GM"`` up to three times for Gauss–Markov terms, ``"sine"`` once for
-        a tone, ``"resonance"`` once for a damped oscillator); a term the data
-        push below zero is still 0.
+        a tone, a resonance and a bounded motion of the mount, the structure
+        with the lowest BIC (the fewest terms that describe the curve). A
+        sequence fits exactly those terms (``"GM"`` up to three times for
+        Gauss–Markov terms, ``"sine"`` once for a tone, ``"resonance"`` once for
+        a damped oscillator, ``"motion"`` once for a bounded motion); a term the
+        data push below zero is still 0.
     tau_range : (float, float), optional
         Only use taus in [min, max] seconds.
     uncertainty : {"independent", "bootstrap"}
@@ -220,6 +232,8 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
     sine_std = np.full((channels, 2), np.nan)
     osc = np.full((channels, 3), np.nan)  # sigma, f_r, tau_r
     osc_std = np.full((channels, 3), np.nan)
+    moving = np.full((channels, 2), np.nan)  # sigma of the angle, tau_c
+    moving_std = np.full((channels, 2), np.nan)
     stats = np.full((channels, 3), np.nan)  # discrepancy, chi2, n_eff
     cov = np.full((channels, PARAMS, PARAMS), np.nan)
     usable = []
@@ -246,11 +260,13 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
             fits = list(pool.map(fit_channel, range(channels)))
         for c, out in enumerate(fits):
             coef[c], std[c], sup[c], gm[c], gm_std[c], sine[c], sine_std[c], osc[c], \
-                osc_std[c], stats[c], cov[c] = out
+                osc_std[c], moving[c], moving_std[c], stats[c], cov[c] = out
             markov = [(a, b) for a, b in gm[c] if np.isfinite(a)]
             tones = [tuple(sine[c])] if np.isfinite(sine[c, 0]) else []
             oscs = [tuple(osc[c])] if np.isfinite(osc[c, 0]) else []
-            parts = term_variances(taus[usable[c]], result.fs, coef[c], markov, tones, oscs)
+            motions = [tuple(moving[c])] if np.isfinite(moving[c, 0]) else []
+            parts = term_variances(taus[usable[c]], result.fs, coef[c], markov, tones, oscs,
+                                   motions)
             rng[c] = _support_range(parts, taus[usable[c]], sup[c])
     else:
         for c in range(channels):
@@ -264,15 +280,17 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
             markov = [(float(a), float(b)) for a, b in gm[c] if np.isfinite(a)]
             tones = [(float(sine[c, 0]), float(sine[c, 1]))] if np.isfinite(sine[c, 0]) else []
             oscs = [tuple(map(float, osc[c]))] if np.isfinite(osc[c, 0]) else []
-            if not kept and not markov and not tones and not oscs:
+            motions = [tuple(map(float, moving[c]))] if np.isfinite(moving[c, 0]) else []
+            if not kept and not markov and not tones and not oscs and not motions:
                 continue
             options = dict(method=method, terms=[*kept, *["GM"] * len(markov),
                                                  *["sine"] * len(tones),
-                                                 *["resonance"] * len(oscs)],
+                                                 *["resonance"] * len(oscs),
+                                                 *["motion"] * len(motions)],
                            tau_range=tau_range)
-            std[c], gm_std[c], sine_std[c], osc_std[c], sheet_std[c] = _bootstrap_std(
-                result, n_record, coef[c], markov, (tones, oscs), int(replicates), generator,
-                options)
+            std[c], gm_std[c], sine_std[c], osc_std[c], moving_std[c], sheet_std[c] = \
+                _bootstrap_std(result, n_record, coef[c], markov, (tones, oscs, motions),
+                               int(replicates), generator, options)
     std[~sup] = np.nan
 
     def shaped(a):
@@ -299,6 +317,10 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
         resonance_sigma_std=shaped(osc_std[:, 0]),
         resonance_freq_std=shaped(osc_std[:, 1]),
         resonance_tau_std=shaped(osc_std[:, 2]),
+        motion_sigma=shaped(moving[:, 0]),
+        motion_tau=shaped(moving[:, 1]),
+        motion_sigma_std=shaped(moving_std[:, 0]),
+        motion_tau_std=shaped(moving_std[:, 1]),
         cov=shaped(cov),
         fs=float(result.fs),
     )
@@ -357,17 +379,17 @@ def _record_length(result) -> int:
 
 def _bootstrap_std(result, n, coef, markov, oscillators, replicates, rng, options):
     """Standard deviation of each coefficient (and Gauss–Markov σ, τc, tone A, f0,
-    resonance σ, f_r, τr, and the datasheet values Q…R) over fits to records simulated
-    from the model with
-    the rate and taus of ``result`` and its length ``n``; ``oscillators`` is (tones,
-    resonances)."""
+    resonance σ, f_r, τr, motion σθ, τc, and the datasheet values Q…R) over fits to
+    records simulated from the model with the rate and taus of ``result`` and its
+    length ``n``; ``oscillators`` is (tones, resonances, motions)."""
     from imunoise._simulate import simulate
     from imunoise.allan import adev
 
-    tones, oscs = oscillators
+    tones, oscs, motions = oscillators
     sims = simulate(n, result.fs, *coef, channels=replicates, seed=rng, gm=markov,
                     sinusoid=tones[0] if tones else None,
-                    resonance=oscs[0] if oscs else None)
+                    resonance=oscs[0] if oscs else None,
+                    motion=motions[0] if motions else None)
     again = adev(sims, result.fs, taus=np.asarray(result.taus), overlapping=result.overlapping,
                  confidence=result.confidence)
     with warnings.catch_warnings():
@@ -381,12 +403,14 @@ def _bootstrap_std(result, n, coef, markov, oscillators, replicates, rng, option
                     axis=-1)
     osc = np.stack([np.atleast_1d(a) for a in (parts.resonance_sigma, parts.resonance_freq,
                                                parts.resonance_tau)], axis=-1)
+    moving = np.stack([np.atleast_1d(parts.motion_sigma), np.atleast_1d(parts.motion_tau)],
+                      axis=-1)
     sheet = np.stack([refit.value(t) for t in TERMS], axis=1)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN: no tone
         return (values.std(axis=0, ddof=1), np.nanstd(gm, axis=0, ddof=1),
                 np.nanstd(tone, axis=0, ddof=1), np.nanstd(osc, axis=0, ddof=1),
-                sheet.std(axis=0, ddof=1))
+                np.nanstd(moving, axis=0, ddof=1), sheet.std(axis=0, ddof=1))
 
 
 def _readonly(a):
@@ -396,11 +420,11 @@ def _readonly(a):
 
 
 def _fit_wls(t, v, e, fs, mask, gm_count, oscillators, select):
-    tone, resonance = oscillators
+    tone, resonance, motion = oscillators
     try:
         r = _core_fit.fit_noise(
             np.ascontiguousarray(t), np.ascontiguousarray(v), np.ascontiguousarray(e), fs,
-            [bool(m) for m in mask], gm_count, select, tone, resonance,
+            [bool(m) for m in mask], gm_count, select, tone, resonance, motion,
         )
     except ValueError as exc:
         raise ValueError(f"cannot fit the noise model to result: {exc}") from None
@@ -437,8 +461,15 @@ def _fit_wls(t, v, e, fs, mask, gm_count, oscillators, select):
                       f_r * math.sqrt(cov[RES_SLOT + 1, RES_SLOT + 1]) if np.isfinite(
                           cov[RES_SLOT + 1, RES_SLOT + 1]) else np.nan,
                       tau_r * math.sqrt(max(cov[RES_SLOT + 2, RES_SLOT + 2], 0.0)))
+    moving = np.full(2, np.nan)
+    moving_std = np.full(2, np.nan)
+    for v2, tau_c in r.motion:
+        sigma = math.sqrt(v2)
+        moving[:] = sigma, tau_c
+        moving_std[:] = (math.sqrt(max(cov[MOTION_SLOT, MOTION_SLOT], 0.0)) / (2 * sigma),
+                         tau_c * math.sqrt(max(cov[MOTION_SLOT + 1, MOTION_SLOT + 1], 0.0)))
     return (np.where(supported, coef, 0.0), std, supported, markov, markov_std, sine, sine_std,
-            osc, osc_std, (delta, chi2, n_eff), cov)
+            osc, osc_std, moving, moving_std, (delta, chi2, n_eff), cov)
 
 
 def _support_range(parts, t, sup, min_share=0.25):

@@ -122,9 +122,20 @@ class NoiseModel(PerTerm):
         Returns the total curve σ(τ) and each component's own curve, e.g.
         ``terms["N"]`` = (fitted N)/√τ, ``terms["GM1"]`` for the first
         Gauss–Markov term, ``terms["sine"]`` for the tone and
-        ``terms["resonance"]`` for the resonance (when a channel has one).
+        ``terms["resonance"]`` for the resonance and ``terms["motion"]`` for a
+        bounded motion (when a channel has one).
         """
         return self.components.predict(self.taus if taus is None else taus)
+
+    def floor(self, channel: int = 0) -> tuple[float, float] | None:
+        """(τ, σ(τ)) of the model's floor over the fitted taus, where ``B`` is read
+        (B = σ/√(2 ln2/π)); None where the curve has none (B not resolved)."""
+        from imunoise.noise._datasheet import model_floor, parameters
+
+        if self.method != "wls":
+            return None
+        p = parameters(self.components, channel)
+        return model_floor(p, np.asarray(self.taus, float), float(self.fs))
 
     def plot(self, result: AllanResult, **kwargs) -> Figure:
         """The model over ``result``, the Allan result it was fitted to, with its terms,
@@ -178,6 +189,8 @@ class NoiseModel(PerTerm):
         extra = "".join(f", tone {_summary.number(f0)} Hz" for _, f0 in parts.sine(channel))
         extra += "".join(f", resonance {_summary.number(f)} Hz"
                          for _, f, _ in parts.resonance(channel))
+        extra += "".join(f", bounded motion τc {_summary.number(tc)} s"
+                         for _, tc in parts.motion(channel))
         return ((" ".join(terms) or "no term resolved") + (f", {gm} GM" if gm else "") + extra
                 + f", covers {100 * float(np.atleast_1d(self.coverage)[channel]):.3g} %")
 
@@ -193,16 +206,16 @@ class NoiseModel(PerTerm):
 
     def _repr_html_(self) -> str:
         """One row per axis: each datasheet value ± standard uncertainty in the
-        input's units (``not resolved`` where the data do not resolve it), the
-        fitted components and the coverage."""
+        input's units, rounded to it as in the repr (``not resolved`` where the data
+        do not resolve it), the fitted components and the coverage."""
         units = _INPUT_UNITS
         rows = []
         for c, name in enumerate(_schema.axis_names(self.channels)):
             row: list[object] = [name]
             for t in TERMS:
                 v, e = self.value(t)[c], self.std(t)[c]
-                row.append(_numbers.NOT_RESOLVED if not self.resolved(t)[c]
-                           else _summary.number(v) + (f" ± {e:.2g}" if np.isfinite(e) else ""))
+                row.append(_summary.estimate(v, e) if self.resolved(t)[c]
+                           else _numbers.NOT_RESOLVED)
             row.append(self.components.structure(c))
             row.append(f"{100 * float(np.atleast_1d(self.coverage)[c]):.3g} %")
             rows.append(row)
@@ -261,8 +274,8 @@ class NoiseModel(PerTerm):
         """Per-axis table in datasheet units: one row per datasheet value, then the
         fitted components beyond the IEEE terms where any axis has them (``σ1``,
         ``τc1``, … per Gauss–Markov term, ``A``, ``f0`` of the tone, ``σr``,
-        ``f_r``, ``τr`` of the resonance; σ and A in the unit of B, times in s,
-        frequencies in Hz).
+        ``f_r``, ``τr`` of the resonance, ``σθ``, ``τm`` of a bounded motion; σ and A
+        in the unit of B, σθ in the unit of Q, times in s, frequencies in Hz).
 
         Each row is a dict with ``term``, ``quantity``, ``unit``, ``label``,
         ``missing`` (the text of an axis without the value: ``not resolved`` for
@@ -285,28 +298,80 @@ class NoiseModel(PerTerm):
                 row[ax + "_std"] = float(stds[i])
                 row[ax + "_supported"] = bool(sup[i])
             rows.append(row)
-        rate, rate_label = conv["B"]["unit"], conv["B"]["label"]  # σ and A: in B's unit
-
-        def to_rate(v):
-            return _units.convert(v, "B", rate, sensor=sensor, input_unit=input_unit)
-
+        # σ and A in B's unit (a rate), a motion's σθ in Q's (rate·s)
+        like = {None: "B", "Q": "Q"}
         for term, quantity, unit, values, stds in self.components.other_terms():
-            rate_valued = unit is None
+            as_term = like.get(unit)
+            shown = conv[as_term]["unit"] if as_term else unit
+
+            def scaled(v, as_term=as_term, shown=shown):
+                if as_term is None or not np.isfinite(v):
+                    return v
+                return float(_units.convert(v, as_term, shown, sensor=sensor,
+                                            input_unit=input_unit))
+
             row = {"term": term, "quantity": "component: " + quantity, "missing": "—",
-                   "unit": rate if rate_valued else unit,
-                   "label": rate_label if rate_valued else unit}
+                   "unit": shown, "label": conv[as_term]["label"] if as_term else unit}
             for i, ax in enumerate(axes):
                 v, e = float(values[i]), float(stds[i])
-                row[ax] = float(to_rate(v)) if rate_valued and np.isfinite(v) else v
-                row[ax + "_std"] = float(to_rate(e)) if rate_valued and np.isfinite(e) else e
+                row[ax] = scaled(v)
+                row[ax + "_std"] = scaled(e)
                 row[ax + "_supported"] = bool(np.isfinite(v))
             rows.append(row)
         return rows
 
-    def table_text(self, sensor: str = "gyro", **kwargs) -> str:
-        """Text rendering of :meth:`table`."""
-        rows = self.table(sensor, **kwargs)
-        return format_table(rows, _schema.axis_names(self.channels, kwargs.get("axes")))
+    def lab_table(self, sensor: str = "gyro", *, spec="vn100",
+                  units: dict[str, str] | str | None = None, input_unit: str | None = None,
+                  axes: Sequence[str] | None = None) -> list[dict]:
+        """The lab report's table: N, B and K per axis beside the datasheet's value.
+
+        The rows of :meth:`table` for N, B and K (same keys, same ``units``), each
+        with ``spec`` (the datasheet's value in the row's unit, NaN when the
+        datasheet does not give it), ``spec_text`` (as the datasheet prints it:
+        ``"< 10 °/h"``, ``"0.0035 °/s/√Hz typ."``, ``"—"``) and ``spec_quantity``.
+
+        Parameters
+        ----------
+        spec : str, path, :class:`imunoise.datasheet.Spec` or None
+            The datasheet (:func:`imunoise.datasheet.load_spec`; default the VN-100's);
+            None: no datasheet values.
+        """
+        from imunoise import datasheet
+
+        items = datasheet.load_spec(spec).items if spec is not None else ()
+        given = {item.term: item for item in items if item.sensor == sensor}
+        rows = [r for r in self.table(sensor, units=units, input_unit=input_unit, axes=axes,
+                                      terms=LAB_TERMS) if r["term"] in LAB_TERMS]
+        for row in rows:
+            item = given.get(row["term"])
+            row["spec"], row["spec_text"], row["spec_quantity"] = float("nan"), "—", ""
+            if item is None:
+                continue
+            label = _units.unit_info(row["term"], item.unit, sensor).label
+            row["spec"] = float(_units.convert(
+                _units.convert_back(item.value, row["term"], item.unit, sensor=sensor,
+                                    input_unit=input_unit),
+                row["term"], row["unit"], sensor=sensor, input_unit=input_unit))
+            bound = {"max": "< ", "min": "> "}.get(item.limit, "")
+            row["spec_text"] = (f"{bound}{item.value:g} {label}"
+                                + (" typ." if item.limit == "typical" else ""))
+            row["spec_quantity"] = item.quantity
+        return rows
+
+    def table_text(self, which: str = "gyro", /, **kwargs) -> str:
+        """Text rendering of :meth:`table` (``which`` is the sensor, ``"gyro"`` or
+        ``"accel"``), or with ``which="lab"`` of :meth:`lab_table` (pass
+        ``sensor=``, default ``"gyro"``, and ``spec=``): N, B, K per axis beside the
+        datasheet's values, in one unit."""
+        axes = _schema.axis_names(self.channels, kwargs.get("axes"))
+        if which == "lab":
+            rows = self.lab_table(kwargs.pop("sensor", "gyro"), **kwargs)
+            return format_table(rows, axes, datasheet=True)
+        sensor = kwargs.pop("sensor", which)
+        if which not in ("gyro", sensor):
+            raise ValueError(f"table_text takes the sensor once; got {which!r} and "
+                             f"sensor={sensor!r}")
+        return format_table(self.table(sensor, **kwargs), axes)
 
     # -- exports ------------------------------------------------------------
     @old_call_forms(keyword_only=("accel", "path"))
@@ -354,13 +419,19 @@ _MOVED_FIELDS = frozenset({
 })
 
 
-def format_table(rows: list[dict], axes: Sequence[str]) -> str:
+#: The terms of the lab table (:meth:`NoiseModel.lab_table`): what a lab report asks for.
+LAB_TERMS = ("N", "B", "K")
+
+
+def format_table(rows: list[dict], axes: Sequence[str], *, datasheet: bool = False) -> str:
     """Render :meth:`NoiseModel.table` rows as fixed-width text.
 
     Terms the data do not resolve print as ``not resolved`` (the report's and
     ``imunoise fit``'s wording too), a component an axis's model does not have
     as ``—``; values carry ``± std``, rounded to it
-    (:func:`imunoise.numbers.format_value`).
+    (:func:`imunoise.numbers.format_value`). With ``datasheet`` (rows of
+    :meth:`NoiseModel.lab_table`), two more columns: the datasheet's value in the
+    row's unit and as the datasheet prints it.
     """
     def cell(row, ax):
         if not row[ax + "_supported"]:
@@ -370,6 +441,10 @@ def format_table(rows: list[dict], axes: Sequence[str]) -> str:
     header = ["coefficient", "unit", *axes]
     body = [[f"{r['term']} {r['quantity']}", r["label"], *(cell(r, a) for a in axes)]
             for r in rows]
+    if datasheet:
+        header += ["datasheet", "as printed"]
+        for line, r in zip(body, rows, strict=True):
+            line += [_numbers.cell(r["spec"], digits=3), r["spec_text"]]
     widths = [max(len(str(x[i])) for x in [header, *body]) for i in range(len(header))]
     lines = ["  ".join(str(x).ljust(w) for x, w in zip(line, widths, strict=True)).rstrip()
              for line in [header, *body]]

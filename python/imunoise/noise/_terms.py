@@ -40,6 +40,8 @@ SINE_SLOT: int = _core_fit.SINE_SLOT
 """Slot of the tone's variance A²/2 in the covariance (its ln f0 follows)."""
 RES_SLOT: int = _core_fit.RESONANCE_SLOT
 """Slot of the resonance's variance σ² in the covariance (ln f_r, ln τr follow)."""
+MOTION_SLOT: int = _core_fit.MOTION_SLOT
+"""Slot of the bounded motion's variance σθ² in the covariance (ln τc follows)."""
 
 
 def gm_white_density(sigma: float, tau_c: float, fs: float) -> float:
@@ -62,7 +64,8 @@ def resonance_white_density(sigma: float, f_r: float, tau_r: float, fs: float) -
 
 def is_log_time(slot: int) -> bool:
     """Whether covariance slot ``slot`` holds a logarithm (ln τc, ln f0, ln f_r, ln τr)."""
-    return slot > RES_SLOT or (5 <= slot < RES_SLOT and (slot - 5) % 2 == 1)
+    return (slot > RES_SLOT and slot != MOTION_SLOT) or (5 <= slot < RES_SLOT
+                                                          and (slot - 5) % 2 == 1)
 
 
 FLAT_SLOPE = -0.25
@@ -73,18 +76,21 @@ CLOSE = 0.05
 """A model within this relative distance of the measured deviation follows it."""
 
 
-def term_variances(taus, fs: float, coef, markov=(), tone=(), resonance=()) -> np.ndarray:
+def term_variances(taus, fs: float, coef, markov=(), tone=(), resonance=(),
+                   motion=()) -> np.ndarray:
     """Allan variance of each model term at ``taus``: (len(taus), 5 + len(markov) +
-    len(tone) + len(resonance)), from the one implementation of the model (Rust);
-    ``coef`` holds Q…R, ``markov`` (sigma, tau_c) pairs, ``tone`` (amplitude, f0)
-    pairs, ``resonance`` (sigma, f_r, tau_r) triples."""
+    len(tone) + len(resonance) + len(motion)), from the one implementation of the
+    model (Rust); ``coef`` holds Q…R, ``markov`` (sigma, tau_c) pairs, ``tone``
+    (amplitude, f0) pairs, ``resonance`` (sigma, f_r, tau_r) triples, ``motion``
+    (sigma, tau_c) pairs of a bounded motion (sigma of its angle, rate·s)."""
     t = np.ascontiguousarray(np.atleast_1d(np.asarray(taus, dtype=float)))
     with np.errstate(over="ignore"):  # a coefficient near 1e154 squares to inf, not an error
         squares = np.square(np.asarray(coef, dtype=float)).tolist()
     return _core_fit.noise_terms(t, float(fs), squares,
                              [(s * s, tc) for s, tc in markov],
                              [(a * a / 2, f0) for a, f0 in tone],
-                             [(s * s, f, tr) for s, f, tr in resonance])
+                             [(s * s, f, tr) for s, f, tr in resonance],
+                             [(s * s, tc) for s, tc in motion])
 
 
 def model_variance(taus, Q=0.0, N=0.0, B=0.0, K=0.0, R=0.0) -> np.ndarray:

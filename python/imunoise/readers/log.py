@@ -129,21 +129,26 @@ class ParseIssues:
         unit = "sample" if kind in TIME_KINDS else self.location
         return f"{unit}{'s' if len(where) > 1 else ''} {shown}{more}"
 
+    def _missing(self) -> list[str]:
+        """``["4 of 13223 samples missing (0.03 %) in 2 gaps"]``, or nothing."""
+        if not self.samples_missing:
+            return []
+        return [f"{self.samples_missing} of {self.samples} samples missing "
+                f"({100 * self.share_missing:.3g} %) in {_summary.plural(self.gaps, 'gap')}"]
+
     def __repr__(self) -> str:
         parts = [f"{k}={v}" + (f" ({self._first(k)})" if self.first[k] else "")
                  for k, v in self.counts.items() if v]
-        if self.samples_missing:
-            parts.append(f"{self.samples_missing} of {self.samples} samples missing "
-                         f"({100 * self.share_missing:.3g} %) in "
-                         f"{_summary.plural(self.gaps, 'gap')}")
-        return _summary.lines("ParseIssues(", parts or ["no issues"], sep=", ")
+        return _summary.lines("ParseIssues(", parts + self._missing() or ["no issues"],
+                              sep=", ")
 
     def _repr_html_(self) -> str:
         rows = [[k, v, self._first(k)] for k, v in self.counts.items() if v]
+        counts = [f"{k}={v}" for k, v in self.counts.items() if v]
         return _summary.html_table(
             ["kind", "count", "first locations"],
             rows or [["no issues", 0, ""]],
-            caption=f"ParseIssues: {self}",
+            caption="ParseIssues: " + (", ".join(counts + self._missing()) or "no issues"),
         )
 
 

@@ -38,12 +38,13 @@ from __future__ import annotations
 import errno
 import os
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from types import MappingProxyType
 
 import numpy as np
 
 from imunoise._core import vn as _core_vn
+from imunoise.readers import recording
 from imunoise.readers.grid import TimeGrid
 from imunoise.readers.log import ISSUE_KINDS, ImuLog, ParseIssues, log_on_grid
 
@@ -298,10 +299,46 @@ def read_vn(
     """Read a VN-100 log (ASCII, binary or both interleaved) into an :class:`ImuLog`.
 
     See :func:`read_vn_tables` for the arguments and the module docstring for how
-    channels are chosen when the stream has several message types.
+    channels are chosen when the stream has several message types. A log written
+    by ``imunoise record`` brings its side files (:mod:`imunoise.readers.recording`):
+    ``fs`` defaults to the rate the recorder set, and without timestamps each port
+    outage is a gap of its length at its place.
     """
-    name = "<bytes>" if isinstance(source, (bytes, bytearray, memoryview)) else os.fspath(source)
-    return vn_log(read_vn_tables(source, strict=strict, progress=progress), fs=fs, source=name)
+    if isinstance(source, (bytes, bytearray, memoryview)):
+        return vn_log(read_vn_tables(source, strict=strict, progress=progress), fs=fs,
+                      source="<bytes>")
+    name = os.fspath(source)
+    tables = read_vn_tables(source, strict=strict, progress=progress)
+    fs = fs if fs is not None else recording.recorded_fs(name)
+    cut = recording.outages(name)
+    if cut:
+        tables = _with_outages(tables, name, cut, fs)
+    return vn_log(tables, fs=fs, source=name)
+
+
+def _with_outages(tables: VnTables, path: str, cut, fs: float | None) -> VnTables:
+    """``tables`` with ``round(seconds * fs)`` missing records of the main table at
+    every outage (the good records before its byte offset), when the main table
+    has no timestamps and the rate is known."""
+    name, channels = _primary(tables.tables)
+    if not name or "time" in channels or fs is None:
+        return tables
+    stream = _core_vn.VnStream(False)
+    before, rows, done = [], 0, 0
+    with open(path, "rb") as f:
+        for outage in sorted(cut, key=lambda o: o.offset):
+            while done < outage.offset:
+                piece = f.read(min(outage.offset - done, 1 << 23))
+                if not piece:
+                    break
+                done += len(piece)
+                cols = stream.feed(piece).tables.get(name, {})
+                rows += len(next(iter(cols.values()))) if cols else 0
+            before.extend([rows] * max(0, round(outage.seconds * fs) - 1))
+    missing = dict(tables.missing)
+    missing[name] = np.sort(np.concatenate([np.asarray(missing.get(name, ()), np.int64),
+                                            np.asarray(before, np.int64)]))
+    return replace(tables, missing=MappingProxyType(missing))
 
 
 def parse_vn_sentences(

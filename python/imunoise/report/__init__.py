@@ -25,7 +25,12 @@ Modules: :mod:`.build` (:func:`build`, the context and the list of sections),
 from imunoise.report.build import SECTIONS, TAUS_PER_DECADE, Report, build
 from imunoise.report.formatting import gap_note, terms_used
 from imunoise.report.inputs import read_log
-from imunoise.report.model_text import comparison_rows, datasheet_rows, model_sentences
+from imunoise.report.model_text import (
+    comparison_rows,
+    datasheet_rows,
+    lab_rows,
+    model_sentences,
+)
 
 __all__ = [
     "SECTIONS",
@@ -35,6 +40,7 @@ __all__ = [
     "comparison_rows",
     "datasheet_rows",
     "gap_note",
+    "lab_rows",
     "model_sentences",
     "read_log",
     "terms_used",

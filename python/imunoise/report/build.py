@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from imunoise import _atomic, _schema, _stream, export, noise, plot, stats
+from imunoise import _atomic, _schema, _stream, _summary, export, noise, plot, stats
 from imunoise import allan as _allan
 from imunoise._core import __version__
 from imunoise._events import Events, events
@@ -62,6 +62,9 @@ class Context:
     block: int = _stream.BLOCK_ROWS
     #: (stage, seconds, peak RSS in MiB so far) of each stage, for the appendix.
     timings: list[tuple[str, float, float]] = field(default_factory=list)
+    #: Units of the noise coefficients in every table (None: the defaults, or
+    #: "datasheet"; :meth:`imunoise.noise.NoiseModel.table`).
+    units: str | None = None
 
     @property
     def logs(self) -> list[tuple[str, ImuLog]]:
@@ -264,6 +267,22 @@ class Report:
     logs: tuple = ()
     attitude: dict = field(default_factory=dict)
 
+    def _facts(self) -> list[str]:
+        return [_summary.plural(len(self.logs), "log"),
+                _summary.plural(len(self.figures), "figure file"),
+                "models " + (" ".join(self.models) or "none")]
+
+    def __repr__(self) -> str:
+        return _summary.lines(f"Report({str(self.out_dir)!r}", self._facts(), sep=", ")
+
+    def _repr_html_(self) -> str:
+        """What the report wrote, one file kind a row."""
+        rows = [["report", self.html.name], ["Markdown", self.markdown.name],
+                ["figures", _summary.plural(len(self.figures), "file")],
+                ["model files", ", ".join(p.name for p in self.model_files) or "—"]]
+        return _summary.html_table(["", str(self.out_dir)], rows,
+                                   caption="Report: " + ", ".join(self._facts()))
+
 
 def build(
     short,
@@ -276,6 +295,7 @@ def build(
     read_options: Mapping[str, object] | None = None,
     trim: str | None = None,
     force: bool = False,
+    units: str | None = None,
     stream: bool | None = None,
 ) -> Report:
     """Analyse the logs and write the report directory.
@@ -309,6 +329,10 @@ def build(
     force : bool
         Write into an existing folder that is not a report (default False: refused
         with a ``ValueError``).
+    units : {None, "datasheet"}
+        Units of N, B, K, Q, R in every table of the report (one unit per quantity):
+        None the defaults (°/√h, °/h, mg/√Hz, µg, …), ``"datasheet"`` the units MEMS
+        datasheets write (°/s/√Hz, °/h, µg/√Hz, µg; :data:`imunoise.units.DATASHEET_UNITS`).
     stream : bool or None
         Bounded memory for logs larger than memory (:mod:`imunoise._stream`): each
         log file is parsed once into memory maps (a temporary folder beside
@@ -319,6 +343,8 @@ def build(
     """
     if trim not in (None, "auto"):
         raise ValueError(f"trim must be None or 'auto'; got {trim!r}")
+    if units not in (None, "datasheet"):
+        raise ValueError(f"units must be None or 'datasheet'; got {units!r}")
     if stream not in (None, True, False):
         raise ValueError(f"stream must be None, True or False; got {stream!r}")
     out = Path(out_dir)
@@ -330,14 +356,14 @@ def build(
     workdirs: list[Path] = []
     try:
         return _build(short, long, out, previous, inputs, options, workdirs, spec=spec,
-                      fs=fs, progress=progress, trim=trim, streamed=streamed)
+                      fs=fs, progress=progress, trim=trim, streamed=streamed, units=units)
     finally:
         for w in workdirs:
             shutil.rmtree(w, ignore_errors=True)
 
 
 def _build(short, long, out: Path, previous, inputs, options, workdirs: list[Path], *,
-           spec, fs, progress, trim, streamed: bool) -> Report:
+           spec, fs, progress, trim, streamed: bool, units: str | None) -> Report:
     """:func:`build` once the folder is claimed; ``workdirs`` collects the folders of
     the streamed path's memory maps (the caller removes them)."""
     timings: list[tuple[str, float, float]] = []
@@ -362,7 +388,7 @@ def _build(short, long, out: Path, previous, inputs, options, workdirs: list[Pat
     folder.mark(out, previous)
     (out / "figures").mkdir(parents=True, exist_ok=True)
     ctx = Context(short=short_log, long=long_log, one_log=long is None, spec=spec, out_dir=out,
-                  streamed=streamed, block=_stream.BLOCK_ROWS, timings=timings)
+                  streamed=streamed, block=_stream.BLOCK_ROWS, timings=timings, units=units)
     if trim == "auto":
         start = time.perf_counter()
         _trim_warmup(ctx)

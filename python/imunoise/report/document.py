@@ -26,8 +26,13 @@ class Doc:
     def p(self, text: str) -> None:
         self.blocks.append(("p", text))
 
-    def table(self, header: Sequence[str], rows: Sequence[Sequence[str]], caption="") -> None:
-        self.blocks.append(("table", list(header), [list(r) for r in rows], caption))
+    def table(self, header: Sequence[str], rows: Sequence[Sequence[str]], caption="", *,
+              collapsed: bool = False) -> None:
+        """A table; ``collapsed``: a long reference table (a full Allan table) the
+        reader opens on demand (``<details>``, its caption the summary), so the
+        body keeps the tables decisions are read from."""
+        self.blocks.append(("table", list(header), [list(r) for r in rows], caption,
+                            collapsed))
 
     def figure(self, png: Path, caption: str) -> None:
         self.blocks.append(("figure", png, caption))
@@ -41,13 +46,18 @@ class Doc:
             elif b[0] == "p":
                 lines += [b[1], ""]
             elif b[0] == "table":
-                _, header, rows, caption = b
-                if caption:
+                _, header, rows, caption, collapsed = b
+                if collapsed:
+                    lines += ["<details>", f"<summary>{caption} ({len(rows)} rows)</summary>",
+                              ""]
+                elif caption:
                     lines += [f"*{caption}*", ""]
                 lines.append("| " + " | ".join(header) + " |")
                 lines.append("|" + "|".join("---" for _ in header) + "|")
                 lines += ["| " + " | ".join(r) + " |" for r in rows]
                 lines.append("")
+                if collapsed:
+                    lines += ["</details>", ""]
             elif b[0] == "figure":
                 rel = b[1].relative_to(out_dir).as_posix()
                 lines += [f"![{b[2]}]({rel})", "", f"*{b[2]}*", ""]
@@ -64,19 +74,29 @@ class Doc:
             elif b[0] == "p":
                 body.append(f"<p>{_inline(b[1])}</p>")
             elif b[0] == "table":
-                _, header, rows, caption = b
-                cap = f"<caption>{e(caption)}</caption>" if caption else ""
-                th = "".join(f"<th>{e(h)}</th>" for h in header)
+                _, header, rows, caption, collapsed = b
+                cap = f"<caption>{e(caption)}</caption>" if caption and not collapsed else ""
+                # columns of words (quantity, verdict, remark) read left-aligned,
+                # columns of numbers right-aligned
+                cells = [[r[i] for r in rows if i < len(r) and r[i] not in _NEUTRAL]
+                         for i in range(len(header))]
+                left = [i > 0 and bool(c) and not any(_NUMERIC.match(v) for v in c)
+                        for i, c in enumerate(cells)]
+                cls = [' class="l"' if flag else "" for flag in left]
+                th = "".join(f"<th{cls[i]}>{e(h)}</th>" for i, h in enumerate(header))
                 trs = "".join(
-                    "<tr>" + "".join(f"<td>{e(c)}</td>" for c in r) + "</tr>" for r in rows
+                    "<tr>" + "".join(f"<td{cls[i] if i < len(cls) else ''}>{e(c)}</td>"
+                                     for i, c in enumerate(r)) + "</tr>" for r in rows
                 )
                 # A short table is kept on one printed page; a long one flows
                 # across pages with its header repeated.
                 keep = " keep" if len(rows) <= _KEEP_TOGETHER_ROWS else ""
-                body.append(
-                    f'<div class="tw{keep}"><table>{cap}<thead><tr>{th}</tr></thead>'
-                    f"<tbody>{trs}</tbody></table></div>"
-                )
+                table = (f'<div class="tw{keep}"><table>{cap}<thead><tr>{th}</tr></thead>'
+                         f"<tbody>{trs}</tbody></table></div>")
+                if collapsed:
+                    table = (f"<details><summary>{e(caption)} ({len(rows)} rows)</summary>"
+                             f"{table}</details>")
+                body.append(table)
             elif b[0] == "figure":
                 data = base64.b64encode(b[1].read_bytes()).decode("ascii")
                 body.append(
@@ -85,6 +105,12 @@ class Doc:
                 )
         return _HTML.format(title=e(title), css=_CSS, body="\n".join(body))
 
+
+#: A cell that reads as a number: "1.2", "(3.4 ± 0.1)e-3", "−5", "< 10", "typ. 0.2".
+_NUMERIC = re.compile(r"^(typ\.\s*)?[(<>~−-]?\s*[\d.]")
+
+#: Cells that say nothing about their column's kind.
+_NEUTRAL = frozenset({"", "—", "not resolved"})
 
 #: Tables with at most this many rows are not split across printed pages.
 _KEEP_TOGETHER_ROWS = 20
@@ -117,9 +143,12 @@ padding:.05rem .3rem;border-radius:3px}
 .tw{overflow-x:auto;margin:.6rem 0 1.2rem}
 table{border-collapse:collapse;font-size:13px;font-variant-numeric:tabular-nums}
 caption{caption-side:top;text-align:left;color:var(--mut);font-style:italic;padding:.2rem 0}
-th,td{border:1px solid var(--bd);padding:.3rem .6rem;text-align:right;white-space:nowrap}
+th,td{border:1px solid var(--bd);padding:.3rem .45rem;text-align:right;white-space:nowrap}
+th{white-space:normal;vertical-align:bottom}
+details{margin:.4rem 0 1rem}
+summary{cursor:pointer;color:var(--mut);font-style:italic}
 th{background:var(--hd);font-weight:600}
-td:first-child,th:first-child{text-align:left}
+td:first-child,th:first-child,td.l,th.l{text-align:left}
 tbody tr:nth-child(even){background:#fafbfd}
 figure{margin:1rem 0 1.6rem}
 img{max-width:100%;height:auto;border:1px solid var(--bd);border-radius:4px}

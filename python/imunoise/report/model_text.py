@@ -8,20 +8,21 @@ import math
 
 import numpy as np
 
-from imunoise import datasheet, units
+from imunoise import datasheet
+from imunoise import units as _units
 from imunoise._schema import axis_names
 from imunoise.noise import NoiseModel
 from imunoise.report.formatting import format_number
 
-__all__ = ["comparison_rows", "datasheet_rows", "model_sentences"]
+__all__ = ["comparison_rows", "datasheet_rows", "lab_rows", "model_sentences"]
 
 #: Coverage (share of taus the model follows) below which the report says that
 #: the coefficients only summarise the curve.
 POOR_COVERAGE = 0.8
 
 
-def datasheet_rows(model: NoiseModel, sensor: str,
-                   units: str | dict | None = None) -> tuple[list[str], list[list[str]]]:
+def datasheet_rows(model: NoiseModel, sensor: str, units: str | dict | None = None, *,
+                   symbols: bool = False) -> tuple[list[str], list[list[str]]]:
     """Noise coefficients per axis in datasheet units, as text.
 
     Returns the header (``quantity, term, unit``, then one column per axis) and
@@ -29,11 +30,13 @@ def datasheet_rows(model: NoiseModel, sensor: str,
     ``not resolved`` where the data do not resolve the coefficient, or ``—``
     where the axis's model has no such term. ``units`` as for
     :meth:`NoiseModel.table` (``"datasheet"``: °/s/√Hz, °/h, µg/√Hz, µg).
+    ``symbols``: units as the report writes them (``°/√h``; default the ASCII name
+    ``deg/sqrt(h)`` a terminal shows).
     """
     axes = axis_names(model.channels)
     out = []
     for r in model.table(sensor, axes=axes, units=units):
-        cells = [r["quantity"], r["term"], r["unit"]]
+        cells = [r["quantity"], r["term"], r["label"] if symbols else r["unit"]]
         for a in axes:
             if not r[f"{a}_supported"]:
                 cells.append(r["missing"])
@@ -43,13 +46,38 @@ def datasheet_rows(model: NoiseModel, sensor: str,
     return ["quantity", "term", "unit", *axes], out
 
 
-def model_sentences(model: NoiseModel, sensor: str) -> list[str]:
+def lab_rows(models: dict[str, NoiseModel], spec,
+             units: str | dict | None = None) -> tuple[list[str], list[list[str]]]:
+    """The lab table of every sensor (:meth:`NoiseModel.lab_table`) as text: N, B and
+    K per axis and the datasheet's value in the same unit, and as it prints it.
+
+    Returns the header (``sensor, quantity, unit``, one column per axis of the
+    first model, ``datasheet, as printed``) and one row per sensor and term."""
+    axes: list[str] = []
+    out = []
+    for sensor, model in models.items():
+        names = axis_names(model.channels)
+        axes = axes or names
+        for r in model.lab_table(sensor, spec=spec, units=units, axes=names):
+            cells = [sensor, f"{r['quantity']} ({r['term']})", r["label"]]
+            cells += [format_number(r[a], r[f"{a}_std"]) if r[f"{a}_supported"]
+                      else r["missing"] for a in names]
+            cells += [""] * (len(axes) - len(names))
+            cells += [format_number(r["spec"]), r["spec_text"]]
+            out.append(cells)
+    return ["sensor", "quantity", "unit", *axes, "datasheet", "as printed"], out
+
+
+def model_sentences(model: NoiseModel, sensor: str,
+                    units: str | dict | None = None) -> list[str]:
     """One sentence per axis: the fitted components, how well the model follows the curve
     (and, below :data:`POOR_COVERAGE`, that its coefficients only summarise it),
     the Gauss–Markov terms, and whether the model's N and B agree with the
-    datasheet read-offs of the curve. Emphasis is Markdown ``**``."""
-    b_unit = units.unit_info("B", None, sensor)
-    n_unit = units.unit_info("N", None, sensor)
+    datasheet read-offs of the curve, in ``units`` (as for :meth:`NoiseModel.table`;
+    σ and amplitudes in the unit of B). Emphasis is Markdown ``**``."""
+    chosen = _units.unit_choice(units, sensor)
+    b_unit = _units.unit_info("B", chosen.get("B"), sensor)
+    n_unit = _units.unit_info("N", chosen.get("N"), sensor)
     out = []
     for c, axis in enumerate(axis_names(model.channels)):
         parts = [f"{axis}: fitted components {model.components.structure(c)}"]
@@ -62,14 +90,14 @@ def model_sentences(model: NoiseModel, sensor: str) -> list[str]:
             parts.append("**the model does not describe this curve: read its coefficients "
                          "as a summary only** (see the data/model panel)")
         for sigma, sigma_std, tau_c, tau_std in _gauss_markov_with_std(model, c):
-            value, value_std = units.convert(np.array([sigma, sigma_std]), "B", b_unit.name,
+            value, value_std = _units.convert(np.array([sigma, sigma_std]), "B", b_unit.name,
                                              sensor=sensor)
             parts.append(f"Gauss–Markov bias σ = {format_number(value, value_std)} "
                          f"{b_unit.label}, τc = {format_number(tau_c, tau_std)} s")
         for amplitude, f0 in parts_of.sine(c):
             amp_std = float(np.atleast_1d(parts_of.sine_amplitude_std)[c])
             f0_std = float(np.atleast_1d(parts_of.sine_freq_std)[c])
-            value, value_std = units.convert(np.array([amplitude, amp_std]), "B", b_unit.name,
+            value, value_std = _units.convert(np.array([amplitude, amp_std]), "B", b_unit.name,
                                              sensor=sensor)
             parts.append(f"a tone of amplitude {format_number(value, value_std)} "
                          f"{b_unit.label} at {format_number(f0, f0_std)} Hz")
@@ -77,16 +105,42 @@ def model_sentences(model: NoiseModel, sensor: str) -> list[str]:
             stds = [float(np.atleast_1d(a)[c]) for a in (
                 parts_of.resonance_sigma_std, parts_of.resonance_freq_std,
                 parts_of.resonance_tau_std)]
-            value, value_std = units.convert(np.array([sigma, stds[0]]), "B", b_unit.name,
+            value, value_std = _units.convert(np.array([sigma, stds[0]]), "B", b_unit.name,
                                              sensor=sensor)
             parts.append(f"a resonance (damped oscillation, a band rather than a line) of "
                          f"σ = {format_number(value, value_std)} {b_unit.label} at "
                          f"{format_number(f_r, stds[1])} Hz, damping time "
                          f"{format_number(tau_r, stds[2])} s (quality factor "
                          f"{math.pi * f_r * tau_r:.2g})")
+        parts += _motion_sentence(model, c, sensor, n_unit,
+                                  _units.unit_info("Q", chosen.get("Q"), sensor))
         for term, unit in (("N", n_unit), ("B", b_unit)):
             parts += _readoff_agreement(model, c, term, unit, sensor)
         out.append("; ".join(parts) + ".")
+    return out
+
+
+def _motion_sentence(model: NoiseModel, c: int, sensor: str, n_unit, q_unit) -> list[str]:
+    """What a bounded motion of the mount means for channel ``c``: its size and time,
+    and that N leaves it out (an upper bound on N where N is not resolved)."""
+    parts_of = model.components
+    out = []
+    for sigma, tau_c in parts_of.motion(c):
+        sigma_std, tau_std = (float(np.atleast_1d(a)[c]) for a in
+                              (parts_of.motion_sigma_std, parts_of.motion_tau_std))
+        value, value_std = _units.convert(np.array([sigma, sigma_std]), "Q", q_unit.name,
+                                          sensor=sensor)
+        white = math.sqrt(2.0 * sigma**2 / tau_c)  # its density below τc
+        n_now = float(model.value("N")[c])
+        bound = _units.convert(math.hypot(n_now, white), "N", n_unit.name, sensor=sensor)
+        text = (f"**a bounded motion of the mount** (the platform's angle wanders by "
+                f"σ = {format_number(value, value_std)} {q_unit.label} over "
+                f"τc = {format_number(tau_c, tau_std)} s and comes back: white below τc, "
+                f"falling as 1/τ beyond) — not the sensor's noise, so N leaves it out")
+        if not n_now > 0:
+            text += (f"; under it the sensor's own white noise does not show: N is not "
+                     f"resolved, at most {format_number(float(bound))} {n_unit.label}")
+        out.append(text)
     return out
 
 
@@ -108,7 +162,7 @@ def _readoff_agreement(model: NoiseModel, c: int, term: str, unit, sensor: str) 
     if not (np.isfinite(read) and eq > 0):
         return []
     eq_std = float(model.std(term)[c])
-    read_c, std_c, eq_c, eq_std_c = units.convert(np.array([read, std, eq, eq_std]), term,
+    read_c, std_c, eq_c, eq_std_c = _units.convert(np.array([read, std, eq, eq_std]), term,
                                                   unit.name, sensor=sensor)
     diff = abs(read - eq) / max(std, 1e-300)
     verdict = ("agree" if diff <= 2 or abs(read / eq - 1) <= 0.05 else
@@ -117,16 +171,25 @@ def _readoff_agreement(model: NoiseModel, c: int, term: str, unit, sensor: str) 
             f"{format_number(eq_c, eq_std_c)} {unit.label} ({verdict})"]
 
 
-def comparison_rows(models: dict[str, NoiseModel], spec) -> tuple[list[str], list[list[str]]]:
-    """Measured vs datasheet (:func:`imunoise.datasheet.compare`) as text rows."""
+def comparison_rows(models: dict[str, NoiseModel], spec,
+                    units: str | dict | None = None) -> tuple[list[str], list[list[str]]]:
+    """Measured vs datasheet (:func:`imunoise.datasheet.compare`) as text rows, the
+    measured and specified values in ``units`` (as for :meth:`NoiseModel.table`: the
+    report's one unit per quantity, whatever unit the datasheet file uses)."""
     cmp = datasheet.compare(models, spec)
     header = ["sensor", "quantity", "axis", "unit", "measured", "spec", "ratio", "verdict"]
     out = []
     for r in cmp.rows:
         bound = {"max": "<", "min": ">"}.get(r["limit"], "typ.")
+        term, sensor = r["term"], r["sensor"]
+        unit = _units.unit_info(term, _units.unit_choice(units, sensor).get(term), sensor)
+        measured, std, spec_value = (
+            _units.convert(_units.convert_back(v, term, r["unit"], sensor=sensor), term,
+                           unit.name, sensor=sensor)
+            for v in (r["measured"], r["std"], r["spec"]))
         out.append([
-            r["sensor"], f"{r['quantity']} ({r['term']})", r["axis"], r["unit"],
-            format_number(r["measured"], r["std"]), f"{bound} {format_number(r['spec'])}",
+            sensor, f"{r['quantity']} ({term})", r["axis"], unit.label,
+            format_number(measured, std), f"{bound} {format_number(spec_value)}",
             format_number(r["ratio"], r["ratio_std"]),
             r["verdict"] + (f" ({r['remark']})" if r.get("remark") else ""),
         ])

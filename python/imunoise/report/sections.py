@@ -7,22 +7,29 @@ computes each analysis once, on first use) and adds its figures through it.
 
 from __future__ import annotations
 
+from functools import partial
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from imunoise import allan as _allan
-from imunoise import noise, numbers, plot, stats
+from imunoise import noise, numbers, plot, stats, units
 from imunoise._schema import CHANNELS, SAMPLE_SENSORS, axis_names
 from imunoise.numbers import format_value
+from imunoise.planner import fit_line
 from imunoise.report.formatting import (
     format_duration,
     format_number,
     missing_text,
     terms_used,
 )
-from imunoise.report.model_text import comparison_rows, datasheet_rows, model_sentences
+from imunoise.report.model_text import (
+    comparison_rows,
+    datasheet_rows,
+    lab_rows,
+    model_sentences,
+)
 
 if TYPE_CHECKING:
     from imunoise.report.build import Context
@@ -52,6 +59,12 @@ GAP_WARN_SHARE = 0.01
 #: Gaps listed in the summary table / shaded on the time plots (the largest).
 GAP_ROWS = 10
 GAP_SHADE = plot.SHADED_GAPS
+
+
+def _unit_of(channel: str) -> str:
+    """Unit of a channel named like ``"gyro X"``; "" for a name that is no log channel's."""
+    sensor = channel.split(" ")[0]
+    return CHANNELS[sensor][1] if sensor in CHANNELS else ""
 
 
 def _which(label: str) -> str:
@@ -127,28 +140,30 @@ def distribution_fits(ctx: Context, doc: Doc) -> None:
           "some of the printed grid), centred on the levels. With this many samples any "
           "real sensor fails a normality test: read KS D, A², skewness and excess kurtosis "
           "as sizes of the departure from normal.")
-    rows = []
+    rows, bins = [], []
     for sensor, per_axis in ctx.sensor_distributions.items():
         unit = CHANNELS[sensor][1]
         for name, d in per_axis.items():
             rows.append([
-                name, unit, format_number(d.step) if d.step else "—",
-                format_number(d.level_spacing) if d.level_spacing else "—",
-                str(len(d.counts)), format_number(d.mu, d.mu_std),
-                format_number(d.sigma, d.sigma_std), *(numbers.cell(v) for v in (
-                    d.ks_statistic, d.ks_pvalue, d.ad_statistic, d.skewness,
-                    d.excess_kurtosis)),
+                name, unit, format_number(d.mu, d.mu_std), format_number(d.sigma, d.sigma_std),
+                *(numbers.cell(v) for v in (d.ks_statistic, d.ks_pvalue, d.ad_statistic,
+                                            d.skewness, d.excess_kurtosis)),
             ])
+            bins.append([name, unit, format_number(d.step) if d.step else "—",
+                         format_number(d.level_spacing) if d.level_spacing else "—",
+                         str(len(d.counts))])
         fig = plot.histograms(list(per_axis.values()),
                               title=f"{sensor} distribution (short log)", unit=unit)
         ctx.add_figure(doc, fig, f"hist_{sensor}",
                        f"Histogram of {sensor} with the fitted normal density")
     doc.table(
-        ["channel", "unit", "quantization step", "level spacing", "bins", "μ", "σ", "KS D",
-         "KS p", "AD A²", "skewness", "excess kurtosis"],
+        ["channel", "unit", "μ", "σ", "KS D", "KS p", "AD A²", "skewness", "excess kurtosis"],
         rows,
         caption="Distribution fits (short log)",
     )
+    doc.table(["channel", "unit", "quantization step", "level spacing", "bins"], bins,
+              caption="Histogram bins (short log): the sensor's quantization step and the "
+                      "spacing of the levels it uses")
 
 
 def attitude(ctx: Context, doc: Doc) -> None:
@@ -221,7 +236,7 @@ def allan_deviation(ctx: Context, doc: Doc) -> None:
         header = ["τ [s]", "n"]
         for a in axis_names(r.dev.shape[1]):
             header += [f"σ {a} [{unit}]", f"CI {a}"]
-        doc.table(header, rows, caption=f"Allan deviation of {sensor}")
+        doc.table(header, rows, caption=f"Allan deviation of {sensor}: every τ", collapsed=True)
 
 
 def noise_coefficients(ctx: Context, doc: Doc) -> None:
@@ -231,11 +246,18 @@ def noise_coefficients(ctx: Context, doc: Doc) -> None:
           "IEEE 952 Annex C) and a resonance (a damped oscillator), on ln σ², each octave of τ "
           "weighted alike, the terms chosen by BIC; standard uncertainties from the fit "
           "(docs/noise.md). Read-offs: N on the −½ line at τ = 1 s, B = σ_min/0.664.")
+    if ctx.models:
+        header, rows = lab_rows(ctx.models, ctx.spec, ctx.units)
+        doc.table(header, rows, caption="Lab table: N, B and K per axis"
+                  + (f" beside the datasheet ({ctx.spec}), in one unit" if ctx.spec else ""))
     for sensor, m in ctx.models.items():
-        header, rows = datasheet_rows(m, sensor)
+        header, rows = datasheet_rows(m, sensor, ctx.units, symbols=True)
         doc.table(header, rows, caption=f"{sensor} noise coefficients per axis")
-        for sentence in model_sentences(m, sensor):
+        for sentence in model_sentences(m, sensor, ctx.units):
             doc.p(sentence)
+        r = ctx.allan.get(sensor)
+        if r is not None:  # how long to record for the coefficients (imunoise plan)
+            doc.p(fit_line(m, r.fs, r.n_samples / r.fs).replace("plan:", f"Plan ({sensor}):"))
 
 
 def datasheet_comparison(ctx: Context, doc: Doc) -> None:
@@ -243,7 +265,7 @@ def datasheet_comparison(ctx: Context, doc: Doc) -> None:
     if ctx.spec is None:
         doc.p("No datasheet given (`--spec`).")
         return
-    header, rows = comparison_rows(ctx.models, ctx.spec)
+    header, rows = comparison_rows(ctx.models, ctx.spec, ctx.units)
     doc.table(header, rows, caption=f"Measured vs datasheet ({ctx.spec})")
 
 
@@ -314,16 +336,19 @@ def power_spectral_density(ctx: Context, doc: Doc) -> None:
                   else np.full(s.channels, np.nan))
         n, n_std = np.atleast_1d(s.N), np.atleast_1d(s.N_std)
         band = np.reshape(s.band, (-1, 2))
+        # N in the unit of every other table of the report
+        n_unit = units.unit_info("N", units.unit_choice(ctx.units, sensor).get("N"), sensor)
+        in_n_unit = partial(units.convert, term="N", unit=n_unit.name, sensor=sensor)
         rows = []
         for j, a in enumerate(axis_names(s.channels)):
             with np.errstate(divide="ignore", invalid="ignore"):
                 ratio = n[j] / fitted[j] if fitted[j] > 0 else np.nan
-            rows.append([a, format_value(n[j], n_std[j]),
+            rows.append([a, format_value(in_n_unit(n[j]), in_n_unit(n_std[j])),
                          f"{band[j, 0]:.3g} – {band[j, 1]:.3g}",
-                         format_value(fitted[j]), f"{ratio:.3g}",
+                         format_value(in_n_unit(fitted[j])), f"{ratio:.3g}",
                          _n_remark(s, j, ratio)])
-        doc.table(["axis", f"N PSD [{unit}/√Hz]", "white band [Hz]", "N ADEV fit",
-                   "PSD/ADEV", "remark"], rows,
+        doc.table(["axis", f"N PSD [{n_unit.label}]", "white band [Hz]",
+                   f"N ADEV fit [{n_unit.label}]", "PSD/ADEV", "remark"], rows,
                   caption=f"{sensor}: noise density from the spectrum and from the Allan fit"
                   + (f" ({s.segments_skipped} of {s.segments + s.segments_skipped} Welch "
                      "segments hold a missing sample and are left out)"
@@ -393,10 +418,26 @@ def events_section(ctx: Context, doc: Doc) -> None:
         return found.kind[i] if j < 0 else (
             f"{found.kind[i]} inside the event from {format_number(found.start[j] + offset)} s")
 
+    loud = found.rms_ratio(log)
+    column = {name: j for j, name in enumerate(found.names)}
+
+    def loudest(i: int) -> str:
+        """RMS ratio of the event's loudest channel, and which."""
+        ratios = {c: loud[i, column[c]] for c in found.channels[i]}
+        c = max(ratios, key=lambda k: np.nan_to_num(ratios[k]))
+        return f"{ratios[c]:.2g} ({c})"
+
+    doc.p("The evidence per event: its peak in sigmas of the quiet noise, its length, and "
+          "how much louder it is than the quiet record (RMS over the event ÷ RMS outside "
+          "every event, on its loudest channel; 1 = no louder; energy is the square). A "
+          "burst is flagged only where its energy is significantly above the quiet "
+          "noise's.")
     doc.table(
-        ["start [s]", "end [s]", "kind", "channels", "peak [σ]"],
+        ["start [s]", "end [s]", "duration [s]", "kind", "channels", "peak [σ]",
+         "RMS ÷ quiet RMS"],
         [[format_number(found.start[i] + offset), format_number(found.end[i] + offset),
-          kind(i), ", ".join(found.channels[i]), f"{found.peak[i]:.3g}"]
+          numbers.cell(found.duration[i], digits=3), kind(i), ", ".join(found.channels[i]),
+          f"{found.peak[i]:.3g}", loudest(i)]
          for i in sorted(order)],
         caption=f"Events of the short log ({min(len(found), EVENT_ROWS)} largest of "
                 f"{len(found)})",
@@ -476,12 +517,12 @@ def long_log_events(ctx: Context, doc: Doc) -> None:
                 outside = not lo[i, j] <= dev_out[i, j] <= hi[i, j]
                 if outside:
                     changed.append(f"{sensor} {axis} at {format_duration(tau)}")
-                rows.append([f"{sensor} {axis}", format_duration(tau),
+                rows.append([f"{sensor} {axis}", CHANNELS[sensor][1], format_duration(tau),
                              numbers.cell(dev[i, j]), numbers.cell(dev_out[i, j]),
                              f"{dev_out[i, j] / dev[i, j]:.3g}" if dev[i, j] > 0 else "—",
                              "yes" if outside else "no"])
     level = f"{100 * next(iter(ctx.allan.values())).confidence:.3g} %"
-    doc.table(["channel", "τ", "ADEV", "without events", "ratio",
+    doc.table(["channel", "unit", "τ", "ADEV", "without events", "ratio",
                f"outside the {level} interval"], rows,
               caption=f"Allan deviation of the {'only' if ctx.one_log else 'long'} log with "
                       "and without its events")
@@ -508,8 +549,8 @@ def warmup_section(ctx: Context, doc: Doc) -> None:
           "and has settled when what is left of it is below "
           "the channel's Allan-deviation floor (docs/events.md).")
     doc.table(
-        ["channel", "A", "τ", "p", "tolerance", "settled after"],
-        [[r["name"],
+        ["channel", "unit of A and tolerance", "A", "τ", "p", "tolerance", "settled after"],
+        [[r["name"], _unit_of(r["name"]),
           format_number(r["amplitude"], r["amplitude_std"]) if r["significant"] else "—",
           format_duration(r["tau"]) if r["significant"] else "—", f"{r['p_value']:.2g}",
           numbers.cell(r["tolerance"]),

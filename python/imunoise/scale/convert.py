@@ -4,9 +4,11 @@
 the file is read in pieces of ``chunk_bytes`` and fed to one streaming parser
 (:class:`imunoise._core.vn.VnStream`), which hands back the rows of the records
 each piece completes (a record cut by the end of a piece waits for the next), and
-those rows are appended to the output.
-Memory stays about three pieces (the bytes, their decoded columns, the rows being
-written) whatever the size of the log. :func:`load` opens the result as an
+those rows are appended to the output. Three things overlap: the next piece is read
+(into one of two reused buffers) while one is parsed, and a piece's rows are written by a
+thread while the next is parsed. Memory stays about five pieces (two buffers, the
+columns being decoded, those being written, their growth) whatever the size of the log:
+about 400 MB at the default 64 MiB. :func:`load` opens the result as an
 :class:`~imunoise.readers.log.ImuLog` whose channels are memory-mapped ``.npy``
 arrays, which :func:`imunoise.adev` reads in place (the Allan core takes arrays of
 any strides without copying them), so ``convert → load → adev → fit`` analyses a
@@ -37,13 +39,15 @@ import json
 import os
 import shutil
 from collections.abc import Callable, Iterable, Iterator, Mapping
+from concurrent.futures import Future, ThreadPoolExecutor
+from concurrent.futures import wait as futures_wait
 from contextlib import ExitStack
 from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
 
-from imunoise import _atomic
+from imunoise import _atomic, _summary
 from imunoise._core import vn as _core_vn
 from imunoise._schema import CHANNELS, column_names
 from imunoise.readers import registry
@@ -69,7 +73,7 @@ CHUNK_BYTES = 64 << 20
 MAX_STREAM_PIECE = 1 << 30
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class Conversion:
     """What :func:`convert` wrote.
 
@@ -102,6 +106,24 @@ class Conversion:
     bytes_read: int
     gaps: Gaps
 
+    def _facts(self) -> list[str]:
+        return [f"{self.samples} samples at {_summary.number(self.fs)} Hz = "
+                f"{_summary.duration(self.samples / self.fs)}",
+                "channels " + " ".join(self.channels),
+                f"{_summary.plural(len(self.files), 'file')}, {self.bytes_read} bytes read",
+                str(self.gaps), f"issues: {self.issues}" if self.issues.total else "no issues"]
+
+    def __repr__(self) -> str:
+        return _summary.lines(f"Conversion({_summary.source_name(str(self.out))!r}",
+                              self._facts(), sep=", ")
+
+    def _repr_html_(self) -> str:
+        """The output, what it holds and what the reader skipped, one fact a row."""
+        return _summary.html_table(
+            ["output", "samples", "channels", "files", "gaps", "issues"],
+            [[str(self.out), *self._facts()]],
+            caption=f"Conversion: {_summary.source_name(str(self.out))}")
+
 
 def _width(channel: str) -> int:
     return 1 if channel == "time" else CHANNELS[channel][0]
@@ -111,6 +133,20 @@ def _order(channels: Iterable[str]) -> list[str]:
     """Channels in a fixed order: ``time`` first, then :data:`CHANNELS` order."""
     have = set(channels)
     return [c for c in ("time", *CHANNELS) if c in have]
+
+
+#: Bytes of the buffer that rows are gathered through before they are written.
+GATHER_BYTES = 1 << 20
+
+
+def _gather_buffer(owner, dtype: np.dtype, row_shape: tuple[int, ...]) -> np.ndarray:
+    """``owner``'s reusable buffer of about :data:`GATHER_BYTES` rows."""
+    buf = getattr(owner, "_gather", None)
+    if buf is None:
+        row_bytes = np.dtype(dtype).itemsize * int(np.prod(row_shape, dtype=np.int64))
+        buf = np.empty((max(1, GATHER_BYTES // row_bytes), *row_shape), dtype=dtype)
+        owner._gather = buf
+    return buf
 
 
 class _NpyAppender:
@@ -138,8 +174,19 @@ class _NpyAppender:
         )
 
     def append(self, rows: np.ndarray) -> None:
-        rows = np.ascontiguousarray(rows, dtype=self.dtype)
-        self.f.write(memoryview(rows).cast("B"))
+        rows = np.asarray(rows)
+        if rows.dtype == self.dtype and rows.flags.c_contiguous:
+            self.f.write(memoryview(rows).cast("B"))
+        else:
+            # Columns of the parser's row-major table: gathered block by block into
+            # one buffer that stays in cache (a whole-piece copy would be a fresh
+            # allocation per piece: page faults and a pass over memory).
+            block = _gather_buffer(self, self.dtype, self.row_shape)
+            for i in range(0, len(rows), len(block)):
+                part = rows[i:i + len(block)]
+                out = block[:len(part)]
+                out[...] = part
+                self.f.write(memoryview(out).cast("B"))
         self.rows += len(rows)
 
     def close(self) -> None:
@@ -241,10 +288,12 @@ class _NpySink(_Sink):
 
     def append(self, cols):
         m = len(cols[self.channels[0]])
-        rows = np.empty(m, dtype=self.dtype)
-        for ch in self.channels:
-            rows[ch] = cols[ch]
-        self.file.append(rows)
+        block = _gather_buffer(self, self.dtype, ())
+        for i in range(0, m, len(block)):
+            out = block[:min(len(block), m - i)]
+            for ch in self.channels:
+                out[ch] = cols[ch][i:i + len(out)]
+            self.file.append(out)
         self.rows += m
 
     def close(self, meta):
@@ -596,14 +645,82 @@ class _GridStream:
         return TimeGrid(slot=np.arange(n, dtype=np.int64) + shift, n=n + len(inner))
 
 
-def _blocks(f, first: bytes, chunk_bytes: int) -> Iterator[bytes]:
-    """``first``, then the rest of the open file ``f`` in pieces of ``chunk_bytes``."""
-    block = first
-    while block:
-        yield block
-        if len(block) < chunk_bytes:
+def _blocks(f, first: bytes | None, chunk_bytes: int) -> Iterator[bytes | memoryview]:
+    """``first`` (a piece already read, or None), then the rest of the open file ``f``
+    in pieces of ``chunk_bytes``.
+
+    Each piece is read while the one before is parsed, into one of two reused
+    buffers (fresh ``bytes`` per piece would cost page faults and a pass over
+    memory); a piece's view is released when the next is asked for, so use it
+    before.
+    """
+    if first is not None:
+        if not first:
             return
-        block = f.read(chunk_bytes)
+        short = len(first) < chunk_bytes
+        yield first
+        del first  # not held for the rest of the run
+        if short:
+            return
+    buffers = [bytearray(chunk_bytes), bytearray(chunk_bytes)]
+    with ThreadPoolExecutor(1, thread_name_prefix="imunoise-read") as pool:
+        k = 0
+        pending = pool.submit(_fill, f, buffers[k])
+        while True:
+            got = pending.result()
+            if not got:
+                return
+            if got == chunk_bytes:
+                pending = pool.submit(_fill, f, buffers[1 - k])
+            view = memoryview(buffers[k])[:got]
+            try:
+                yield view
+            finally:
+                view.release()
+            if got < chunk_bytes:
+                return
+            k = 1 - k
+
+
+def _fill(f, buf: bytearray) -> int:
+    """Read into ``buf`` until it is full or ``f`` ends; bytes read."""
+    got = 0
+    with memoryview(buf) as view:
+        while got < len(buf):
+            n = f.readinto(view[got:])
+            if not n:
+                break
+            got += n
+    return got
+
+
+class _WriteBehind:
+    """``writer.append`` one call behind, in a thread: the rows of a piece are written
+    while the next piece is parsed (the parse runs without the GIL). At most one
+    append is pending, so memory holds at most two pieces' rows."""
+
+    def __init__(self, writer: _Writer):
+        self.writer = writer
+        self.pool = ThreadPoolExecutor(1, thread_name_prefix="imunoise-write")
+        self.pending: Future | None = None
+
+    def append(self, table: str, cols: Mapping[str, np.ndarray]) -> None:
+        self.wait()
+        self.pending = self.pool.submit(self.writer.append, table, cols)
+
+    def wait(self) -> None:
+        pending, self.pending = self.pending, None
+        if pending is not None:
+            pending.result()
+
+    def close(self, *, raise_errors: bool) -> None:
+        try:
+            if raise_errors:
+                self.wait()
+            elif self.pending is not None:
+                futures_wait([self.pending])
+        finally:
+            self.pool.shutdown(wait=True)
 
 
 def _stream_vn(blocks: Iterable[bytes], total: int | None, writer: _Writer, progress) -> tuple:
@@ -619,6 +736,7 @@ def _stream_vn(blocks: Iterable[bytes], total: int | None, writer: _Writer, prog
     grids: dict[str, _GridStream] = {}
     steps: dict[str, _Steps] = {}
     shape: dict[str, tuple[int, int]] = {}
+    behind = _WriteBehind(writer)
 
     def write(rows) -> None:
         for name, cols in rows.tables.items():
@@ -636,21 +754,26 @@ def _stream_vn(blocks: Iterable[bytes], total: int | None, writer: _Writer, prog
             shape[name] = (filled, prev[1] + n)
             if "time" in chans:
                 steps.setdefault(name, _Steps()).add(chans["time"])
-            writer.append(name, grid.place(chans, rows.missing.get(name)))
+            behind.append(name, grid.place(chans, rows.missing.get(name)))
 
     done = 0
-    for block in blocks:
-        done += len(block)
-        write(stream.feed(block))
-        if progress is not None:
-            progress(done, max(total or done, done))
-        del block
-    summary = stream.finish()
-    write(summary)
-    for name, grid in grids.items():  # the stamps held back for the outlier window
-        rest = grid.flush()
-        if rest is not None:
-            writer.append(name, rest)
+    try:
+        for block in blocks:
+            done += len(block)
+            write(stream.feed(block))
+            if progress is not None:
+                progress(done, max(total or done, done))
+            del block
+        summary = stream.finish()
+        write(summary)
+        for name, grid in grids.items():  # the stamps held back for the outlier window
+            rest = grid.flush()
+            if rest is not None:
+                behind.append(name, rest)
+    except BaseException:
+        behind.close(raise_errors=False)
+        raise
+    behind.close(raise_errors=True)
     return tables_of(summary), steps, shape, grids
 
 
@@ -747,7 +870,7 @@ def convert(
                         and total > chunk_bytes)
             if streamed:
                 f = stack.enter_context(open(path, "rb"))
-                first = f.read(chunk_bytes)
+                first = None
         if streamed:
             source = _blocks(f, first, chunk_bytes)
             del first

@@ -57,6 +57,84 @@ pub fn ratio_count(n_phase: usize) -> Option<usize> {
     (n_phase / 30).checked_sub(3)
 }
 
+/// The ladder of averaging factors the bias ratio averages over.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Ladder {
+    /// n = ⌊0.1·N/3⌋ − 3: ratios from 9τ0 to 10 % of the record (Taylor & Howe
+    /// 2010, Stable32).
+    #[default]
+    TaylorHowe,
+    /// n = ⌊N/6⌋ − 3 (SP 1065 eq. 33 as printed): ratios out to half the record,
+    /// the sweep to ≈ 2N/3 instead of 0.13·N, so about 25 times the work. Its
+    /// last AVAR would have no term when N is a multiple of 6; the ladder stops
+    /// at the last AVAR with one.
+    Sp1065,
+}
+
+impl Ladder {
+    pub fn name(self) -> &'static str {
+        match self {
+            Ladder::TaylorHowe => "taylor-howe",
+            Ladder::Sp1065 => "sp1065",
+        }
+    }
+
+    /// n for N phase points (the ratio averages n + 1 terms), or `None` when N is
+    /// too short.
+    pub fn count(self, n_phase: usize) -> Option<usize> {
+        match self {
+            Ladder::TaylorHowe => ratio_count(n_phase),
+            Ladder::Sp1065 => {
+                let printed = (n_phase / 6).checked_sub(3)?;
+                // AVAR(9 + 3i) needs N − 2(9 + 3i) ≥ 1.
+                let with_terms = (n_phase.checked_sub(1)? / 2).checked_sub(9)? / 3;
+                Some(printed.min(with_terms))
+            }
+        }
+    }
+}
+
+impl std::str::FromStr for Ladder {
+    type Err = crate::error::CoreError;
+    fn from_str(name: &str) -> Result<Self, Self::Err> {
+        [Ladder::TaylorHowe, Ladder::Sp1065]
+            .into_iter()
+            .find(|l| l.name() == name)
+            .ok_or_else(|| {
+                crate::error::CoreError::InvalidArgument(format!(
+                    "ratio ladder must be 'taylor-howe' or 'sp1065'; got {name:?}"
+                ))
+            })
+    }
+}
+
+/// How the bias ratio is computed: its ladder, and `block` > 1 for the
+/// "fast ThêoBR", whose ratio comes from the phase at every block-th point
+/// (the record averaged in blocks of that many samples): the sweep's work
+/// shrinks by block², Theo1 at the requested factors stays that of the whole
+/// record, and κ changes by the error docs/total.md tabulates.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct RatioOptions {
+    pub ladder: Ladder,
+    pub block: usize,
+}
+
+impl Default for RatioOptions {
+    fn default() -> Self {
+        RatioOptions {
+            ladder: Ladder::TaylorHowe,
+            block: 1,
+        }
+    }
+}
+
+impl RatioOptions {
+    /// Phase points the ratio is computed on, of `n_phase`.
+    pub fn ratio_points(&self, n_phase: usize) -> usize {
+        (n_phase.saturating_sub(1)) / self.block.max(1) + 1
+    }
+}
+
 /// Averaging factors (AVAR m, Theo1 m) of the i-th ratio.
 pub fn ratio_factors(i: usize) -> (usize, usize) {
     (9 + 3 * i, 12 + 4 * i)
@@ -120,7 +198,32 @@ fn swept_ratios(c: &[f64], n: usize, extra: &[usize], stop: &Interrupt) -> Optio
         .collect();
     swept_ms.sort_unstable();
     swept_ms.dedup();
-    let sums = theo1_sums(&exact, &swept_ms, stop)?;
+    // The sweep runs on one thread; the AVARs and the check's per-factor
+    // estimators beside it.
+    let checked = [0, n / 2];
+    let (sums, (avar, direct)) = rayon::join(
+        || theo1_sums(&exact, &swept_ms, stop),
+        || {
+            let avar: Vec<f64> = avar_ms
+                .par_iter()
+                .map(|&m| {
+                    if stop.raised() {
+                        return f64::NAN;
+                    }
+                    exact.allan_sum(m) / (2.0 * (m * m) as f64 * (n_phase - 2 * m) as f64)
+                })
+                .collect();
+            let direct: Vec<(f64, f64)> = checked
+                .par_iter()
+                .map(|&i| {
+                    let (ma, mt) = ratio_factors(i);
+                    (theo1_var(c, mt, stop), oavar(c, ma))
+                })
+                .collect();
+            (avar, direct)
+        },
+    );
+    let sums = sums?;
     let theo_at: Vec<(usize, f64)> = swept_ms
         .iter()
         .zip(&sums)
@@ -132,19 +235,9 @@ fn swept_ratios(c: &[f64], n: usize, extra: &[usize], stop: &Interrupt) -> Optio
             .into()
     };
     let theo: Vec<f64> = theo_ms.iter().map(|&m| find(m)).collect::<Option<_>>()?;
-    let avar: Vec<f64> = avar_ms
-        .par_iter()
-        .map(|&m| {
-            if stop.raised() {
-                return f64::NAN;
-            }
-            exact.allan_sum(m) / (2.0 * (m * m) as f64 * (n_phase - 2 * m) as f64)
-        })
-        .collect();
     let agrees = |got: f64, want: f64| (got - want).abs() <= CHECK_TOLERANCE * want.abs();
-    for i in [0, n / 2] {
-        let (ma, mt) = ratio_factors(i);
-        if !agrees(theo[i], theo1_var(c, mt, stop)) || !agrees(avar[i], oavar(c, ma)) {
+    for (&i, &(theo1_direct, avar_direct)) in checked.iter().zip(&direct) {
+        if !agrees(theo[i], theo1_direct) || !agrees(avar[i], avar_direct) {
             return None;
         }
     }
@@ -167,11 +260,37 @@ fn swept_ratios(c: &[f64], n: usize, extra: &[usize], stop: &Interrupt) -> Optio
 /// or, if that fails its check, factor by factor. The values are meaningless
 /// once `stop` is raised (the caller checks it).
 pub fn bias_ratios(phases: &[&[f64]], ms: &[usize], stop: &Interrupt) -> Option<Vec<BiasRatio>> {
+    bias_ratios_with(phases, ms, RatioOptions::default(), stop)
+}
+
+/// [`bias_ratios`] with a ladder and block (see [`RatioOptions`]); with a block
+/// the sweep gives no Theo1 values (they belong to the whole record).
+pub fn bias_ratios_with(
+    phases: &[&[f64]],
+    ms: &[usize],
+    options: RatioOptions,
+    stop: &Interrupt,
+) -> Option<Vec<BiasRatio>> {
     let n_phase = phases.first()?.len();
-    let n = ratio_count(n_phase)?;
     if phases.iter().any(|c| c.len() != n_phase) {
         return None;
     }
+    let block = options.block.max(1);
+    let decimated: Vec<Vec<f64>> = if block > 1 {
+        phases
+            .iter()
+            .map(|c| c.iter().step_by(block).copied().collect())
+            .collect()
+    } else {
+        Vec::new()
+    };
+    let phases: Vec<&[f64]> = if block > 1 {
+        decimated.iter().map(|c| c.as_slice()).collect()
+    } else {
+        phases.to_vec()
+    };
+    let n = options.ladder.count(phases[0].len())?;
+    let ms = if block > 1 { &[][..] } else { ms };
     let per_phase: Vec<Swept> = phases
         .par_iter()
         .map(|c| match swept_ratios(c, n, ms, stop) {
@@ -213,7 +332,13 @@ pub fn bias_ratio(c: &[f64], stop: &Interrupt) -> Option<f64> {
 /// products for the bias ratio: M² + Σ_i m_i/2 (both ends' pair triangles, then
 /// the terms of each ratio's factor), 0 when the ratio is not defined.
 pub fn theobr_work(n_phase: usize, ms: &[usize]) -> (f64, f64, f64) {
-    let sweep = ratio_count(n_phase).map_or(0.0, |n| {
+    theobr_work_with(n_phase, ms, RatioOptions::default())
+}
+
+/// [`theobr_work`] with a ladder and block (the sweep runs on the ratio's points).
+pub fn theobr_work_with(n_phase: usize, ms: &[usize], options: RatioOptions) -> (f64, f64, f64) {
+    let ratio_points = options.ratio_points(n_phase);
+    let sweep = options.ladder.count(ratio_points).map_or(0.0, |n| {
         let top = ratio_factors(n).1 as f64;
         let terms: f64 = (0..=n).map(|i| (ratio_factors(i).1 / 2) as f64).sum();
         top * top + terms
@@ -228,17 +353,19 @@ pub fn theobr_work(n_phase: usize, ms: &[usize]) -> (f64, f64, f64) {
 /// Kernel rates, measured on the release build on the development machine
 /// (2 shared cores; `benches/bench_theo.py` prints them next to real timings):
 /// direct multiply-adds per second below `theo1::FFT_FROM`, N·log₂(m)² units
-/// per second of the expansion above, and the sweep's pair products per second.
+/// per second of the expansion above, and the sweep's pair products per second
+/// (with AVX-512 IFMA, one thread: 720,000 samples, about 3 s for 9.8·10⁹; a CPU
+/// without IFMA is several times slower).
 /// They only decide whether a warning says a run will be long, so a machine
 /// twice as fast or slow changes nothing else.
 const DIRECT_STEPS_PER_SECOND: f64 = 1.2e9;
 const FAST_UNITS_PER_SECOND: f64 = 1.1e9;
-const SWEEP_PRODUCTS_PER_SECOND: f64 = 1.0e9;
+const SWEEP_PRODUCTS_PER_SECOND: f64 = 3.0e9;
 
 /// Seconds ThêoBR at `ms` takes on one phase of `n_phase` points, from
 /// [`theobr_work`] and the measured kernel rates.
-pub fn estimated_seconds(n_phase: usize, ms: &[usize]) -> f64 {
-    let (direct, fast, sweep) = theobr_work(n_phase, ms);
+pub fn estimated_seconds(n_phase: usize, ms: &[usize], options: RatioOptions) -> f64 {
+    let (direct, fast, sweep) = theobr_work_with(n_phase, ms, options);
     direct / DIRECT_STEPS_PER_SECOND
         + fast / FAST_UNITS_PER_SECOND
         + sweep / SWEEP_PRODUCTS_PER_SECOND
@@ -308,6 +435,52 @@ mod tests {
     }
 
     #[test]
+    fn the_sp1065_ladder_follows_its_printed_definition() {
+        assert_eq!(Ladder::Sp1065.count(17), None);
+        for n_phase in 90..2000 {
+            let printed = n_phase / 6 - 3;
+            let n = Ladder::Sp1065.count(n_phase).unwrap();
+            // As printed, stopping only where the last AVAR would have no term.
+            assert!(
+                n == printed || n_phase - 2 * (9 + 3 * printed) < 1,
+                "N = {n_phase}"
+            );
+            assert!(n_phase - 2 * (9 + 3 * n) >= 1, "N = {n_phase}");
+        }
+        let c = sample(400);
+        let n = Ladder::Sp1065.count(c.len()).unwrap();
+        assert_eq!(n, 63);
+        let want: f64 = (0..=n)
+            .map(|i| naive_oavar(&c, 9 + 3 * i) / naive_theo1(&c, 12 + 4 * i))
+            .sum::<f64>()
+            / (n + 1) as f64;
+        let options = RatioOptions {
+            ladder: Ladder::Sp1065,
+            block: 1,
+        };
+        let got = bias_ratios_with(&[&c], &[], options, &NEVER).unwrap()[0].kappa;
+        assert!((got - want).abs() <= 1e-12 * want, "{got} vs {want}");
+        assert_eq!("sp1065".parse::<Ladder>().unwrap(), Ladder::Sp1065);
+        assert!("stable32".parse::<Ladder>().is_err());
+    }
+
+    #[test]
+    fn a_block_takes_the_ratio_from_every_block_th_phase_point() {
+        let c = sample(1000);
+        let options = RatioOptions {
+            ladder: Ladder::TaylorHowe,
+            block: 4,
+        };
+        let got = bias_ratios_with(&[&c], &[100], options, &NEVER).unwrap();
+        let decimated: Vec<f64> = c.iter().step_by(4).copied().collect();
+        assert_eq!(decimated.len(), options.ratio_points(c.len()));
+        assert_eq!(got[0].kappa, bias_ratio(&decimated, &NEVER).unwrap());
+        // Theo1 of the whole record is not taken from the decimated sweep.
+        assert!(got[0].theo1.is_empty());
+        assert_ne!(got[0].kappa, bias_ratio(&c, &NEVER).unwrap());
+    }
+
+    #[test]
     fn too_short_and_degenerate_phases() {
         assert_eq!(bias_ratio(&sample(88), &NEVER), None);
         assert_eq!(bias_ratio(&[], &NEVER), None);
@@ -363,7 +536,7 @@ mod tests {
             1332.0 * 1332.0 + (6..=666).step_by(2).sum::<usize>() as f64
         );
         assert_eq!(theo1_work(100, 100), (0.0, 0.0));
-        let seconds = estimated_seconds(10_001, &[1024]);
+        let seconds = estimated_seconds(10_001, &[1024], RatioOptions::default());
         assert_eq!(
             seconds,
             fast / FAST_UNITS_PER_SECOND + sweep / SWEEP_PRODUCTS_PER_SECOND

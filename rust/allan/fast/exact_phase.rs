@@ -124,12 +124,9 @@ impl ExactPhase {
     }
 }
 
-/// Σ a_j b_j exactly.
+/// Σ a_j b_j exactly (q < 2⁵¹, so the limb kernel's factors).
 fn lag_products(a: &[i64], b: &[i64]) -> i128 {
-    a.iter()
-        .zip(b)
-        .map(|(&x, &y)| (x as i128) * (y as i128))
-        .fold(0i128, |s, p| s.wrapping_add(p))
+    super::limbs::dot(a, b)
 }
 
 /// A non-negative i128 as f64 (within 2 ulp; negative values, which only a

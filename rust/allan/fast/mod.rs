@@ -11,6 +11,7 @@
 
 pub mod blocked;
 pub mod exact_phase;
+pub mod limbs;
 pub mod reflected;
 pub mod sliding;
 pub mod theo1_fft;

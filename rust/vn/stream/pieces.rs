@@ -6,14 +6,18 @@
 //! counts, first locations, binary configurations and line numbers run on across
 //! pieces exactly as in one whole-stream parse; only the rows are moved out.
 //! Each table handed out holds the rows decoded since the last call, and its
-//! `missing` counts good rows of that piece. Cost: that of the parse, plus one
-//! copy of a cut record's bytes per piece.
+//! `missing` counts good rows of that piece. Cost: that of the parse, plus a copy
+//! of a cut record's bytes and the first 64 KiB of the next piece, per piece.
 
 use std::collections::BTreeMap;
 
 use crate::error::CoreResult;
 use crate::vn::stream::Parser;
 use crate::vn::{Table, VnData};
+
+/// Bytes of a new piece joined to a cut record to finish it (longer than any
+/// record, so that the join nearly always completes it).
+const BRIDGE: usize = 1 << 16;
 
 /// The streaming parser: feed pieces, take their rows, finish for the summary.
 pub struct Pieces {
@@ -37,13 +41,30 @@ impl Pieces {
     /// and return their rows by table name. In strict mode the first damaged
     /// record is an error.
     pub fn feed(&mut self, data: &[u8]) -> CoreResult<BTreeMap<String, Table>> {
-        if self.carry.is_empty() {
-            let used = self.parser.feed_block(data, false);
-            self.carry.extend_from_slice(&data[used..]);
-        } else {
-            self.carry.extend_from_slice(data);
+        let mut rest = data;
+        if !self.carry.is_empty() {
+            // The record cut by the last piece is finished from the first bytes of
+            // this one; the piece itself is then parsed in place, not copied
+            // behind the carry. Only a cut record longer than the bridge (noise
+            // without a record end) falls back to joining the whole piece.
+            let kept = self.carry.len();
+            let bridge = data.len().min(BRIDGE);
+            self.carry.extend_from_slice(&data[..bridge]);
             let used = self.parser.feed_block(&self.carry, false);
-            self.carry.drain(..used);
+            if used >= kept {
+                self.carry.clear();
+                rest = &data[used - kept..];
+            } else {
+                self.carry.drain(..used);
+                self.carry.extend_from_slice(&data[bridge..]);
+                let used = self.parser.feed_block(&self.carry, false);
+                self.carry.drain(..used);
+                rest = &[];
+            }
+        }
+        if !rest.is_empty() && self.parser.fail.is_none() {
+            let used = self.parser.feed_block(rest, false);
+            self.carry.extend_from_slice(&rest[used..]);
         }
         self.check()?;
         Ok(self.take_rows())

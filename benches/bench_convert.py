@@ -1,0 +1,100 @@
+"""`imunoise convert` against the parser alone, same log, same run.
+
+    python benches/bench_convert.py [--gb 1] [--log PATH] [--repeats 3] [--dir DIR] [--keep]
+
+Generates a still-VN-100 ``$VNYMR`` log of ``--gb`` gigabytes (800 Hz blocks, as
+``scale_bench.py``) unless ``--log`` names one, then, alternating, each in a fresh
+subprocess: the parser alone (``imunoise._core.vn.parse_vn(path)``: read, every checksum,
+decode into columns) and ``imunoise.scale.convert(path, DIR)`` (the same parse streamed in
+64 MiB pieces, the rows placed on the time grid and written as ``.npy``). Prints wall
+time, CPU time, throughput (MB/s of log), peak RSS and convert/parser throughput ratio
+per round, with the load average, as a Markdown table.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import platform
+import shutil
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+
+PARSE = """
+import json, resource, sys, time
+from imunoise._core import vn
+c, t = time.process_time(), time.perf_counter()
+r = vn.parse_vn(sys.argv[1])
+wall, cpu = time.perf_counter() - t, time.process_time() - c
+rows = max(len(next(iter(cols.values()))) for cols in r.tables.values())
+print(json.dumps({"wall": wall, "cpu": cpu, "rows": rows,
+                  "rss": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024}))
+"""
+
+CONVERT = """
+import json, resource, shutil, sys, time, warnings
+from imunoise import scale
+warnings.simplefilter("ignore")
+shutil.rmtree(sys.argv[2], ignore_errors=True)
+c, t = time.process_time(), time.perf_counter()
+done = scale.convert(sys.argv[1], sys.argv[2], fs=800.0)
+wall, cpu = time.perf_counter() - t, time.process_time() - c
+print(json.dumps({"wall": wall, "cpu": cpu, "rows": done.samples,
+                  "rss": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024}))
+"""
+
+
+def run(code: str, *args: str) -> dict:
+    res = subprocess.run([sys.executable, "-c", textwrap.dedent(code), *args],
+                         capture_output=True, text=True, check=True)
+    return json.loads(res.stdout.strip().splitlines()[-1])
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--gb", type=float, default=1.0)
+    ap.add_argument("--log", help="an existing $VNYMR log instead of a generated one")
+    ap.add_argument("--repeats", type=int, default=3)
+    ap.add_argument("--dir", default="/tmp/imunoise-bench-convert")
+    ap.add_argument("--keep", action="store_true", help="keep the generated log")
+    args = ap.parse_args()
+    d = Path(args.dir)
+    d.mkdir(parents=True, exist_ok=True)
+    out = d / "cols"
+    if args.log:
+        src = Path(args.log)
+    else:
+        sys.path.insert(0, str(Path(__file__).parent))
+        from scale_bench import generate
+
+        src = d / "big.txt"
+        if not src.exists():
+            generate(src, int(args.gb * 1e9))
+    size = src.stat().st_size
+    print(f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores; "
+          f"log {src} ({size / 1e6:.0f} MB)\n")
+    print("| round | load | parser wall / CPU (s) | parser MB/s | parser RSS (MB) "
+          "| convert wall / CPU (s) | convert MB/s | convert RSS (MB) | ratio |")
+    print("|---|---|---|---|---|---|---|---|---|")
+    try:
+        run(PARSE, str(src))  # the log into the page cache
+        for k in range(args.repeats):
+            load = os.getloadavg()[0]
+            p = run(PARSE, str(src))
+            c = run(CONVERT, str(src), str(out))
+            assert c["rows"] == p["rows"], (c["rows"], p["rows"])
+            mbs = [size / 1e6 / r["wall"] for r in (p, c)]
+            print(f"| {k + 1} | {load:.1f} | {p['wall']:.2f} / {p['cpu']:.2f} | {mbs[0]:.0f} "
+                  f"| {p['rss'] / 1e6:.0f} | {c['wall']:.2f} / {c['cpu']:.2f} | {mbs[1]:.0f} "
+                  f"| {c['rss'] / 1e6:.0f} | {mbs[1] / mbs[0]:.2f} |", flush=True)
+    finally:
+        shutil.rmtree(out, ignore_errors=True)
+        if not args.log and not args.keep:
+            shutil.rmtree(d, ignore_errors=True)
+
+
+if __name__ == "__main__":
+    main()

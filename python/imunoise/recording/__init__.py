@@ -1,0 +1,8 @@
+"""Record a VN-100 on a serial port (``imunoise record``): lossless raw log, side
+files, live view. See :mod:`imunoise.recording.recorder`."""
+
+from imunoise.recording.config import binary_output
+from imunoise.recording.protocol import DeviceError
+from imunoise.recording.recorder import Recording, record
+
+__all__ = ["DeviceError", "Recording", "binary_output", "record"]

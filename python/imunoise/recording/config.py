@@ -1,0 +1,151 @@
+"""What the recorder sets on the sensor, reads back, and restores.
+
+The output settings are the asynchronous ASCII type and rate (registers 6, 7), the
+three binary outputs (75–77) and the communication protocol control (30, whose
+SerialChecksum field chooses XOR-8 or CRC-16). Every write's echo is checked and
+every written register read back (:func:`apply`); :func:`restore` writes the
+settings read before (:func:`read_outputs`) back the same way.
+"""
+
+from __future__ import annotations
+
+from imunoise.recording.protocol import ADOF_RATES, ADOR_MESSAGES, IMU_RATE, DeviceError
+from imunoise.recording.session import Session
+
+__all__ = ["IDENTITY", "OUTPUT_REGISTERS", "ascii_type", "apply", "binary_output",
+           "read_identity", "read_outputs", "restore", "wanted_outputs"]
+
+#: Identity registers read into the metadata: number -> name.
+IDENTITY = {1: "model", 2: "hardware_revision", 3: "serial_number", 4: "firmware"}
+#: Registers that hold the output settings, in the order they are written.
+OUTPUT_REGISTERS = (30, 75, 76, 77, 7, 6)
+#: ASCII types by name (``"VNYMR"``) -> register 6 value.
+_ADOR_OF = {name: ador for ador, name in ADOR_MESSAGES.items()}
+
+
+def _normal(fields: tuple[str, ...]) -> tuple[str, ...]:
+    """Fields compared as numbers where they are (``"08"`` equals ``"8"``)."""
+    out = []
+    for f in fields:
+        try:
+            out.append(str(int(f, 16 if any(c in "ABCDEFabcdef" for c in f) else 10)))
+        except ValueError:
+            out.append(f.upper())
+    return tuple(out)
+
+
+def read_register(session: Session, reg: int) -> tuple[str, ...]:
+    """The fields of register ``reg``."""
+    reply, _ = session.command(f"VNRRG,{reg:02d}")
+    return reply.fields[1:]
+
+
+def read_identity(session: Session) -> dict[str, str]:
+    """Model, hardware revision, serial number and firmware (registers 1–4)."""
+    return {name: ",".join(read_register(session, reg)) for reg, name in IDENTITY.items()}
+
+
+def read_outputs(session: Session) -> dict[int, tuple[str, ...]]:
+    """The output settings now on the sensor: register -> fields."""
+    return {reg: read_register(session, reg) for reg in OUTPUT_REGISTERS}
+
+
+def write_register(session: Session, reg: int, fields: tuple[str, ...]) -> None:
+    """Write, check the echo, read back and check again; :class:`DeviceError` naming
+    the register, what was written and what came back otherwise."""
+    body = f"VNWRG,{reg:02d}," + ",".join(fields)
+    reply, _ = session.command(body)
+    echo = reply.fields[1:]
+    back = read_register(session, reg)
+    for what, got in (("echoed", echo), ("read back", back)):
+        if _normal(got) != _normal(fields):
+            raise DeviceError(f"register {reg}: wrote {','.join(fields)} but the sensor "
+                              f"{what} {','.join(got)}")
+
+
+def apply(session: Session, wanted: dict[int, tuple[str, ...]]) -> None:
+    """Write every register of ``wanted`` (in :data:`OUTPUT_REGISTERS` order)."""
+    for reg in OUTPUT_REGISTERS:
+        if reg in wanted:
+            write_register(session, reg, wanted[reg])
+            if reg == 30:
+                session.crc = wanted[30][4] == "3"
+
+
+def restore(session: Session, previous: dict[int, tuple[str, ...]], changed) -> None:
+    """Write back the ``previous`` value of every register in ``changed``."""
+    for reg in OUTPUT_REGISTERS:
+        if reg in changed and reg in previous:
+            write_register(session, reg, previous[reg])
+            if reg == 30:
+                session.crc = previous[30][4] == "3"
+
+
+def ascii_type(name: str) -> int:
+    """Register 6 value of an ASCII type name (``"VNYMR"`` or ``"YMR"``)."""
+    key = name.upper() if name.upper().startswith("VN") else "VN" + name.upper()
+    if key not in _ADOR_OF:
+        raise ValueError(f"ascii type must be one of {sorted(_ADOR_OF)}; got {name!r}")
+    return _ADOR_OF[key]
+
+
+def binary_output(rate: float, fields: str) -> tuple[str, ...]:
+    """Register 75 fields for a binary output at ``rate`` Hz of ``fields``
+    (``"common=0x0029"`` or ``"common=TimeStartup+AngularRate+Accel,imu=Temp"``)."""
+    from imunoise._core import vn as _core_vn
+
+    divisor = IMU_RATE / rate if rate > 0 else 0.0
+    if not (divisor >= 1 and abs(divisor - round(divisor)) < 1e-9):
+        raise ValueError(f"binary rate must be {IMU_RATE} Hz divided by a whole number; "
+                         f"got {rate!r}")
+    divisor = round(divisor)
+    table = _core_vn.vn_binary_fields()
+    words: dict[int, int] = {}
+    for part in fields.split(","):
+        group, sep, names = part.partition("=")
+        group = group.strip().lower()
+        if not sep or group not in table:
+            raise ValueError(f"binary fields must be GROUP=FIELDS with GROUP one of "
+                             f"{sorted(table)}; got {part!r}")
+        index, known = table[group]
+        mask = 0
+        for name in names.split("+"):
+            name = name.strip()
+            if name.lower().startswith("0x"):
+                mask |= int(name, 16)
+            elif name in known:
+                mask |= 1 << known[name]
+            else:
+                raise ValueError(f"binary field {name!r} is not in group {group}; known: "
+                                 f"{', '.join(sorted(known))}")
+        words[index] = words.get(index, 0) | mask
+    group_byte = sum(1 << i for i in words)
+    return ("1", str(divisor), f"{group_byte:02X}",
+            *(f"{words[i]:04X}" for i in sorted(words)))
+
+
+def wanted_outputs(previous: dict[int, tuple[str, ...]], *, ascii: str | None = None,
+                   rate: float | None = None, binary=(), crc: bool | None = None,
+                   ) -> dict[int, tuple[str, ...]]:
+    """The registers to write for the options given (unchanged ones left out).
+
+    ``binary`` is a sequence of register-75 field tuples (:func:`binary_output`),
+    one per binary output; the others are switched off when any is given.
+    """
+    wanted: dict[int, tuple[str, ...]] = {}
+    if ascii is not None:
+        wanted[6] = ("0",) if ascii.lower() == "off" else (str(ascii_type(ascii)),)
+    if rate is not None:
+        if rate not in ADOF_RATES:
+            raise ValueError(f"rate must be one of {ADOF_RATES} Hz; got {rate:g}")
+        wanted[7] = (str(int(rate)),)
+    if len(binary) > 3:
+        raise ValueError(f"at most 3 binary outputs; got {len(binary)}")
+    if binary:
+        for k, reg in enumerate((75, 76, 77)):
+            wanted[reg] = tuple(binary[k]) if k < len(binary) else ("0", "0", "00")
+    if crc is not None:
+        fields = list(previous.get(30, ("0", "0", "0", "0", "1", "0", "1")))
+        fields[4] = "3" if crc else "1"
+        wanted[30] = tuple(fields)
+    return {reg: f for reg, f in wanted.items() if _normal(previous.get(reg, ())) != _normal(f)}

@@ -1,0 +1,546 @@
+//! Exact integer sums held as three signed 52-bit limbs, v = l₀ + l₁·2⁵² + l₂·2¹⁰⁴,
+//! each limb in its own `i64` array, so that the products of non-negative
+//! integers below 2⁵² (each split into its low and high 52 bits, as AVX-512 IFMA
+//! splits it) are added eight lanes at a time where the CPU has IFMA, and with
+//! the same integers, one lane at a time, elsewhere.
+//!
+//! Limbs are redundant between normalisations: a lane may hold more than 52 bits
+//! in l₀ and l₁ (each product adds below 2⁵² to both), which is exact as long as
+//! no limb leaves ±2⁶³; [`Limbs::normalise`] carries them back below 2⁵².
+
+/// Bits of one limb.
+const LIMB_BITS: u32 = 52;
+const MASK: i64 = (1 << LIMB_BITS) - 1;
+/// 2⁵² and 2¹⁰⁴ as f64.
+const LIMB_1: f64 = 4503599627370496.0;
+const LIMB_2: f64 = LIMB_1 * LIMB_1;
+
+/// Largest factor a product may have: below 2⁵², where IFMA reads its inputs.
+pub const MAX_FACTOR: i64 = MASK;
+
+/// An array of exact integers in limbs.
+pub struct Limbs {
+    pub l0: Vec<i64>,
+    pub l1: Vec<i64>,
+    pub l2: Vec<i64>,
+}
+
+/// v as normalised limbs (l₀, l₁ in [0, 2⁵²)).
+pub fn split(v: i128) -> [i64; 3] {
+    [
+        (v as i64) & MASK,
+        ((v >> LIMB_BITS) as i64) & MASK,
+        (v >> (2 * LIMB_BITS)) as i64,
+    ]
+}
+
+/// The integer of (possibly redundant) limbs.
+pub fn join(l: [i64; 3]) -> i128 {
+    l[0] as i128 + ((l[1] as i128) << LIMB_BITS) + ((l[2] as i128) << (2 * LIMB_BITS))
+}
+
+/// Limbs carried: l₀, l₁ in [0, 2⁵²), the rest in l₂.
+#[inline(always)]
+fn carry(l: [i64; 3]) -> [i64; 3] {
+    let c0 = l[0] >> LIMB_BITS;
+    let l1 = l[1] + c0;
+    [l[0] & MASK, l1 & MASK, l[2] + (l1 >> LIMB_BITS)]
+}
+
+/// A non-negative integer in limbs as f64 (within 1 ulp); NaN when negative,
+/// which only a failed computation gives.
+#[inline(always)]
+fn to_f64(l: [i64; 3]) -> f64 {
+    let [a, b, c] = carry(l);
+    if c < 0 {
+        return f64::NAN;
+    }
+    c as f64 * LIMB_2 + (b as f64 * LIMB_1 + a as f64)
+}
+
+impl Limbs {
+    pub fn from_values(values: impl ExactSizeIterator<Item = i128>) -> Self {
+        let n = values.len();
+        let mut out = Limbs {
+            l0: Vec::with_capacity(n),
+            l1: Vec::with_capacity(n),
+            l2: Vec::with_capacity(n),
+        };
+        for v in values {
+            let [a, b, c] = split(v);
+            out.l0.push(a);
+            out.l1.push(b);
+            out.l2.push(c);
+        }
+        out
+    }
+
+    pub fn len(&self) -> usize {
+        self.l0.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.l0.is_empty()
+    }
+
+    /// The integer at `i`.
+    pub fn get(&self, i: usize) -> i128 {
+        join([self.l0[i], self.l1[i], self.l2[i]])
+    }
+
+    /// Adds a·b (0 ≤ a, b ≤ [`MAX_FACTOR`]) at `i`.
+    #[inline(always)]
+    pub fn add_product(&mut self, i: usize, a: i64, b: i64) {
+        let p = a as u128 * b as u128;
+        self.l0[i] += (p as i64) & MASK;
+        self.l1[i] += (p >> LIMB_BITS) as i64;
+    }
+
+    /// Carries every lane back to l₀, l₁ < 2⁵².
+    pub fn normalise(&mut self) {
+        for ((a, b), c) in self.l0.iter_mut().zip(&mut self.l1).zip(&mut self.l2) {
+            [*a, *b, *c] = carry([*a, *b, *c]);
+        }
+    }
+}
+
+/// For every lane i of `lo`, `hi` (the l₀, l₁ of one range of [`Limbs`]):
+/// adds Σ_r s_r·x_r[i], where `rows` holds R pairs (s_r, x_r), x_r at least as
+/// long as the range; every factor in [0, [`MAX_FACTOR`]].
+pub fn add_scaled_rows<const R: usize>(lo: &mut [i64], hi: &mut [i64], rows: [(i64, &[i64]); R]) {
+    #[cfg(target_arch = "x86_64")]
+    if ifma() {
+        // SAFETY: the CPU has the features the kernel is compiled for, and it
+        // reads x_r[..lo.len()] only (asserted inside).
+        unsafe { x86::scaled_rows(lo, hi, rows) };
+        return;
+    }
+    scaled_rows_scalar(lo, hi, rows, 0);
+}
+
+/// For every lane i: adds Σ_r a_r[i]·b_r[i] (factors in [0, [`MAX_FACTOR`]]).
+pub fn add_pair_products<const R: usize>(
+    lo: &mut [i64],
+    hi: &mut [i64],
+    pairs: [(&[i64], &[i64]); R],
+) {
+    #[cfg(target_arch = "x86_64")]
+    if ifma() {
+        // SAFETY: as above.
+        unsafe { x86::pair_products(lo, hi, pairs) };
+        return;
+    }
+    pair_products_scalar(lo, hi, pairs, 0);
+}
+
+/// Σ a[i]·b[i] exactly, over the shorter length (factors in [0, [`MAX_FACTOR`]]).
+pub fn dot(a: &[i64], b: &[i64]) -> i128 {
+    let n = a.len().min(b.len());
+    let (a, b) = (&a[..n], &b[..n]);
+    #[cfg(target_arch = "x86_64")]
+    if ifma() {
+        // SAFETY: the CPU has the features; the slices have equal lengths.
+        return unsafe { x86::dot(a, b) };
+    }
+    dot_scalar(a, b, 0)
+}
+
+fn dot_scalar(a: &[i64], b: &[i64], from: usize) -> i128 {
+    a[from..]
+        .iter()
+        .zip(&b[from..])
+        .map(|(&x, &y)| x as i128 * y as i128)
+        .sum()
+}
+
+/// The three limb arrays of one range (a view into [`Limbs`]).
+#[derive(Clone, Copy)]
+pub struct LimbSlice<'a> {
+    pub l0: &'a [i64],
+    pub l1: &'a [i64],
+    pub l2: &'a [i64],
+}
+
+impl<'a> LimbSlice<'a> {
+    pub fn range(&self, range: std::ops::Range<usize>) -> LimbSlice<'a> {
+        LimbSlice {
+            l0: &self.l0[range.clone()],
+            l1: &self.l1[range.clone()],
+            l2: &self.l2[range],
+        }
+    }
+}
+
+impl Limbs {
+    pub fn slice(&self, range: std::ops::Range<usize>) -> LimbSlice<'_> {
+        LimbSlice {
+            l0: &self.l0[range.clone()],
+            l1: &self.l1[range.clone()],
+            l2: &self.l2[range],
+        }
+    }
+}
+
+/// Σ_u w[h−1−u]·(f + a[u] + b[h−1−u] − 2c[u]) over u < h = a.len(), each term
+/// the exact integer rounded once (NaN if a term is negative). a, b, c and w
+/// have length h; every limb of a, b, c below 2⁶⁰ in magnitude.
+pub fn weighted_terms(f: [i64; 3], a: LimbSlice, b: LimbSlice, c: LimbSlice, w: &[f64]) -> f64 {
+    #[cfg(target_arch = "x86_64")]
+    if avx512() {
+        // SAFETY: the CPU has the features; lengths are asserted inside.
+        return unsafe { x86::weighted_terms(f, a, b, c, w) };
+    }
+    weighted_terms_scalar(f, a, b, c, w, 0, 0.0)
+}
+
+fn scaled_rows_scalar<const R: usize>(
+    lo: &mut [i64],
+    hi: &mut [i64],
+    rows: [(i64, &[i64]); R],
+    from: usize,
+) {
+    for i in from..lo.len() {
+        for &(s, x) in &rows {
+            let p = s as u128 * x[i] as u128;
+            lo[i] += (p as i64) & MASK;
+            hi[i] += (p >> LIMB_BITS) as i64;
+        }
+    }
+}
+
+fn pair_products_scalar<const R: usize>(
+    lo: &mut [i64],
+    hi: &mut [i64],
+    pairs: [(&[i64], &[i64]); R],
+    from: usize,
+) {
+    for i in from..lo.len() {
+        for &(a, b) in &pairs {
+            let p = a[i] as u128 * b[i] as u128;
+            lo[i] += (p as i64) & MASK;
+            hi[i] += (p >> LIMB_BITS) as i64;
+        }
+    }
+}
+
+fn weighted_terms_scalar(
+    f: [i64; 3],
+    a: LimbSlice,
+    b: LimbSlice,
+    c: LimbSlice,
+    w: &[f64],
+    from: usize,
+    start: f64,
+) -> f64 {
+    let h = a.l0.len();
+    let mut total = start;
+    for u in from..h {
+        let v = h - 1 - u;
+        let t = [
+            f[0] + a.l0[u] + b.l0[v] - 2 * c.l0[u],
+            f[1] + a.l1[u] + b.l1[v] - 2 * c.l1[u],
+            f[2] + a.l2[u] + b.l2[v] - 2 * c.l2[u],
+        ];
+        total += to_f64(t) * w[v];
+    }
+    total
+}
+
+#[cfg(target_arch = "x86_64")]
+fn ifma() -> bool {
+    std::arch::is_x86_feature_detected!("avx512ifma") && avx512()
+}
+
+#[cfg(target_arch = "x86_64")]
+fn avx512() -> bool {
+    std::arch::is_x86_feature_detected!("avx512f")
+        && std::arch::is_x86_feature_detected!("avx512dq")
+}
+
+#[cfg(target_arch = "x86_64")]
+mod x86 {
+    use std::arch::x86_64::*;
+
+    use super::*;
+
+    #[target_feature(enable = "avx512f,avx512ifma")]
+    pub unsafe fn scaled_rows<const R: usize>(
+        lo: &mut [i64],
+        hi: &mut [i64],
+        rows: [(i64, &[i64]); R],
+    ) {
+        let n = lo.len();
+        assert!(hi.len() == n && rows.iter().all(|(_, x)| x.len() >= n));
+        let scale: [__m512i; R] = std::array::from_fn(|r| _mm512_set1_epi64(rows[r].0));
+        let mut i = 0;
+        while i + 8 <= n {
+            // Two chains per limb, so that IFMA's latency overlaps.
+            let mut l = _mm512_loadu_si512(lo.as_ptr().add(i).cast());
+            let mut h = _mm512_loadu_si512(hi.as_ptr().add(i).cast());
+            let mut l2 = _mm512_setzero_si512();
+            let mut h2 = _mm512_setzero_si512();
+            for r in 0..R {
+                let x = _mm512_loadu_si512(rows[r].1.as_ptr().add(i).cast());
+                if r % 2 == 0 {
+                    l = _mm512_madd52lo_epu64(l, scale[r], x);
+                    h = _mm512_madd52hi_epu64(h, scale[r], x);
+                } else {
+                    l2 = _mm512_madd52lo_epu64(l2, scale[r], x);
+                    h2 = _mm512_madd52hi_epu64(h2, scale[r], x);
+                }
+            }
+            _mm512_storeu_si512(lo.as_mut_ptr().add(i).cast(), _mm512_add_epi64(l, l2));
+            _mm512_storeu_si512(hi.as_mut_ptr().add(i).cast(), _mm512_add_epi64(h, h2));
+            i += 8;
+        }
+        scaled_rows_scalar(lo, hi, rows, i);
+    }
+
+    #[target_feature(enable = "avx512f,avx512ifma")]
+    pub unsafe fn pair_products<const R: usize>(
+        lo: &mut [i64],
+        hi: &mut [i64],
+        pairs: [(&[i64], &[i64]); R],
+    ) {
+        let n = lo.len();
+        assert!(hi.len() == n && pairs.iter().all(|(a, b)| a.len() >= n && b.len() >= n));
+        let mut i = 0;
+        while i + 8 <= n {
+            let mut l = _mm512_loadu_si512(lo.as_ptr().add(i).cast());
+            let mut h = _mm512_loadu_si512(hi.as_ptr().add(i).cast());
+            for (a, b) in pairs {
+                let x = _mm512_loadu_si512(a.as_ptr().add(i).cast());
+                let y = _mm512_loadu_si512(b.as_ptr().add(i).cast());
+                l = _mm512_madd52lo_epu64(l, x, y);
+                h = _mm512_madd52hi_epu64(h, x, y);
+            }
+            _mm512_storeu_si512(lo.as_mut_ptr().add(i).cast(), l);
+            _mm512_storeu_si512(hi.as_mut_ptr().add(i).cast(), h);
+            i += 8;
+        }
+        pair_products_scalar(lo, hi, pairs, i);
+    }
+
+    /// Eight lanes of low and high halves, folded into an i128 every 1024 steps
+    /// (each adds below 2⁵² to a lane).
+    #[target_feature(enable = "avx512f,avx512ifma")]
+    pub unsafe fn dot(a: &[i64], b: &[i64]) -> i128 {
+        let n = a.len();
+        assert!(b.len() == n);
+        let mut total: i128 = 0;
+        let mut i = 0;
+        while i + 8 <= n {
+            let stop = (i + 8 * 1024).min(n - n % 8);
+            let (mut l, mut h) = (_mm512_setzero_si512(), _mm512_setzero_si512());
+            while i < stop {
+                let x = _mm512_loadu_si512(a.as_ptr().add(i).cast());
+                let y = _mm512_loadu_si512(b.as_ptr().add(i).cast());
+                l = _mm512_madd52lo_epu64(l, x, y);
+                h = _mm512_madd52hi_epu64(h, x, y);
+                i += 8;
+            }
+            let (mut lo, mut hi) = ([0u64; 8], [0u64; 8]);
+            _mm512_storeu_si512(lo.as_mut_ptr().cast(), l);
+            _mm512_storeu_si512(hi.as_mut_ptr().cast(), h);
+            for k in 0..8 {
+                total += lo[k] as i128 + ((hi[k] as i128) << LIMB_BITS);
+            }
+        }
+        total + dot_scalar(a, b, i)
+    }
+
+    #[target_feature(enable = "avx512f,avx512dq")]
+    pub unsafe fn weighted_terms(
+        f: [i64; 3],
+        a: LimbSlice,
+        b: LimbSlice,
+        c: LimbSlice,
+        w: &[f64],
+    ) -> f64 {
+        let h = a.l0.len();
+        for s in [a, b, c] {
+            assert!(s.l0.len() == h && s.l1.len() == h && s.l2.len() == h);
+        }
+        assert!(w.len() == h);
+        let reverse = _mm512_set_epi64(0, 1, 2, 3, 4, 5, 6, 7);
+        let mask = _mm512_set1_epi64(MASK);
+        let fv = f.map(|v| _mm512_set1_epi64(v));
+        let (one, two) = (_mm512_set1_pd(LIMB_1), _mm512_set1_pd(LIMB_2));
+        let mut acc = _mm512_setzero_pd();
+        let mut lowest = _mm512_setzero_si512();
+        // One limb of eight terms: f + a[u..] + reversed b[v..] − 2·c[u..].
+        macro_rules! limb {
+            ($k:expr, $sa:expr, $sb:expr, $sc:expr, $u:expr, $v:expr) => {{
+                let bv = _mm512_permutexvar_epi64(
+                    reverse,
+                    _mm512_loadu_si512($sb.as_ptr().add($v).cast()),
+                );
+                let av = _mm512_loadu_si512($sa.as_ptr().add($u).cast());
+                let cv = _mm512_loadu_si512($sc.as_ptr().add($u).cast());
+                _mm512_sub_epi64(
+                    _mm512_add_epi64(_mm512_add_epi64(fv[$k], av), bv),
+                    _mm512_add_epi64(cv, cv),
+                )
+            }};
+        }
+        let mut u = 0;
+        while u + 8 <= h {
+            let v = h - 8 - u; // b and w run backwards: lanes v + 7 … v
+            let t0 = limb!(0, a.l0, b.l0, c.l0, u, v);
+            let t1 = limb!(1, a.l1, b.l1, c.l1, u, v);
+            let t2 = limb!(2, a.l2, b.l2, c.l2, u, v);
+            // Carry: t0, t1 into [0, 2⁵²), the rest into t2.
+            let t1 = _mm512_add_epi64(t1, _mm512_srai_epi64::<52>(t0));
+            let t0 = _mm512_and_si512(t0, mask);
+            let t2 = _mm512_add_epi64(t2, _mm512_srai_epi64::<52>(t1));
+            let t1 = _mm512_and_si512(t1, mask);
+            lowest = _mm512_min_epi64(lowest, t2);
+            let value = _mm512_fmadd_pd(
+                _mm512_cvtepi64_pd(t2),
+                two,
+                _mm512_fmadd_pd(_mm512_cvtepi64_pd(t1), one, _mm512_cvtepi64_pd(t0)),
+            );
+            let wv = _mm512_permutexvar_pd(reverse, _mm512_loadu_pd(w.as_ptr().add(v)));
+            acc = _mm512_fmadd_pd(value, wv, acc);
+            u += 8;
+        }
+        if _mm512_reduce_min_epi64(lowest) < 0 {
+            return f64::NAN;
+        }
+        weighted_terms_scalar(f, a, b, c, w, u, _mm512_reduce_add_pd(acc))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn pseudo(n: usize, seed: u64, bits: u32) -> Vec<i64> {
+        let mut s = seed;
+        (0..n)
+            .map(|_| {
+                s = s
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                ((s >> 11) & ((1 << bits) - 1)) as i64
+            })
+            .collect()
+    }
+
+    #[test]
+    fn split_and_join_round_trip() {
+        for v in [0i128, 1, -1, 1 << 52, -(1 << 110) + 12345, (1 << 120) - 7] {
+            assert_eq!(join(split(v)), v);
+            let l = split(v);
+            assert!((0..1 << 52).contains(&l[0]) && (0..1 << 52).contains(&l[1]));
+        }
+    }
+
+    #[test]
+    fn kernels_add_exact_products() {
+        // 37 lanes: eight-lane blocks and a scalar tail.
+        let n = 37;
+        let x: Vec<Vec<i64>> = (0..4).map(|s| pseudo(n, s, 51)).collect();
+        let start: Vec<i128> = pseudo(n, 9, 60)
+            .iter()
+            .map(|&v| (v as i128) << 50)
+            .collect();
+        let mut limbs = Limbs::from_values(start.iter().copied());
+        let s = [(1i64 << 51) - 3, 12345, MAX_FACTOR, 0];
+        add_scaled_rows(
+            &mut limbs.l0,
+            &mut limbs.l1,
+            [
+                (s[0], &x[0][..]),
+                (s[1], &x[1]),
+                (s[2], &x[2]),
+                (s[3], &x[3]),
+            ],
+        );
+        add_pair_products(&mut limbs.l0, &mut limbs.l1, [(&x[0][..], &x[1][..])]);
+        // The portable kernels (what a CPU without IFMA runs) give the same limbs.
+        let mut portable = Limbs::from_values(start.iter().copied());
+        scaled_rows_scalar(
+            &mut portable.l0,
+            &mut portable.l1,
+            [
+                (s[0], &x[0][..]),
+                (s[1], &x[1]),
+                (s[2], &x[2]),
+                (s[3], &x[3]),
+            ],
+            0,
+        );
+        pair_products_scalar(
+            &mut portable.l0,
+            &mut portable.l1,
+            [(&x[0][..], &x[1][..])],
+            0,
+        );
+        assert_eq!((&portable.l0, &portable.l1), (&limbs.l0, &limbs.l1));
+        limbs.normalise();
+        for i in 0..n {
+            let want = start[i]
+                + (0..4).map(|r| s[r] as i128 * x[r][i] as i128).sum::<i128>()
+                + x[0][i] as i128 * x[1][i] as i128;
+            assert_eq!(limbs.get(i), want, "lane {i}");
+        }
+    }
+
+    #[test]
+    fn dot_is_exact() {
+        for n in [0, 7, 8, 9000, 20_001] {
+            let (a, b) = (pseudo(n, 5, 51), pseudo(n + 3, 6, 51));
+            let want: i128 = a.iter().zip(&b).map(|(&x, &y)| x as i128 * y as i128).sum();
+            assert_eq!(dot(&a, &b), want, "n {n}");
+            assert_eq!(dot_scalar(&a, &b[..n], 0), want, "n {n}");
+        }
+    }
+
+    #[test]
+    fn weighted_terms_round_each_exact_term() {
+        let h = 29;
+        let big = |s| -> Vec<i128> {
+            pseudo(h, s, 62)
+                .iter()
+                .map(|&v| ((v as i128) << 55) - (1 << 115))
+                .collect()
+        };
+        let (a, b) = (big(1), big(2));
+        // c chosen so that every term is a small positive integer after cancelling.
+        let small = pseudo(h, 3, 20);
+        let f: i128 = 1 << 100;
+        let c: Vec<i128> = (0..h)
+            .map(|u| (f + a[u] + b[h - 1 - u] - small[u] as i128) >> 1)
+            .collect();
+        let w: Vec<f64> = (1..=h).map(|k| 1.0 / k as f64).collect();
+        let (la, lb, lc) = (
+            Limbs::from_values(a.iter().copied()),
+            Limbs::from_values(b.iter().copied()),
+            Limbs::from_values(c.iter().copied()),
+        );
+        let got = weighted_terms(split(f), la.slice(0..h), lb.slice(0..h), lc.slice(0..h), &w);
+        let want: f64 = (0..h)
+            .map(|u| (f + a[u] + b[h - 1 - u] - 2 * c[u]) as f64 * w[h - 1 - u])
+            .sum();
+        assert!((got - want).abs() <= 1e-14 * want, "{got} vs {want}");
+        let (sa, sb, sc) = (la.slice(0..h), lb.slice(0..h), lc.slice(0..h));
+        let portable = weighted_terms_scalar(split(f), sa, sb, sc, &w, 0, 0.0);
+        assert!(
+            (portable - want).abs() <= 1e-14 * want,
+            "{portable} vs {want}"
+        );
+        // A negative term is a failed computation.
+        let mut c2 = c.clone();
+        c2[5] += 1 << 30;
+        let lc2 = Limbs::from_values(c2.iter().copied());
+        let neg = weighted_terms(
+            split(f),
+            la.slice(0..h),
+            lb.slice(0..h),
+            lc2.slice(0..h),
+            &w,
+        );
+        assert!(neg.is_nan(), "{neg}");
+    }
+}

@@ -1,0 +1,56 @@
+"""imunoise.plan: its promise holds in simulated records of the planned length."""
+
+from __future__ import annotations
+
+import imunoise
+import numpy as np
+import pytest
+from imunoise.noise._terms import model_variance
+from imunoise.planner import plan
+
+SIMULATIONS = 40
+
+
+def _met(p, term: str, fs: float) -> float:
+    """Share of simulated records of the planned length whose ADEV at the term's tau
+    is within the target of the true one."""
+    c, t = p.coefficients, p.terms[term]
+    n = int(np.ceil(t.seconds * fs))
+    hits = 0
+    for seed in range(SIMULATIONS):
+        y = imunoise.simulate(n, fs, N=c["N"], B=c["B"], K=c["K"], seed=seed)
+        r = imunoise.adev(y, fs, taus=np.array([t.tau]))
+        true = np.sqrt(model_variance(r.taus, N=c["N"], B=c["B"], K=c["K"]))[0]
+        hits += abs(r.dev[0] / true - 1) <= p.target
+    return hits / SIMULATIONS
+
+
+@pytest.mark.parametrize("term, fs", [("N", 40.0), ("B", 1.0), ("K", 1.0)])
+def test_plan_vn100_promise_is_met_in_90_percent_of_simulated_records(term, fs):
+    p = plan("vn100", fs=fs, target=0.2)
+    assert _met(p, term, fs) >= 0.9
+
+
+def test_a_shorter_record_does_not_keep_the_promise():
+    """The check above can fail: a quarter of the planned length misses it."""
+    p = plan("vn100", fs=1.0, target=0.2)
+    short = type(p)(fs=p.fs, target=p.target, confidence=p.confidence,
+                    terms={"B": type(p.terms["B"])("B", p.terms["B"].value, p.terms["B"].tau,
+                                                   p.terms["B"].seconds / 4)},
+                    coefficients=p.coefficients)
+    assert _met(short, "B", 1.0) < 0.9
+    assert p.uncertainty(p.terms["B"].seconds / 4)["B"] > 0.2 >= p.uncertainty(
+        p.terms["B"].seconds)["B"]
+
+
+def test_plan_numbers_and_errors():
+    p = plan("vn100", fs=40.0)
+    assert p.terms["N"].tau == 1.0 and p.terms["N"].seconds < p.terms["B"].seconds \
+        < p.terms["K"].seconds == p.seconds
+    assert "needs N" in p.line() and "resolves" in p.line(3600)
+    assert plan({"N": 1e-4, "B": 0.0, "K": 0.0}).terms.keys() == {"N"}
+    assert "no N, B or K" in plan({}).line(60)
+    with pytest.raises(ValueError, match="target"):
+        plan("vn100", target=0)
+    with pytest.raises(ValueError, match="coefficients must be finite"):
+        plan({"N": -1.0})

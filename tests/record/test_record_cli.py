@@ -1,0 +1,37 @@
+"""imunoise record / emulate / plan on the command line: errors are one line, exit 2."""
+
+from __future__ import annotations
+
+import pytest
+from imunoise.cli import main
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["record", "/nonexistent/port", "-o", "x.vn", "--seconds", "1"], "/nonexistent/port"),
+    (["record", "p", "-o", "x.vn", "--binary", "800"], "--binary must be HZ:FIELDS"),
+    (["record", "p", "-o", "x.vn", "--binary", "300:common=TimeStartup"],
+     "800 Hz divided by a whole number"),
+    (["record", "p", "-o", "x.vn", "--binary", "800:common=Bogus"], "'Bogus' is not in group"),
+    (["record", "p", "-o", "x.vn", "--baud", "fast"], "--baud must be a number or 'auto'"),
+    (["record", "p", "-o", "x.vn", "--rate", "33"], "rate must be one of"),
+    (["plan", "--target", "2"], "target must be a relative uncertainty in (0, 1)"),
+    (["emulate", "p", "--fault", "melt@1"], "fault kind must be one of"),
+])
+def test_errors_are_one_line_with_status_2(argv, message, capsys, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("imunoise: error: ") and "\n" not in err and message in err
+    assert list(tmp_path.iterdir()) == []  # no log begun for a port that is not there
+
+
+def test_record_from_the_emulator_and_plan(emulator, tmp_path, capsys):
+    emu = emulator(speed=10, seed=8)
+    out = tmp_path / "cli.vn"
+    assert main(["record", emu.path, "-o", str(out), "--seconds", "1", "--ascii", "VNYMR",
+                 "--rate", "100"]) == 0
+    text = capsys.readouterr().out
+    assert text.startswith("recorded ") and "restored" in text and "\x1b[" not in text
+    assert out.stat().st_size > 0 and emu.registers[7] == (40,)
+    assert main(["plan", "--spec", "vn100", "--sensor", "gyro"]) == 0
+    assert "needs N" in capsys.readouterr().out
