@@ -121,6 +121,18 @@ class Plan:
     def __str__(self) -> str:
         return self.line()
 
+    def __repr__(self) -> str:
+        return f"Plan({self.line()})"
+
+    def _repr_html_(self) -> str:
+        """Per term: its value, the τ it is read at and the record it needs."""
+        from imunoise import _summary
+
+        rows = [(k, _summary.number(t.value), _summary.number(t.tau), _length(t.seconds))
+                for k, t in self.terms.items()]
+        return _summary.html_table(["term", "value", "τ [s]", "record needed"], rows,
+                                   caption=f"Plan — {self.line()}")
+
 
 def _length(seconds: float) -> str:
     from imunoise.numbers import duration
@@ -145,8 +157,11 @@ def _taus(N: float, B: float, K: float, fs: float) -> dict[str, float]:
     if N > 0:
         ok = parts["N"] >= _DOMINANT * (total - parts["N"])
         taus["N"] = min(1.0, float(grid[ok][-1])) if ok.any() else float(grid[0])
-    if B > 0:
+    if B > 0 and K > 0:
         taus["B"] = float(grid[np.argmin(model_variance(grid, N=N, B=B, K=K))])
+    elif B > 0:  # no walk: the curve only flattens; B is read where the floor dominates
+        ok = parts["B"] >= _DOMINANT * (total - parts["B"])
+        taus["B"] = float(grid[ok][0]) if ok.any() else float(grid[-1])
     if K > 0:
         ok = parts["K"] >= _DOMINANT * (total - parts["K"])
         taus["K"] = float(grid[ok][0]) if ok.any() else float(grid[-1])

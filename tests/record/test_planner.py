@@ -54,3 +54,13 @@ def test_plan_numbers_and_errors():
         plan("vn100", target=0)
     with pytest.raises(ValueError, match="coefficients must be finite"):
         plan({"N": -1.0})
+
+
+def test_b_without_a_walk_is_read_where_its_floor_dominates():
+    # No K: the curve only flattens, so B's tau is where the floor is 3x the rest,
+    # not the end of the search grid (1e9 s, "> 1000 h" before).
+    plan = imunoise.plan({"N": 1e-4, "B": 3.8e-5, "K": 0.0}, fs=40.0)
+    tau = plan.terms["B"].tau
+    assert 1.0 < tau < 1e4
+    assert 0.6643**2 * 3.8e-5**2 >= 2.9 * 1e-8 / tau
+    assert plan.terms["B"].seconds < 3.6e6

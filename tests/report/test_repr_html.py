@@ -15,6 +15,7 @@ from pathlib import Path
 import imunoise
 import numpy as np
 import pytest
+from imunoise.recording.recorder import Recording
 from imunoise.report.build import Report
 
 LOG = resources.files("imunoise") / "data" / "vn100_stationary_5min.txt"
@@ -101,12 +102,16 @@ def objects(tmp_path_factory):
         "Stationarity": dynamic.stationarity, "Events": imunoise.events(log),
         "Warmup": imunoise.warmup(thermal_log), "Thermal": imunoise.thermal(thermal_log),
         "Conversion": conversion, "Report": report,
+        "Plan": imunoise.plan(model, fs=40.0),
+        "Recording": Recording(path="still.vn", bytes=1_234_567, seconds=4.5, outages=(),
+                               identity={}, settings={}, previous={}, restored=True),
     }
 
 
 NAMES = ("ImuLog", "damaged ImuLog", "ParseIssues", "Gaps", "AllanResult", "NoiseModel",
          "Components", "Prediction", "Description", "Distribution", "Comparison", "Spectrum",
-         "DynamicAllan", "Stationarity", "Events", "Warmup", "Thermal", "Conversion", "Report")
+         "DynamicAllan", "Stationarity", "Events", "Warmup", "Thermal", "Conversion", "Report",
+         "Plan", "Recording")
 
 
 @pytest.mark.parametrize("name", NAMES)

@@ -52,6 +52,23 @@ class Recording:
     restored: bool
     snapshot: Snapshot | None = field(default=None, repr=False)
 
+    def __repr__(self) -> str:
+        from imunoise import _summary
+
+        return (f"Recording({self.path}: {self.bytes:,} bytes in "
+                f"{_summary.duration(self.seconds)}, {len(self.outages)} port outages, "
+                f"settings {'restored' if self.restored else 'kept'})")
+
+    def _repr_html_(self) -> str:
+        """The log, its size and length, the outages and whether the settings came back."""
+        from imunoise import _summary
+
+        rows = [("log", self.path), ("bytes", f"{self.bytes:,}"),
+                ("wall time", _summary.duration(self.seconds)),
+                ("port outages", len(self.outages)),
+                ("settings", "restored" if self.restored else "kept")]
+        return _summary.html_table(["", ""], rows, caption="Recording")
+
 
 def output_rates(settings: dict[int, tuple[str, ...]]) -> dict[str, float]:
     """Rates (Hz) of the ASCII output and of the first binary output, where on."""
