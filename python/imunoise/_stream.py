@@ -225,8 +225,33 @@ def describe(log: ImuLog, block: int = BLOCK_ROWS):
 
 def workdir_for(out_dir: Path) -> Path:
     """A fresh folder beside ``out_dir`` for the parsed log (removed after the report)."""
-    import tempfile
-
     parent = Path(os.path.abspath(out_dir)).parent
     parent.mkdir(parents=True, exist_ok=True)
-    return Path(tempfile.mkdtemp(prefix=".imunoise-stream-", dir=parent))
+    return fresh_workdir(parent, ".imunoise-stream-")
+
+
+def fresh_workdir(parent: Path, prefix: str) -> Path:
+    """A new folder ``<prefix><pid>-…`` in ``parent``, after removing those of runs
+    whose process is gone (killed before they could clean up), with a warning."""
+    import shutil
+    import tempfile
+
+    from imunoise import _warn
+
+    for old in Path(parent).glob(f"{prefix}*"):
+        pid = old.name[len(prefix):].split("-", 1)[0]
+        if old.is_dir() and pid.isdigit() and not _alive(int(pid)):
+            shutil.rmtree(old, ignore_errors=True)
+            _warn.warn(f"removed {old}, the parsed log of an earlier run that was killed",
+                       RuntimeWarning)
+    return Path(tempfile.mkdtemp(prefix=f"{prefix}{os.getpid()}-", dir=parent))
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except OSError:  # exists, owned by another user
+        return True
+    return True

@@ -385,9 +385,10 @@ def _stream_workdir():
     import atexit
     import shutil
     import tempfile
-    from pathlib import Path
 
-    path = Path(tempfile.mkdtemp(prefix="imunoise-stream-"))
+    from imunoise._stream import fresh_workdir
+
+    path = fresh_workdir(tempfile.gettempdir(), "imunoise-stream-")
     atexit.register(shutil.rmtree, path, ignore_errors=True)
     return path
 

@@ -3,7 +3,10 @@ a channel at a time print the numbers of the in-memory report. Small blocks and 
 pieces force many of them on small logs (the memory bound itself is measured by
 benches/report_scale.py, not here)."""
 
+import os
 import re
+import subprocess
+import sys
 
 import imunoise
 import numpy as np
@@ -184,3 +187,16 @@ def test_commands_take_the_mapped_path_for_large_logs(vn_binary, monkeypatch, ca
     assert main(["stats", str(vn_binary)]) == 0
     assert capsys.readouterr().out == whole
     assert seen  # the mapped path was taken (its folder is removed when the command ends)
+
+
+def test_a_killed_runs_parsed_log_is_removed_by_the_next(tmp_path):
+    dead = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"],
+                          capture_output=True, text=True, check=True)
+    left = tmp_path / f".imunoise-stream-{dead.stdout.strip()}-abc"
+    (left / "gyro").mkdir(parents=True)
+    mine = tmp_path / f".imunoise-stream-{os.getpid()}-keep"  # a run still going
+    mine.mkdir()
+    with pytest.warns(RuntimeWarning, match="parsed log of an earlier run that was killed"):
+        fresh = _stream.workdir_for(tmp_path / "report")
+    assert not left.exists() and mine.exists() and fresh.exists()
+    assert fresh.name.startswith(f".imunoise-stream-{os.getpid()}-")
