@@ -212,32 +212,30 @@ def simulate(n_samples: int, fs: float, Q: float = 0.0, N: float = 0.0, B: float
 
 
 def _check_sinusoid(sinusoid) -> tuple[float, float] | None:
-    if sinusoid is None:
-        return None
-    try:
-        amplitude, f0 = (float(v) for v in sinusoid)
-    except (TypeError, ValueError):
-        raise TypeError(
-            f"sinusoid must be an (amplitude, f0) pair or None; got {sinusoid!r}") from None
-    if not (math.isfinite(amplitude) and amplitude >= 0):
-        raise ValueError(f"sinusoid amplitude must be finite and >= 0; got {amplitude!r}")
-    if not (math.isfinite(f0) and f0 > 0):
-        raise ValueError(f"sinusoid f0 must be finite and > 0 Hz; got {f0!r}")
-    return amplitude, f0
+    return _size_and_rate(sinusoid, "sinusoid", "an", ("amplitude", "f0"), "Hz")
 
 
 def _check_motion(motion) -> tuple[float, float] | None:
-    if motion is None:
+    return _size_and_rate(motion, "motion", "a", ("sigma", "tau_c"), "s")
+
+
+def _size_and_rate(value, name: str, article: str, members: tuple[str, str],
+                   unit: str) -> tuple[float, float] | None:
+    """``value`` as (size ≥ 0, frequency or time > 0 in ``unit``), or None; the
+    errors name ``name`` and its two ``members``."""
+    if value is None:
         return None
+    size_name, rate_name = members
     try:
-        sigma, tau_c = (float(v) for v in motion)
+        size, rate = (float(v) for v in value)
     except (TypeError, ValueError):
-        raise TypeError(f"motion must be a (sigma, tau_c) pair or None; got {motion!r}") from None
-    if not (math.isfinite(sigma) and sigma >= 0):
-        raise ValueError(f"motion sigma must be finite and >= 0; got {sigma!r}")
-    if not (math.isfinite(tau_c) and tau_c > 0):
-        raise ValueError(f"motion tau_c must be finite and > 0 s; got {tau_c!r}")
-    return sigma, tau_c
+        raise TypeError(f"{name} must be {article} ({size_name}, {rate_name}) pair or None; "
+                        f"got {value!r}") from None
+    if not (math.isfinite(size) and size >= 0):
+        raise ValueError(f"{name} {size_name} must be finite and >= 0; got {size!r}")
+    if not (math.isfinite(rate) and rate > 0):
+        raise ValueError(f"{name} {rate_name} must be finite and > 0 {unit}; got {rate!r}")
+    return size, rate
 
 
 def _check_resonance(resonance, fs: float) -> tuple[float, float, float] | None:
