@@ -115,7 +115,7 @@ def model_floor(p: np.ndarray, taus: np.ndarray, fs: float) -> tuple[float, floa
     bounded motion are part of the curve whose floor B is read from; the tone and
     the resonance are neither white nor a walk, so N and K leave them out.
     """
-    gm = [(p[5 + 2 * k], math.exp(p[6 + 2 * k])) for k in range(GM_MAX) if p[5 + 2 * k] > 0]
+    gm = _gauss_markov(p)
     tone = [(p[SINE_SLOT], math.exp(p[SINE_SLOT + 1]))] if p[SINE_SLOT] > 0 else []
     osc = ([(p[RES_SLOT], math.exp(p[RES_SLOT + 1]), math.exp(p[RES_SLOT + 2]))]
            if p[RES_SLOT] > 0 else [])
@@ -141,9 +141,13 @@ def model_floor(p: np.ndarray, taus: np.ndarray, fs: float) -> tuple[float, floa
     return float(grid[i]), float(dev[i])
 
 
+def _gauss_markov(p: np.ndarray) -> list[tuple[float, float]]:
+    """(σ², τc) of each Gauss–Markov slot of ``p`` in use."""
+    return [(p[5 + 2 * k], math.exp(p[6 + 2 * k])) for k in range(GM_MAX) if p[5 + 2 * k] > 0]
+
+
 def value_of(term: str, p: np.ndarray, taus: np.ndarray, fs: float) -> float:
     """The datasheet value of ``term`` for the parameter vector ``p``."""
-    gm = [(p[5 + 2 * k], math.exp(p[6 + 2 * k])) for k in range(GM_MAX) if p[5 + 2 * k] > 0]
     if term == "B":
         floor = model_floor(p, taus, fs)
         return 0.0 if floor is None else floor[1] / FLICKER
@@ -151,7 +155,7 @@ def value_of(term: str, p: np.ndarray, taus: np.ndarray, fs: float) -> float:
     if term == "N" and p[RES_SLOT] > 0 and p[RES_SLOT + 2] <= 0.0:  # τr ≤ 1 s
         total += resonance_white_density(1.0, math.exp(p[RES_SLOT + 1]),
                                          math.exp(p[RES_SLOT + 2]), fs) * p[RES_SLOT]
-    for q2, tau_c in gm:
+    for q2, tau_c in _gauss_markov(p):
         if term == "N" and tau_c <= 1.0:
             total += q2 * gm_white_density(1.0, tau_c, fs)
         elif term == "K" and tau_c > 1.0:
