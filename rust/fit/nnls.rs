@@ -1,43 +1,92 @@
 //! Lawson–Hanson non-negative least squares on a small dense system.
 //!
-//! Every unconstrained sub-problem is solved by a faer QR factorisation of the
-//! passive columns; callers scale the columns first (τ spans many decades, so
-//! raw columns differ by up to 10²⁰ in norm). Reference: Lawson & Hanson,
-//! *Solving Least Squares Problems* (1974), ch. 23.
+//! Every unconstrained sub-problem is solved by a Householder QR of the passive
+//! columns; callers scale the columns first (τ spans many decades, so raw
+//! columns differ by up to 10²⁰ in norm). The sub-problems are at most 18
+//! columns by a few dozen rows and a fit solves thousands of them, so the QR is
+//! an unblocked one on a buffer the whole NNLS reuses: faer's blocked QR spent
+//! more time allocating and dispatching than factorising at this size (faer
+//! still inverts the Fisher matrix below). Reference: Lawson & Hanson, *Solving
+//! Least Squares Problems* (1974), ch. 23.
 
 use faer::linalg::solvers::SolveLstsq;
 use faer::Mat;
 
 use crate::error::{CoreError, CoreResult};
 
+/// Relative size below which a diagonal entry of R makes the sub-problem
+/// numerically rank deficient.
+const RANK_TOL: f64 = 1e-12;
+
 /// Least squares restricted to the columns in `passive`; `None` when that
-/// sub-problem is not numerically full rank.
-fn solve_passive(a: &Mat<f64>, b: &[f64], passive: &[bool]) -> Option<Vec<f64>> {
+/// sub-problem is not numerically full rank. `work` is scratch space.
+fn solve_passive(
+    a: &Mat<f64>,
+    b: &[f64],
+    passive: &[bool],
+    work: &mut Vec<f64>,
+) -> Option<Vec<f64>> {
     let k = a.ncols();
     let cols: Vec<usize> = (0..k).filter(|&j| passive[j]).collect();
     let mut out = vec![0.0; k];
-    if cols.is_empty() {
+    let p = cols.len();
+    if p == 0 {
         return Some(out);
     }
     let n = a.nrows();
-    if n < cols.len() {
+    if n < p {
         return None;
     }
-    let sub = Mat::from_fn(n, cols.len(), |i, c| a[(i, cols[c])]);
-    let rhs = Mat::from_fn(n, 1, |i, _| b[i]);
-    let qr = sub.qr();
-    let r = qr.thin_R();
-    let rmax = (0..cols.len()).map(|c| r[(c, c)].abs()).fold(0.0, f64::max);
-    if rmax.is_nan() || rmax <= 0.0 || (0..cols.len()).any(|c| r[(c, c)].abs() <= 1e-12 * rmax) {
-        return None;
+    // Column-major n × p copy of the passive columns, then the right-hand side.
+    work.clear();
+    for &j in &cols {
+        work.extend_from_slice(a.col_as_slice(j));
     }
-    let x = qr.solve_lstsq(&rhs);
-    for (c, &j) in cols.iter().enumerate() {
-        let v = x[(c, 0)];
-        if !v.is_finite() {
+    work.extend_from_slice(b);
+    let mut diag = vec![0.0; p];
+    for c in 0..p {
+        let (done, rest) = work.split_at_mut((c + 1) * n);
+        let v = &mut done[c * n + c..];
+        let norm = v.iter().map(|x| x * x).sum::<f64>().sqrt();
+        if norm == 0.0 || !norm.is_finite() {
             return None;
         }
-        out[j] = v;
+        let alpha = if v[0] > 0.0 { -norm } else { norm };
+        v[0] -= alpha;
+        let vv = v.iter().map(|x| x * x).sum::<f64>();
+        diag[c] = alpha;
+        if vv == 0.0 {
+            continue;
+        }
+        let beta = 2.0 / vv;
+        // Reflect every later column and the right-hand side.
+        for col in rest.chunks_exact_mut(n) {
+            let tail = &mut col[c..];
+            let s = beta * v.iter().zip(tail.iter()).map(|(x, y)| x * y).sum::<f64>();
+            for (t, x) in tail.iter_mut().zip(v.iter()) {
+                *t -= s * x;
+            }
+        }
+    }
+    let rmax = diag.iter().fold(0.0_f64, |m, d| m.max(d.abs()));
+    if rmax.is_nan() || rmax <= 0.0 || diag.iter().any(|d| d.abs() <= RANK_TOL * rmax) {
+        return None;
+    }
+    // Back-substitution: R x = Qᵀb, with R above the diagonal in the buffer.
+    let qtb = &work[p * n..];
+    let mut x = vec![0.0; p];
+    for c in (0..p).rev() {
+        let mut s = qtb[c];
+        for d in c + 1..p {
+            s -= work[d * n + c] * x[d];
+        }
+        x[c] = s / diag[c];
+        if !x[c].is_finite() {
+            return None;
+        }
+    }
+    for (c, &j) in cols.iter().enumerate() {
+        out[j] = x[c];
     }
     Some(out)
 }
@@ -47,18 +96,25 @@ pub fn nnls(a: &Mat<f64>, b: &[f64], allowed: &[bool]) -> CoreResult<Vec<f64>> {
     let (n, k) = (a.nrows(), a.ncols());
     let mut x = vec![0.0; k];
     let mut passive = vec![false; k];
+    // The gradient aᵀ(b − a x), a column at a time (faer stores columns contiguously).
     let gradient = |x: &[f64]| -> Vec<f64> {
-        let mut w = vec![0.0; k];
-        for i in 0..n {
-            let mut r = b[i];
-            for (j, xj) in x.iter().enumerate() {
-                r -= a[(i, j)] * xj;
-            }
-            for (j, wj) in w.iter_mut().enumerate() {
-                *wj += a[(i, j)] * r;
+        let mut r = b.to_vec();
+        for (j, &xj) in x.iter().enumerate() {
+            if xj != 0.0 {
+                for (ri, aij) in r.iter_mut().zip(a.col_as_slice(j)) {
+                    *ri -= aij * xj;
+                }
             }
         }
-        w
+        (0..k)
+            .map(|j| {
+                a.col_as_slice(j)
+                    .iter()
+                    .zip(&r)
+                    .map(|(aij, ri)| aij * ri)
+                    .sum()
+            })
+            .collect()
     };
     let scale = b
         .iter()
@@ -68,6 +124,7 @@ pub fn nnls(a: &Mat<f64>, b: &[f64], allowed: &[bool]) -> CoreResult<Vec<f64>> {
         .max(f64::MIN_POSITIVE);
     let tol = 1e-12 * scale * (n as f64).sqrt();
     let limit = 3 * k + 10;
+    let mut work = Vec::with_capacity(n * (k + 1));
     for _ in 0..limit {
         let w = gradient(&x);
         let candidate = (0..k)
@@ -85,7 +142,7 @@ pub fn nnls(a: &Mat<f64>, b: &[f64], allowed: &[bool]) -> CoreResult<Vec<f64>> {
                     "noise-model NNLS did not converge (inner loop)".into(),
                 ));
             }
-            let Some(z) = solve_passive(a, b, &passive) else {
+            let Some(z) = solve_passive(a, b, &passive, &mut work) else {
                 // The new column is (numerically) dependent on the others.
                 passive[j] = false;
                 if passive.iter().all(|p| !p) {
