@@ -224,7 +224,13 @@ class AllanResult:
         terms actually used. Shape (T,) unless the channels' gaps differ so that
         they used different numbers of terms; then (T, channels).
     edf : ndarray
-        Equivalent degrees of freedom.
+        Equivalent degrees of freedom: Greenhall's for the noise type ``alpha``
+        (the total family and Theo1: SP 1065's). Where a channel's phase noise
+        (α ≥ 1) begins only beyond the first tau — a bounded motion, a cycle —
+        its phase points are counted that corner apart (the EDF of the phase
+        decimated by the corner, never more than Greenhall's): Greenhall's
+        white-PM EDF counts every sample as a draw and overstated it up to
+        a thousandfold there against the Monte Carlo spread.
     ci_low, ci_high : ndarray
         Bounds of the ``confidence`` interval on ``dev``.
     alpha : ndarray of int

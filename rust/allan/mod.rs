@@ -35,7 +35,7 @@ pub use estimators::Estimate;
 pub use phase::{column_phases, row_major_phases, Gaps, Phase};
 pub use statistic::Statistic;
 use uncertainty::edf::EdfModel;
-use uncertainty::noise_id;
+use uncertainty::{corner, noise_id};
 
 /// Results for `taus.len()` taus × `channels` channels, tau-major
 /// (`var[t * channels + c]`), the layout of a C-ordered `(taus, channels)` array.
@@ -325,23 +325,64 @@ impl<'a> Job<'a> {
         Ok((var, alpha, alpha_identified))
     }
 
-    /// The EDF of every pair for its noise type, pooled over the runs with gaps.
+    /// The EDF of every pair for its noise type, pooled over the runs with gaps,
+    /// with the phase points counted a corner apart where a channel's phase noise
+    /// begins beyond its first tau (`uncertainty::corner`).
     fn edf(&self, alpha: &[i32]) -> Vec<f64> {
+        let corners = self.phase_noise_corners(alpha);
         self.pairs
             .iter()
             .enumerate()
             .map(|(i, &(t, _))| {
                 let (statistic, m) = self.plan[t];
+                let corner = corners[i];
                 match (statistic.spec().edf, &self.runs[i]) {
                     (EdfModel::Greenhall(est), Some(lengths)) => {
                         runs::pooled_edf(lengths, self.terms[i], statistic, m, |len| {
-                            uncertainty::edf::greenhall_edf(alpha[i], est, m, len)
+                            corner::edf_beyond_corner(
+                                |m, n| uncertainty::edf::greenhall_edf(alpha[i], est, m, n),
+                                m,
+                                len,
+                                corner,
+                            )
                         })
                     }
-                    (model, _) => model.edf(alpha[i], m, self.n_phase),
+                    (model, _) => corner::edf_beyond_corner(
+                        |m, n| model.edf(alpha[i], m, n),
+                        m,
+                        self.n_phase,
+                        corner,
+                    ),
                 }
             })
             .collect()
+    }
+
+    /// The corner of every pair: its channel's and statistic's series in turn.
+    fn phase_noise_corners(&self, alpha: &[i32]) -> Vec<usize> {
+        let mut corners = vec![1; self.pairs.len()];
+        let mut statistics: Vec<Statistic> = Vec::new();
+        for &(s, _) in self.plan {
+            if !statistics.contains(&s) {
+                statistics.push(s);
+            }
+        }
+        for s in statistics {
+            let taus: Vec<usize> = (0..self.plan.len())
+                .filter(|&t| self.plan[t].0 == s)
+                .collect();
+            let ms: Vec<usize> = taus.iter().map(|&t| self.plan[t].1).collect();
+            for c in 0..self.channels {
+                let series: Vec<i32> = taus.iter().map(|&t| alpha[t * self.channels + c]).collect();
+                for (k, corner) in corner::phase_noise_corners(&ms, &series)
+                    .into_iter()
+                    .enumerate()
+                {
+                    corners[taus[k] * self.channels + c] = corner;
+                }
+            }
+        }
+        corners
     }
 }
 
