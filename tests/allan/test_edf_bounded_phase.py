@@ -6,9 +6,8 @@ corner apart. Judged against the Monte Carlo spread of the estimates."""
 
 import warnings
 
-import numpy as np
-
 import imunoise
+import numpy as np
 
 FS = 100.0
 N = 60_000

@@ -53,7 +53,7 @@ pub fn edf_beyond_corner(
     let m_coarse = ((m as f64 / c).round() as usize).max(1);
     let n_coarse = ((n_phase as f64 / c) as usize).max(2 * m_coarse + 1);
     let coarse = edf_of(m_coarse, n_coarse);
-    if coarse.is_finite() && coarse > 0.0 && !(coarse >= full) {
+    if coarse.is_finite() && coarse > 0.0 && (full.is_nan() || coarse < full) {
         coarse
     } else {
         full
