@@ -111,7 +111,8 @@ def model_floor(p: np.ndarray, taus: np.ndarray, fs: float) -> tuple[float, floa
     (where its slope turns from falling to rising), else the lowest point of its
     flat parts (log-log slope ≥ −¼): a slow Gauss–Markov bump beyond a flat bottom
     falls again past its peak, and the bottom before it is the bias floor a reader
-    sees. A curve that never flattens has none. The tone, the resonance and a
+    sees. A curve that never flattens after falling has none (a filter's rising
+    head at the shortest taus is no floor). The tone, the resonance and a
     bounded motion are part of the curve whose floor B is read from; the tone and
     the resonance are neither white nor a walk, so N and K leave them out.
     """
@@ -130,7 +131,10 @@ def model_floor(p: np.ndarray, taus: np.ndarray, fs: float) -> tuple[float, floa
         smooth = np.sqrt(_core_fit.noise_terms(grid, fs, list(p[:5]), gm, [], [], moving)
                          .sum(axis=1))
         slope = np.gradient(np.log(smooth), np.log(grid))
-        flat = slope >= FLAT_SLOPE
+        # only where the curve has fallen into it: a head that rises or stays flat
+        # and then falls is a filter's or a fast Gauss–Markov term's hump, no bias
+        # floor (a sensor low-pass filtered at 100 Hz read B 40× the truth there)
+        flat = (slope >= FLAT_SLOPE) & (np.cumsum(slope < FLAT_SLOPE) > 0)
         if not flat.any():
             return None
         # a valley (the slope turns from falling to rising) where the curve has

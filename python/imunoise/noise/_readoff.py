@@ -102,12 +102,19 @@ def fit_slopes(t, v, e, mask, tolerance=0.25):
     dev = np.sqrt(v)
     logt, logd = np.log10(t), np.log10(dev)
     slope = np.diff(logd) / np.diff(logt)  # slope[i] between points i and i+1
+    # The rising terms (K, R) only from the curve's minimum on: a rise before the
+    # curve falls is a filter's or a fast correlated term's hump (a sensor low-pass
+    # filtered at 100 Hz read K 3,000× the truth at 2 ms there).
+    bottom = int(np.argmin(dev))
     for i, term in enumerate(TERMS):
         if not mask[i]:
             continue
         target = SLOPE[term]
-        j = int(np.argmin(np.abs(slope - target)))
-        if abs(slope[j] - target) > tolerance:
+        miss = np.abs(slope - target)
+        if target > 0:
+            miss[:bottom] = np.inf
+        j = int(np.argmin(miss))
+        if not miss[j] <= tolerance:
             continue  # no part of the curve has this slope: not resolved
         # MATLAB: the line of exact slope through point j (the segment's left end).
         sigma, tau = dev[j], t[j]
