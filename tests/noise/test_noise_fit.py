@@ -7,6 +7,8 @@ test_simulate.py), and the closed forms of the model for the slope read-off.
 
 from __future__ import annotations
 
+import warnings
+
 import imunoise
 import numpy as np
 import pytest
@@ -288,3 +290,18 @@ def test_bootstrap_bad_arguments(kwargs, error, match):
     r = imunoise.adev(imunoise.simulate(2000, 10.0, N=1e-3, seed=1), 10.0)
     with pytest.raises(error, match=match):
         imunoise.fit(r, **kwargs)
+
+
+def test_a_sparse_grid_warns_when_the_model_has_components_it_places_poorly():
+    x = imunoise.simulate(200_000, 100.0, N=1e-4, B=2e-5, gm=[(1e-4, 0.05)], seed=1)
+    with pytest.warns(UserWarning, match=r"3\.3 taus per decade.*taus=10"):
+        octave = imunoise.fit(imunoise.adev(x, 100.0))
+    assert octave.components.gauss_markov()  # the premise: a component was fitted
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        imunoise.fit(imunoise.adev(x, 100.0, taus=10))
+    # IEEE terms alone are no reason to warn, whatever the grid.
+    plain = imunoise.simulate(200_000, 100.0, N=1e-4, seed=2)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        imunoise.fit(imunoise.adev(plain, 100.0), terms=["N", "B", "K"])

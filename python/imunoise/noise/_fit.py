@@ -346,6 +346,10 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
     )
     cover = coverage(model, taus, dev_all, edf_raw)
     object.__setattr__(model, "coverage", shaped(cover))
+    if method == "wls" and any(
+            components.gauss_markov(c) or components.sine(c) or components.resonance(c)
+            or components.motion(c) for c in range(channels)):
+        _warn_sparse_grid(taus)
     for c in np.flatnonzero(cover < 0.8) if method == "wls" and warn_coverage else ():
         _warn.warn(
             f"the noise model follows the Allan deviation of channel {c} at only "
@@ -355,6 +359,30 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
             RuntimeWarning,
         )
     return model
+
+
+#: Taus per decade below which a fitted line or correlated term is placed poorly.
+SPARSE_TAUS_PER_DECADE = 5.0
+
+
+def _warn_sparse_grid(taus) -> None:
+    """Warn when the model has components beyond the IEEE terms and the grid is too
+    sparse to place them: on octaves (3.3 taus per decade) the ADIS16405
+    accelerometers' 0.53 Hz line went to a fast Gauss–Markov term or was left
+    out, and N moved by up to 5 standard uncertainties from its value on 5 to 50
+    taus per decade, which agree within 0.1."""
+    taus = np.asarray(taus, dtype=float)
+    if taus.size < 2:
+        return
+    density = (taus.size - 1) / math.log10(taus[-1] / taus[0])
+    if density < SPARSE_TAUS_PER_DECADE:
+        _warn.warn(
+            f"the Allan deviation has {density:.1f} taus per decade and the model has "
+            "lines or correlated terms, which a grid this sparse places poorly: its N, B "
+            "and K can move by several standard uncertainties against a denser grid's; "
+            "fit adev(..., taus=10) or denser",
+            UserWarning,
+        )
 
 
 def _record_length(result) -> int:
