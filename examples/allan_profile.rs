@@ -7,7 +7,7 @@
 use std::time::Instant;
 
 use _core::allan::fast::blocked::{sums_of_squares, Difference};
-use _core::allan::{column_phases, Statistic};
+use _core::allan::{column_phases, contiguous_phase, Statistic};
 use rayon::prelude::*;
 
 fn main() {
@@ -46,6 +46,10 @@ fn main() {
     stage("phase", reps, || {
         let p = column_phases(vec![std::hint::black_box(&y).iter().copied()]).unwrap();
         check += p[0].c[n / 2];
+    });
+    stage("phase (contiguous)", reps, || {
+        let p = contiguous_phase(std::hint::black_box(&y)).unwrap();
+        check += p.c[n / 2];
     });
     stage("octave sweep", reps, || {
         check += sums_of_squares(std::hint::black_box(&phases[0].c), &ms, Difference::Second)[0];

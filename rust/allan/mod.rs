@@ -17,6 +17,7 @@
 pub mod estimators;
 pub mod fast;
 pub mod phase;
+pub mod running_sum;
 pub mod runs;
 pub mod statistic;
 pub mod sum;
@@ -32,7 +33,7 @@ use crate::error::{CoreError, CoreResult};
 use crate::interrupt::{Interrupt, NEVER};
 pub use estimators::theobr::{Ladder, RatioOptions};
 pub use estimators::Estimate;
-pub use phase::{column_phases, row_major_phases, Gaps, Phase};
+pub use phase::{column_phases, contiguous_phase, row_major_phases, Gaps, Phase};
 pub use statistic::Statistic;
 use uncertainty::edf::EdfModel;
 use uncertainty::noise_id;
