@@ -5,7 +5,8 @@
 //! statistic is, `estimators/` compute one tau of one channel, `fast/` holds the
 //! kernels that make them O(n) or sweep all taus at once, `uncertainty/` the noise
 //! identification and EDF, `runs.rs` the handling of missing samples, and
-//! `phase.rs`/`sum.rs` the numerics they share. Dependencies point down that list.
+//! `phase.rs`/`running_sum.rs`/`sum.rs` the numerics they share. Dependencies
+//! point down that list.
 //!
 //! Missing samples (NaN) are gaps. The difference estimators (Allan, modified
 //! Allan, Hadamard; [`Statistic::skips_gaps`]) leave out every term whose window
