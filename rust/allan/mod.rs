@@ -5,7 +5,8 @@
 //! statistic is, `estimators/` compute one tau of one channel, `fast/` holds the
 //! kernels that make them O(n) or sweep all taus at once, `uncertainty/` the noise
 //! identification and EDF, `runs.rs` the handling of missing samples, and
-//! `phase.rs`/`sum.rs` the numerics they share. Dependencies point down that list.
+//! `phase.rs`/`running_sum.rs`/`sum.rs` the numerics they share. Dependencies
+//! point down that list.
 //!
 //! Missing samples (NaN) are gaps. The difference estimators (Allan, modified
 //! Allan, Hadamard; [`Statistic::skips_gaps`]) leave out every term whose window
@@ -17,6 +18,7 @@
 pub mod estimators;
 pub mod fast;
 pub mod phase;
+pub mod running_sum;
 pub mod runs;
 pub mod statistic;
 pub mod sum;
@@ -32,7 +34,7 @@ use crate::error::{CoreError, CoreResult};
 use crate::interrupt::{Interrupt, NEVER};
 pub use estimators::theobr::{Ladder, RatioOptions};
 pub use estimators::Estimate;
-pub use phase::{column_phases, row_major_phases, Gaps, Phase};
+pub use phase::{column_phases, contiguous_phase, row_major_phases, Gaps, Phase};
 pub use statistic::Statistic;
 use uncertainty::edf::EdfModel;
 use uncertainty::{corner, noise_id};

@@ -15,6 +15,7 @@ use std::ops::Range;
 
 use rayon::prelude::*;
 
+use super::running_sum::{self, two_sum, CHUNK};
 use super::sum::Neumaier;
 use crate::error::{CoreError, CoreResult};
 
@@ -130,32 +131,71 @@ where
     phase
 }
 
-/// Samples per chunk of the parallel passes. Fixed (not derived from the thread
-/// count), so the result is the same on any machine; a record of one chunk is
-/// transformed exactly as by a single sequential pass.
-const CHUNK: usize = 1 << 16;
-
 /// The same transformation for samples already gathered behind a leading slot:
 /// `phase[0]` is overwritten with 0 and `phase[1..]` holds y_0 … y_{n−1}, NaN
 /// where a sample is missing (±∞ is an error).
 ///
-/// Long records use all cores: chunk totals of the mean-removed samples are
-/// accumulated with two-sum in parallel, their prefix gives each chunk its
-/// starting (sum, error) pair, and the chunks then run the same compensated
-/// running sum in parallel.
+/// Long records use all cores (see [`running_phase`]).
 pub fn into_cumulative_phase(mut phase: Vec<f64>) -> CoreResult<Phase> {
-    let n = phase.len().saturating_sub(1);
+    if phase.len() < 2 {
+        return Err(CoreError::InvalidArgument("x must not be empty".into()));
+    }
+    phase[0] = 0.0;
+    let chunk_sums: Vec<f64> = phase[1..].par_chunks(CHUNK).map(compensated_sum).collect();
+    with_gaps_located(phase, chunk_sums)
+}
+
+/// [`into_cumulative_phase`] of one contiguous channel, with the same result:
+/// the copy into the phase vector and the chunk sums run together on all cores.
+pub fn contiguous_phase(samples: &[f64]) -> CoreResult<Phase> {
+    let n = samples.len();
     if n == 0 {
         return Err(CoreError::InvalidArgument("x must not be empty".into()));
     }
-    // The one scan a record without gaps pays for them.
-    let gaps = match phase[1..].iter().position(|v| !v.is_finite()) {
-        None => None,
-        Some(first) => Some(find_gaps(&mut phase[1..], first)?),
-    };
-    phase[0] = 0.0;
-    let chunk_sums: Vec<f64> = phase[1..].par_chunks(CHUNK).map(compensated_sum).collect();
-    let total = chunk_sums.into_iter().sum::<Neumaier>().value();
+    let mut phase = Vec::with_capacity(n + 1);
+    crate::memory::advise_huge_pages(&phase);
+    phase.push(0.0);
+    let chunk_sums: Vec<f64> = phase.spare_capacity_mut()[..n]
+        .par_chunks_mut(CHUNK)
+        .zip(samples.par_chunks(CHUNK))
+        .map(|(out, values)| {
+            for (slot, &v) in out.iter_mut().zip(values) {
+                slot.write(v);
+            }
+            compensated_sum(values)
+        })
+        .collect();
+    // SAFETY: the loop above wrote all n slots after the leading 0.
+    unsafe { phase.set_len(n + 1) };
+    with_gaps_located(phase, chunk_sums)
+}
+
+/// The cumulative phase of `phase[1..]` given the sums of its chunks. A finite
+/// total stands for the scan for missing samples (a NaN or ±∞ anywhere makes
+/// every sum that takes it non-finite); only a non-finite one (gaps, or a sum
+/// that overflows) is followed by the scan, and with gaps the chunks are summed
+/// again with the missing samples set to 0.
+fn with_gaps_located(mut phase: Vec<f64>, mut chunk_sums: Vec<f64>) -> CoreResult<Phase> {
+    let mut gaps = None;
+    if !chunk_sums.iter().sum::<Neumaier>().value().is_finite() {
+        if let Some(first) = phase[1..].iter().position(|v| !v.is_finite()) {
+            gaps = Some(find_gaps(&mut phase[1..], first)?);
+            chunk_sums = phase[1..].par_chunks(CHUNK).map(compensated_sum).collect();
+        }
+    }
+    Ok(running_phase(phase, &chunk_sums, gaps))
+}
+
+/// The running compensated sum of the mean-removed samples in `phase[1..]`,
+/// given the plain sums of its chunks of [`CHUNK`] samples (missing samples
+/// set to 0 and located by `gaps`).
+///
+/// Each chunk's total as (sum, error) is accumulated in parallel, their prefix
+/// gives each chunk its starting pair, and the chunks then run the same
+/// compensated running sum in parallel (`running_sum.rs`).
+fn running_phase(mut phase: Vec<f64>, chunk_sums: &[f64], gaps: Option<Gaps>) -> Phase {
+    let n = phase.len() - 1;
+    let total = chunk_sums.iter().sum::<Neumaier>().value();
     let valid = n - gaps.as_ref().map_or(0, |g| g.missing);
     let mean = total / valid as f64;
     if let Some(g) = &gaps {
@@ -167,14 +207,7 @@ pub fn into_cumulative_phase(mut phase: Vec<f64>) -> CoreResult<Phase> {
         }
     }
     // Each chunk's total as (sum, error), then the running pair at each chunk start.
-    let totals: Vec<(f64, f64)> = phase[1..]
-        .par_chunks(CHUNK)
-        .map(|chunk| {
-            chunk
-                .iter()
-                .fold((0.0, 0.0), |acc, &v| compensated_step(acc, v - mean))
-        })
-        .collect();
+    let totals = running_sum::chunk_totals(&phase[1..], mean);
     let mut starts = Vec::with_capacity(totals.len());
     let mut at = (0.0f64, 0.0f64);
     for (sum, comp) in totals {
@@ -182,17 +215,8 @@ pub fn into_cumulative_phase(mut phase: Vec<f64>) -> CoreResult<Phase> {
         let (t, err) = two_sum(at.0, sum);
         at = (t, at.1 + err + comp);
     }
-    phase[1..]
-        .par_chunks_mut(CHUNK)
-        .zip(starts)
-        .for_each(|(chunk, start)| {
-            let mut acc = start;
-            for value in chunk.iter_mut() {
-                acc = compensated_step(acc, *value - mean);
-                *value = acc.0 + acc.1;
-            }
-        });
-    Ok(Phase { c: phase, gaps })
+    running_sum::run_chunks(&mut phase[1..], &starts, mean);
+    Phase { c: phase, gaps }
 }
 
 /// The runs of valid samples of `y`, whose first non-finite value is at `first`;
@@ -226,22 +250,6 @@ fn find_gaps(y: &mut [f64], first: usize) -> CoreResult<Gaps> {
         )));
     }
     Ok(Gaps { missing, segments })
-}
-
-/// Knuth's branch-free two-sum: a + b = t + err exactly.
-#[inline(always)]
-fn two_sum(a: f64, b: f64) -> (f64, f64) {
-    let t = a + b;
-    let bp = t - a;
-    (t, (a - (t - bp)) + (b - bp))
-}
-
-/// One step of the compensated running sum: the sum and the accumulated rounding
-/// errors form two independent dependency chains.
-#[inline(always)]
-fn compensated_step((sum, comp): (f64, f64), v: f64) -> (f64, f64) {
-    let (t, err) = two_sum(sum, v);
-    (t, comp + err)
 }
 
 /// Mean and least-squares slope of f(t), t < count (slope about t = (count − 1)/2).
@@ -303,6 +311,40 @@ mod tests {
             err.contains("sample 1") && err.contains("channel 1"),
             "{err}"
         );
+    }
+
+    #[test]
+    fn contiguous_phase_equals_the_gathered_one() {
+        // Several chunks (the parallel and vector paths), an offset, and records
+        // that take the general way: gaps, ±∞, a sum that overflows.
+        let n = 9 * CHUNK + 77;
+        let y: Vec<f64> = (0..n)
+            .map(|k| ((k * 7919) % 1009) as f64 * 1e-3 + 9.81)
+            .collect();
+        let mut gapped = y.clone();
+        gapped[3] = f64::NAN;
+        gapped[2 * CHUNK..2 * CHUNK + 500].fill(f64::NAN);
+        let mut infinite = y.clone();
+        infinite[CHUNK + 1] = f64::NEG_INFINITY;
+        let overflowing = vec![1.5e308; 4];
+        for samples in [&y[..], &y[..1], &gapped, &infinite, &overflowing] {
+            let fast = contiguous_phase(samples);
+            let gathered = into_cumulative_phase(gather(samples.iter().copied()));
+            match (fast, gathered) {
+                (Ok(a), Ok(b)) => {
+                    assert_eq!(a.gaps, b.gaps);
+                    assert!(a
+                        .c
+                        .iter()
+                        .zip(&b.c)
+                        .all(|(x, y)| x.to_bits() == y.to_bits()));
+                    assert_eq!(a.c.len(), samples.len() + 1);
+                }
+                (Err(a), Err(b)) => assert_eq!(a.to_string(), b.to_string()),
+                (a, b) => panic!("{a:?} vs {b:?}"),
+            }
+        }
+        assert!(contiguous_phase(&[]).is_err());
     }
 
     #[test]

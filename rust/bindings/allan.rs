@@ -113,11 +113,11 @@ fn run_plan<'py>(
     let view = x.as_array();
     let result = run_interruptible(py, |stop| {
         // A C-ordered array with several channels is scattered row by row in one
-        // pass, one contiguous channel is copied as a slice; anything else
-        // (Fortran order, strided views) is gathered column by column.
+        // pass, one contiguous channel is copied and summed on all cores;
+        // anything else (Fortran order, strided views) is gathered column by column.
         let phases = match view.as_slice() {
             Some(data) if view.ncols() > 1 => allan::row_major_phases(data, view.ncols())?,
-            Some(data) => allan::column_phases(vec![data.iter().copied()])?,
+            Some(data) => vec![allan::contiguous_phase(data)?],
             _ => {
                 let columns: Vec<_> = view
                     .columns()

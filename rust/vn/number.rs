@@ -140,7 +140,9 @@ pub(crate) fn fast_number(b: &[u8], j: &mut usize) -> Option<f64> {
     }
     debug_assert!(mant <= EXACT_MANT && frac < POW10.len());
     *j = k;
-    let v = mant as f64 / POW10[frac];
+    // Below 2^53 the signed conversion is the same exact value, and one
+    // instruction where the unsigned one takes several on x86-64.
+    let v = mant as i64 as f64 / POW10[frac];
     Some(f64::from_bits(v.to_bits() | (neg as u64) << 63))
 }
 

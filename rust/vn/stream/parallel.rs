@@ -60,13 +60,20 @@ fn good_packet_at_or_after(buf: &[u8], from: usize, window: usize) -> Option<usi
     None
 }
 
+/// Whether `byte` occurs in `buf`: blocks of 4 kB compared without a branch per
+/// byte (vectorised), where `contains` tests one byte at a time.
+fn has_byte(buf: &[u8], byte: u8) -> bool {
+    buf.chunks(4096)
+        .any(|block| block.iter().fold(false, |seen, &c| seen | (c == byte)))
+}
+
 impl Parser {
     /// Parse a block, using all cores when it is large and pure ASCII.
     pub fn feed_block(&mut self, buf: &[u8], fin: bool) -> usize {
         if buf.len() < self.parallel_min || self.fail.is_some() {
             return self.feed(buf, fin);
         }
-        if buf.contains(&0xFA) {
+        if has_byte(buf, 0xFA) {
             return self.feed_block_binary(buf, fin);
         }
         // Everything up to the last newline is split into pieces at newlines and
@@ -305,5 +312,21 @@ impl Parser {
     fn rows_scale(&self, start: u64, done: usize, block: usize) -> f64 {
         let left = self.size_hint.saturating_sub(start).max(block as u64) as f64;
         left / done.max(1) as f64 * 1.01
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::has_byte;
+
+    #[test]
+    fn has_byte_finds_it_anywhere() {
+        let mut buf = vec![b'$'; 3 * 4096 + 17];
+        assert!(!has_byte(&buf, 0xFA) && !has_byte(&[], 0xFA));
+        for at in [0, 4095, 4096, 2 * 4096 + 1, buf.len() - 1] {
+            buf[at] = 0xFA;
+            assert!(has_byte(&buf, 0xFA), "{at}");
+            buf[at] = b'$';
+        }
     }
 }
