@@ -60,7 +60,7 @@ from scipy import signal as _signal
 from scipy import stats as _sstats
 
 from imunoise import _summary
-from imunoise._channels import rate_channels, rate_columns
+from imunoise._channels import rate_columns
 from imunoise._runs import true_runs
 from imunoise._validate import positive_finite
 from imunoise.readers.log import ImuLog
@@ -258,18 +258,19 @@ class Events:
             1 for an event no louder than the quiet noise; NaN where a channel has
             no valid sample in the event.
         """
-        x, _fs, names = rate_channels(data, None if isinstance(data, ImuLog) else self.fs,
-                                      None)
-        if x.shape[0] != self.n_samples or names != self.names:
+        # a channel at a time (a memory-mapped log: one channel in memory)
+        cols, _fs, names = rate_columns(data, None if isinstance(data, ImuLog) else self.fs,
+                                        None)
+        if cols.n != self.n_samples or names != self.names:
             raise ValueError(f"data must be the record of the events ({self.n_samples} "
-                             f"samples of {', '.join(self.names)}); got {x.shape[0]} samples "
+                             f"samples of {', '.join(self.names)}); got {cols.n} samples "
                              f"of {', '.join(names)}")
         baseline = positive_finite(baseline, "baseline", unit="s")
         block = max(2 * self.window, int(round(baseline * self.fs)))
         quiet = ~self.mask
-        out = np.full((len(self), x.shape[1]), np.nan)
-        for j in range(x.shape[1]):
-            r, _sigma = _standardise(x[:, j], block)
+        out = np.full((len(self), len(cols)), np.nan)
+        for j in range(len(cols)):
+            r, _sigma = _standardise(cols[j], block)
             sq = np.where(np.isfinite(r), r * r, np.nan)
             with np.errstate(invalid="ignore", divide="ignore"):
                 level = np.sqrt(np.nanmean(sq[quiet])) if quiet.any() else np.nan

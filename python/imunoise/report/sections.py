@@ -13,8 +13,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from imunoise import _stream, noise, numbers, plot, stats, units
 from imunoise import allan as _allan
-from imunoise import noise, numbers, plot, stats, units
 from imunoise._schema import CHANNELS, SAMPLE_SENSORS, axis_names
 from imunoise.numbers import format_value
 from imunoise.planner import fit_line
@@ -447,7 +447,6 @@ def events_section(ctx: Context, doc: Doc) -> None:
         y = getattr(log, sensor)
         if y is None:
             continue
-        z = found.exclude(y)  # one sensor copied at a time, not the whole log
         fig = plot.events(y, found, log.fs, title=f"{sensor} with events (short log)",
                           unit=CHANNELS[sensor][1])
         ctx.add_figure(doc, fig, f"events_{sensor}",
@@ -455,10 +454,12 @@ def events_section(ctx: Context, doc: Doc) -> None:
         kept = []
         for j, axis in enumerate(axis_names(y.shape[1])):
             with_ = list(ctx.sensor_distributions[sensor].values())[j]  # the same samples
-            without = stats.distribution(z[:, j][np.isfinite(z[:, j])])
+            col = _stream.column(y, j, ctx.block) if ctx.streamed else y[:, j]
+            z = found.exclude(col)  # one channel copied at a time, not the sensor
+            without = stats.distribution(z[np.isfinite(z)])
             kept.append(without)
             rows.append([f"{sensor} {axis}", *(numbers.cell(v) for v in (
-                np.nanstd(y[:, j], ddof=1), np.nanstd(z[:, j], ddof=1), with_.excess_kurtosis,
+                np.nanstd(col, ddof=1), np.nanstd(z, ddof=1), with_.excess_kurtosis,
                 without.excess_kurtosis, with_.ks_statistic, without.ks_statistic))])
         fig = plot.histograms(kept, title=f"{sensor} without events (short log)",
                               unit=CHANNELS[sensor][1])
