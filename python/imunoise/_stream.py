@@ -26,7 +26,7 @@ from imunoise import _schema
 from imunoise.readers.log import ImuLog
 
 __all__ = ["BLOCK_ROWS", "PARSE_BYTES", "STREAM_BYTES", "blocks", "column", "describe",
-           "is_mapped", "open_mapped", "release", "release_log", "workdir_for"]
+           "is_mapped", "open_mapped", "release", "release_log", "trim_heap", "workdir_for"]
 
 #: VN logs larger than this are streamed by default (parsed once into memory maps).
 STREAM_BYTES = 256 << 20
@@ -77,6 +77,27 @@ def release(*arrays) -> None:
                 m.madvise(mmap.MADV_DONTNEED)
             except (OSError, ValueError):  # pragma: no cover - not on this platform
                 pass
+
+
+def trim_heap() -> None:
+    """Give the C heap's free memory back to the system (glibc's ``malloc_trim``):
+    arrays numpy freed below malloc's mmap threshold (up to 32 MiB, which it raises
+    as larger blocks come and go) otherwise stay resident. No-op elsewhere."""
+    global _LIBC
+    if _LIBC is None:
+        import ctypes
+        import ctypes.util
+
+        try:
+            _LIBC = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6")
+            _LIBC.malloc_trim  # noqa: B018 - present on glibc only
+        except (OSError, AttributeError):
+            _LIBC = False
+    if _LIBC:
+        _LIBC.malloc_trim(0)
+
+
+_LIBC = None
 
 
 def release_log(log: ImuLog | None) -> None:
