@@ -270,7 +270,7 @@ class Events:
         quiet = ~self.mask
         out = np.full((len(self), len(cols)), np.nan)
         for j in range(len(cols)):
-            r, _sigma = _standardise(cols[j], block)
+            r, _sigma, _knots = _standardise(cols[j], block)
             sq = np.where(np.isfinite(r), r * r, np.nan)
             with np.errstate(invalid="ignore", divide="ignore"):
                 level = np.sqrt(np.nanmean(sq[quiet])) if quiet.any() else np.nan
@@ -394,7 +394,7 @@ def events(
     per_channel = []
     sigma = np.empty(len(cols))
     for j in range(len(cols)):
-        r, mad_sigma = _standardise(cols[j], block)
+        r, mad_sigma, knots = _standardise(cols[j], block)
         # first pass with the noise law of the whole channel, then once more with
         # the law of its quiet part: a record with vibration of its own (the VN-100
         # live capture, 20 % of it) otherwise sets thresholds for quiet noise from
@@ -425,13 +425,15 @@ def events(
         # found by itself is then inside the vibration it was joined to
         inner = _inner_bursts(z, [(a, b, kind) for a, b, kind, _c in joined], windows, p_v,
                               k_spike, isolated)
-        # z again when the events' peaks are read (_merge_channels), not kept: one
-        # channel's samples in memory at a time
-        per_channel.append((joined, (j, scale), [(a, b, kind, {j}) for a, b, kind in inner]))
+        # z again over each event when the events' peaks are read (_merge_channels),
+        # from the baseline's knots: one channel's samples in memory at a time
+        per_channel.append((joined, (j, scale, knots, mad_sigma),
+                            [(a, b, kind, {j}) for a, b, kind in inner]))
         del r, z, quiet, isolated
     return _merge_channels(
-        per_channel, names, fs, n, gap, touch, sigma, lambda j, scale: _standardise(
-            cols[j], block)[0] / np.sqrt(scale),
+        per_channel, names, fs, n, gap, touch, sigma,
+        lambda j, scale, knots, mad_sigma, a, b: _standardised_rows(
+            cols.rows(j, a, b), a, knots, mad_sigma) / np.sqrt(scale),
         k_spike=k_spike,
         energy=float(_sstats.chi2.isf(p_window, w)) / w,
         window=w,
@@ -439,8 +441,9 @@ def events(
     )
 
 
-def _standardise(col: np.ndarray, block: int) -> tuple[np.ndarray, float]:
-    """``(x - baseline)/σ̂`` (NaN where missing) and σ̂ of one channel."""
+def _standardise(col: np.ndarray, block: int) -> tuple[np.ndarray, float, tuple | None]:
+    """``(x - baseline)/σ̂`` (NaN where missing), σ̂ and the knots of the baseline
+    (block centres and medians; None when no block has a valid sample) of one channel."""
     n = len(col)
     starts = np.arange(0, n, block)
     full = n // block
@@ -454,9 +457,9 @@ def _standardise(col: np.ndarray, block: int) -> tuple[np.ndarray, float]:
     centres = np.minimum(starts + block / 2, n) - 0.5
     ok = np.isfinite(medians)
     if not ok.any():
-        return np.full(n, np.nan), float("nan")
-    base = np.interp(np.arange(n), centres[ok], medians[ok])
-    r = col - base
+        return np.full(n, np.nan), float("nan"), None
+    knots = (centres[ok], medians[ok])
+    r = col - np.interp(np.arange(n), *knots)
     valid = np.isfinite(r)
     rv = r[valid]
     sigma = 1.4826 * float(np.median(np.abs(rv)))
@@ -464,8 +467,21 @@ def _standardise(col: np.ndarray, block: int) -> tuple[np.ndarray, float]:
         q75, q25 = np.percentile(rv, [75, 25])
         sigma = 0.7413 * float(q75 - q25) or float(np.std(rv))
     if sigma == 0:
-        return np.where(valid, 0.0, np.nan), 0.0
-    return r / sigma, sigma
+        return np.where(valid, 0.0, np.nan), 0.0, knots
+    return r / sigma, sigma, knots
+
+
+def _standardised_rows(rows: np.ndarray, a: int, knots: tuple | None,
+                       sigma: float) -> np.ndarray:
+    """:func:`_standardise`'s values at rows ``a`` … ``a + len(rows) − 1`` of a channel
+    (``rows``), from its baseline ``knots`` and σ̂: the same numbers, from those rows
+    only."""
+    if knots is None:
+        return np.full(len(rows), np.nan)
+    r = rows - np.interp(np.arange(a, a + len(rows)), *knots)
+    if sigma == 0:
+        return np.where(np.isfinite(r), 0.0, np.nan)
+    return r / sigma
 
 
 def _raised(seg: np.ndarray, rho: np.ndarray) -> bool:
@@ -827,19 +843,17 @@ def _join_kind(spans: list[tuple], gap: int) -> list[list]:
 def _merge_channels(per_channel, names, fs, n, gap, touch, sigma, standardised,
                     **thresholds) -> Events:
     """One event per overlapping group of the channels' events; a group's peak is the
-    largest |z| of its channels in it (``standardised(*key)``: a channel's z, from the
-    key each entry of ``per_channel`` holds)."""
+    largest |z| of its channels in it (``standardised(*key, a, b)``: a channel's z over
+    rows a … b − 1, from the key each entry of ``per_channel`` holds)."""
     groups = _join([span for spans, _z, _in in per_channel for span in spans], gap, touch)
     nested = _join_kind(sorted((span for _s, _z, inner in per_channel for span in inner),
                                key=lambda span: span[:3]), gap)
     groups = sorted(groups + nested, key=lambda g: (g[0], g[1]))
     per_group: list[dict[int, float]] = [{} for _g in groups]
     for j in sorted({j for g in groups for j in g[3]}):
-        z = standardised(*per_channel[j][1])
         for i, (a, b, _k, chans) in enumerate(groups):
             if j in chans:
-                per_group[i][j] = _peak(z[a:b])
-        del z
+                per_group[i][j] = _peak(standardised(*per_channel[j][1], a, b))
     peaks = [max(found[j] for j in g[3]) for g, found in zip(groups, per_group, strict=True)]
     return Events(
         fs=fs,
