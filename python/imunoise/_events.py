@@ -674,8 +674,7 @@ def _energy_law(z: np.ndarray, w: int) -> tuple[float, np.ndarray]:
     c = np.clip(z, -3.0, 3.0)
     c = np.where(valid, c - c[valid].mean() if m else 0.0, 0.0)
     acf = _lag_products(c, w)
-    pairs = (len(z) - np.arange(w)).astype(float) if m == len(z) else _lag_products(
-        valid.astype(float), w)
+    pairs = (len(z) - np.arange(w)).astype(float) if m == len(z) else _valid_pairs(valid, w)
     rho = acf / np.maximum(pairs, 1.0) / (acf[0] / max(pairs[0], 1.0)) if acf[0] > 0 \
         else np.zeros(w)
     dof = _dof(rho, w)
@@ -687,6 +686,35 @@ def _energy_law(z: np.ndarray, w: int) -> tuple[float, np.ndarray]:
     median = float(np.median(blocks[complete].mean(axis=1)))
     expected = float(_sstats.chi2.median(dof)) / dof
     return (median / expected if median > 0 else 1.0), rho
+
+
+#: Most runs of missing samples whose pairs :func:`_valid_pairs` counts directly.
+PAIR_RUNS = 512
+
+
+def _valid_pairs(valid: np.ndarray, lags: int) -> np.ndarray:
+    """Σ_i valid_i·valid_(i+k) for k = 0 … lags − 1 (float): the pairs of valid samples
+    k apart, counted from the runs of missing ones, (n − k) less those touching one
+    (missing at i, at i + k, or both); by :func:`_lag_products` when there are more
+    than :data:`PAIR_RUNS` runs."""
+    n = len(valid)
+    start, stop = true_runs(~valid)
+    if start.size > PAIR_RUNS:
+        return _lag_products(valid.astype(float), lags)
+    k = np.arange(lags)
+
+    def missing_below(end: np.ndarray) -> np.ndarray:  # missing samples in [0, end)
+        return np.clip(np.minimum(stop[:, None], end[None, :]) - start[:, None], 0,
+                       None).sum(axis=0)
+
+    both = np.zeros(lags, dtype=np.int64)  # i and i + k both missing
+    for r in range(start.size):
+        near = slice(r, int(np.searchsorted(start, stop[r] + lags)))  # runs after it, close
+        both += np.clip(np.minimum(stop[r], stop[near, None] - k[None, :])
+                        - np.maximum(start[r], start[near, None] - k[None, :]), 0,
+                        None).sum(axis=0)
+    total = int(stop.sum() - start.sum())
+    return ((n - k) - missing_below(n - k) - (total - missing_below(k)) + both).astype(float)
 
 
 #: Bytes of block transforms :func:`_lag_products` holds at once.
