@@ -390,7 +390,8 @@ def _null_p_values(cols, fs, t, bias, duration, seed) -> np.ndarray:
     taus = taus[taus < duration / 2]  # as the significance rule: longer is drift
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # a poorly followed curve still bounds the wander
-        half = adev(np.column_stack([cols[j][cols.n // 2:] for j in np.flatnonzero(ok)]), fs)
+        half = adev(np.column_stack([cols.rows(j, cols.n // 2, cols.n)
+                                     for j in np.flatnonzero(ok)]), fs)
         model = fit(half, warn_coverage=False)
     k_floor = _random_walk_bound(half, model)
     rng = np.random.default_rng(seed)
