@@ -143,14 +143,16 @@ class _Moments:
         self.sxx, self.stt, self.stx = np.zeros(k), np.zeros(k), np.zeros(k)
 
     def first(self, v: np.ndarray, t: np.ndarray) -> None:
-        ok = ~np.isnan(v)
-        if ok.all():
+        sx = v.sum(axis=0)
+        # finite sums: no NaN in the block (one would make its column's sum NaN)
+        if np.isfinite(sx).all() or not np.isnan(v).any():
             self.n += len(v)
-            self.sx += v.sum(axis=0)
+            self.sx += sx
             self.st += t.sum()
             self.lo = np.minimum(self.lo, v.min(axis=0))
             self.hi = np.maximum(self.hi, v.max(axis=0))
             return
+        ok = ~np.isnan(v)
         for j in range(v.shape[1]):
             w = v[ok[:, j], j]
             if w.size:
@@ -164,13 +166,17 @@ class _Moments:
             mean, tmean = self.sx / self.n, self.st / self.n
         d = v - mean
         tc = t[:, None] - tmean
-        ok = ~np.isnan(d)
-        if not ok.all():
-            d = np.where(ok, d, 0.0)
-            tc = np.where(ok, tc, 0.0)
-        self.sxx += np.einsum("ij,ij->j", d, d)
-        self.stt += np.einsum("ij,ij->j", tc, tc)
-        self.stx += np.einsum("ij,ij->j", tc, d)
+        sums = [np.einsum("ij,ij->j", a, b) for a, b in ((d, d), (tc, tc), (tc, d))]
+        # finite sums: no missing sample in the block (it would make them NaN)
+        if not all(np.isfinite(x).all() for x in sums):
+            ok = ~np.isnan(d)
+            if not ok.all():
+                d = np.where(ok, d, 0.0)
+                tc = np.where(ok, tc, 0.0)
+                sums = [np.einsum("ij,ij->j", a, b) for a, b in ((d, d), (tc, tc), (tc, d))]
+        self.sxx += sums[0]
+        self.stt += sums[1]
+        self.stx += sums[2]
 
 
 def _yaw_centre(ypr: np.ndarray, block: int) -> float | None:
