@@ -270,8 +270,11 @@ class Events:
         quiet = ~self.mask
         out = np.full((len(self), len(cols)), np.nan)
         for j in range(len(cols)):
-            r, _sigma, _knots = _standardise(cols[j], block)
-            sq = np.where(np.isfinite(r), r * r, np.nan)
+            sq, _sigma, _knots = _standardise(cols[j], block)
+            missing = ~np.isfinite(sq)
+            sq *= sq
+            sq[missing] = np.nan
+            del missing
             with np.errstate(invalid="ignore", divide="ignore"):
                 level = np.sqrt(np.nanmean(sq[quiet])) if quiet.any() else np.nan
                 for i, (a, b) in enumerate(zip(self.start_index, self.end_index, strict=True)):
@@ -461,8 +464,8 @@ def _standardise(col: np.ndarray, block: int) -> tuple[np.ndarray, float, tuple 
     knots = (centres[ok], medians[ok])
     r = col - np.interp(np.arange(n), *knots)
     valid = np.isfinite(r)
-    rv = r[valid]
-    sigma = 1.4826 * float(np.median(np.abs(rv)))
+    rv = r if valid.all() else r[valid]
+    sigma = 1.4826 * float(np.median(np.abs(rv), overwrite_input=True))  # its own copy
     if sigma == 0:  # coarse quantization: most samples on one level
         q75, q25 = np.percentile(rv, [75, 25])
         sigma = 0.7413 * float(q75 - q25) or float(np.std(rv))
