@@ -8,6 +8,7 @@ Adding a section is one function in :mod:`.sections` and one entry in
 from __future__ import annotations
 
 import datetime as _dt
+import gc
 import os
 import shutil
 import time
@@ -193,6 +194,9 @@ class Context:
         if self.streamed:
             for log in (self.short, self.long, self.untrimmed):
                 _stream.release_log(log)
+            # arrays a section's reference cycles still hold (its figures), then the heap:
+            # without the collection 7 channel lengths outlived the attitude section
+            gc.collect()
             _stream.trim_heap()
         self.timings.append((name, time.perf_counter() - start, _peak_mib()))
 
