@@ -29,6 +29,21 @@ class Columns:
         arr, col = self._parts[j]
         return _stream.column(arr, col)
 
+    def rows(self, j: int, a: int, b: int) -> np.ndarray:
+        """Rows ``a`` … ``b − 1`` of channel ``j`` as float64 (only those read)."""
+        arr, col = self._parts[j]
+        return np.asarray(arr[a:b] if col is None else arr[a:b, col], dtype=np.float64)
+
+    def arrays(self) -> list[np.ndarray]:
+        """The arrays the columns are read from, in column order, each as (n, k) (a
+        memory map stays one): a sensor's columns together, for reductions that read
+        them side by side."""
+        out: list[np.ndarray] = []
+        for arr, _col in self._parts:
+            if not any(arr is seen for seen in out):
+                out.append(arr)
+        return [a.reshape(len(a), -1) for a in out]
+
 
 def rate_columns(data, fs, channels) -> tuple[Columns, float, tuple[str, ...]]:
     """:func:`rate_channels` a column at a time: the same checks, names and rate, the

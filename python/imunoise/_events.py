@@ -60,7 +60,7 @@ from scipy import signal as _signal
 from scipy import stats as _sstats
 
 from imunoise import _summary
-from imunoise._channels import rate_channels, rate_columns
+from imunoise._channels import rate_columns
 from imunoise._runs import true_runs
 from imunoise._validate import positive_finite
 from imunoise.readers.log import ImuLog
@@ -258,19 +258,23 @@ class Events:
             1 for an event no louder than the quiet noise; NaN where a channel has
             no valid sample in the event.
         """
-        x, _fs, names = rate_channels(data, None if isinstance(data, ImuLog) else self.fs,
-                                      None)
-        if x.shape[0] != self.n_samples or names != self.names:
+        # a channel at a time (a memory-mapped log: one channel in memory)
+        cols, _fs, names = rate_columns(data, None if isinstance(data, ImuLog) else self.fs,
+                                        None)
+        if cols.n != self.n_samples or names != self.names:
             raise ValueError(f"data must be the record of the events ({self.n_samples} "
-                             f"samples of {', '.join(self.names)}); got {x.shape[0]} samples "
+                             f"samples of {', '.join(self.names)}); got {cols.n} samples "
                              f"of {', '.join(names)}")
         baseline = positive_finite(baseline, "baseline", unit="s")
         block = max(2 * self.window, int(round(baseline * self.fs)))
         quiet = ~self.mask
-        out = np.full((len(self), x.shape[1]), np.nan)
-        for j in range(x.shape[1]):
-            r, _sigma = _standardise(x[:, j], block)
-            sq = np.where(np.isfinite(r), r * r, np.nan)
+        out = np.full((len(self), len(cols)), np.nan)
+        for j in range(len(cols)):
+            sq, _sigma, _knots = _standardise(cols[j], block)
+            missing = ~np.isfinite(sq)
+            sq *= sq
+            sq[missing] = np.nan
+            del missing
             with np.errstate(invalid="ignore", divide="ignore"):
                 level = np.sqrt(np.nanmean(sq[quiet])) if quiet.any() else np.nan
                 for i, (a, b) in enumerate(zip(self.start_index, self.end_index, strict=True)):
@@ -393,7 +397,7 @@ def events(
     per_channel = []
     sigma = np.empty(len(cols))
     for j in range(len(cols)):
-        r, mad_sigma = _standardise(cols[j], block)
+        r, mad_sigma, knots = _standardise(cols[j], block)
         # first pass with the noise law of the whole channel, then once more with
         # the law of its quiet part: a record with vibration of its own (the VN-100
         # live capture, 20 % of it) otherwise sets thresholds for quiet noise from
@@ -424,13 +428,15 @@ def events(
         # found by itself is then inside the vibration it was joined to
         inner = _inner_bursts(z, [(a, b, kind) for a, b, kind, _c in joined], windows, p_v,
                               k_spike, isolated)
-        # z again when the events' peaks are read (_merge_channels), not kept: one
-        # channel's samples in memory at a time
-        per_channel.append((joined, (j, scale), [(a, b, kind, {j}) for a, b, kind in inner]))
+        # z again over each event when the events' peaks are read (_merge_channels),
+        # from the baseline's knots: one channel's samples in memory at a time
+        per_channel.append((joined, (j, scale, knots, mad_sigma),
+                            [(a, b, kind, {j}) for a, b, kind in inner]))
         del r, z, quiet, isolated
     return _merge_channels(
-        per_channel, names, fs, n, gap, touch, sigma, lambda j, scale: _standardise(
-            cols[j], block)[0] / np.sqrt(scale),
+        per_channel, names, fs, n, gap, touch, sigma,
+        lambda j, scale, knots, mad_sigma, a, b: _standardised_rows(
+            cols.rows(j, a, b), a, knots, mad_sigma) / np.sqrt(scale),
         k_spike=k_spike,
         energy=float(_sstats.chi2.isf(p_window, w)) / w,
         window=w,
@@ -438,8 +444,9 @@ def events(
     )
 
 
-def _standardise(col: np.ndarray, block: int) -> tuple[np.ndarray, float]:
-    """``(x - baseline)/σ̂`` (NaN where missing) and σ̂ of one channel."""
+def _standardise(col: np.ndarray, block: int) -> tuple[np.ndarray, float, tuple | None]:
+    """``(x - baseline)/σ̂`` (NaN where missing), σ̂ and the knots of the baseline
+    (block centres and medians; None when no block has a valid sample) of one channel."""
     n = len(col)
     starts = np.arange(0, n, block)
     full = n // block
@@ -453,18 +460,31 @@ def _standardise(col: np.ndarray, block: int) -> tuple[np.ndarray, float]:
     centres = np.minimum(starts + block / 2, n) - 0.5
     ok = np.isfinite(medians)
     if not ok.any():
-        return np.full(n, np.nan), float("nan")
-    base = np.interp(np.arange(n), centres[ok], medians[ok])
-    r = col - base
+        return np.full(n, np.nan), float("nan"), None
+    knots = (centres[ok], medians[ok])
+    r = col - np.interp(np.arange(n), *knots)
     valid = np.isfinite(r)
-    rv = r[valid]
-    sigma = 1.4826 * float(np.median(np.abs(rv)))
+    rv = r if valid.all() else r[valid]
+    sigma = 1.4826 * float(np.median(np.abs(rv), overwrite_input=True))  # its own copy
     if sigma == 0:  # coarse quantization: most samples on one level
         q75, q25 = np.percentile(rv, [75, 25])
         sigma = 0.7413 * float(q75 - q25) or float(np.std(rv))
     if sigma == 0:
-        return np.where(valid, 0.0, np.nan), 0.0
-    return r / sigma, sigma
+        return np.where(valid, 0.0, np.nan), 0.0, knots
+    return r / sigma, sigma, knots
+
+
+def _standardised_rows(rows: np.ndarray, a: int, knots: tuple | None,
+                       sigma: float) -> np.ndarray:
+    """:func:`_standardise`'s values at rows ``a`` … ``a + len(rows) − 1`` of a channel
+    (``rows``), from its baseline ``knots`` and σ̂: the same numbers, from those rows
+    only."""
+    if knots is None:
+        return np.full(len(rows), np.nan)
+    r = rows - np.interp(np.arange(a, a + len(rows)), *knots)
+    if sigma == 0:
+        return np.where(np.isfinite(r), 0.0, np.nan)
+    return r / sigma
 
 
 def _raised(seg: np.ndarray, rho: np.ndarray) -> bool:
@@ -657,8 +677,7 @@ def _energy_law(z: np.ndarray, w: int) -> tuple[float, np.ndarray]:
     c = np.clip(z, -3.0, 3.0)
     c = np.where(valid, c - c[valid].mean() if m else 0.0, 0.0)
     acf = _lag_products(c, w)
-    pairs = (len(z) - np.arange(w)).astype(float) if m == len(z) else _lag_products(
-        valid.astype(float), w)
+    pairs = (len(z) - np.arange(w)).astype(float) if m == len(z) else _valid_pairs(valid, w)
     rho = acf / np.maximum(pairs, 1.0) / (acf[0] / max(pairs[0], 1.0)) if acf[0] > 0 \
         else np.zeros(w)
     dof = _dof(rho, w)
@@ -670,6 +689,35 @@ def _energy_law(z: np.ndarray, w: int) -> tuple[float, np.ndarray]:
     median = float(np.median(blocks[complete].mean(axis=1)))
     expected = float(_sstats.chi2.median(dof)) / dof
     return (median / expected if median > 0 else 1.0), rho
+
+
+#: Most runs of missing samples whose pairs :func:`_valid_pairs` counts directly.
+PAIR_RUNS = 512
+
+
+def _valid_pairs(valid: np.ndarray, lags: int) -> np.ndarray:
+    """Σ_i valid_i·valid_(i+k) for k = 0 … lags − 1 (float): the pairs of valid samples
+    k apart, counted from the runs of missing ones, (n − k) less those touching one
+    (missing at i, at i + k, or both); by :func:`_lag_products` when there are more
+    than :data:`PAIR_RUNS` runs."""
+    n = len(valid)
+    start, stop = true_runs(~valid)
+    if start.size > PAIR_RUNS:
+        return _lag_products(valid.astype(float), lags)
+    k = np.arange(lags)
+
+    def missing_below(end: np.ndarray) -> np.ndarray:  # missing samples in [0, end)
+        return np.clip(np.minimum(stop[:, None], end[None, :]) - start[:, None], 0,
+                       None).sum(axis=0)
+
+    both = np.zeros(lags, dtype=np.int64)  # i and i + k both missing
+    for r in range(start.size):
+        near = slice(r, int(np.searchsorted(start, stop[r] + lags)))  # runs after it, close
+        both += np.clip(np.minimum(stop[r], stop[near, None] - k[None, :])
+                        - np.maximum(start[r], start[near, None] - k[None, :]), 0,
+                        None).sum(axis=0)
+    total = int(stop.sum() - start.sum())
+    return ((n - k) - missing_below(n - k) - (total - missing_below(k)) + both).astype(float)
 
 
 #: Bytes of block transforms :func:`_lag_products` holds at once.
@@ -714,8 +762,21 @@ def _tail_dof(z: np.ndarray) -> float:
     z = z[np.isfinite(z)]
     if z.size < 8:
         return CHANGE_POINT_DOF
-    excess = float(_sstats.kurtosis(z))
+    excess = _excess_kurtosis(z)
     return 1e6 if excess <= 6 / (1e6 - 4) else max(CHANGE_POINT_DOF, 4 + 6 / excess)
+
+
+def _excess_kurtosis(z: np.ndarray) -> float:
+    """``scipy.stats.kurtosis(z)`` of finite samples, the same operations (its central
+    moments m2 = mean(d²), m4 = mean((d²)²)) without its checks and copies."""
+    mean = z.mean()
+    square = z - mean
+    square *= square
+    m2 = square.mean()
+    if m2 <= (np.finfo(np.float64).eps * mean) ** 2:
+        return float("nan")
+    square *= square
+    return float(square.mean() / m2**2.0 - 3)
 
 
 def _change_points(seg: np.ndarray, nu: float) -> tuple[int, int]:
@@ -826,19 +887,17 @@ def _join_kind(spans: list[tuple], gap: int) -> list[list]:
 def _merge_channels(per_channel, names, fs, n, gap, touch, sigma, standardised,
                     **thresholds) -> Events:
     """One event per overlapping group of the channels' events; a group's peak is the
-    largest |z| of its channels in it (``standardised(*key)``: a channel's z, from the
-    key each entry of ``per_channel`` holds)."""
+    largest |z| of its channels in it (``standardised(*key, a, b)``: a channel's z over
+    rows a … b − 1, from the key each entry of ``per_channel`` holds)."""
     groups = _join([span for spans, _z, _in in per_channel for span in spans], gap, touch)
     nested = _join_kind(sorted((span for _s, _z, inner in per_channel for span in inner),
                                key=lambda span: span[:3]), gap)
     groups = sorted(groups + nested, key=lambda g: (g[0], g[1]))
     per_group: list[dict[int, float]] = [{} for _g in groups]
     for j in sorted({j for g in groups for j in g[3]}):
-        z = standardised(*per_channel[j][1])
         for i, (a, b, _k, chans) in enumerate(groups):
             if j in chans:
-                per_group[i][j] = _peak(z[a:b])
-        del z
+                per_group[i][j] = _peak(standardised(*per_channel[j][1], a, b))
     peaks = [max(found[j] for j in g[3]) for g, found in zip(groups, per_group, strict=True)]
     return Events(
         fs=fs,

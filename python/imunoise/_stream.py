@@ -26,7 +26,7 @@ from imunoise import _schema
 from imunoise.readers.log import ImuLog
 
 __all__ = ["BLOCK_ROWS", "PARSE_BYTES", "STREAM_BYTES", "blocks", "column", "describe",
-           "is_mapped", "open_mapped", "release", "release_log", "workdir_for"]
+           "is_mapped", "open_mapped", "release", "release_log", "trim_heap", "workdir_for"]
 
 #: VN logs larger than this are streamed by default (parsed once into memory maps).
 STREAM_BYTES = 256 << 20
@@ -79,6 +79,27 @@ def release(*arrays) -> None:
                 pass
 
 
+def trim_heap() -> None:
+    """Give the C heap's free memory back to the system (glibc's ``malloc_trim``):
+    arrays numpy freed below malloc's mmap threshold (up to 32 MiB, which it raises
+    as larger blocks come and go) otherwise stay resident. No-op elsewhere."""
+    global _LIBC
+    if _LIBC is None:
+        import ctypes
+        import ctypes.util
+
+        try:
+            _LIBC = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6")
+            _LIBC.malloc_trim  # noqa: B018 - present on glibc only
+        except (OSError, AttributeError):
+            _LIBC = False
+    if _LIBC:
+        _LIBC.malloc_trim(0)
+
+
+_LIBC = None
+
+
 def release_log(log: ImuLog | None) -> None:
     """:func:`release` every channel of ``log``."""
     if log is not None:
@@ -122,14 +143,16 @@ class _Moments:
         self.sxx, self.stt, self.stx = np.zeros(k), np.zeros(k), np.zeros(k)
 
     def first(self, v: np.ndarray, t: np.ndarray) -> None:
-        ok = ~np.isnan(v)
-        if ok.all():
+        sx = v.sum(axis=0)
+        # finite sums: no NaN in the block (one would make its column's sum NaN)
+        if np.isfinite(sx).all() or not np.isnan(v).any():
             self.n += len(v)
-            self.sx += v.sum(axis=0)
+            self.sx += sx
             self.st += t.sum()
             self.lo = np.minimum(self.lo, v.min(axis=0))
             self.hi = np.maximum(self.hi, v.max(axis=0))
             return
+        ok = ~np.isnan(v)
         for j in range(v.shape[1]):
             w = v[ok[:, j], j]
             if w.size:
@@ -143,13 +166,17 @@ class _Moments:
             mean, tmean = self.sx / self.n, self.st / self.n
         d = v - mean
         tc = t[:, None] - tmean
-        ok = ~np.isnan(d)
-        if not ok.all():
-            d = np.where(ok, d, 0.0)
-            tc = np.where(ok, tc, 0.0)
-        self.sxx += np.einsum("ij,ij->j", d, d)
-        self.stt += np.einsum("ij,ij->j", tc, tc)
-        self.stx += np.einsum("ij,ij->j", tc, d)
+        sums = [np.einsum("ij,ij->j", a, b) for a, b in ((d, d), (tc, tc), (tc, d))]
+        # finite sums: no missing sample in the block (it would make them NaN)
+        if not all(np.isfinite(x).all() for x in sums):
+            ok = ~np.isnan(d)
+            if not ok.all():
+                d = np.where(ok, d, 0.0)
+                tc = np.where(ok, tc, 0.0)
+                sums = [np.einsum("ij,ij->j", a, b) for a, b in ((d, d), (tc, tc), (tc, d))]
+        self.sxx += sums[0]
+        self.stt += sums[1]
+        self.stx += sums[2]
 
 
 def _yaw_centre(ypr: np.ndarray, block: int) -> float | None:

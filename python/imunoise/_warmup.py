@@ -55,8 +55,8 @@ import numpy as np
 from scipy import optimize as _opt
 from scipy import stats as _stats
 
-from imunoise import _summary
-from imunoise._channels import rate_channels
+from imunoise import _stream, _summary
+from imunoise._channels import rate_columns
 from imunoise._simulate import simulate
 from imunoise.allan import adev
 from imunoise.noise import fit, model_variance
@@ -269,8 +269,8 @@ def warmup(
     -------
     Warmup
     """
-    x, fs, names = rate_channels(data, fs, channels)
-    n = x.shape[0]
+    cols, fs, names = rate_columns(data, fs, channels)  # one channel in memory at a time
+    n = cols.n
     duration = n / fs
     if not 0 < alpha < 1:
         raise ValueError(f"alpha must be in (0, 1); got {alpha!r}")
@@ -288,17 +288,23 @@ def warmup(
         warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN blocks stay NaN
         # a group of blocks at a time: nanmean copies what it is given (NaN → 0) and
         # each block's mean depends on its own samples only
+        # (a sensor at a time: its columns side by side, summed as the whole log's were;
+        # a memory map's pages given back behind it)
         group = max(1, BIAS_GROUP_ROWS // size)
-        bias = np.concatenate([
-            np.nanmean(x[g * size:min(g + group, m) * size].reshape(-1, size, x.shape[1]),
-                       axis=1) for g in range(0, m, group)])
-    k = x.shape[1]
+        parts = []
+        for x in cols.arrays():
+            parts.append(np.concatenate([
+                np.nanmean(np.asarray(x[g * size:min(g + group, m) * size], dtype=np.float64)
+                           .reshape(-1, size, x.shape[1]), axis=1) for g in range(0, m, group)]))
+            _stream.release(x)
+        bias = np.hstack(parts)
+    k = len(cols)
     temp = _temperature(data, temperature, n)
     fits = [_fit_exponential(t, bias[:, j], duration) for j in range(k)]
     final, amp, tau, amp_sd, tau_sd = (np.array(v) for v in zip(*fits, strict=True))
-    p = _null_p_values(x, fs, t, bias, duration, seed)
+    p = _null_p_values(cols, fs, t, bias, duration, seed)
     significant = (p < alpha) & (tau < duration / 2)
-    tol = _tolerance(tolerance, x, amp, tau, fs)
+    tol = _tolerance(tolerance, cols, amp, tau, fs)
     ts, ts_sd = _settle_times(amp, tau, amp_sd, tau_sd, tol, significant)
     ts = np.minimum(ts, duration)
     t_fit = (np.nan, np.nan, np.nan)
@@ -368,9 +374,9 @@ def _explained(t: np.ndarray, y: np.ndarray, taus: np.ndarray) -> np.ndarray:
         return np.where(total > 0, best / total, 0.0)
 
 
-def _null_p_values(x, fs, t, bias, duration, seed) -> np.ndarray:
+def _null_p_values(cols, fs, t, bias, duration, seed) -> np.ndarray:
     """p of each channel's transient against records of its own stationary noise
-    (the noise model of the second half of the samples ``x``, simulated at the
+    (the noise model of the second half of the columns ``cols``, simulated at the
     block rate)."""
     k = bias.shape[1]
     p = np.ones(k)
@@ -384,7 +390,8 @@ def _null_p_values(x, fs, t, bias, duration, seed) -> np.ndarray:
     taus = taus[taus < duration / 2]  # as the significance rule: longer is drift
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # a poorly followed curve still bounds the wander
-        half = adev(x[len(x) // 2:, ok], fs)
+        half = adev(np.column_stack([cols.rows(j, cols.n // 2, cols.n)
+                                     for j in np.flatnonzero(ok)]), fs)
         model = fit(half, warn_coverage=False)
     k_floor = _random_walk_bound(half, model)
     rng = np.random.default_rng(seed)
@@ -452,10 +459,10 @@ def _transient(amp, tau, n, fs) -> np.ndarray:
     return np.where(finite, amp * np.exp(-t[:, None] / np.where(finite, tau, 1.0)), 0.0)
 
 
-def _residual(x, amp, tau, fs, j: int) -> np.ndarray:
-    """Channel ``j`` of ``x`` without its fitted transient (:func:`_transient`), one
+def _residual(cols, amp, tau, fs, j: int) -> np.ndarray:
+    """Channel ``j`` of ``cols`` without its fitted transient (:func:`_transient`), one
     channel in memory at a time."""
-    return x[:, j] - _transient(amp[j:j + 1], tau[j:j + 1], len(x), fs)[:, 0]
+    return cols[j] - _transient(amp[j:j + 1], tau[j:j + 1], cols.n, fs)[:, 0]
 
 
 def _fit_exponential(t, y, duration):
@@ -490,11 +497,11 @@ def _fit_exponential(t, y, duration):
     return float(c), float(a), float(tau), float(sd[1]), float(sd[2])
 
 
-def _tolerance(tolerance, x, amp, tau, fs) -> np.ndarray:
-    """The given tolerance per channel, or the Allan-deviation floor of the samples
-    ``x`` without their transient (channel by channel: the Allan statistics of one
+def _tolerance(tolerance, cols, amp, tau, fs) -> np.ndarray:
+    """The given tolerance per channel, or the Allan-deviation floor of the columns
+    ``cols`` without their transient (channel by channel: the Allan statistics of one
     channel do not depend on the others)."""
-    k = x.shape[1]
+    k = len(cols)
     if tolerance is not None:
         tol = np.broadcast_to(np.asarray(tolerance, dtype=float), (k,)).copy()
         if not np.all(np.isfinite(tol) & (tol > 0)):
@@ -502,7 +509,7 @@ def _tolerance(tolerance, x, amp, tau, fs) -> np.ndarray:
         return tol
     floor = np.empty(k)
     for j in range(k):
-        r = adev(_residual(x, amp, tau, fs, j), fs)
+        r = adev(_residual(cols, amp, tau, fs, j), fs)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", RuntimeWarning)
             floor[j] = np.nanmin(r.dev)

@@ -375,25 +375,27 @@ def dynamic_adev(
 # -- the computation ---------------------------------------------------------------
 
 
-def _phase(y: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
-    """Cumulative sum c (channels, n + 1) of the mean-removed samples (NaN as 0), and the
-    running count of missing samples (None when there is none). Summed in blocks of
-    :data:`_BLOCK` whose totals are added pairwise, so the error grows with the block,
-    not the record."""
-    missing = np.isnan(y)
-    any_missing = bool(missing.any())
-    centred = y - (np.nanmean(y, axis=0) if any_missing else y.mean(axis=0))
-    if any_missing:
+def _phase(y: np.ndarray, mean: np.ndarray, any_missing: bool
+           ) -> tuple[np.ndarray, np.ndarray | None]:
+    """Cumulative sum c (channels, n + 1) of the samples ``y`` less ``mean`` (NaN as 0),
+    and the running count of missing samples (None when the record has none:
+    ``any_missing``). Summed in blocks of :data:`_BLOCK` whose totals are added
+    pairwise, so the error grows with the block, not the record."""
+    centred = y - mean
+    missing = np.isnan(y) if any_missing else None
+    if missing is not None:
         centred[missing] = 0.0
     n, ch = centred.shape
     pad = (-n) % _BLOCK
     blocks = np.concatenate([centred.T, np.zeros((ch, pad))], axis=1).reshape(ch, -1, _BLOCK)
+    del centred
     inner = np.cumsum(blocks, axis=2)
     inner += np.concatenate([np.zeros((ch, 1)), np.cumsum(blocks.sum(axis=2), axis=1)[:, :-1]],
                             axis=1)[:, :, None]
+    del blocks
     c = np.zeros((ch, n + 1))
     c[:, 1:] = inner.reshape(ch, -1)[:, :n]
-    if not any_missing:
+    if missing is None:
         return c, None
     bad = np.zeros((ch, n + 1), dtype=np.int64)
     np.cumsum(missing.T, axis=1, out=bad[:, 1:])
@@ -412,36 +414,46 @@ def _prefix_at(values: np.ndarray, points: np.ndarray) -> np.ndarray:
 
 def _window_sums(data, m, starts, width, stride):
     """Sums of the squared second differences and their counts, (W, T, channels), of
-    every window; and per tau searched for intervals, the same per block of ``stride``."""
-    c, bad = _phase(data)
+    every window; and per tau searched for intervals, the same per block of ``stride``.
+    A channel at a time (the phase and the differences of one channel in memory), each
+    centred on its mean over the whole record."""
     n, ch = data.shape
+    any_missing = bool(np.isnan(data).any())
+    mean = np.nanmean(data, axis=0) if any_missing else data.mean(axis=0)
     sums = np.empty((len(starts), len(m), ch))
     counts = np.empty((len(starts), len(m), ch))
     block_edges = np.arange(0, n + 1, stride, dtype=np.int64)
-    blocks = []
-    for t, mm in enumerate(int(v) for v in m):
-        k = n + 1 - 2 * mm
-        second = c[:, 2 * mm:] + c[:, :k]
-        second -= 2.0 * c[:, mm:mm + k]
-        second *= second
-        last = starts + width + 1 - 2 * mm
-        edges = np.minimum(block_edges, k)
-        points = np.r_[starts, last, edges]
-        if bad is None:
-            prefix = _prefix_at(second, points)
-            terms = np.broadcast_to(points, prefix.shape)
-        else:
-            ok = (bad[:, 2 * mm:] - bad[:, :k]) == 0
-            second[~ok] = 0.0
-            prefix = _prefix_at(second, points)
-            terms = _prefix_at(ok.astype(np.int64), points)
-        w, e = len(starts), len(edges)
-        sums[:, t] = (prefix[:, w:2 * w] - prefix[:, :w]).T
-        counts[:, t] = (terms[:, w:2 * w] - terms[:, :w]).T
-        if mm * _BLOCK_TERMS_PER_M <= stride:
-            block_p, block_n = prefix[:, 2 * w:2 * w + e], terms[:, 2 * w:2 * w + e]
-            blocks.append((t, np.diff(block_p, axis=1).T, np.diff(block_n, axis=1).T))
-    return sums, counts, tuple(blocks)
+    per_tau: dict[int, list[tuple[np.ndarray, np.ndarray]]] = {}
+    for j in range(ch):
+        c, bad = _phase(data[:, j:j + 1], mean[j:j + 1], any_missing)
+        for t, mm in enumerate(int(v) for v in m):
+            k = n + 1 - 2 * mm
+            second = c[:, 2 * mm:] + c[:, :k]
+            second -= 2.0 * c[:, mm:mm + k]
+            second *= second
+            last = starts + width + 1 - 2 * mm
+            edges = np.minimum(block_edges, k)
+            points = np.r_[starts, last, edges]
+            if bad is None:
+                prefix = _prefix_at(second, points)
+                terms = np.broadcast_to(points, prefix.shape)
+            else:
+                ok = (bad[:, 2 * mm:] - bad[:, :k]) == 0
+                second[~ok] = 0.0
+                prefix = _prefix_at(second, points)
+                terms = _prefix_at(ok.astype(np.int64), points)
+            del second
+            w, e = len(starts), len(edges)
+            sums[:, t, j] = prefix[0, w:2 * w] - prefix[0, :w]
+            counts[:, t, j] = terms[0, w:2 * w] - terms[0, :w]
+            if mm * _BLOCK_TERMS_PER_M <= stride:
+                block_p, block_n = prefix[:, 2 * w:2 * w + e], terms[:, 2 * w:2 * w + e]
+                per_tau.setdefault(t, []).append((np.diff(block_p, axis=1).T,
+                                                  np.diff(block_n, axis=1).T))
+        del c, bad
+    blocks = tuple((t, np.hstack([p for p, _n in parts]), np.hstack([q for _p, q in parts]))
+                   for t, parts in per_tau.items())
+    return sums, counts, blocks
 
 
 def _edf(n_phase: int, alpha: np.ndarray, m: np.ndarray) -> np.ndarray:

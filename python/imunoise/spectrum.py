@@ -486,16 +486,26 @@ def _segment_starts(present: np.ndarray, seg: int) -> np.ndarray:
     return starts[missing[starts + seg] == missing[starts]]
 
 
+#: Segment samples (segments × length × channels) the Welch average transforms at once:
+#: ``scipy.signal.welch`` holds every segment, its windowed copy and its transform
+#: together, about four times a long record (1.3 GB for 2 h of gyro at 800 Hz); a
+#: gap-free record with more is averaged a group of segments at a time.
+WELCH_PIECE = 1 << 22
+
+
 def _welch(data: np.ndarray, fs: float, seg: int, starts: np.ndarray):
     """Frequencies (0 excluded) and the mean Hann periodogram (F, channels) of the
     segments of ``data`` starting at ``starts``, each with its mean removed:
     ``scipy.signal.welch`` where no segment is left out."""
-    if starts.size == _segment_count(len(data), seg):
+    complete = starts.size == _segment_count(len(data), seg)
+    if complete and starts.size * seg * data.shape[1] <= WELCH_PIECE:
         f, p = _signal.welch(data, fs=fs, window="hann", nperseg=seg, noverlap=seg // 2,
                              detrend="constant", scaling="density", axis=0)
         return f[1:], p[1:]
+    pieces = starts.size * seg * data.shape[1] // WELCH_PIECE if complete else \
+        starts.size * seg // (1 << 22)
     p = 0.0
-    for chunk in np.array_split(starts, max(1, starts.size * seg // (1 << 22))):
+    for chunk in np.array_split(starts, max(1, pieces)):
         pieces = np.lib.stride_tricks.sliding_window_view(data, seg, axis=0)[chunk]
         f, q = _signal.welch(pieces, fs=fs, window="hann", nperseg=seg, noverlap=0,
                              detrend="constant", scaling="density", axis=-1)

@@ -55,6 +55,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from scipy import special as _special
 from scipy import stats as _sstats
 
 from imunoise import _schema, _summary
@@ -94,6 +95,9 @@ KS_EXACT_MAX_N = 10_000
 #: variance (Stephens 1974; as scipy.stats.anderson) at these significance levels (%).
 _AD_NORM = np.array([0.576, 0.656, 0.787, 0.918, 1.092])
 _AD_LEVELS = np.array([15.0, 10.0, 5.0, 2.5, 1.0])
+#: Sorted samples :func:`distribution` evaluates at once (the CDF, the moments): its
+#: memory beyond the samples and their sorted copy is a few arrays of this length.
+CHUNK = 1 << 20
 
 
 @dataclass(frozen=True, repr=False)
@@ -370,21 +374,29 @@ def quantization_step(x, *, rtol: float = 1e-3) -> float | None:
 
 
 def _step_of_levels(v: np.ndarray, rtol: float = 1e-3) -> float | None:
-    """:func:`quantization_step` of sorted unique finite values ``v``."""
+    """:func:`quantization_step` of sorted finite values ``v`` (unique or not: the
+    differences between equal values are left out), read :data:`CHUNK` values at a
+    time: continuous data are told apart without an array of all the differences."""
     if len(v) < 2:
         return None
-    d = np.diff(v)
     scale = max(abs(v[0]), abs(v[-1]))
     # Differences at the level of float rounding are not steps of the data.
-    d = d[d > 64 * np.finfo(np.float64).eps * scale]
-    if len(d) == 0:
+    tiny = 64 * np.finfo(np.float64).eps * scale
+
+    def diffs():
+        for a in range(0, len(v) - 1, CHUNK):
+            d = np.diff(v[a:a + CHUNK + 1])
+            yield d[d > tiny]
+
+    dmin = min((float(d.min()) for d in diffs() if d.size), default=None)
+    if dmin is None:
         return None
-    dmin = d.min()
     for k in range(1, 11):
         q = dmin / k
-        r = d / q
-        if np.all(np.abs(r - np.round(r)) <= rtol):
-            return float(np.mean(d / np.round(r)))
+        # chunk by chunk: the first chunk off the grid settles it
+        if all(np.all(np.abs(r - np.round(r)) <= rtol) for r in (d / q for d in diffs())):
+            d = np.concatenate(list(diffs()))
+            return float(np.mean(d / np.round(d / q)))
     return None
 
 
@@ -583,13 +595,13 @@ def distribution(x, *, bins="auto", qq_points: int = 1001, extent: str = "bulk")
 
     n = len(arr)
     xs = np.sort(arr)
-    levels = xs[np.concatenate(([True], xs[1:] != xs[:-1]))]
-    step = _step_of_levels(levels)
+    step = _step_of_levels(xs)
     shown = _bulk(xs) if extent == "bulk" else xs
     if step is None:
         spacing = None
         edges = _edges(shown, bins, None)
     else:
+        levels = xs[np.concatenate(([True], xs[1:] != xs[:-1]))]
         spacing = _level_spacing(xs, levels, step)
         edges = _edges(shown, bins, spacing)
         if isinstance(bins, str) or np.ndim(bins) == 0:
@@ -602,27 +614,17 @@ def distribution(x, *, bins="auto", qq_points: int = 1001, extent: str = "bulk")
     # Normal fit by maximum likelihood (what scipy.stats.norm.fit returns).
     # in units of the largest |x|: squares and fourth powers of values near 1e100
     # would overflow
-    scale = float(np.max(np.abs(xs))) or 1.0
-    u = xs / scale
-    mu_u = float(u.mean())
-    sigma_u = float(np.sqrt(np.mean((u - mu_u) ** 2)))
+    scale = max(abs(float(xs[0])), abs(float(xs[-1]))) or 1.0
+    mu_u = _chunk_sum(xs, lambda v: v / scale) / n
+    sigma_u = float(np.sqrt(_chunk_sum(xs, lambda v: np.square(v / scale - mu_u)) / n))
     mu, sigma = mu_u * scale, sigma_u * scale
     if sigma > 0:
-        i = np.arange(1, n + 1, dtype=np.float64)
-        cdf = _sstats.norm.cdf(xs, mu, sigma)
-        ks_stat = float(max(np.max(i / n - cdf), np.max(cdf - (i - 1) / n)))
+        ks_stat, ad_stat, skew, kurt = _normality(xs, scale, mu_u, sigma_u)
         if n <= KS_EXACT_MAX_N:
             ks_p = float(_sstats.kstwo.sf(ks_stat, n))
         else:
             ks_p = float(_sstats.kstwobign.sf(ks_stat * np.sqrt(n)))
-        w = (u - mu_u) / (sigma_u * np.sqrt(n / (n - 1)))
-        logcdf = _sstats.norm.logcdf(w)
-        logsf = _sstats.norm.logsf(w)
-        ad_stat = float(-n - np.sum((2 * i - 1.0) / n * (logcdf + logsf[::-1])))
         ad_crit = np.around(_AD_NORM / (1.0 + 4.0 / n - 25.0 / n / n), 3)
-        standard = (u - mu_u) / sigma_u
-        skew = float(np.mean(standard**3))
-        kurt = float(np.mean(standard**4) - 3.0)
     else:
         ks_stat = ks_p = ad_stat = skew = kurt = float("nan")
         ad_crit = np.full(5, np.nan)
@@ -651,6 +653,43 @@ def distribution(x, *, bins="auto", qq_points: int = 1001, extent: str = "bulk")
         **_fit_uncertainty(arr, sigma),
         **off_scale,
     )
+
+
+def _chunk_sum(xs: np.ndarray, f) -> float:
+    """Σ f(xs) over chunks of :data:`CHUNK` samples (numpy's pairwise sum within each:
+    one chunk is ``np.sum(f(xs))``)."""
+    return float(sum(np.add.reduce(f(xs[a:a + CHUNK])) for a in range(0, len(xs), CHUNK)))
+
+
+def _normality(xs: np.ndarray, scale: float, mu_u: float,
+               sigma_u: float) -> tuple[float, float, float, float]:
+    """KS D, Anderson–Darling A², skewness and excess kurtosis of the sorted samples
+    ``xs`` against the normal fit (mean ``mu_u``, σ ``sigma_u`` in units of ``scale``),
+    a chunk of :data:`CHUNK` samples at a time: ``scipy.stats.norm``'s cdf, logcdf and
+    logsf are ``ndtr(x)``, ``log_ndtr(x)`` and ``log_ndtr(−x)`` of the standardised
+    samples."""
+    n = len(xs)
+    mu, sigma = mu_u * scale, sigma_u * scale
+    w_scale = sigma_u * np.sqrt(n / (n - 1))  # A² with ddof = 1, as scipy.stats.anderson
+    ks = -np.inf
+    ad = m3 = m4 = 0.0
+    for a in range(0, n, CHUNK):
+        b = min(n, a + CHUNK)
+        x = xs[a:b]
+        i = np.arange(a + 1, b + 1, dtype=np.float64)
+        cdf = _special.ndtr((x - mu) / sigma)
+        ks = max(ks, float(np.max(i / n - cdf)), float(np.max(cdf - (i - 1) / n)))
+        u = x / scale
+        # sample i pairs with sample n + 1 − i: the mirror chunk, reversed
+        mirror = xs[n - b:n - a][::-1] / scale
+        ad += float(np.add.reduce((2 * i - 1.0) / n * (
+            _special.log_ndtr((u - mu_u) / w_scale)
+            + _special.log_ndtr(-((mirror - mu_u) / w_scale)))))
+        standard = (u - mu_u) / sigma_u
+        square = standard * standard
+        m3 += float(np.add.reduce(square * standard))
+        m4 += float(np.add.reduce(square * square))
+    return ks, float(-n - ad), m3 / n, m4 / n - 3.0
 
 
 def _bulk(xs: np.ndarray) -> np.ndarray:

@@ -157,3 +157,21 @@ def test_log_channel_that_is_not_there():
     log = imunoise.ImuLog.from_arrays(FS, gyro=np.zeros((1000, 3)))
     with pytest.raises(ValueError, match=r"channels \['accel'\] are not in the log"):
         imunoise.events(log, channels="accel")
+
+
+@pytest.mark.parametrize("runs", [0, 1, 7, 40])
+def test_valid_pairs_count_every_pair_of_valid_samples(runs, monkeypatch):
+    """The pairs of valid samples k apart behind the energy law's autocorrelation,
+    counted from the runs of missing samples (or by FFT beyond PAIR_RUNS runs), are
+    the brute-force counts."""
+    from imunoise import _events
+
+    rng = np.random.default_rng(runs)
+    n, lags = 3000, 250
+    valid = np.ones(n, dtype=bool)
+    for a in rng.integers(0, n, runs):
+        valid[a:a + rng.integers(1, 300)] = False  # runs may touch, overlap, end the record
+    brute = np.array([np.sum(valid[:n - k] & valid[k:]) for k in range(lags)], dtype=float)
+    np.testing.assert_array_equal(_events._valid_pairs(valid, lags), brute)
+    monkeypatch.setattr(_events, "PAIR_RUNS", 0)
+    np.testing.assert_allclose(_events._valid_pairs(valid, lags), brute, atol=1e-6)

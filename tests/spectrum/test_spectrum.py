@@ -341,3 +341,16 @@ def test_plot_range_holds_every_panels_line():
     highest = max(float(np.nanmax(line.get_ydata())) for ax in fig.axes[:3]
                   for line in ax.lines if line.get_label() == "PSD")
     assert highest < top, (highest, top)
+
+
+def test_long_record_welch_by_groups_of_segments_is_scipys(monkeypatch):
+    """A gap-free record with more segment samples than ``WELCH_PIECE`` is averaged a
+    group of segments at a time (bounded memory): the periodogram of scipy's welch."""
+    from scipy import signal
+
+    y = np.random.default_rng(5).normal(size=(40_000, 3))
+    monkeypatch.setattr(spectrum, "WELCH_PIECE", 3 * 4096)
+    s = imunoise.psd(y, 100.0, nperseg=1024)
+    f, p = signal.welch(y, fs=100.0, window="hann", nperseg=1024, noverlap=512, axis=0)
+    np.testing.assert_allclose(s.f, f[1:])
+    np.testing.assert_allclose(s.psd, p[1:], rtol=1e-12)

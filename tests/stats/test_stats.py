@@ -5,6 +5,7 @@ import warnings
 import imunoise
 import numpy as np
 import pytest
+from imunoise import stats
 from imunoise.stats import quantization_step
 from scipy import stats as sstats
 
@@ -85,6 +86,28 @@ def test_distribution_matches_scipy():
     np.testing.assert_allclose(np.sum(d.density() * np.diff(d.edges)), 1.0)
     assert np.all(np.diff(d.qq_sample) >= 0)
     np.testing.assert_allclose(d.qq_sample, np.quantile(x, sstats.norm.cdf(d.qq_theoretical)))
+
+
+def test_distribution_in_chunks_is_the_whole_sample(monkeypatch):
+    """Chunks of the sorted samples (a prime count, so the mirror chunks of A² are
+    cut elsewhere than the chunks) give scipy's statistics and the same step."""
+    rng = np.random.default_rng(3)
+    x = rng.standard_t(8, size=20_000) * 0.2 + 1.0
+    quantized = np.round(x, 3)
+    whole = imunoise.distribution(quantized)
+    monkeypatch.setattr(stats, "CHUNK", 997)
+    d = imunoise.distribution(x)
+    assert d.ks_statistic == pytest.approx(
+        sstats.kstest(x, "norm", args=sstats.norm.fit(x)).statistic, rel=1e-12)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", FutureWarning)
+        assert d.ad_statistic == pytest.approx(sstats.anderson(x, "norm").statistic, rel=1e-9)
+    assert d.skewness == pytest.approx(sstats.skew(x), rel=1e-12)
+    assert d.excess_kurtosis == pytest.approx(sstats.kurtosis(x), rel=1e-12)
+    assert d.step is None
+    q = imunoise.distribution(quantized)
+    assert q.step == whole.step == pytest.approx(1e-3)
+    np.testing.assert_array_equal(q.counts, whole.counts)
 
 
 @pytest.mark.parametrize("step", [1e-3, 0.5, 2.0**-12, 1e-6])

@@ -8,6 +8,7 @@ Adding a section is one function in :mod:`.sections` and one entry in
 from __future__ import annotations
 
 import datetime as _dt
+import gc
 import os
 import shutil
 import time
@@ -93,17 +94,25 @@ class Context:
         return out
 
     @cached_property
+    def has_attitude(self) -> bool:
+        """Whether the short log has an attitude channel with a finite value."""
+        ypr = self.short.ypr
+        if ypr is None:
+            return False
+        if not self.streamed:
+            return bool(np.any(np.isfinite(ypr)))
+        return any(np.isfinite(rows).any() for _a, rows in _stream.blocks(ypr, self.block))
+
     def attitude(self) -> dict[str, np.ndarray] | None:
         """``{"yaw": …, "pitch": …, "roll": …}`` (degrees) of the short log, yaw
         unwrapped about its circular mean so that a heading near ±180° stays in
-        one piece; None when the log has no attitude."""
+        one piece; None when the log has no attitude. Computed on each call, not
+        kept (three channels of the log)."""
+        if not self.has_attitude:
+            return None
         ypr = self.short.ypr
-        if ypr is None:
-            return None
         if not self.streamed:
-            return stats.attitude_angles(ypr) if np.any(np.isfinite(ypr)) else None
-        if not any(np.isfinite(rows).any() for _a, rows in _stream.blocks(ypr, self.block)):
-            return None
+            return stats.attitude_angles(ypr)
         angles = {name: _stream.column(ypr, j, self.block)
                   for j, name in enumerate(_schema.ATTITUDE_NAMES)}
         angles["yaw"] = stats.unwrap_about_circular_mean(angles["yaw"])
@@ -113,7 +122,7 @@ class Context:
     def attitude_distributions(self) -> dict[str, stats.Distribution]:
         """Normal fit of each attitude angle of the short log (missing samples left out)."""
         return {name: stats.distribution(v[np.isfinite(v)])
-                for name, v in (self.attitude or {}).items()}
+                for name, v in (self.attitude() or {}).items()}
 
     @property
     def distributions(self) -> dict[str, stats.Distribution]:
@@ -124,9 +133,13 @@ class Context:
     @cached_property
     def allan(self) -> dict[str, _allan.AllanResult]:
         """Overlapping Allan deviation per sensor of the long log on the report's grid."""
-        return {sensor: _allan.adev(getattr(self.long, sensor), self.long.fs,
-                                    taus=self.taus_per_decade)
-                for sensor in ALLAN_SENSORS if getattr(self.long, sensor) is not None}
+        out = {}
+        for sensor in ALLAN_SENSORS:
+            y = getattr(self.long, sensor)
+            if y is not None:
+                out[sensor] = _allan.adev(y, self.long.fs, taus=self.taus_per_decade)
+                _stream.release(y)  # a memory map's pages, before the next sensor's
+        return out
 
     @cached_property
     def models(self) -> dict[str, noise.NoiseModel]:
@@ -181,6 +194,10 @@ class Context:
         if self.streamed:
             for log in (self.short, self.long, self.untrimmed):
                 _stream.release_log(log)
+            # arrays a section's reference cycles still hold (its figures), then the heap:
+            # without the collection 7 channel lengths outlived the attitude section
+            gc.collect()
+            _stream.trim_heap()
         self.timings.append((name, time.perf_counter() - start, _peak_mib()))
 
     def add_figure(self, doc: Doc, fig, name: str, caption: str) -> None:
@@ -210,7 +227,7 @@ SECTIONS: tuple[Section, ...] = (
     Section("Sample statistics", sections.sample_statistics),
     Section("Distribution fits", sections.distribution_fits),
     Section("Attitude (yaw, pitch, roll)", sections.attitude,
-            applies=lambda ctx: ctx.attitude is not None),
+            applies=lambda ctx: ctx.has_attitude),
     Section("Events (vibration, shocks, spikes)", sections.events_section,
             applies=lambda ctx: ctx.events is not None and len(ctx.events) > 0),
     Section("Warm-up", sections.warmup_section, applies=lambda ctx: ctx.warmup is not None),

@@ -13,8 +13,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from imunoise import _stream, noise, numbers, plot, stats, units
 from imunoise import allan as _allan
-from imunoise import noise, numbers, plot, stats, units
 from imunoise._schema import CHANNELS, SAMPLE_SENSORS, axis_names
 from imunoise.numbers import format_value
 from imunoise.planner import fit_line
@@ -118,6 +118,7 @@ def recording_summary(ctx: Context, doc: Doc) -> None:
                                    gaps=shade)
             ctx.add_figure(doc, fig, f"timeseries_{label}_{sensor}",
                            f"Time series of {which}: {sensor} [{unit}] (min/max per pixel)")
+            _stream.release(y)  # a memory map's pages, before the next sensor's
 
 
 def sample_statistics(ctx: Context, doc: Doc) -> None:
@@ -169,7 +170,7 @@ def distribution_fits(ctx: Context, doc: Doc) -> None:
 def attitude(ctx: Context, doc: Doc) -> None:
     """Yaw, pitch and roll of the short log: statistics, time series, histograms
     with the normal fit, and why a filter's output need not be normal."""
-    angles = ctx.attitude
+    angles = ctx.attitude()
     dists = ctx.attitude_distributions
     doc.p("Yaw, pitch and roll are the output of the sensor's attitude filter, not "
           "measurements: the filter blends the gyro, accelerometer and magnetometer, so its "
@@ -327,6 +328,7 @@ def power_spectral_density(ctx: Context, doc: Doc) -> None:
             continue
         model = ctx.models.get(sensor) if ctx.one_log else noise.fit(
             _allan.adev(y, ctx.short.fs, taus=ctx.taus_per_decade), warn_coverage=False)
+        _stream.release(y)
         unit = CHANNELS[sensor][1]
         doc.h(3, sensor)
         ctx.add_figure(doc, plot.spectrum(s, model, unit=unit, title=f"{sensor} PSD"),
@@ -366,6 +368,7 @@ def dynamic_allan(ctx: Context, doc: Doc) -> None:
         if y is None:
             continue
         d = dynamic.dynamic_adev(y, log.fs)
+        _stream.release(y)
         st = d.stationarity
         doc.h(3, sensor)
         ctx.add_figure(doc, plot.dynamic(d, title=f"{sensor} dynamic Allan deviation"),
@@ -447,7 +450,6 @@ def events_section(ctx: Context, doc: Doc) -> None:
         y = getattr(log, sensor)
         if y is None:
             continue
-        z = found.exclude(y)  # one sensor copied at a time, not the whole log
         fig = plot.events(y, found, log.fs, title=f"{sensor} with events (short log)",
                           unit=CHANNELS[sensor][1])
         ctx.add_figure(doc, fig, f"events_{sensor}",
@@ -455,11 +457,14 @@ def events_section(ctx: Context, doc: Doc) -> None:
         kept = []
         for j, axis in enumerate(axis_names(y.shape[1])):
             with_ = list(ctx.sensor_distributions[sensor].values())[j]  # the same samples
-            without = stats.distribution(z[:, j][np.isfinite(z[:, j])])
+            col = _stream.column(y, j, ctx.block) if ctx.streamed else y[:, j]
+            z = found.exclude(col)  # one channel copied at a time, not the sensor
+            without = stats.distribution(z[np.isfinite(z)])
             kept.append(without)
             rows.append([f"{sensor} {axis}", *(numbers.cell(v) for v in (
-                np.nanstd(y[:, j], ddof=1), np.nanstd(z[:, j], ddof=1), with_.excess_kurtosis,
+                np.nanstd(col, ddof=1), np.nanstd(z, ddof=1), with_.excess_kurtosis,
                 without.excess_kurtosis, with_.ks_statistic, without.ks_statistic))])
+        _stream.release(y)
         fig = plot.histograms(kept, title=f"{sensor} without events (short log)",
                               unit=CHANNELS[sensor][1])
         ctx.add_figure(doc, fig, f"hist_{sensor}_no_events",
@@ -512,6 +517,7 @@ def long_log_events(ctx: Context, doc: Doc) -> None:
         dev, lo, hi = (np.reshape(v, (len(both.taus), -1))[a] for v in (
             both.dev, both.ci_low, both.ci_high))
         dev_out = np.reshape(without.dev, (len(without.taus), -1))[b]
+        _stream.release(getattr(log, sensor))
         for j, axis in enumerate(axis_names(dev.shape[1])):
             for i, tau in enumerate(taus):
                 outside = not lo[i, j] <= dev_out[i, j] <= hi[i, j]
