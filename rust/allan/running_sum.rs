@@ -182,15 +182,10 @@ mod tests {
         // Two full groups of eight chunks and a partial one; values spanning many
         // magnitudes so that the error terms matter.
         let n = 2 * LANES * CHUNK + 3 * CHUNK + 1234;
-        let mut state = 0x2545_F491_4F6C_DD1Du64;
-        let values: Vec<f64> = (0..n)
-            .map(|k| {
-                state ^= state << 13;
-                state ^= state >> 7;
-                state ^= state << 17;
-                let u = (state >> 11) as f64 / (1u64 << 53) as f64;
-                (u - 0.5) * 10f64.powi((k % 17) as i32 - 8) + 9.81
-            })
+        let values: Vec<f64> = crate::allan::test_signals::noise(n, 0x2545_F491_4F6C_DD1D)
+            .into_iter()
+            .enumerate()
+            .map(|(k, u)| u * 10f64.powi((k % 17) as i32 - 8) + 9.81)
             .collect();
         let mean = 9.81;
         let (totals, run) = reference(&values, mean);
