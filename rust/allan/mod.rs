@@ -210,27 +210,38 @@ impl<'a> Job<'a> {
         })
     }
 
+    /// Each statistic of the plan once, in order of first appearance, with its
+    /// tau indices and averaging factors.
+    fn by_statistic(&self) -> Vec<(Statistic, Vec<usize>, Vec<usize>)> {
+        let mut statistics: Vec<Statistic> = Vec::new();
+        for &(s, _) in self.plan {
+            if !statistics.contains(&s) {
+                statistics.push(s);
+            }
+        }
+        statistics
+            .into_iter()
+            .map(|s| {
+                let taus: Vec<usize> = (0..self.plan.len())
+                    .filter(|&t| self.plan[t].0 == s)
+                    .collect();
+                let ms = taus.iter().map(|&t| self.plan[t].1).collect();
+                (s, taus, ms)
+            })
+            .collect()
+    }
+
     /// The overlapping Allan and Hadamard variances sweep all their taus of a
     /// channel at once (see `fast::blocked`, run over each gap-free run); every
     /// other pair is `None` here and goes tau by tau.
     fn sweep_blocked(&self) -> Vec<Option<f64>> {
         let mut swept: Vec<Option<f64>> = vec![None; self.pairs.len()];
-        let mut blocked: Vec<Statistic> = Vec::new();
-        for &(s, _) in self.plan {
-            if s.spec().blocked.is_some() && !blocked.contains(&s) {
-                blocked.push(s);
-            }
-        }
-        for statistic in blocked {
+        for (statistic, taus, ms) in self.by_statistic() {
             let (Some(difference), Some(estimator)) =
                 (statistic.spec().blocked, statistic.difference_variance())
             else {
                 continue;
             };
-            let taus: Vec<usize> = (0..self.plan.len())
-                .filter(|&t| self.plan[t].0 == statistic)
-                .collect();
-            let ms: Vec<usize> = taus.iter().map(|&t| self.plan[t].1).collect();
             let sums: Vec<Vec<f64>> = self
                 .phases
                 .par_iter()
@@ -363,17 +374,7 @@ impl<'a> Job<'a> {
     /// The corner of every pair: its channel's and statistic's series in turn.
     fn phase_noise_corners(&self, alpha: &[i32]) -> Vec<usize> {
         let mut corners = vec![1; self.pairs.len()];
-        let mut statistics: Vec<Statistic> = Vec::new();
-        for &(s, _) in self.plan {
-            if !statistics.contains(&s) {
-                statistics.push(s);
-            }
-        }
-        for s in statistics {
-            let taus: Vec<usize> = (0..self.plan.len())
-                .filter(|&t| self.plan[t].0 == s)
-                .collect();
-            let ms: Vec<usize> = taus.iter().map(|&t| self.plan[t].1).collect();
+        for (_, taus, ms) in self.by_statistic() {
             for c in 0..self.channels {
                 let series: Vec<i32> = taus.iter().map(|&t| alpha[t * self.channels + c]).collect();
                 for (k, corner) in corner::phase_noise_corners(&ms, &series)
