@@ -108,7 +108,7 @@ def flicker(n_samples: int, scale: float, rng: np.random.Generator, *,
 def simulate(n_samples: int, fs: float, Q: float = 0.0, N: float = 0.0, B: float = 0.0,
              K: float = 0.0, R: float = 0.0, *, channels: int = 1, seed=None,
              gm: Sequence[tuple[float, float]] = (),
-             sinusoid: tuple[float, float] | None = None,
+             sinusoid: tuple[float, float] | Sequence[tuple[float, float]] | None = None,
              resonance: tuple[float, float, float] | None = None,
              motion: tuple[float, float] | None = None) -> np.ndarray:
     """Rate noise with the given IEEE 952 coefficients.
@@ -131,10 +131,10 @@ def simulate(n_samples: int, fs: float, Q: float = 0.0, N: float = 0.0, B: float
         x[t] = φ·x[t−1] + w[t] with standard deviation ``sigma`` (rate) and
         correlation time ``tau_c`` (s), φ = exp(−1/(fs·tau_c)) — the process whose
         Allan variance :func:`imunoise.fit` models.
-    sinusoid : (amplitude, f0), optional
+    sinusoid : (amplitude, f0) or sequence of them, optional
         A tone A·sin(2π·f0·t + ϕ) of peak amplitude A (rate) and frequency f0
         (Hz), a random phase ϕ per channel: IEEE 952 Annex C's sinusoidal term,
-        Allan variance A²·sin⁴(πf0τ)/(πf0τ)².
+        Allan variance A²·sin⁴(πf0τ)/(πf0τ)²; several tones add.
     resonance : (sigma, f_r, tau_r), optional
         A damped oscillator (second-order Gauss–Markov process): the real part
         of the complex AR1 z[t] = ρe^(iθ)·z[t−1] + w[t], ρ = exp(−1/(fs·tau_r)),
@@ -167,7 +167,7 @@ def simulate(n_samples: int, fs: float, Q: float = 0.0, N: float = 0.0, B: float
     fs = sample_rate(fs)
     Q, N, B, K, R = (_check_coef(k, v) for k, v in zip("QNBKR", (Q, N, B, K, R), strict=True))
     markov = _check_gm(gm)
-    tone = _check_sinusoid(sinusoid)
+    tones = _check_sinusoids(sinusoid)
     oscillator = _check_resonance(resonance, fs)
     moving = _check_motion(motion)
     rng = np.random.default_rng(seed)
@@ -200,10 +200,10 @@ def simulate(n_samples: int, fs: float, Q: float = 0.0, N: float = 0.0, B: float
             flicker(n, B, rng, out=col)
         for sigma, tau_c in markov:
             col += gauss_markov(n, fs, sigma, tau_c, rng)
-        if tone is not None and tone[0] > 0:
-            amplitude, f0 = tone
-            phase = rng.uniform(0.0, 2 * math.pi)
-            col += amplitude * np.sin(2 * math.pi * f0 / fs * np.arange(n) + phase)
+        for amplitude, f0 in tones:
+            if amplitude > 0:
+                phase = rng.uniform(0.0, 2 * math.pi)
+                col += amplitude * np.sin(2 * math.pi * f0 / fs * np.arange(n) + phase)
         if oscillator is not None and oscillator[0] > 0:
             col += damped_oscillator(n, fs, *oscillator, rng)
         if moving is not None and moving[0] > 0:
@@ -211,8 +211,17 @@ def simulate(n_samples: int, fs: float, Q: float = 0.0, N: float = 0.0, B: float
     return out[:, 0].copy() if channels == 1 else out
 
 
-def _check_sinusoid(sinusoid) -> tuple[float, float] | None:
-    return _size_and_rate(sinusoid, "sinusoid", "an", ("amplitude", "f0"), "Hz")
+def _check_sinusoids(sinusoid) -> list[tuple[float, float]]:
+    """``sinusoid`` — None, one (amplitude, f0) pair or a sequence of them — as a list
+    of checked pairs."""
+    if sinusoid is None or (isinstance(sinusoid, (list, tuple)) and not sinusoid):
+        return []
+    try:
+        several = len(sinusoid) > 0 and all(np.ndim(p) == 1 for p in sinusoid)
+    except TypeError:
+        several = False
+    pairs = sinusoid if several else [sinusoid]
+    return [_size_and_rate(p, "sinusoid", "an", ("amplitude", "f0"), "Hz") for p in pairs]
 
 
 def _check_motion(motion) -> tuple[float, float] | None:

@@ -453,17 +453,18 @@ def _model_curves(model: NoiseModel, grid: np.ndarray, channel: int) -> dict[str
 
 def _tone_envelope(model: NoiseModel, grid: np.ndarray, channel: int,
                    curve: np.ndarray) -> np.ndarray:
-    """The tone's Allan deviation up to its first peak, its upper envelope beyond:
+    """The tones' Allan deviation up to its first peak, their upper envelope beyond:
     the sampled form 2·(A²/2)·sin⁴(πνm)/(m² sin²πν) with sin⁴ → 1, A/(m·|sin πν|),
-    ν = f0/fs, m = τ·fs. The curve itself is a comb of zeros at whole periods, which
-    drew spikes across the panel."""
+    ν = f0/fs, m = τ·fs, the tones' variances added. The curve itself is a comb of
+    zeros at whole periods, which drew spikes across the panel."""
     tones = model.components.sine(channel)
     if not tones:
         return curve
-    amplitude, f0 = tones[0]
     fs = float(model.fs)
-    envelope = amplitude / (grid * fs * abs(np.sin(np.pi * f0 / fs)))
-    first = grid <= 1.0 / f0  # the first peak lies below one period (≈ 0.37/f0)
+    envelope = np.sqrt(sum((amplitude / (grid * fs * abs(np.sin(np.pi * f0 / fs)))) ** 2
+                           for amplitude, f0 in tones))
+    # The first peak lies below one period (≈ 0.37/f0) of the slowest tone.
+    first = grid <= 1.0 / min(f0 for _, f0 in tones)
     if not first.any():
         return envelope
     peak = int(np.argmax(np.where(first, curve, -np.inf)))

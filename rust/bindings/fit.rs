@@ -10,8 +10,8 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
 use crate::fit::{
-    self, Options, FLICKER_FACTOR, IEEE_TERMS, IEEE_TERM_NAMES, MAX_GM, MOTION_SLOT, PARAMETERS,
-    RESONANCE_SLOT, SINE_SLOT,
+    self, Options, FLICKER_FACTOR, IEEE_TERMS, IEEE_TERM_NAMES, MAX_GM, MAX_TONES, MOTION_SLOT,
+    PARAMETERS, RESONANCE_SLOT, SINE_SLOT,
 };
 
 /// The fit of one channel, as `_core.fit.NoiseFit`.
@@ -61,10 +61,10 @@ fn to_matrix(rows: Vec<Vec<f64>>, cols: usize) -> PyResult<Array2<f64>> {
         .map_err(|e| PyValueError::new_err(e.to_string()))
 }
 
-/// fit_noise(taus, var, edf, fs, terms, gm, select, sine, resonance, motion) -> NoiseFit
+/// fit_noise(taus, var, edf, fs, terms, gm, select, tones, resonance, motion) -> NoiseFit
 #[pyfunction]
 #[allow(clippy::too_many_arguments)] // mirrors the Python keyword arguments
-#[pyo3(signature = (taus, var, edf, fs, terms, gm=3, select=true, sine=true, resonance=true, motion=true))]
+#[pyo3(signature = (taus, var, edf, fs, terms, gm=MAX_GM, select=true, tones=MAX_TONES, resonance=true, motion=true))]
 fn fit_noise<'py>(
     py: Python<'py>,
     taus: PyReadonlyArray1<'py, f64>,
@@ -74,14 +74,14 @@ fn fit_noise<'py>(
     terms: Vec<bool>,
     gm: usize,
     select: bool,
-    sine: bool,
+    tones: usize,
     resonance: bool,
     motion: bool,
 ) -> PyResult<PyNoiseFit> {
     let opts = Options {
         ieee: ieee_flags(&terms)?,
         gm,
-        sine,
+        tones,
         resonance,
         motion,
         select,
@@ -164,6 +164,7 @@ fn noise_terms<'py>(
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("IEEE_TERM_NAMES", IEEE_TERM_NAMES.to_vec())?;
     m.add("MAX_GAUSS_MARKOV", MAX_GM)?;
+    m.add("MAX_TONES", MAX_TONES)?;
     m.add("PARAMETERS", PARAMETERS)?;
     m.add("SINE_SLOT", SINE_SLOT)?;
     m.add("RESONANCE_SLOT", RESONANCE_SLOT)?;

@@ -8,8 +8,8 @@
 //! the IEEE Std 952 / 1293 terms plus up to [`MAX_GM`] = 3 first-order
 //! Gauss–Markov bias terms of variance qₖ² and correlation time τcₖ (three: a
 //! MEMS sensor's own filter, a bump of correlated bias, and slow wander), and
-//! at most one sinusoid (tone) of variance s² (amplitude √2·s) and frequency f₀
-//! and at most one resonance (damped oscillator, second-order Gauss–Markov) of
+//! up to [`search::MAX_TONES`] sinusoids (tones) of variance s² (amplitude √2·s)
+//! and frequency f₀ and at most one resonance (damped oscillator, second-order Gauss–Markov) of
 //! variance r², frequency f_r and damping time τr (`basis`). The estimator
 //! (`estimate`) is a weighted least-squares fit of ln σ̂² with weights from the
 //! EDF, the share of an octave each tau stands for, and a model-discrepancy
@@ -39,22 +39,24 @@ use search::Candidate;
 /// Most Gauss–Markov terms a model may have.
 pub const MAX_GM: usize = 3;
 
-/// First slot of the tone in the parameter covariance: s², then ln f₀.
+pub use search::MAX_TONES;
+
+/// First slot of the tones in the parameter covariance: s², then ln f₀, per tone.
 pub const SINE_SLOT: usize = IEEE_TERMS + 2 * MAX_GM;
 
 /// First slot of the resonance in the parameter covariance: r², ln f_r, ln τr.
-pub const RESONANCE_SLOT: usize = SINE_SLOT + 2;
+pub const RESONANCE_SLOT: usize = SINE_SLOT + 2 * MAX_TONES;
 
 /// First slot of the bounded motion in the parameter covariance: σθ², ln τc.
 pub const MOTION_SLOT: usize = RESONANCE_SLOT + 3;
 
 /// Slots of the parameter covariance: Q², N², B², K², R², then (q², ln τc) per
-/// Gauss–Markov term, then (s², ln f₀) of the tone, then (r², ln f_r, ln τr) of
+/// Gauss–Markov term, then (s², ln f₀) per tone, then (r², ln f_r, ln τr) of
 /// the resonance, then (σθ², ln τc) of the bounded motion.
 pub const PARAMETERS: usize = MOTION_SLOT + 2;
 
 /// The tone (s², f₀), resonance (r², f_r, τr) and bounded motion (σθ², τc) terms
-/// of a model, at most one each.
+/// of a model: up to [`MAX_TONES`] tones, at most one of the others.
 pub type Oscillators<'a> = (&'a [(f64, f64)], &'a [(f64, f64, f64)], &'a [(f64, f64)]);
 
 /// What [`fit_noise`] may use.
@@ -64,8 +66,9 @@ pub struct Options {
     pub ieee: [bool; IEEE_TERMS],
     /// Gauss–Markov terms: the most allowed (`select`) or the exact number.
     pub gm: usize,
-    /// A tone: may enter (`select`) or is fitted (not `select`).
-    pub sine: bool,
+    /// Tones: the most allowed (`select`, at most [`MAX_TONES`]) or the exact
+    /// number fitted.
+    pub tones: usize,
     /// A resonance: may enter (`select`) or is fitted (not `select`).
     pub resonance: bool,
     /// A bounded motion: may enter (`select`) or is fitted (not `select`).
@@ -79,7 +82,7 @@ impl Default for Options {
         Options {
             ieee: [true; IEEE_TERMS],
             gm: MAX_GM,
-            sine: true,
+            tones: MAX_TONES,
             resonance: true,
             motion: true,
             select: true,
@@ -95,7 +98,7 @@ pub struct NoiseFit {
     /// Variance q² and correlation time τc (s) of each Gauss–Markov term in the
     /// model, by increasing τc.
     pub gm: Vec<(f64, f64)>,
-    /// Variance s² and frequency f₀ (Hz) of the tone, if the model has one.
+    /// Variance s² and frequency f₀ (Hz) of each tone, by increasing frequency.
     pub sine: Vec<(f64, f64)>,
     /// Variance r², frequency f_r (Hz) and damping time τr (s) of the
     /// resonance, if the model has one.
@@ -127,6 +130,12 @@ pub fn fit_noise(
     fs: f64,
     opts: &Options,
 ) -> CoreResult<NoiseFit> {
+    if opts.tones > MAX_TONES {
+        return Err(CoreError::InvalidArgument(format!(
+            "at most {MAX_TONES} tones; got {}",
+            opts.tones
+        )));
+    }
     if opts.gm > MAX_GM {
         return Err(CoreError::InvalidArgument(format!(
             "at most {MAX_GM} Gauss-Markov terms; got {}",
@@ -136,7 +145,7 @@ pub fn fit_noise(
     let data = Data::new(taus, var, edf, fs)?;
     let chosen = if opts.select {
         let selected = |motion: bool| -> CoreResult<Candidate> {
-            let kinds = (opts.sine, opts.resonance, motion);
+            let kinds = (opts.tones, opts.resonance, motion);
             let best = search::select(&data, fs, opts.ieee, opts.gm, kinds)?;
             let best = search::prefer_random_walk(&data, fs, opts.ieee, opts.gm, kinds, best)?;
             prune_insignificant(&data, fs, best)
@@ -182,11 +191,11 @@ fn fixed_structure(data: &Data, fs: f64, opts: &Options) -> CoreResult<Candidate
     };
     let shape = |c: &Option<Candidate>| match c {
         Some(c) => (c.gm_tau.clone(), c.sine, c.resonance, c.solution.d2),
-        None => (Vec::new(), None, None, d2),
+        None => (Vec::new(), search::Tones::NONE, None, d2),
     };
-    if opts.sine {
-        let (times, _, _, d2) = shape(&current);
-        let toned = search::with_sine(data, fs, opts.ieee, (&times, None), d2, false)?;
+    for _ in 0..opts.tones {
+        let (times, tones, _, d2) = shape(&current);
+        let toned = search::with_sine(data, fs, opts.ieee, (&times, tones, None), d2, false)?;
         current = toned.or(current);
     }
     if opts.resonance {
@@ -260,7 +269,7 @@ fn prune_insignificant(data: &Data, fs: f64, mut best: Candidate) -> CoreResult<
             .filter(|&j| fit.ieee[j] > 0.0)
             .map(|j| (j, fit.ieee[j]))
             .collect();
-        let sine_slots = fit.sine.iter().map(|s| (SINE_SLOT, s.0));
+        let sine_slots = (fit.sine.iter().enumerate()).map(|(k, s)| (SINE_SLOT + 2 * k, s.0));
         let res_slots = fit.resonance.iter().map(|r| (RESONANCE_SLOT, r.0));
         let motion_slots = fit.motion.iter().map(|r| (MOTION_SLOT, r.0));
         let mut order = weak(sine_slots.chain(res_slots).chain(motion_slots).collect());
@@ -269,13 +278,14 @@ fn prune_insignificant(data: &Data, fs: f64, mut best: Candidate) -> CoreResult<
         for (slot, _) in order {
             let mut ieee = best.ieee;
             let mut times: Vec<f64> = fit.gm.iter().map(|g| g.1).collect();
-            let mut sine = fit.sine.first().map(|s| s.1);
+            let tones: Vec<f64> = fit.sine.iter().map(|s| s.1).collect();
+            let mut sine = search::Tones::from_slice(&tones);
             let mut resonance = fit.resonance.first().map(|r| (r.1, r.2));
             let mut motion = fit.motion.first().map(|r| r.1);
             if slot < IEEE_TERMS {
                 ieee[slot] = false;
-            } else if slot == SINE_SLOT {
-                sine = None;
+            } else if (SINE_SLOT..RESONANCE_SLOT).contains(&slot) {
+                sine = sine.without((slot - SINE_SLOT) / 2);
             } else if slot == RESONANCE_SLOT {
                 resonance = None;
             } else if slot == MOTION_SLOT {
@@ -309,13 +319,13 @@ fn summarise(data: &Data, fs: f64, c: &Candidate) -> NoiseFit {
         .filter(|(k, _)| theta[IEEE_TERMS + k] > 0.0)
         .map(|(k, &t)| (theta[IEEE_TERMS + k], t))
         .collect();
-    let sine: Vec<(f64, f64)> = c
-        .sine
-        .map(|f| (theta[IEEE_TERMS + c.gm_tau.len()], f))
+    let tone_column = IEEE_TERMS + c.gm_tau.len();
+    let mut sine: Vec<(f64, f64)> = (c.sine.as_slice().iter().enumerate())
+        .map(|(k, &f)| (theta[tone_column + k], f))
         .filter(|s| s.0 > 0.0)
-        .into_iter()
         .collect();
-    let res_column = IEEE_TERMS + c.gm_tau.len() + usize::from(c.sine.is_some());
+    sine.sort_by(|a, b| a.1.total_cmp(&b.1));
+    let res_column = tone_column + c.sine.len();
     let resonance: Vec<(f64, f64, f64)> = c
         .resonance
         .map(|(f, t)| (theta[res_column], f, t))
@@ -406,9 +416,9 @@ fn covariance(
         slots.push(IEEE_TERMS + 2 * k);
         slots.push(IEEE_TERMS + 2 * k + 1);
     }
-    if !sine.is_empty() {
-        slots.push(SINE_SLOT);
-        slots.push(SINE_SLOT + 1);
+    for k in 0..sine.len() {
+        slots.push(SINE_SLOT + 2 * k);
+        slots.push(SINE_SLOT + 2 * k + 1);
     }
     // A resonance at fs/2 sits on the bound of its frequency, where the sampled
     // curve is even in f_r − fs/2 (∂/∂f_r = 0): the frequency is then not a
@@ -468,11 +478,13 @@ fn covariance(
                             1 => (osc(r2, f * e, tr) - osc(r2, f * ie, tr)) / (2.0 * h),
                             _ => (osc(r2, f, tr * e) - osc(r2, f, tr * ie)) / (2.0 * h),
                         }
-                    } else if s == SINE_SLOT {
-                        tone(1.0, sine[0].1)
-                    } else if s == SINE_SLOT + 1 {
-                        let (s2, f0) = sine[0];
-                        (tone(s2, f0 * h.exp()) - tone(s2, f0 * (-h).exp())) / (2.0 * h)
+                    } else if s >= SINE_SLOT {
+                        let (s2, f0) = sine[(s - SINE_SLOT) / 2];
+                        if (s - SINE_SLOT).is_multiple_of(2) {
+                            tone(1.0, f0)
+                        } else {
+                            (tone(s2, f0 * h.exp()) - tone(s2, f0 * (-h).exp())) / (2.0 * h)
+                        }
                     } else {
                         let (q2, tc) = gm[(s - IEEE_TERMS) / 2];
                         if (s - IEEE_TERMS).is_multiple_of(2) {
@@ -621,6 +633,47 @@ mod tests {
     }
 
     #[test]
+    fn two_tones_are_recovered_where_one_alone_would_not_pay() {
+        // Lines at 0.2 and 3.3 Hz over white noise: each dominates its own
+        // decade of taus, and the structure with one of them keeps the other's
+        // misfit (the simulated parked-vehicle class of the fit's benchmark).
+        let ieee = [0.0, 4e-10, 0.0, 0.0, 0.0];
+        let tones = [(5e-9, 0.2), (4.5e-8, 3.3)];
+        for per_decade in [10.0, 20.0] {
+            let taus = grid(per_decade, 0.01, 180.0);
+            let var: Vec<f64> = terms(&taus, FS, &ieee, &[], (&tones, &[], &[]))
+                .iter()
+                .map(|r| r.iter().sum())
+                .collect();
+            let fit = fit_exact(&taus, &var);
+            assert_eq!(fit.sine.len(), 2, "{per_decade}: {fit:?}");
+            for (k, &(s2, f0)) in fit.sine.iter().enumerate() {
+                assert!(
+                    (s2 / tones[k].0 - 1.0).abs() < 0.01,
+                    "{per_decade}: {fit:?}"
+                );
+                assert!(
+                    (f0 / tones[k].1 - 1.0).abs() < 1e-3,
+                    "{per_decade}: {fit:?}"
+                );
+                let u = fit.cov[SINE_SLOT + 2 * k][SINE_SLOT + 2 * k].sqrt();
+                assert!(u.is_finite() && u < s2, "{per_decade}: {u}");
+            }
+            assert!((fit.ieee[1] / ieee[1] - 1.0).abs() < 0.01, "{fit:?}");
+            let one = Options {
+                tones: 1,
+                ..Options::default()
+            };
+            let edf = vec![1e6; taus.len()];
+            let single = fit_noise(&taus, &var, &edf, FS, &one).unwrap();
+            assert!(
+                single.sine.len() <= 1 && single.bic > fit.bic + 10.0,
+                "{single:?}"
+            );
+        }
+    }
+
+    #[test]
     fn a_resonance_is_recovered_next_to_a_tone() {
         // A 10 Hz line and a band at 30 Hz (Q = π·30·0.02 ≈ 1.9), on white and
         // rate random walk noise: the VN-100 gyro's pattern at 100 Hz.
@@ -677,7 +730,7 @@ mod tests {
         let opts = Options {
             select: false,
             gm: 0,
-            sine: false,
+            tones: 0,
             resonance: false,
             motion: false,
             ieee: [false, true, true, true, false],

@@ -57,6 +57,10 @@ const MIN_RATIO: f64 = 2.0;
 /// well past the tone's peak; the fine scan then resolves the longer taus.
 const FREQ_PER_DECADE: f64 = 96.0;
 
+/// A tone refined below this multiple of the frequency grid's lowest point (two
+/// grid steps) is on the grid's bound.
+const SINE_BOUND: f64 = 1.049;
+
 /// Most steps of the fine frequency scan around the best grid point.
 const FINE_SCAN: f64 = 100.0;
 
@@ -106,22 +110,94 @@ pub type Resonance = (f64, f64);
 /// τ ≈ 0.37/f₀ stays more than a decade inside the curve).
 pub const SINE_PERIODS: f64 = 10.0;
 
-/// The tone's frequency, the resonance and the bounded motion's correlation
-/// time of a structure, each if it has one.
-pub type Extras = (Option<f64>, Option<Resonance>, Option<f64>);
+/// Most tones in a structure. Two lines are common where one sensor sits on
+/// something that moves (a parked vehicle's two modes, a dither line beside a
+/// building's sway), and each leaves the other's misfit: with one of them
+/// undescribed, the discrepancy it keeps hides what describing the other gains
+/// (a simulated 100 Hz gyro with lines at 3.3 and 0.2 Hz: no tone was kept on
+/// two of three axes, covering 29–48 % of taus).
+pub const MAX_TONES: usize = 2;
+
+/// The tones' frequencies (Hz) of a structure, in the order they were found.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Tones {
+    freq: [f64; MAX_TONES],
+    len: usize,
+}
+
+impl Tones {
+    /// No tone.
+    pub const NONE: Self = Self {
+        freq: [0.0; MAX_TONES],
+        len: 0,
+    };
+
+    /// The first [`MAX_TONES`] of `freqs`.
+    pub fn from_slice(freqs: &[f64]) -> Self {
+        freqs.iter().fold(Self::NONE, |t, &f| t.with(f))
+    }
+
+    pub fn as_slice(&self) -> &[f64] {
+        &self.freq[..self.len]
+    }
+
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    pub fn is_full(&self) -> bool {
+        self.len == MAX_TONES
+    }
+
+    /// These tones and `f` (unchanged when already full).
+    pub fn with(mut self, f: f64) -> Self {
+        if self.len < MAX_TONES {
+            self.freq[self.len] = f;
+            self.len += 1;
+        }
+        self
+    }
+
+    /// These tones without the `k`-th.
+    pub fn without(self, k: usize) -> Self {
+        let mut out = Self::NONE;
+        for (j, &f) in self.as_slice().iter().enumerate() {
+            if j != k {
+                out = out.with(f);
+            }
+        }
+        out
+    }
+
+    /// These tones with the `k`-th at `f`.
+    pub fn replaced(mut self, k: usize, f: f64) -> Self {
+        if k < self.len {
+            self.freq[k] = f;
+        }
+        self
+    }
+}
+
+/// The tones, the resonance and the bounded motion's correlation time of a
+/// structure, the last two each if it has one.
+pub type Extras = (Tones, Option<Resonance>, Option<f64>);
 
 /// Columns of a structure beyond the IEEE terms and its Gauss–Markov times.
 fn extra_columns((sine, resonance, motion): Extras) -> usize {
-    usize::from(sine.is_some()) + usize::from(resonance.is_some()) + usize::from(motion.is_some())
+    sine.len() + usize::from(resonance.is_some()) + usize::from(motion.is_some())
 }
 
-/// The basis of a structure: IEEE columns, one column per GM time, then the
-/// tone if any, then the resonance if any, then the bounded motion if any.
+/// The basis of a structure: IEEE columns, one column per GM time, then one per
+/// tone, then the resonance if any, then the bounded motion if any.
 pub fn design(data: &Data, fs: f64, gm_tau: &[f64], extras: Extras) -> Mat<f64> {
     let (sine, resonance, motion) = extras;
     let g = gm_tau.len();
     let tone = IEEE_TERMS + g;
-    let osc = tone + usize::from(sine.is_some());
+    let osc = tone + sine.len();
     let k = tone + extra_columns(extras);
     let rates = resonance.map(|(f, t)| basis::resonance_rates(f, t, fs));
     Mat::from_fn(data.len(), k, |i, j| {
@@ -129,8 +205,8 @@ pub fn design(data: &Data, fs: f64, gm_tau: &[f64], extras: Extras) -> Mat<f64> 
             basis::ieee(data.taus[i])[j]
         } else if j < tone {
             basis::gauss_markov(data.m[i], basis::gm_rate(gm_tau[j - IEEE_TERMS], fs))
-        } else if let (Some(f), true) = (sine, j == tone) {
-            basis::sinusoid(data.m[i], f / fs)
+        } else if j < osc {
+            basis::sinusoid(data.m[i], sine.as_slice()[j - tone] / fs)
         } else if let (Some((u, theta)), true) = (rates, j == osc) {
             basis::resonance(data.m[i], u, theta)
         } else {
@@ -309,8 +385,9 @@ struct Searcher<'a> {
     fs: f64,
     ieee: [bool; IEEE_TERMS],
     d2: f64,
-    /// The tone's frequency, held fixed while the times are searched.
-    sine: Option<f64>,
+    /// The tones, held fixed while the times are searched (and beside which
+    /// another tone is searched).
+    sine: Tones,
     /// The resonance, held fixed while the times and the tone are searched.
     resonance: Option<Resonance>,
     /// The bounded motion's correlation time, held fixed while the times are
@@ -324,13 +401,13 @@ impl Searcher<'_> {
         self.loss_with(times, self.sine)
     }
 
-    /// Loss of the best θ for these times and this tone.
-    fn loss_with(&self, times: &[f64], sine: Option<f64>) -> f64 {
+    /// Loss of the best θ for these times and these tones.
+    fn loss_with(&self, times: &[f64], sine: Tones) -> f64 {
         self.loss_full(times, sine, self.resonance)
     }
 
-    /// Loss of the best θ for these times, this tone and this resonance.
-    fn loss_full(&self, times: &[f64], sine: Option<f64>, resonance: Option<Resonance>) -> f64 {
+    /// Loss of the best θ for these times, these tones and this resonance.
+    fn loss_full(&self, times: &[f64], sine: Tones, resonance: Option<Resonance>) -> f64 {
         let extras = (sine, resonance, self.motion);
         let basis = design(self.data, self.fs, times, extras);
         let extra = times.len() + extra_columns(extras);
@@ -382,14 +459,30 @@ impl Searcher<'_> {
         }
     }
 
-    /// Best tone frequency on the grid with these times, and its loss (None
-    /// when the curve is too short for any tone); [`Self::refine_frequency`]
-    /// then refines it.
+    /// Best frequency on the grid of one more tone beside the searcher's, with
+    /// these times, and its loss (None when the curve is too short for any tone
+    /// or the structure has [`MAX_TONES`]); [`Self::refine_frequency`] then
+    /// refines it.
     fn coarse_frequency(&self, times: &[f64]) -> Option<(f64, f64)> {
+        if self.sine.is_full() {
+            return None;
+        }
         frequency_grid(self.data, self.fs)
             .into_iter()
-            .map(|f| (f, self.loss_with(times, Some(f))))
+            .map(|f| (f, self.loss_with(times, self.sine.with(f))))
             .min_by(|a, b| a.1.total_cmp(&b.1))
+    }
+
+    /// Each of `tones` refined in turn ([`Self::refine_frequency`]) with the
+    /// others in place; the searcher's own tones are left as they were.
+    fn refine_tones(&mut self, times: &[f64], mut tones: Tones) -> Tones {
+        let fixed = self.sine;
+        for k in 0..tones.len() {
+            self.sine = tones.without(k);
+            tones = tones.replaced(k, self.refine_frequency(times, tones.as_slice()[k]));
+        }
+        self.sine = fixed;
+        tones
     }
 
     /// A finer scan within one grid step of `f`, then golden section. The
@@ -398,7 +491,7 @@ impl Searcher<'_> {
     /// steps a tenth of that (at most [`FINE_SCAN`] steps; beyond, the tone has
     /// faded under the other terms long before τ_max).
     fn refine_frequency(&self, times: &[f64], f: f64) -> f64 {
-        let loss = |f: f64| self.loss_with(times, Some(f));
+        let loss = |f: f64| self.loss_with(times, self.sine.with(f));
         let top = 0.5 * self.fs;
         let span = std::f64::consts::LN_10 / FREQ_PER_DECADE;
         let tau_max = self.data.taus[self.data.len() - 1];
@@ -518,8 +611,8 @@ impl Searcher<'_> {
 #[derive(Debug, Clone)]
 pub struct Candidate {
     pub gm_tau: Vec<f64>,
-    /// Frequency (Hz) of the tone, if the structure has one.
-    pub sine: Option<f64>,
+    /// Frequencies (Hz) of the structure's tones.
+    pub sine: Tones,
     /// The resonance, if the structure has one.
     pub resonance: Option<Resonance>,
     /// The bounded motion's correlation time (s), if the structure has one.
@@ -621,12 +714,12 @@ pub fn fit_structure(
         fs,
         ieee,
         d2,
-        sine: None,
+        sine: Tones::NONE,
         resonance: None,
         motion: None,
     };
     let times = searcher.times(gm, seed);
-    let first = candidate(data, fs, ieee, times, (None, None, None), d2)?;
+    let first = candidate(data, fs, ieee, times, (Tones::NONE, None, None), d2)?;
     let settled = first.solution.d2;
     if gm == 0 || (settled <= 2.0 * d2 && settled >= 0.5 * d2) {
         return Ok(first);
@@ -637,7 +730,14 @@ pub fn fit_structure(
         ..searcher
     };
     let times = again.times(gm, seed);
-    let second = candidate(data, fs, ieee, times, (None, None, None), first.solution.d2)?;
+    let second = candidate(
+        data,
+        fs,
+        ieee,
+        times,
+        (Tones::NONE, None, None),
+        first.solution.d2,
+    )?;
     Ok(if second.solution.loss < first.solution.loss {
         second
     } else {
@@ -645,43 +745,44 @@ pub fn fit_structure(
     })
 }
 
-/// Add a tone to the Gauss–Markov times `gm_tau` (and a fixed `resonance`): its
-/// frequency searched, then the times refined around theirs with the tone in
-/// place, the frequency once more; refined again at the discrepancy the toned
-/// fit settles on when that moved by more than a factor of two. None when the
-/// curve is too short for a tone or, when `gated` (model selection), the grid
-/// finds no use for one.
+/// Add a tone to the Gauss–Markov times `gm_tau`, the tones `tones` and a fixed
+/// `resonance`: its frequency searched, then the times refined around theirs
+/// with the tone in place, every tone's frequency once more; refined again at
+/// the discrepancy the toned fit settles on when that moved by more than a
+/// factor of two. None when the curve is too short for a tone, the structure
+/// has [`MAX_TONES`] or, when `gated` (model selection), the grid finds no use
+/// for one or a tone is refined onto the grid's slowest frequencies.
 pub fn with_sine(
     data: &Data,
     fs: f64,
     ieee: [bool; IEEE_TERMS],
-    (gm_tau, resonance): (&[f64], Option<Resonance>),
+    (gm_tau, tones, resonance): (&[f64], Tones, Option<Resonance>),
     d2: f64,
     gated: bool,
 ) -> CoreResult<Option<Candidate>> {
     let step = 10f64.powf(1.0 / PER_DECADE);
-    // Times and frequency polished at δ² from a start frequency.
-    let polish = |d2: f64, mut times: Vec<f64>, f: f64| -> CoreResult<Candidate> {
+    // Times and frequencies polished at δ² from the tones found.
+    let polish = |d2: f64, mut times: Vec<f64>, found: Tones| -> CoreResult<Candidate> {
         let mut searcher = Searcher {
             data,
             fs,
             ieee,
             d2,
-            sine: Some(f),
+            sine: found,
             resonance,
             motion: None,
         };
         searcher.polish(&mut times, step);
-        searcher.sine = None;
-        let f = searcher.refine_frequency(&times, f);
-        candidate(data, fs, ieee, times, (Some(f), resonance, None), d2)
+        searcher.sine = Tones::NONE;
+        let found = searcher.refine_tones(&times, found);
+        candidate(data, fs, ieee, times, (found, resonance, None), d2)
     };
     let searcher = Searcher {
         data,
         fs,
         ieee,
         d2,
-        sine: None,
+        sine: tones,
         resonance,
         motion: None,
     };
@@ -695,17 +796,44 @@ pub fn with_sine(
     if gated && toned > searcher.loss(gm_tau) - 0.5 * data.n_eff().max(2.0).ln() {
         return Ok(None);
     }
-    let first = polish(d2, gm_tau.to_vec(), f)?;
+    // A tone refined onto the grid's slowest frequencies is the longest taus'
+    // rise or scatter, which the loss would bend a slower one to (a wander:
+    // on an ADIS16405 accelerometer Z, whose spectrum has no line there, a
+    // second tone at 0.0022 Hz took the rise from K on the denser grids and K
+    // moved by 2.7 standard uncertainties across them). Like a resonance on a
+    // bound of its Q, it is dropped.
+    let lowest = frequency_grid(data, fs).first().copied().unwrap_or(0.0);
+    let on_bound = |c: &Candidate| {
+        let slowest = c
+            .sine
+            .as_slice()
+            .iter()
+            .copied()
+            .fold(f64::INFINITY, f64::min);
+        gated && slowest <= lowest * SINE_BOUND
+    };
+    let first = polish(d2, gm_tau.to_vec(), tones.with(f))?;
     let settled = first.solution.d2;
     if settled <= 2.0 * d2 && settled >= 0.5 * d2 {
-        return Ok(Some(first));
+        return Ok((!on_bound(&first)).then_some(first));
     }
-    let second = polish(settled, first.gm_tau.clone(), first.sine.unwrap_or(f))?;
-    Ok(Some(if second.solution.loss < first.solution.loss {
+    // The grid again at the discrepancy the toned fit settled on: at the one
+    // before, inflated by what the tone now describes, the loss weighs every tau
+    // alike and a line whose nulls lie under a larger one's curve found the wrong
+    // basin (0.42 Hz for a 0.37 Hz line beside a 0.05 Hz one, 83 % of taus
+    // covered), which the refinement within a grid step keeps.
+    let settled_searcher = Searcher {
+        d2: settled,
+        ..searcher
+    };
+    let again = (settled_searcher.coarse_frequency(&first.gm_tau)).map_or(f, |(g, _)| g);
+    let second = polish(settled, first.gm_tau.clone(), tones.with(again))?;
+    let better = if second.solution.loss < first.solution.loss {
         second
     } else {
         first
-    }))
+    };
+    Ok((!on_bound(&better)).then_some(better))
 }
 
 /// Add a resonance to the Gauss–Markov times `gm_tau` and tone `sine`: grid,
@@ -718,7 +846,7 @@ pub fn with_resonance(
     data: &Data,
     fs: f64,
     ieee: [bool; IEEE_TERMS],
-    (gm_tau, sine): (&[f64], Option<f64>),
+    (gm_tau, sine): (&[f64], Tones),
     d2: f64,
     gated: bool,
 ) -> CoreResult<Option<Candidate>> {
@@ -738,7 +866,7 @@ pub fn with_resonance(
     if gated && loss > searcher.loss(gm_tau) - 0.75 * data.n_eff().max(2.0).ln() {
         return Ok(None);
     }
-    let polish = |d2: f64, mut times: Vec<f64>, sine: Option<f64>, res: Resonance| {
+    let polish = |d2: f64, mut times: Vec<f64>, sine: Tones, res: Resonance| {
         let mut s = Searcher {
             data,
             fs,
@@ -751,8 +879,8 @@ pub fn with_resonance(
         let res = s.refine_resonance(&times, res);
         s.resonance = Some(res);
         s.polish(&mut times, step);
-        s.sine = None;
-        let sine = sine.map(|f| s.refine_frequency(&times, f));
+        s.sine = Tones::NONE;
+        let sine = s.refine_tones(&times, sine);
         candidate(data, fs, ieee, times, (sine, Some(res), None), d2)
     };
     let on_bound = |c: &Candidate| {
@@ -842,14 +970,14 @@ fn rebuilt(
 }
 
 /// Automatic selection over 0..=`max_gm` Gauss–Markov terms and the IEEE terms
-/// in `ieee`, each also with a tone when `sine`, then with a resonance when
+/// in `ieee`, each also with up to `max_tones` tones, then with a resonance when
 /// `resonance`, then with a bounded motion when `motion`.
 pub fn select(
     data: &Data,
     fs: f64,
     ieee: [bool; IEEE_TERMS],
     max_gm: usize,
-    (sine, resonance, motion): (bool, bool, bool),
+    (max_tones, resonance, motion): (usize, bool, bool),
 ) -> CoreResult<Candidate> {
     let base = fit_structure(data, fs, ieee, 0, 0.0, &[])?;
     let mut best = eliminate(data, fs, ieee, base.clone())?;
@@ -890,7 +1018,7 @@ pub fn select(
         }
     }
     let plain = best.clone();
-    if sine {
+    if max_tones > 0 {
         // The tone on its own, beside the best structure and beside the one BIC
         // alone prefers (refined around their times): a tone may complete a
         // structure that lost without it. Beside the best one only, a tone was
@@ -903,18 +1031,20 @@ pub fn select(
                 times.push(t);
             }
         }
-        for gm_tau in &times {
-            if let Some(toned) = with_sine(data, fs, ieee, (gm_tau, None), base.solution.d2, true)?
-            {
-                let reduced = eliminate(data, fs, ieee, toned)?;
-                if reduced.score() < best.score() {
-                    best = reduced;
-                }
-            }
+        for gm_tau in times {
+            let start = (gm_tau, Tones::NONE, None);
+            add_tones(
+                data,
+                fs,
+                ieee,
+                start,
+                (base.solution.d2, max_tones),
+                &mut best,
+            )?;
         }
     }
     if resonance && misses_short_taus(data, &best) {
-        best = add_resonance(data, fs, ieee, best, &plain, sine)?;
+        best = add_resonance(data, fs, ieee, best, &plain, max_tones)?;
     }
     if motion {
         // On the best structure, and on the IEEE terms alone: a fast
@@ -975,8 +1105,8 @@ fn misses_short_taus(data: &Data, c: &Candidate) -> bool {
 
 /// The best of `best`, `best` with a resonance, and, when `best` has a tone in
 /// the resonance's range (≥ fs/[`RES_LOWEST`]), `plain` (the best structure
-/// without one) with a resonance and then a tone searched again on top (when
-/// `sine`): the tone may have taken the band the resonance describes better,
+/// without one) with a resonance and then tones searched again on top (up to
+/// `max_tones`): the tone may have taken the band the resonance describes better,
 /// leaving the line next to it. A slower tone cannot have, and is kept.
 fn add_resonance(
     data: &Data,
@@ -984,11 +1114,11 @@ fn add_resonance(
     ieee: [bool; IEEE_TERMS],
     mut best: Candidate,
     plain: &Candidate,
-    sine: bool,
+    max_tones: usize,
 ) -> CoreResult<Candidate> {
     let d2 = best.solution.d2;
     let mut bases = vec![best.clone()];
-    if best.sine.is_some_and(|f| f >= fs / RES_LOWEST) {
+    if best.sine.as_slice().iter().any(|&f| f >= fs / RES_LOWEST) {
         bases.push(plain.clone());
     }
     for base in &bases {
@@ -999,17 +1129,48 @@ fn add_resonance(
         if reduced.score() < best.score() {
             best = reduced;
         }
-        if sine && base.sine.is_none() {
-            let on_top = (res.gm_tau.as_slice(), res.resonance);
-            if let Some(toned) = with_sine(data, fs, ieee, on_top, res.solution.d2, true)? {
-                let reduced = eliminate(data, fs, ieee, toned)?;
-                if reduced.score() < best.score() {
-                    best = reduced;
-                }
-            }
+        if base.sine.is_empty() {
+            let on_top = (res.gm_tau.clone(), Tones::NONE, res.resonance);
+            add_tones(
+                data,
+                fs,
+                ieee,
+                on_top,
+                (res.solution.d2, max_tones),
+                &mut best,
+            )?;
         }
     }
     Ok(best)
+}
+
+/// Tones searched one at a time on top of the times, tones and resonance of
+/// `start`, up to `max_tones` (and [`MAX_TONES`]), from discrepancy `d2`; each
+/// toned structure, reduced, replaces `best` when it scores lower. The next tone is searched on top of the last whether
+/// or not that one won: two lines each leave the other's misfit, so the first
+/// of them alone can lose and the pair win.
+fn add_tones(
+    data: &Data,
+    fs: f64,
+    ieee: [bool; IEEE_TERMS],
+    (gm_tau, tones, resonance): (Vec<f64>, Tones, Option<Resonance>),
+    (d2, max_tones): (f64, usize),
+    best: &mut Candidate,
+) -> CoreResult<()> {
+    let mut current = (gm_tau, tones, d2);
+    while current.1.len() < max_tones {
+        let start = (current.0.as_slice(), current.1, resonance);
+        let Some(toned) = with_sine(data, fs, ieee, start, current.2, true)? else {
+            break;
+        };
+        // The next tone is searched at the discrepancy this structure settled on.
+        current = (toned.gm_tau.clone(), toned.sine, toned.solution.d2);
+        let reduced = eliminate(data, fs, ieee, toned)?;
+        if reduced.score() < best.score() {
+            *best = reduced;
+        }
+    }
+    Ok(())
 }
 
 /// Shortest correlation time of a bounded motion, in samples: a faster one is
@@ -1037,7 +1198,7 @@ pub fn with_motion(
     data: &Data,
     fs: f64,
     ieee: [bool; IEEE_TERMS],
-    (gm_tau, sine, resonance): (&[f64], Option<f64>, Option<Resonance>),
+    (gm_tau, sine, resonance): (&[f64], Tones, Option<Resonance>),
     d2: f64,
     gated: bool,
 ) -> CoreResult<Option<Candidate>> {
@@ -1081,18 +1242,18 @@ pub fn with_motion(
     // it had also been bent to the motion's white part (on a simulated gyro with
     // lines at 1.2 and 2.1 Hz on a rocking vehicle, 1.217 Hz refined to 1.25 Hz,
     // and the structure with both scored 12 lower).
-    let sine = match sine {
-        Some(f) => {
-            moving.sine = None;
-            let coarse = moving.coarse_frequency(&times).map_or(f, |(g, _)| g);
-            let refined = moving.refine_frequency(&times, coarse);
-            moving.sine = Some(refined);
-            moving.polish(&mut times, step);
-            Some(refined)
-        }
-        None => None,
-    };
-    let extras = (sine, resonance, Some(tau_c));
+    let mut tones = sine;
+    for k in 0..tones.len() {
+        moving.sine = tones.without(k);
+        let f = tones.as_slice()[k];
+        let coarse = moving.coarse_frequency(&times).map_or(f, |(g, _)| g);
+        tones = tones.replaced(k, moving.refine_frequency(&times, coarse));
+    }
+    if !tones.is_empty() {
+        moving.sine = tones;
+        moving.polish(&mut times, step);
+    }
+    let extras = (tones, resonance, Some(tau_c));
     candidate(data, fs, ieee, times, extras, d2).map(Some)
 }
 
@@ -1120,7 +1281,7 @@ pub fn prefer_random_walk(
     fs: f64,
     ieee: [bool; IEEE_TERMS],
     max_gm: usize,
-    kinds: (bool, bool, bool),
+    kinds: (usize, bool, bool),
     best: Candidate,
 ) -> CoreResult<Candidate> {
     if best.solution.theta[RAMP] <= 0.0 {

@@ -145,10 +145,19 @@ def test_goodness_of_fit_warns_only_when_the_model_misses():
         warnings.simplefilter("error", RuntimeWarning)
         followed = imunoise.fit(imunoise.adev(tone, FS, taus=20))
     assert float(followed.coverage) > 0.95
-    # ... two are not: the model has one tone and no term follows the other's nulls.
-    two = good + 3.0 * np.sin(2 * np.pi * 0.05 * t) + 2.0 * np.sin(2 * np.pi * 0.37 * t)
+    # ... two are its two tones (each with its own frequency and amplitude) ...
+    two = good + 3.0 * np.sin(2 * np.pi * 0.05 * t) + 2.0 * np.sin(2 * np.pi * 1.3 * t)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        pair = imunoise.fit(imunoise.adev(two, FS, taus=20))
+    assert float(pair.coverage) > 0.95
+    found = pair.components.sine()  # by increasing frequency
+    np.testing.assert_allclose([f0 for _, f0 in found], [0.05, 1.3], rtol=1e-3)
+    np.testing.assert_allclose([a for a, _ in found], [3.0, 2.0], rtol=0.05)
+    # ... three are not: the model has two tones and no term follows the third's nulls.
+    three = two + 1.5 * np.sin(2 * np.pi * 0.37 * t)
     with pytest.warns(RuntimeWarning, match="follows the Allan deviation of channel 0"):
-        missed = imunoise.fit(imunoise.adev(two, FS, taus=20))
+        missed = imunoise.fit(imunoise.adev(three, FS, taus=20))
     assert float(missed.coverage) < 0.8
     assert float(missed.discrepancy) > 0.1
 

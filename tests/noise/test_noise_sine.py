@@ -60,7 +60,7 @@ def test_tone_is_selected_and_recovered(toned):
         amp, f0 = tone[0]
         assert f0 == pytest.approx(truth["f0"], rel=0.01)
         assert amp == pytest.approx(truth["A"], rel=0.10)
-        assert abs(amp - truth["A"]) < 4 * np.atleast_1d(model.components.sine_amplitude_std)[c]
+        assert abs(amp - truth["A"]) < 4 * model.components.sine_amplitude_std[c, 0]
         assert model.N[c] == pytest.approx(truth["N"], rel=0.02)
         assert model.components.gauss_markov(c) == []
     assert np.all(model.coverage >= 0.9)
@@ -114,8 +114,8 @@ def test_tone_in_prediction_dict_repr_and_plot(toned):
 
 def test_explicit_sine_terms_are_checked(toned):
     _, r = toned
-    with pytest.raises(ValueError, match="each of 'sine', 'resonance', 'motion' at most once"):
-        imunoise.fit(r, terms=["N", "sine", "sine"])
+    with pytest.raises(ValueError, match="'sine' at most 2 times"):
+        imunoise.fit(r, terms=["N", "sine", "sine", "sine"])
     only = quiet_fit(r, terms=["N", "sine"])
     assert all(len(only.components.sine(c)) == 1 for c in range(2))
     assert not np.any(only.supported["K"])
@@ -127,7 +127,26 @@ def test_bootstrap_simulates_and_refits_the_tone():
     model = quiet_fit(r, uncertainty="bootstrap", replicates=6, seed=2)
     assert model.components.sine(0) != []
     parts = model.components
-    amp_std, f_std = float(parts.sine_amplitude_std), float(parts.sine_freq_std)
+    amp_std, f_std = parts.sine_amplitude_std[0], parts.sine_freq_std[0]
     # The replicates' spread is small next to the tone yet not zero.
-    assert 0 < amp_std < 0.1 * float(model.components.sine_amplitude)
-    assert 0 < f_std < 0.01 * float(model.components.sine_freq)
+    assert 0 < amp_std < 0.1 * parts.sine_amplitude[0]
+    assert 0 < f_std < 0.01 * parts.sine_freq[0]
+    assert np.isnan(parts.sine_amplitude[1])
+
+
+def test_two_tones_fixed_and_simulated():
+    """``terms`` may name ``"sine"`` twice, ``simulate`` takes a list of tones, and
+    the bootstrap simulates and refits both."""
+    x = imunoise.simulate(int(1800 * FS), FS, N=1e-3, seed=9,
+                          sinusoid=[(4e-3, 7.3), (3e-3, 0.9)])
+    r = imunoise.adev(x, FS, taus=10)
+    model = quiet_fit(r, terms=["N", "sine", "sine"], uncertainty="bootstrap", replicates=6,
+                      seed=2)
+    tones = model.components.sine(0)
+    np.testing.assert_allclose([f0 for _, f0 in tones], [0.9, 7.3], rtol=0.01)
+    np.testing.assert_allclose([a for a, _ in tones], [3e-3, 4e-3], rtol=0.1)
+    stds = model.components.sine_amplitude_std
+    assert np.all((stds > 0) & (stds < 0.2 * model.components.sine_amplitude))
+    rows = [row[0] for row in model.components.other_terms()]
+    assert rows == ["A1", "f1", "A2", "f2"]
+    assert model.components.count(0) == 3

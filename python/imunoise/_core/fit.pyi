@@ -9,12 +9,14 @@ IEEE_TERM_NAMES: list[str]
 """The IEEE 952 coefficients in array order: Q, N, B, K, R."""
 MAX_GAUSS_MARKOV: int
 """Most first-order Gauss–Markov terms a model may have."""
+MAX_TONES: int
+"""Most tones a model may have."""
 PARAMETERS: int
 """Slots of the covariance: Q²…R², then (q², ln τc) per Gauss–Markov term, then
-(s², ln f₀) of the tone, then (r², ln f_r, ln τr) of the resonance, then
+(s², ln f₀) per tone slot, then (r², ln f_r, ln τr) of the resonance, then
 (σθ², ln τc) of the bounded motion."""
 SINE_SLOT: int
-"""Slot of the tone's variance s² (its ln f₀ follows)."""
+"""Slot of the first tone's variance s² (its ln f₀ follows, then the next tone's)."""
 RESONANCE_SLOT: int
 """Slot of the resonance's variance r² (its ln f_r, ln τr follow)."""
 MOTION_SLOT: int
@@ -34,7 +36,7 @@ class NoiseFit:
         """(k, 2) rows of (q², τc), one per Gauss–Markov term."""
     @property
     def sine(self) -> npt.NDArray[np.float64]:
-        """(k, 2) rows of (s², f₀), k ≤ 1: the tone."""
+        """(k, 2) rows of (s², f₀), k ≤ MAX_TONES: the tones."""
     @property
     def resonance(self) -> npt.NDArray[np.float64]:
         """(k, 3) rows of (r², f_r, τr), k ≤ 1: the resonance."""
@@ -44,7 +46,7 @@ class NoiseFit:
     @property
     def cov(self) -> npt.NDArray[np.float64]:
         """(PARAMETERS, PARAMETERS) covariance of (Q²…R², then q², ln τc per slot,
-        then s², ln f₀, then r², ln f_r, ln τr, then σθ², ln τc; NaN variance of
+        then s², ln f₀ per tone slot, then r², ln f_r, ln τr, then σθ², ln τc; NaN variance of
         ln f_r at fs/2)."""
     @property
     def discrepancy(self) -> float:

@@ -17,9 +17,9 @@ taus and slowly wandering biases put bumps in the curve. The model therefore
 also has up to three first-order Gauss–Markov (exponentially correlated) bias
 terms, each with a standard deviation σ and a correlation time τc, whose Allan
 variance is the discrete AR1 form of IEEE 952 Annex C (slope +½ for τ ≪ τc, a
-peak near 1.9 τc, slope −½ for τ ≫ τc), and at most one tone A·sin(2πf₀t + ϕ)
-(a line: dither, ripple, a sharp mode), IEEE 952 Annex C's sinusoidal term
-A²·sin⁴(πf₀τ)/(πf₀τ)² in its sampled form 2·(A²/2)·sin⁴(πνm)/(m² sin²πν),
+peak near 1.9 τc, slope −½ for τ ≫ τc), and up to two tones A·sin(2πf₀t + ϕ)
+(lines: dither, ripple, a sharp mode, a vehicle's two modes), IEEE 952 Annex C's
+sinusoidal term A²·sin⁴(πf₀τ)/(πf₀τ)² in its sampled form 2·(A²/2)·sin⁴(πνm)/(m² sin²πν),
 ν = f₀/fs, m = τ·fs, whose frequency is searched like the correlation times,
 and at most one resonance: a damped oscillator (second-order Gauss–Markov
 process) of standard deviation σ, centre frequency f_r and damping time τr,
@@ -78,10 +78,11 @@ from imunoise.noise._terms import (
     FLICKER,
     GM_MAX,
     TERMS,
+    TONES_MAX,
     gm_white_density,
     model_variance,
     resonance_white_density,
 )
 
-__all__ = ["TERMS", "FLICKER", "GM_MAX", "Components", "NoiseModel", "Prediction", "fit",
-           "format_table", "gm_white_density", "model_variance", "resonance_white_density"]
+__all__ = ["TERMS", "FLICKER", "GM_MAX", "TONES_MAX", "Components", "NoiseModel", "Prediction",
+           "fit", "format_table", "gm_white_density", "model_variance", "resonance_white_density"]

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from imunoise import _schema, _summary
-from imunoise.noise._terms import GM_MAX, TERMS, term_variances
+from imunoise.noise._terms import GM_MAX, TERMS, TONES_MAX, term_variances
 
 
 def check_term(term: str) -> None:
@@ -126,8 +126,8 @@ class Components(PerTerm):
     gm_sigma_std, gm_tau_std : ndarray
         Their standard uncertainties.
     sine_amplitude, sine_freq : ndarray
-        A tone A·sin(2πf0·t + ϕ): peak amplitude (rate) and frequency (Hz),
-        shape () or (channels,); NaN where a channel has none.
+        Tones A·sin(2πf0·t + ϕ): peak amplitude (rate) and frequency (Hz), shape
+        (2,) or (channels, 2), by increasing frequency; NaN in unused slots.
     sine_amplitude_std, sine_freq_std : ndarray
         Their standard uncertainties.
     resonance_sigma, resonance_freq, resonance_tau : ndarray
@@ -151,9 +151,9 @@ class Components(PerTerm):
         Their standard uncertainties.
     cov : ndarray
         ``"wls"``: covariance of (Q², N², B², K², R², then σ², ln τc of each
-        Gauss–Markov slot, then A²/2, ln f0 of the tone, then σ², ln f_r, ln τr
-        of the resonance, then σθ², ln τc of the motion), shape (18, 18) or
-        (channels, 18, 18); NaN for ``"slopes"``.
+        Gauss–Markov slot, then A²/2, ln f0 of each tone slot, then σ², ln f_r,
+        ln τr of the resonance, then σθ², ln τc of the motion), shape (20, 20) or
+        (channels, 20, 20); NaN for ``"slopes"``.
     fs : float
         Sample rate of the data (Hz): the terms' sampled forms depend on it.
     """
@@ -187,10 +187,10 @@ class Components(PerTerm):
         return [(float(s), float(t)) for s, t in zip(sig, tau, strict=True) if np.isfinite(s)]
 
     def sine(self, channel: int = 0) -> list[tuple[float, float]]:
-        """The (amplitude, f0) of the tone of ``channel``: one pair, or none."""
-        amp = float(np.atleast_1d(self.sine_amplitude)[channel])
-        f0 = float(np.atleast_1d(self.sine_freq)[channel])
-        return [(amp, f0)] if np.isfinite(amp) else []
+        """The (amplitude, f0) of each tone of ``channel``."""
+        amp = np.reshape(self.sine_amplitude, (-1, TONES_MAX))[channel]
+        f0 = np.reshape(self.sine_freq, (-1, TONES_MAX))[channel]
+        return [(float(a), float(f)) for a, f in zip(amp, f0, strict=True) if np.isfinite(a)]
 
     def resonance(self, channel: int = 0) -> list[tuple[float, float, float]]:
         """The (sigma, f_r, tau_r) of the resonance of ``channel``: one triple, or none."""
@@ -223,8 +223,8 @@ class Components(PerTerm):
 
     def predict(self, taus) -> Prediction:
         """Allan deviation of the components at ``taus``: the total curve and each
-        term's own curve (``terms["N"]`` = N/√τ, ``terms["GM1"]``, ``terms["sine"]``,
-        ``terms["resonance"]``, ``terms["motion"]``)."""
+        term's own curve (``terms["N"]`` = N/√τ, ``terms["GM1"]``, ``terms["sine"]``
+        for the tones together, ``terms["resonance"]``, ``terms["motion"]``)."""
         t = np.asarray(taus, dtype=float)
         if t.ndim != 1 or t.size == 0 or not np.all(np.isfinite(t)) or np.any(t <= 0):
             raise ValueError(f"taus must be a non-empty 1-D array of finite values > 0; got {t!r}")
@@ -236,10 +236,10 @@ class Components(PerTerm):
             moving = self.motion(c)
             var = term_variances(t, self.fs, [self.value(k)[c] for k in TERMS], markov, tone, osc,
                                  moving)
-            cols = [*range(len(TERMS) + len(markov)), *([names.index("sine")] if tone else []),
+            cols = [*range(len(TERMS) + len(markov)), *[names.index("sine")] * len(tone),
                     *([names.index("resonance")] if osc else []),
                     *([names.index("motion")] if moving else [])]
-            parts[:, cols, c] = var
+            np.add.at(parts[:, :, c], (slice(None), cols), var)
         total = np.sqrt(parts.sum(axis=1))
         channels = range(self.channels)
         used = [*TERMS, *gm_names[: max(len(self.gauss_markov(c)) for c in channels)],
@@ -266,12 +266,15 @@ class Components(PerTerm):
                             sig_std[:, k]))
                 out.append((f"τc{k + 1}", "Gauss–Markov correlation time", "s", tau[:, k],
                             tau_std[:, k]))
+        tones = [np.reshape(a, (self.channels, TONES_MAX)) for a in (
+            self.sine_amplitude, self.sine_amplitude_std, self.sine_freq, self.sine_freq_std)]
+        used = [k for k in range(TONES_MAX) if np.isfinite(tones[0][:, k]).any()]
+        for k in used:
+            tag = str(k + 1) if len(used) > 1 else ""
+            amp, amp_std, f0, f0_std = (a[:, k] for a in tones)
+            out.append((f"A{tag}", "tone amplitude", None, amp, amp_std))
+            out.append((f"f{tag}" if tag else "f0", "tone frequency", "Hz", f0, f0_std))
         one = np.atleast_1d
-        if np.isfinite(one(self.sine_amplitude)).any():
-            out.append(("A", "tone amplitude", None, one(self.sine_amplitude),
-                        one(self.sine_amplitude_std)))
-            out.append(("f0", "tone frequency", "Hz", one(self.sine_freq),
-                        one(self.sine_freq_std)))
         if np.isfinite(one(self.resonance_sigma)).any():
             out.append(("σr", "resonance standard deviation", None, one(self.resonance_sigma),
                         one(self.resonance_sigma_std)))

@@ -87,14 +87,14 @@ def _propagated(components, taus, term: str) -> tuple[np.ndarray, np.ndarray]:
 
 def parameters(components, channel: int) -> np.ndarray:
     """(Q², N², B², K², R², then σ², ln τc per Gauss–Markov slot, then A²/2,
-    ln f0 of the tone, then σ², ln f_r, ln τr of the resonance, then σθ², ln τc of
+    ln f0 per tone slot, then σ², ln f_r, ln τr of the resonance, then σθ², ln τc of
     the bounded motion) of a channel."""
     p = np.zeros(PARAMS)
     p[:5] = [float(components.value(t)[channel]) ** 2 for t in TERMS]
     for k, (sigma, tau_c) in enumerate(components.gauss_markov(channel)):
         p[5 + 2 * k], p[6 + 2 * k] = sigma**2, math.log(tau_c)
-    for amplitude, f0 in components.sine(channel):
-        p[SINE_SLOT], p[SINE_SLOT + 1] = amplitude**2 / 2, math.log(f0)
+    for k, (amplitude, f0) in enumerate(components.sine(channel)):
+        p[SINE_SLOT + 2 * k], p[SINE_SLOT + 2 * k + 1] = amplitude**2 / 2, math.log(f0)
     for sigma, f_r, tau_r in components.resonance(channel):
         p[RES_SLOT], p[RES_SLOT + 1], p[RES_SLOT + 2] = sigma**2, math.log(f_r), math.log(tau_r)
     for sigma, tau_c in components.motion(channel):

@@ -27,6 +27,7 @@ from imunoise.noise._terms import (
     RES_SLOT,
     SINE_SLOT,
     TERMS,
+    TONES_MAX,
     term_variances,
 )
 
@@ -114,24 +115,25 @@ def _edf_cap(result, taus):
     return np.where(np.isfinite(cap) & (cap > 1.0), cap, 1.0)
 
 
-def _parse_terms(terms) -> tuple[np.ndarray, int, tuple[bool, bool, bool], bool]:
-    """``terms`` → (IEEE mask, Gauss–Markov count, (tone, resonance, motion), select
+def _parse_terms(terms) -> tuple[np.ndarray, int, tuple[int, bool, bool], bool]:
+    """``terms`` → (IEEE mask, Gauss–Markov count, (tones, resonance, motion), select
     by BIC)."""
     if isinstance(terms, str) and terms == "auto":
-        return np.ones(len(TERMS), dtype=bool), GM_MAX, (True, True, True), True
+        return np.ones(len(TERMS), dtype=bool), GM_MAX, (TONES_MAX, True, True), True
     names = tuple(terms) if not isinstance(terms, str) else tuple(terms)
     allowed = (*TERMS, "GM", "sine", "resonance", "motion")
     bad = [t for t in names if t not in allowed]
     gm = names.count("GM")
-    if (bad or not names or gm > GM_MAX
-            or any(names.count(once) > 1 for once in ("sine", "resonance", "motion"))):
+    tones = names.count("sine")
+    if (bad or not names or gm > GM_MAX or tones > TONES_MAX
+            or any(names.count(once) > 1 for once in ("resonance", "motion"))):
         raise ValueError(
             f"terms must be 'auto' or a non-empty sequence of {allowed} with 'GM' at most "
-            f"{GM_MAX} times and each of 'sine', 'resonance', 'motion' at most once; got "
-            f"{terms!r}"
+            f"{GM_MAX} times, 'sine' at most {TONES_MAX} times and each of 'resonance', "
+            f"'motion' at most once; got {terms!r}"
         )
     mask = np.array([t in names for t in TERMS])
-    return mask, gm, ("sine" in names, "resonance" in names, "motion" in names), False
+    return mask, gm, (tones, "resonance" in names, "motion" in names), False
 
 
 @old_call_forms(keyword_only=("method", "terms", "tau_range"))
@@ -152,10 +154,10 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
     terms : "auto" or sequence of {"Q", "N", "B", "K", "R", "GM", "sine", "resonance", \
 "motion"}
         ``"auto"`` (default): the IEEE terms, up to three Gauss–Markov terms,
-        a tone, a resonance and a bounded motion of the mount, the structure
-        with the lowest BIC (the fewest terms that describe the curve). A
-        sequence fits exactly those terms (``"GM"`` up to three times for
-        Gauss–Markov terms, ``"sine"`` once for a tone, ``"resonance"`` once for
+        up to two tones, a resonance and a bounded motion of the mount, the
+        structure with the lowest BIC (the fewest terms that describe the
+        curve). A sequence fits exactly those terms (``"GM"`` up to three times
+        for Gauss–Markov terms, ``"sine"`` up to twice for tones, ``"resonance"`` once for
         a damped oscillator, ``"motion"`` once for a bounded motion); a term the
         data push below zero is still 0.
     tau_range : (float, float), optional
@@ -228,8 +230,8 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
     rng = np.full((channels, 5, 2), np.nan)
     gm = np.full((channels, GM_MAX, 2), np.nan)
     gm_std = np.full((channels, GM_MAX, 2), np.nan)
-    sine = np.full((channels, 2), np.nan)  # amplitude, f0
-    sine_std = np.full((channels, 2), np.nan)
+    sine = np.full((channels, TONES_MAX, 2), np.nan)  # amplitude, f0 per tone slot
+    sine_std = np.full((channels, TONES_MAX, 2), np.nan)
     osc = np.full((channels, 3), np.nan)  # sigma, f_r, tau_r
     osc_std = np.full((channels, 3), np.nan)
     moving = np.full((channels, 2), np.nan)  # sigma of the angle, tau_c
@@ -262,7 +264,7 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
             coef[c], std[c], sup[c], gm[c], gm_std[c], sine[c], sine_std[c], osc[c], \
                 osc_std[c], moving[c], moving_std[c], stats[c], cov[c] = out
             markov = [(a, b) for a, b in gm[c] if np.isfinite(a)]
-            tones = [tuple(sine[c])] if np.isfinite(sine[c, 0]) else []
+            tones = [tuple(p) for p in sine[c] if np.isfinite(p[0])]
             oscs = [tuple(osc[c])] if np.isfinite(osc[c, 0]) else []
             motions = [tuple(moving[c])] if np.isfinite(moving[c, 0]) else []
             parts = term_variances(taus[usable[c]], result.fs, coef[c], markov, tones, oscs,
@@ -278,7 +280,7 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
         for c in range(channels):
             kept = [t for t, keep in zip(TERMS, sup[c], strict=True) if keep]
             markov = [(float(a), float(b)) for a, b in gm[c] if np.isfinite(a)]
-            tones = [(float(sine[c, 0]), float(sine[c, 1]))] if np.isfinite(sine[c, 0]) else []
+            tones = [(float(a), float(f0)) for a, f0 in sine[c] if np.isfinite(a)]
             oscs = [tuple(map(float, osc[c]))] if np.isfinite(osc[c, 0]) else []
             motions = [tuple(map(float, moving[c]))] if np.isfinite(moving[c, 0]) else []
             if not kept and not markov and not tones and not oscs and not motions:
@@ -307,10 +309,10 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
         gm_tau=shaped(gm[:, :, 1]),
         gm_sigma_std=shaped(gm_std[:, :, 0]),
         gm_tau_std=shaped(gm_std[:, :, 1]),
-        sine_amplitude=shaped(sine[:, 0]),
-        sine_freq=shaped(sine[:, 1]),
-        sine_amplitude_std=shaped(sine_std[:, 0]),
-        sine_freq_std=shaped(sine_std[:, 1]),
+        sine_amplitude=shaped(sine[:, :, 0]),
+        sine_freq=shaped(sine[:, :, 1]),
+        sine_amplitude_std=shaped(sine_std[:, :, 0]),
+        sine_freq_std=shaped(sine_std[:, :, 1]),
         resonance_sigma=shaped(osc[:, 0]),
         resonance_freq=shaped(osc[:, 1]),
         resonance_tau=shaped(osc[:, 2]),
@@ -415,7 +417,7 @@ def _bootstrap_std(result, n, coef, markov, oscillators, replicates, rng, option
 
     tones, oscs, motions = oscillators
     sims = simulate(n, result.fs, *coef, channels=replicates, seed=rng, gm=markov,
-                    sinusoid=tones[0] if tones else None,
+                    sinusoid=tones or None,
                     resonance=oscs[0] if oscs else None,
                     motion=motions[0] if motions else None)
     again = adev(sims, result.fs, taus=np.asarray(result.taus), overlapping=result.overlapping,
@@ -427,8 +429,8 @@ def _bootstrap_std(result, n, coef, markov, oscillators, replicates, rng, option
     values = np.stack([np.atleast_1d(parts.value(t)) for t in TERMS], axis=1)
     gm = np.stack([np.reshape(parts.gm_sigma, (-1, GM_MAX)),
                    np.reshape(parts.gm_tau, (-1, GM_MAX))], axis=-1)
-    tone = np.stack([np.atleast_1d(parts.sine_amplitude), np.atleast_1d(parts.sine_freq)],
-                    axis=-1)
+    tone = np.stack([np.reshape(parts.sine_amplitude, (-1, TONES_MAX)),
+                     np.reshape(parts.sine_freq, (-1, TONES_MAX))], axis=-1)
     osc = np.stack([np.atleast_1d(a) for a in (parts.resonance_sigma, parts.resonance_freq,
                                                parts.resonance_tau)], axis=-1)
     moving = np.stack([np.atleast_1d(parts.motion_sigma), np.atleast_1d(parts.motion_tau)],
@@ -471,14 +473,15 @@ def _fit_wls(t, v, e, fs, mask, gm_count, oscillators, select):
         u_q2, u_log_tau = cov[5 + 2 * k, 5 + 2 * k], cov[6 + 2 * k, 6 + 2 * k]
         markov_std[k] = math.sqrt(max(u_q2, 0.0)) / (2 * sigma), tau_c * math.sqrt(
             max(u_log_tau, 0.0))
-    sine = np.full(2, np.nan)
-    sine_std = np.full(2, np.nan)
-    for s2, f0 in r.sine:
+    sine = np.full((TONES_MAX, 2), np.nan)
+    sine_std = np.full((TONES_MAX, 2), np.nan)
+    for k, (s2, f0) in enumerate(r.sine):
         # s² = A²/2, so u(A) = u(s²)/A.
         amplitude = math.sqrt(2 * s2)
-        sine[:] = amplitude, f0
-        sine_std[:] = (math.sqrt(max(cov[SINE_SLOT, SINE_SLOT], 0.0)) / amplitude,
-                       f0 * math.sqrt(max(cov[SINE_SLOT + 1, SINE_SLOT + 1], 0.0)))
+        slot = SINE_SLOT + 2 * k
+        sine[k] = amplitude, f0
+        sine_std[k] = (math.sqrt(max(cov[slot, slot], 0.0)) / amplitude,
+                       f0 * math.sqrt(max(cov[slot + 1, slot + 1], 0.0)))
     osc = np.full(3, np.nan)
     osc_std = np.full(3, np.nan)
     for r2, f_r, tau_r in r.resonance:

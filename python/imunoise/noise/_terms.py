@@ -33,11 +33,15 @@ READ_TAU = {"Q": math.sqrt(3.0), "N": 1.0, "K": 3.0, "R": math.sqrt(2.0)}
 GM_MAX: int = _core_fit.MAX_GAUSS_MARKOV
 """Most first-order Gauss–Markov terms a model may have."""
 
+TONES_MAX: int = _core_fit.MAX_TONES
+"""Most tones a model may have."""
+
 PARAMS: int = _core_fit.PARAMETERS
 """Parameter slots of the covariance: five IEEE variances, (σ², ln τc) per GM term,
-then (A²/2, ln f0) of the tone."""
+then (A²/2, ln f0) per tone slot, then the resonance's and the motion's."""
 SINE_SLOT: int = _core_fit.SINE_SLOT
-"""Slot of the tone's variance A²/2 in the covariance (its ln f0 follows)."""
+"""Slot of the first tone's variance A²/2 in the covariance (its ln f0 follows, then
+the next tone's)."""
 RES_SLOT: int = _core_fit.RESONANCE_SLOT
 """Slot of the resonance's variance σ² in the covariance (ln f_r, ln τr follow)."""
 MOTION_SLOT: int = _core_fit.MOTION_SLOT

@@ -94,9 +94,11 @@ def model_sentences(model: NoiseModel, sensor: str,
                                              sensor=sensor)
             parts.append(f"Gauss–Markov bias σ = {format_number(value, value_std)} "
                          f"{b_unit.label}, τc = {format_number(tau_c, tau_std)} s")
-        for amplitude, f0 in parts_of.sine(c):
-            amp_std = float(np.atleast_1d(parts_of.sine_amplitude_std)[c])
-            f0_std = float(np.atleast_1d(parts_of.sine_freq_std)[c])
+        tone_stds = zip(np.reshape(parts_of.sine_amplitude_std, (parts_of.channels, -1))[c],
+                        np.reshape(parts_of.sine_freq_std, (parts_of.channels, -1))[c],
+                        strict=True)
+        for (amplitude, f0), (amp_std, f0_std) in zip(parts_of.sine(c), tone_stds,
+                                                      strict=False):
             value, value_std = _units.convert(np.array([amplitude, amp_std]), "B", b_unit.name,
                                              sensor=sensor)
             parts.append(f"a tone of amplitude {format_number(value, value_std)} "
