@@ -72,12 +72,12 @@ def fit_noise(
     terms: list[bool],
     gm: int = 3,
     select: bool = True,
-    sine: bool = True,
+    tones: int = 2,
     resonance: bool = True,
     motion: bool = True,
 ) -> NoiseFit:
     """Log-space, octave-weighted fit of the noise model (IEEE terms, up to
-    ``gm`` Gauss–Markov terms, with ``sine`` a tone, with ``resonance`` a
+    ``gm`` Gauss–Markov terms, up to ``tones`` tones, with ``resonance`` a
     damped oscillator and with ``motion`` a bounded motion of the mount) to one
     channel; structure chosen by BIC when ``select``."""
 
