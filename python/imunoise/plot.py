@@ -28,6 +28,7 @@ from imunoise import _atomic, _summary
 from imunoise._schema import ATTITUDE_NAMES, CHANNELS, axis_names
 from imunoise.allan import AllanResult
 from imunoise.noise import FLICKER, TERMS, NoiseModel, model_variance
+from imunoise.noise._terms import term_variances
 from imunoise.numbers import format_value, rounded
 from imunoise.readers.log import ImuLog
 from imunoise.stats import Distribution
@@ -453,22 +454,28 @@ def _model_curves(model: NoiseModel, grid: np.ndarray, channel: int) -> dict[str
 
 def _tone_envelope(model: NoiseModel, grid: np.ndarray, channel: int,
                    curve: np.ndarray) -> np.ndarray:
-    """The tones' Allan deviation up to its first peak, their upper envelope beyond:
-    the sampled form 2·(A²/2)·sin⁴(πνm)/(m² sin²πν) with sin⁴ → 1, A/(m·|sin πν|),
-    ν = f0/fs, m = τ·fs, the tones' variances added. The curve itself is a comb of
-    zeros at whole periods, which drew spikes across the panel."""
+    """The tones' Allan deviation drawn without its comb of zeros at whole periods
+    (which drew spikes across the panel): each tone's own curve up to its first
+    peak (below one period, ≈ 0.37/f0), its upper envelope beyond — the sampled form
+    2·(A²/2)·sin⁴(πνm)/(m² sin²πν) with sin⁴ → 1, A/(m·|sin πν|), ν = f0/fs,
+    m = τ·fs, capped at the peak — and the tones' variances added."""
     tones = model.components.sine(channel)
     if not tones:
         return curve
     fs = float(model.fs)
-    envelope = np.sqrt(sum((amplitude / (grid * fs * abs(np.sin(np.pi * f0 / fs)))) ** 2
-                           for amplitude, f0 in tones))
-    # The first peak lies below one period (≈ 0.37/f0) of the slowest tone.
-    first = grid <= 1.0 / min(f0 for _, f0 in tones)
-    if not first.any():
-        return envelope
-    peak = int(np.argmax(np.where(first, curve, -np.inf)))
-    return np.where(np.arange(grid.size) <= peak, curve, np.minimum(envelope, curve[peak]))
+    total = np.zeros_like(grid)
+    for amplitude, f0 in tones:
+        own = np.sqrt(term_variances(grid, fs, np.zeros(len(TERMS)), tone=[(amplitude, f0)])
+                      [:, len(TERMS)])
+        envelope = amplitude / (grid * fs * abs(np.sin(np.pi * f0 / fs)))
+        first = grid <= 1.0 / f0
+        if not first.any():
+            total += envelope**2
+            continue
+        peak = int(np.argmax(np.where(first, own, -np.inf)))
+        drawn = np.where(np.arange(grid.size) <= peak, own, np.minimum(envelope, own[peak]))
+        total += drawn**2
+    return np.sqrt(total)
 
 
 def _data_floor(model: NoiseModel, channel: int) -> tuple[float, float] | None:
