@@ -11,7 +11,7 @@ import numpy as np
 from imunoise import datasheet
 from imunoise import units as _units
 from imunoise._schema import axis_names
-from imunoise.noise import NoiseModel
+from imunoise.noise import NoiseModel, gm_white_density
 from imunoise.report.formatting import format_number
 
 __all__ = ["comparison_rows", "datasheet_rows", "lab_rows", "model_sentences"]
@@ -116,6 +116,7 @@ def model_sentences(model: NoiseModel, sensor: str,
                          f"{math.pi * f_r * tau_r:.2g})")
         parts += _motion_sentence(model, c, sensor, n_unit,
                                   _units.unit_info("Q", chosen.get("Q"), sensor))
+        parts += _correlated_white_sentence(model, c)
         for term, unit in (("N", n_unit), ("B", b_unit)):
             parts += _readoff_agreement(model, c, term, unit, sensor)
         out.append("; ".join(parts) + ".")
@@ -143,6 +144,33 @@ def _motion_sentence(model: NoiseModel, c: int, sensor: str, n_unit, q_unit) -> 
             text += (f"; under it the sensor's own white noise does not show: N is not "
                      f"resolved, at most {format_number(float(bound))} {n_unit.label}")
         out.append(text)
+    return out
+
+
+#: Share of the datasheet N² above which a term's white tail "carries" N.
+CARRIES_N = 0.5
+
+
+def _correlated_white_sentence(model: NoiseModel, c: int) -> list[str]:
+    """Where most of the datasheet N² is the white tail of a Gauss–Markov term whose
+    hump the curve shows (its peak, at ≈ 1.9 τc, beyond the first two taus): say
+    that it is the sensor's output filter or a disturbance of the mount, which the
+    Allan curve cannot tell apart (a ring-laser gyro on a parked vehicle printed
+    the vehicle's vibration as its angle random walk, 100× the gyro's own)."""
+    n2 = float(model.value("N")[c]) ** 2
+    if not n2 > 0 or len(model.taus) < 3:
+        return []
+    out = []
+    for sigma, tau_c in model.components.gauss_markov(c):
+        share = gm_white_density(sigma, tau_c, model.fs) / n2
+        if tau_c < 1.0 and share > CARRIES_N and 1.9 * tau_c > float(model.taus[1]):
+            out.append(
+                f"N is {share:.0%} the white tail of the Gauss–Markov term of τc "
+                f"{tau_c:.2g} s, whose hump the curve shows near {1.9 * tau_c:.2g} s: "
+                "the sensor's own output filter, or a disturbance of the mount (a "
+                "vehicle's or a machine's vibration), which the Allan deviation cannot "
+                "tell apart; where the sensor's filter is faster, its own white noise "
+                "lies below this N")
     return out
 
 
