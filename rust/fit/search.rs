@@ -119,10 +119,17 @@ pub const SINE_PERIODS: f64 = 10.0;
 pub const MAX_TONES: usize = 2;
 
 /// The tones' frequencies (Hz) of a structure, in the order they were found.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[derive(Debug, Clone, Copy, Default)]
 pub struct Tones {
     freq: [f64; MAX_TONES],
     len: usize,
+}
+
+impl PartialEq for Tones {
+    /// The same frequencies (the unused slots do not count).
+    fn eq(&self, other: &Self) -> bool {
+        self.as_slice() == other.as_slice()
+    }
 }
 
 impl Tones {
@@ -1352,4 +1359,23 @@ pub fn prefer_random_walk(
     } else {
         best
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tones_add_remove_and_replace_by_slot() {
+        let two = Tones::NONE.with(1.0).with(2.0);
+        assert_eq!(two.as_slice(), &[1.0, 2.0]);
+        assert!(two.is_full());
+        assert_eq!(two.with(3.0), two, "a full set takes no more");
+        assert_eq!(two.without(0).as_slice(), &[2.0]);
+        assert_eq!(two.replaced(1, 5.0).as_slice(), &[1.0, 5.0]);
+        assert_eq!(Tones::from_slice(&[4.0, 5.0, 6.0]).as_slice(), &[4.0, 5.0]);
+        // Equal frequencies are equal whatever an unused slot held before.
+        assert_eq!(two.without(1), Tones::NONE.with(1.0));
+        assert_eq!(Tones::NONE.with(1.0).with(2.0).without(1).len(), 1);
+    }
 }
