@@ -243,9 +243,10 @@ def allan_deviation(ctx: Context, doc: Doc) -> None:
 def noise_coefficients(ctx: Context, doc: Doc) -> None:
     """The fitted noise model per sensor: datasheet table and one sentence per axis."""
     doc.p("Fit of σ²(τ) = 3Q²/τ² + N²/τ + (2 ln2/π)B² + K²τ/3 + R²τ²/2 (IEEE Std 952) "
-          "plus up to three first-order Gauss–Markov bias terms, a tone (a sinusoid, "
-          "IEEE 952 Annex C) and a resonance (a damped oscillator), on ln σ², each octave of τ "
-          "weighted alike, the terms chosen by BIC; standard uncertainties from the fit "
+          "plus up to three first-order Gauss–Markov bias terms, up to two tones (sinusoids, "
+          "IEEE 952 Annex C), a resonance (a damped oscillator) and a bounded motion of the "
+          "mount, on ln σ², each octave of τ weighted alike, the terms chosen by BIC; "
+          "standard uncertainties from the fit "
           "(docs/noise.md). Read-offs: N on the −½ line at τ = 1 s, B = σ_min/0.664.")
     if ctx.models:
         header, rows = lab_rows(ctx.models, ctx.spec, ctx.units)
