@@ -29,6 +29,13 @@ class Columns:
         arr, col = self._parts[j]
         return _stream.column(arr, col)
 
+    def owned(self, j: int) -> np.ndarray:
+        """Channel ``j`` as a float64 array of its own (free to overwrite), read as
+        ``cols[j]`` reads it."""
+        col = self[j]
+        arr, _col = self._parts[j]
+        return col if col is not arr and col.base is None else col.copy()
+
     def rows(self, j: int, a: int, b: int) -> np.ndarray:
         """Rows ``a`` … ``b − 1`` of channel ``j`` as float64 (only those read)."""
         arr, col = self._parts[j]
