@@ -88,8 +88,10 @@ class Context:
         for sensor in SAMPLE_SENSORS:
             y = getattr(self.short, sensor)
             if y is not None:
+                # streamed: the column read is the distribution's own, sorted in place
                 out[sensor] = {sensor_label(sensor, j, y.shape[1]): stats.distribution(
-                    _stream.column(y, j, self.block) if self.streamed else y[:, j])
+                    _stream.column(y, j, self.block), overwrite_input=True)
+                    if self.streamed else stats.distribution(y[:, j])
                     for j in range(y.shape[1])}
         return out
 
@@ -121,7 +123,7 @@ class Context:
     @cached_property
     def attitude_distributions(self) -> dict[str, stats.Distribution]:
         """Normal fit of each attitude angle of the short log (missing samples left out)."""
-        return {name: stats.distribution(v[np.isfinite(v)])
+        return {name: stats.distribution(v[np.isfinite(v)], overwrite_input=True)
                 for name, v in (self.attitude() or {}).items()}
 
     @property

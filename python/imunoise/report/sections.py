@@ -455,14 +455,23 @@ def events_section(ctx: Context, doc: Doc) -> None:
         ctx.add_figure(doc, fig, f"events_{sensor}",
                        f"{sensor} of the short log, events shaded, peak in sigmas above")
         kept = []
+        inside = found.mask
         for j, axis in enumerate(axis_names(y.shape[1])):
             with_ = list(ctx.sensor_distributions[sensor].values())[j]  # the same samples
+            # one channel at a time, not the sensor: streamed, its column read is ours,
+            # and the events are made missing in it in place
             col = _stream.column(y, j, ctx.block) if ctx.streamed else y[:, j]
-            z = found.exclude(col)  # one channel copied at a time, not the sensor
-            without = stats.distribution(z[np.isfinite(z)])
+            std = np.nanstd(col, ddof=1)
+            z = col if ctx.streamed else np.array(col, dtype=np.float64)
+            del col
+            z[inside] = np.nan  # found.exclude(col)
+            std_without = np.nanstd(z, ddof=1)
+            z = z[np.isfinite(z)]
+            without = stats.distribution(z, overwrite_input=True)
+            del z
             kept.append(without)
             rows.append([f"{sensor} {axis}", *(numbers.cell(v) for v in (
-                np.nanstd(col, ddof=1), np.nanstd(z, ddof=1), with_.excess_kurtosis,
+                std, std_without, with_.excess_kurtosis,
                 without.excess_kurtosis, with_.ks_statistic, without.ks_statistic))])
         _stream.release(y)
         fig = plot.histograms(kept, title=f"{sensor} without events (short log)",
