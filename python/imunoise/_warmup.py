@@ -58,7 +58,7 @@ from scipy import stats as _stats
 from imunoise import _stream, _summary
 from imunoise._channels import rate_columns
 from imunoise._simulate import simulate
-from imunoise.allan import adev
+from imunoise.allan import adev, adev_by_column
 from imunoise.noise import fit, model_variance
 from imunoise.readers.log import ImuLog
 
@@ -390,7 +390,10 @@ def _null_p_values(cols, fs, t, bias, duration, seed) -> np.ndarray:
     taus = taus[taus < duration / 2]  # as the significance rule: longer is drift
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # a poorly followed curve still bounds the wander
-        half = adev(cols.stacked(np.flatnonzero(ok), cols.n // 2, cols.n), fs)
+        # a column at a time: one half-column and the Allan core's arrays for it
+        chosen = np.flatnonzero(ok)
+        half = adev_by_column(lambda c: cols.stacked([chosen[c]], cols.n // 2, cols.n)[:, 0],
+                              len(chosen), fs)
         model = fit(half, warn_coverage=False)
     k_floor = _random_walk_bound(half, model)
     rng = np.random.default_rng(seed)

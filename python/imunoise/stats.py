@@ -869,6 +869,15 @@ def unwrap_about_circular_mean(angle_deg: np.ndarray) -> np.ndarray:
     ok = np.isfinite(a)
     if not ok.any():
         return a.copy()
-    r = np.radians(a[ok])
-    centre = float(np.degrees(np.arctan2(np.mean(np.sin(r)), np.mean(np.cos(r)))))
-    return centre + (a - centre + 180.0) % 360.0 - 180.0
+    # in place where it can be: a channel of a long log is large
+    r = a[ok]
+    np.radians(r, out=r)
+    sin_mean = np.mean(np.sin(r))
+    centre = float(np.degrees(np.arctan2(sin_mean, np.mean(np.cos(r, out=r)))))
+    del r
+    out = a - centre  # centre + (a − centre + 180°) mod 360° − 180°, one array
+    out += 180.0
+    np.remainder(out, 360.0, out=out)
+    np.add(centre, out, out=out)
+    out -= 180.0
+    return out

@@ -123,8 +123,16 @@ class Context:
     @cached_property
     def attitude_distributions(self) -> dict[str, stats.Distribution]:
         """Normal fit of each attitude angle of the short log (missing samples left out)."""
-        return {name: stats.distribution(v[np.isfinite(v)], overwrite_input=True)
-                for name, v in (self.attitude() or {}).items()}
+        if not self.streamed or not self.has_attitude:
+            return {name: stats.distribution(v[np.isfinite(v)], overwrite_input=True)
+                    for name, v in (self.attitude() or {}).items()}
+        out = {}  # an angle at a time
+        for j, name in enumerate(_schema.ATTITUDE_NAMES):
+            v = _stream.column(self.short.ypr, j, self.block)
+            if name == "yaw":
+                v = stats.unwrap_about_circular_mean(v)
+            out[name] = stats.distribution(v[np.isfinite(v)], overwrite_input=True)
+        return out
 
     @property
     def distributions(self) -> dict[str, stats.Distribution]:
@@ -139,7 +147,8 @@ class Context:
         for sensor in ALLAN_SENSORS:
             y = getattr(self.long, sensor)
             if y is not None:
-                out[sensor] = _allan.adev(y, self.long.fs, taus=self.taus_per_decade)
+                out[sensor] = _stream.adev(y, self.long.fs, self.taus_per_decade,
+                                           self.streamed, self.block)
                 _stream.release(y)  # a memory map's pages, before the next sensor's
         return out
 

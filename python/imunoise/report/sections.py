@@ -170,8 +170,8 @@ def distribution_fits(ctx: Context, doc: Doc) -> None:
 def attitude(ctx: Context, doc: Doc) -> None:
     """Yaw, pitch and roll of the short log: statistics, time series, histograms
     with the normal fit, and why a filter's output need not be normal."""
+    dists = ctx.attitude_distributions  # first: it reads the angles on its own
     angles = ctx.attitude()
-    dists = ctx.attitude_distributions
     doc.p("Yaw, pitch and roll are the output of the sensor's attitude filter, not "
           "measurements: the filter blends the gyro, accelerometer and magnetometer, so its "
           "output is smoothed, correlated from sample to sample and follows slow magnetic "
@@ -182,7 +182,7 @@ def attitude(ctx: Context, doc: Doc) -> None:
           "(−180°, 180°].")
     rows = []
     for name, v in angles.items():
-        ok = v[np.isfinite(v)]
+        ok = v if np.isfinite(v).all() else v[np.isfinite(v)]
         mean = float(ok.mean())
         if name == "yaw":  # back into (−180°, 180°]
             mean = stats.heading(mean)
@@ -199,9 +199,8 @@ def attitude(ctx: Context, doc: Doc) -> None:
         caption="Attitude statistics and normality (short log; std and variance with ddof = 1)",
     )
     names = list(angles)
-    stacked = np.column_stack([angles[n] for n in names])
-    fig = plot.time_series(stacked, ctx.short.fs, title="attitude (short log)", unit="deg",
-                           names=names)
+    fig = plot.time_series([angles[n] for n in names], ctx.short.fs,  # not stacked: a copy
+                           title="attitude (short log)", unit="deg", names=names)
     ctx.add_figure(doc, fig, "timeseries_attitude",
                    "Yaw (about its circular mean), pitch and roll of the short log [deg]")
     fig = plot.histograms([dists[n] for n in names], title="attitude distribution (short log)",
@@ -327,7 +326,8 @@ def power_spectral_density(ctx: Context, doc: Doc) -> None:
         except ValueError:  # no unbroken stretch of 16 samples
             continue
         model = ctx.models.get(sensor) if ctx.one_log else noise.fit(
-            _allan.adev(y, ctx.short.fs, taus=ctx.taus_per_decade), warn_coverage=False)
+            _stream.adev(y, ctx.short.fs, ctx.taus_per_decade, ctx.streamed, ctx.block),
+            warn_coverage=False)
         _stream.release(y)
         unit = CHANNELS[sensor][1]
         doc.h(3, sensor)
@@ -518,9 +518,20 @@ def long_log_events(ctx: Context, doc: Doc) -> None:
         taus = _decade_taus(with_)
         if not taus.size:
             continue
-        both = _allan.adev(getattr(log, sensor), log.fs, taus=taus)
-        without = _allan.adev(found.exclude(getattr(log, sensor), pad=EVENT_PAD), log.fs,
-                              taus=both.taus)
+        y = getattr(log, sensor)
+        both = _stream.adev(y, log.fs, taus, ctx.streamed, ctx.block)
+        _stream.release(y)
+        if ctx.streamed:  # a column at a time, the events made missing in it
+            inside = found.padded_mask(EVENT_PAD)
+
+            def excluded(j: int, y=y, inside=inside) -> np.ndarray:
+                col = _stream.column(y, j, ctx.block)
+                col[inside] = np.nan
+                return col
+
+            without = _allan.adev_by_column(excluded, y.shape[1], log.fs, taus=both.taus)
+        else:
+            without = _allan.adev(found.exclude(y, pad=EVENT_PAD), log.fs, taus=both.taus)
         # the taus both have (the grid's own, whole samples; gaps may cost the longest)
         taus, a, b = np.intersect1d(both.taus, without.taus, return_indices=True)
         dev, lo, hi = (np.reshape(v, (len(both.taus), -1))[a] for v in (
