@@ -510,22 +510,34 @@ def _welch(data: np.ndarray, fs: float, seg: int, starts: np.ndarray):
     pieces = starts.size * seg * data.shape[1] // WELCH_PIECE if complete else \
         starts.size * seg // (1 << 22)
     p = 0.0
+    window = _signal.get_window("hann", seg)
+    scale = 1.0 / (fs * np.sum(window * window))
     # at most one piece per segment (more left empty pieces, whose spectra do not add);
     # a channel at a time (a segment of a long record is large)
     for chunk in np.array_split(starts, min(starts.size, max(1, pieces))):
-        part = None
+        part = np.empty((seg // 2 + 1, data.shape[1]))
         for c in range(data.shape[1]):
             pieces = np.lib.stride_tricks.sliding_window_view(data[:, c], seg)[chunk]
             _stream.release(data)  # a memory map's pages: those of the next piece only
-            f, q = _signal.welch(pieces, fs=fs, window="hann", nperseg=seg, noverlap=0,
-                                 detrend="constant", scaling="density", axis=-1)
-            del pieces
-            if part is None:
-                part = np.empty((q.shape[-1], data.shape[1]))
-            part[:, c] = q.sum(axis=0)
-            del q
+            part[:, c] = _periodograms(pieces, window, scale).sum(axis=0)
         p = p + part
-    return f[1:], (p / starts.size)[1:]
+    return np.fft.rfftfreq(seg, 1.0 / fs)[1:], (p / starts.size)[1:]
+
+
+def _periodograms(segments: np.ndarray, window: np.ndarray, scale: float) -> np.ndarray:
+    """One-sided Hann periodograms (density) of ``segments`` (k, L), each less its mean:
+    ``scipy.signal.welch`` of one segment, without its per-call set-up (a window and
+    its sums per call: a third of the time on a long record's segments)."""
+    x = segments - segments.mean(axis=-1, keepdims=True)
+    x *= window
+    spectrum = np.fft.rfft(x, axis=-1)
+    del x
+    p = spectrum.real ** 2
+    p += spectrum.imag ** 2
+    del spectrum
+    p *= scale
+    p[..., 1:-1 if segments.shape[-1] % 2 == 0 else None] *= 2.0  # both sides but 0, Nyquist
+    return p
 
 
 def _welch_edf(seg: int, starts: np.ndarray) -> float:
