@@ -524,7 +524,7 @@ def _isolated(z: _blocks.Series, n: int, k_spike: float, half: int,
     each side are quiet (mean clipped z² below ``level``, the shortest energy
     window's threshold): outliers, not the onset of a burst."""
     out = np.zeros(n, dtype=bool)
-    big = _above(z, n, k_spike, finite=True)
+    big = _above(z, n, k_spike)  # |nan_to_num(z)| > k: NaN is not above k either
     if not big.size or half < 1:
         return out
 
@@ -545,12 +545,11 @@ def _isolated(z: _blocks.Series, n: int, k_spike: float, half: int,
     return out
 
 
-def _above(z: _blocks.Series, n: int, k: float, *, finite: bool = False) -> np.ndarray:
-    """Rows where |z| > k (``finite``: of ``np.nan_to_num(z)``)."""
+def _above(z: _blocks.Series, n: int, k: float) -> np.ndarray:
+    """Rows where |z| > k (NaN is not)."""
     found = []
     for a, b in _blocks.ranges(n):
-        x = z(a, b)
-        found.append(np.flatnonzero(np.abs(np.nan_to_num(x) if finite else x) > k) + a)
+        found.append(np.flatnonzero(np.abs(z(a, b)) > k) + a)
     return np.concatenate(found) if found else np.zeros(0, dtype=np.int64)
 
 
@@ -727,8 +726,9 @@ def _whiten(z: _blocks.Series, n: int, valid: np.ndarray | None, rho: np.ndarray
     order = min(WHITENING_ORDER, len(rho) - 1)
 
     def clipped(a: int, b: int) -> np.ndarray:
+        # missing samples (NaN) are not kept: no np.nan_to_num needed before the clip
         keep = ~isolated[a:b] if valid is None else valid[a:b] & ~isolated[a:b]
-        return np.where(keep, np.clip(np.nan_to_num(z(a, b)), -k_spike, k_spike), 0.0)
+        return np.where(keep, np.clip(z(a, b), -k_spike, k_spike), 0.0)
 
     out = np.empty(n)
     coefficients = None
@@ -840,10 +840,10 @@ def _dof(rho: np.ndarray, w: int) -> float:
 
 
 def _tail_dof(z: np.ndarray) -> float:
-    """Degrees of freedom ν of the Student-t with the excess kurtosis of ``z``
+    """Degrees of freedom ν of the Student-t with the excess kurtosis of the finite
+    samples ``z`` (:func:`imunoise._blocks.gather`'s: an array of our own, overwritten)
     (6/(ν − 4)), at least :data:`CHANGE_POINT_DOF`: Gaussian-like noise keeps the
     Gaussian likelihood's precision, heavy-tailed noise gets bounded influence."""
-    z = z[np.isfinite(z)]
     if z.size < 8:
         return CHANGE_POINT_DOF
     excess = _excess_kurtosis(z)
@@ -852,9 +852,11 @@ def _tail_dof(z: np.ndarray) -> float:
 
 def _excess_kurtosis(z: np.ndarray) -> float:
     """``scipy.stats.kurtosis(z)`` of finite samples, the same operations (its central
-    moments m2 = mean(d²), m4 = mean((d²)²)) without its checks and copies."""
+    moments m2 = mean(d²), m4 = mean((d²)²)) without its checks and copies (``z`` is
+    overwritten)."""
     mean = z.mean()
-    square = z - mean
+    square = z
+    square -= mean
     square *= square
     m2 = square.mean()
     if m2 <= (np.finfo(np.float64).eps * mean) ** 2:
