@@ -330,6 +330,7 @@ def dynamic_adev(
     """
     data, one_d = samples(x)
     no_infinity(data)
+    _stream.release(data)  # a memory map's pages: read again a column at a time
     fs = sample_rate(fs)
     n = data.shape[0]
     width = n // 10 if window is None else _samples_of("window", window, fs)
@@ -424,6 +425,7 @@ def _window_sums(data, m, starts, width, stride):
     n, ch = data.shape
     any_missing = bool(np.isnan(data).any())
     mean = np.nanmean(data, axis=0) if any_missing else data.mean(axis=0)
+    _stream.release(data)
     sums = np.empty((len(starts), len(m), ch))
     counts = np.empty((len(starts), len(m), ch))
     block_edges = np.arange(0, n + 1, stride, dtype=np.int64)

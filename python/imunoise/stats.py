@@ -869,11 +869,12 @@ def unwrap_about_circular_mean(angle_deg: np.ndarray) -> np.ndarray:
     ok = np.isfinite(a)
     if not ok.any():
         return a.copy()
-    # in place where it can be: a channel of a long log is large
+    # in place, one array at a time: a channel of a long log is large
     r = a[ok]
-    np.radians(r, out=r)
-    sin_mean = np.mean(np.sin(r))
-    centre = float(np.degrees(np.arctan2(sin_mean, np.mean(np.cos(r, out=r)))))
+    sin_mean = np.mean(np.sin(np.radians(r, out=r), out=r))
+    r[:] = a[ok]
+    cos_mean = np.mean(np.cos(np.radians(r, out=r), out=r))
+    centre = float(np.degrees(np.arctan2(sin_mean, cos_mean)))
     del r
     out = a - centre  # centre + (a − centre + 180°) mod 360° − 180°, one array
     out += 180.0

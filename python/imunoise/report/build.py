@@ -115,9 +115,10 @@ class Context:
         ypr = self.short.ypr
         if not self.streamed:
             return stats.attitude_angles(ypr)
-        angles = {name: _stream.column(ypr, j, self.block)
-                  for j, name in enumerate(_schema.ATTITUDE_NAMES)}
-        angles["yaw"] = stats.unwrap_about_circular_mean(angles["yaw"])
+        # yaw first: unwrapped before the other two are read
+        angles = {"yaw": stats.unwrap_about_circular_mean(_stream.column(ypr, 0, self.block))}
+        for j, name in enumerate(_schema.ATTITUDE_NAMES[1:], start=1):
+            angles[name] = _stream.column(ypr, j, self.block)
         return angles
 
     @cached_property

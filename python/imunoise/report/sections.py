@@ -187,8 +187,9 @@ def attitude(ctx: Context, doc: Doc) -> None:
         if name == "yaw":  # back into (−180°, 180°]
             mean = stats.heading(mean)
         d = dists[name]
-        rows.append([name, "deg", format_number(mean), format_number(float(ok.std(ddof=1))),
-                     format_number(float(ok.var(ddof=1))), format_number(float(ok.min())),
+        var = ok.var(ddof=1)  # std is its square root (numpy's std computes it so)
+        rows.append([name, "deg", format_number(mean), format_number(float(np.sqrt(var))),
+                     format_number(float(var)), format_number(float(ok.min())),
                      format_number(float(ok.max())), *(format_number(x) for x in (
                          d.ks_statistic, d.ks_pvalue, d.ad_statistic, d.skewness,
                          d.excess_kurtosis))])
@@ -321,6 +322,7 @@ def power_spectral_density(ctx: Context, doc: Doc) -> None:
             continue
         if np.count_nonzero(~np.isnan(y).any(axis=1)) < 256:
             continue
+        _stream.release(y)
         try:  # segments with a missing sample are left out
             s = spectrum.psd(y, ctx.short.fs)
         except ValueError:  # no unbroken stretch of 16 samples
