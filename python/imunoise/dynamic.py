@@ -436,10 +436,13 @@ def _window_sums(data, m, starts, width, stride):
         column = _stream.column(data, j)[:, None] if mapped else data[:, j:j + 1]
         c, bad = _phase(column, mean[j:j + 1], any_missing)
         del column
+        # the second differences of every tau in two arrays reused (fresh ones per tau
+        # cost the kernel a channel length of page faults each)
+        buffer, twice = np.empty((1, n + 1)), np.empty((1, n + 1))
         for t, mm in enumerate(int(v) for v in m):
             k = n + 1 - 2 * mm
-            second = c[:, 2 * mm:] + c[:, :k]
-            second -= 2.0 * c[:, mm:mm + k]
+            second = np.add(c[:, 2 * mm:], c[:, :k], out=buffer[:, :k])
+            second -= np.multiply(c[:, mm:mm + k], 2.0, out=twice[:, :k])
             second *= second
             last = starts + width + 1 - 2 * mm
             edges = np.minimum(block_edges, k)
@@ -460,7 +463,7 @@ def _window_sums(data, m, starts, width, stride):
                 block_p, block_n = prefix[:, 2 * w:2 * w + e], terms[:, 2 * w:2 * w + e]
                 per_tau.setdefault(t, []).append((np.diff(block_p, axis=1).T,
                                                   np.diff(block_n, axis=1).T))
-        del c, bad
+        del c, bad, buffer, twice
     blocks = tuple((t, np.hstack([p for p, _n in parts]), np.hstack([q for _p, q in parts]))
                    for t, parts in per_tau.items())
     return sums, counts, blocks
