@@ -29,10 +29,32 @@ class Columns:
         arr, col = self._parts[j]
         return _stream.column(arr, col)
 
+    def owned(self, j: int) -> np.ndarray:
+        """Channel ``j`` as a float64 array of its own (free to overwrite), read as
+        ``cols[j]`` reads it."""
+        col = self[j]
+        arr, _col = self._parts[j]
+        return col if col is not arr and col.base is None else col.copy()
+
     def rows(self, j: int, a: int, b: int) -> np.ndarray:
         """Rows ``a`` … ``b − 1`` of channel ``j`` as float64 (only those read)."""
         arr, col = self._parts[j]
         return np.asarray(arr[a:b] if col is None else arr[a:b, col], dtype=np.float64)
+
+    def stacked(self, which, a: int, b: int) -> np.ndarray:
+        """Rows ``a`` … ``b − 1`` of the channels ``which`` side by side, (b − a, k)
+        float64 (``np.column_stack`` of them), read a block of rows at a time (a memory
+        map's pages given back behind each block)."""
+        from imunoise import _stream
+
+        out = np.empty((b - a, len(which)))
+        for c, j in enumerate(which):
+            arr, col = self._parts[j]
+            for lo in range(a, b, _stream.BLOCK_ROWS):
+                hi = min(b, lo + _stream.BLOCK_ROWS)
+                out[lo - a:hi - a, c] = arr[lo:hi] if col is None else arr[lo:hi, col]
+                _stream.release(arr)
+        return out
 
     def arrays(self) -> list[np.ndarray]:
         """The arrays the columns are read from, in column order, each as (n, k) (a

@@ -59,7 +59,7 @@ from scipy import linalg as _linalg
 from scipy import signal as _signal
 from scipy import stats as _sstats
 
-from imunoise import _summary
+from imunoise import _blocks, _summary
 from imunoise._channels import rate_columns
 from imunoise._runs import true_runs
 from imunoise._validate import positive_finite
@@ -196,12 +196,12 @@ class Events:
         if pad < 0 or not np.isfinite(pad):
             raise ValueError(f"pad must be >= 0 and finite (s); got {pad!r}")
         extra = int(np.ceil(pad * self.fs))
-        mark = np.zeros(self.n_samples + 1, dtype=np.int64)
+        out = np.zeros(self.n_samples, dtype=bool)  # a byte per sample, nothing wider
         lo = np.clip(self.start_index - extra, 0, self.n_samples)
         hi = np.clip(self.end_index + extra, 0, self.n_samples)
-        np.add.at(mark, lo, 1)
-        np.add.at(mark, hi, -1)
-        return np.cumsum(mark[:-1]) > 0
+        for a, b in zip(lo.tolist(), hi.tolist(), strict=True):
+            out[a:b] = True
+        return out
 
     def exclude(self, data, *, pad: float = 0.0):
         """``data`` with the events' samples missing (NaN), every channel of the row.
@@ -269,14 +269,12 @@ class Events:
         block = max(2 * self.window, int(round(baseline * self.fs)))
         quiet = ~self.mask
         out = np.full((len(self), len(cols)), np.nan)
+        any_quiet = bool(quiet.any())
         for j in range(len(cols)):
-            sq, _sigma, _knots = _standardise(cols[j], block)
-            missing = ~np.isfinite(sq)
-            sq *= sq
-            sq[missing] = np.nan
-            del missing
+            sq, _sigma, _knots = _standardise(cols.owned(j), block)
+            sq *= sq  # NaN where missing
             with np.errstate(invalid="ignore", divide="ignore"):
-                level = np.sqrt(np.nanmean(sq[quiet])) if quiet.any() else np.nan
+                level = np.sqrt(_nanmean(sq, quiet)) if any_quiet else np.nan
                 for i, (a, b) in enumerate(zip(self.start_index, self.end_index, strict=True)):
                     inside = sq[a:b]
                     if np.isfinite(inside).any():
@@ -397,7 +395,12 @@ def events(
     per_channel = []
     sigma = np.empty(len(cols))
     for j in range(len(cols)):
-        r, mad_sigma, knots = _standardise(cols[j], block)
+        # the one array of the channel's length kept: its standardised samples; what
+        # is derived from them is read a block at a time (imunoise._blocks)
+        r, mad_sigma, knots = _standardise(cols.owned(j), block)
+        valid = np.isfinite(r)
+        if valid.all():
+            valid = None  # no missing sample
         # first pass with the noise law of the whole channel, then once more with
         # the law of its quiet part: a record with vibration of its own (the VN-100
         # live capture, 20 % of it) otherwise sets thresholds for quiet noise from
@@ -408,21 +411,22 @@ def events(
         # machine's line for a few minutes) is not whitened away. (Whitening after
         # the first pass, whose quiet part still holds such a line, cut that
         # vibration into fragments.)
-        quiet = np.ones(n, dtype=bool)
+        quiet = None  # every sample
         for step, whiten in enumerate((False, False, True)):
-            if step == 1 and quiet.all():
+            if step == 1 and quiet is None:
                 continue  # the first pass found nothing: its law is the quiet part's
-            scale, rho = _energy_law(np.where(quiet, r, np.nan), w)
-            z = r / np.sqrt(scale)
-            spans = _spikes(z, k_spike)
+            scale, rho = _energy_law(_masked(_blocks.view(r), quiet), n, w)
+            z = _scaled(r, np.sqrt(scale))
+            spans = _spikes(z, n, k_spike)
             quiet_level = _sstats.chi2.isf(p_v[-1], _dof(rho, windows[-1])) / _dof(
                 rho, windows[-1])
-            isolated = _isolated(z, k_spike, touch, quiet_level)
-            spans += _burst_test(z, rho, quiet, windows, p_v, k_spike, isolated, whiten=whiten)
+            isolated = _isolated(z, n, k_spike, touch, quiet_level)
+            spans += _burst_test(z, n, valid, rho, quiet, windows, p_v, k_spike, isolated,
+                                 whiten=whiten)
             if spans:
                 quiet = ~_span_mask(spans, n, pad=w)
         sigma[j] = mad_sigma * np.sqrt(scale)
-        spans = [sp for sp in spans if sp[2] != "burst" or _raised(z[sp[0]:sp[1]], rho)]
+        spans = [sp for sp in spans if sp[2] != "burst" or _raised(z(sp[0], sp[1]), rho)]
         joined = _join([(a, b, kind, {j}) for a, b, kind in spans], gap, touch)
         # searched once the channel's spans are joined: a shock that the burst test
         # found by itself is then inside the vibration it was joined to
@@ -432,7 +436,7 @@ def events(
         # from the baseline's knots: one channel's samples in memory at a time
         per_channel.append((joined, (j, scale, knots, mad_sigma),
                             [(a, b, kind, {j}) for a, b, kind in inner]))
-        del r, z, quiet, isolated
+        del r, z, valid, quiet, isolated
     return _merge_channels(
         per_channel, names, fs, n, gap, touch, sigma,
         lambda j, scale, knots, mad_sigma, a, b: _standardised_rows(
@@ -446,32 +450,47 @@ def events(
 
 def _standardise(col: np.ndarray, block: int) -> tuple[np.ndarray, float, tuple | None]:
     """``(x - baseline)/σ̂`` (NaN where missing), σ̂ and the knots of the baseline
-    (block centres and medians; None when no block has a valid sample) of one channel."""
+    (block centres and medians; None when no block has a valid sample) of one channel
+    ``col`` (a float64 array of its own, overwritten: the result is ``col``)."""
     n = len(col)
     starts = np.arange(0, n, block)
-    full = n // block
-    if np.isfinite(col).all():  # the usual case: one vectorised median over the blocks
-        medians = np.median(col[: full * block].reshape(full, block), axis=1)
-        if n > full * block:
-            medians = np.append(medians, np.median(col[full * block:]))
-    else:
-        with np.errstate(all="ignore"):
-            medians = np.array([_nanmedian(col[s:s + block]) for s in starts])
+    medians = np.empty(len(starts))
+    # the blocks' medians a group of blocks at a time (each block's its own order
+    # statistics: the same numbers however the blocks are grouped)
+    for a, b in _blocks.ranges(n, block):
+        x, i = col[a:b], a // block
+        if np.isfinite(x).all():  # the usual case: one vectorised median over the blocks
+            full = len(x) // block
+            medians[i:i + full] = np.median(x[: full * block].reshape(full, block), axis=1)
+            if len(x) > full * block:
+                medians[i + full] = np.median(x[full * block:])
+        else:
+            with np.errstate(all="ignore"):
+                medians[i:i + -(-len(x) // block)] = [
+                    _nanmedian(x[s:s + block]) for s in range(0, len(x), block)]
     centres = np.minimum(starts + block / 2, n) - 0.5
     ok = np.isfinite(medians)
     if not ok.any():
-        return np.full(n, np.nan), float("nan"), None
+        col[:] = np.nan
+        return col, float("nan"), None
     knots = (centres[ok], medians[ok])
-    r = col - np.interp(np.arange(n), *knots)
+    for a, b in _blocks.ranges(n):
+        col[a:b] -= np.interp(np.arange(a, b), *knots)
+    r = col
     valid = np.isfinite(r)
-    rv = r if valid.all() else r[valid]
-    sigma = 1.4826 * float(np.median(np.abs(rv), overwrite_input=True))  # its own copy
+    complete = bool(valid.all())
+    rv = np.abs(r) if complete else np.abs(r[valid])  # its own copy
+    sigma = 1.4826 * float(np.median(rv, overwrite_input=True))
     if sigma == 0:  # coarse quantization: most samples on one level
+        rv = r if complete else r[valid]
         q75, q25 = np.percentile(rv, [75, 25])
         sigma = 0.7413 * float(q75 - q25) or float(np.std(rv))
+    del rv
     if sigma == 0:
-        return np.where(valid, 0.0, np.nan), 0.0, knots
-    return r / sigma, sigma, knots
+        r[valid] = 0.0
+        return r, 0.0, knots
+    r /= sigma
+    return r, sigma, knots
 
 
 def _standardised_rows(rows: np.ndarray, a: int, knots: tuple | None,
@@ -499,31 +518,77 @@ def _raised(seg: np.ndarray, rho: np.ndarray) -> bool:
     return float(np.mean(v * v)) > float(_sstats.chi2.isf(CONFIRM_P, dof)) / dof
 
 
-def _isolated(z: np.ndarray, k_spike: float, half: int, level: float) -> np.ndarray:
+def _isolated(z: _blocks.Series, n: int, k_spike: float, half: int,
+              level: float) -> np.ndarray:
     """Boolean (n,): samples above the spike threshold whose ``half`` neighbours on
     each side are quiet (mean clipped z² below ``level``, the shortest energy
     window's threshold): outliers, not the onset of a burst."""
-    n = len(z)
     out = np.zeros(n, dtype=bool)
-    big = np.flatnonzero(np.abs(np.nan_to_num(z)) > k_spike)
+    big = _above(z, n, k_spike)  # |nan_to_num(z)| > k: NaN is not above k either
     if not big.size or half < 1:
         return out
-    c = np.clip(np.nan_to_num(z), -k_spike, k_spike)
-    csum = np.concatenate(([0.0], np.cumsum(c * c)))
+
+    def clipped_square(a: int, b: int) -> np.ndarray:
+        c = np.clip(np.nan_to_num(z(a, b)), -k_spike, k_spike)
+        return c * c
+
     lo, hi = np.maximum(big - half, 0), np.minimum(big + 1 + half, n)
-    left = (csum[big] - csum[lo]) / np.maximum(big - lo, 1)
-    right = (csum[hi] - csum[big + 1]) / np.maximum(hi - big - 1, 1)
+    at = np.unique(np.concatenate((big, lo, hi, big + 1)))
+    sums = _blocks.running_sums_at(clipped_square, n, at)
+
+    def csum(i: np.ndarray) -> np.ndarray:
+        return sums[np.searchsorted(at, i)]
+
+    left = (csum(big) - csum(lo)) / np.maximum(big - lo, 1)
+    right = (csum(hi) - csum(big + 1)) / np.maximum(hi - big - 1, 1)
     out[big] = np.maximum(left, right) < level
     return out
 
 
+def _above(z: _blocks.Series, n: int, k: float) -> np.ndarray:
+    """Rows where |z| > k (NaN is not)."""
+    found = []
+    for a, b in _blocks.ranges(n):
+        found.append(np.flatnonzero(np.abs(z(a, b)) > k) + a)
+    return np.concatenate(found) if found else np.zeros(0, dtype=np.int64)
+
+
 def _span_mask(spans: list[tuple[int, int, str]], n: int, *, pad: int) -> np.ndarray:
     """Boolean (n,): within ``pad`` samples of one of ``spans``."""
-    mark = np.zeros(n + 1, dtype=np.int64)
+    out = np.zeros(n, dtype=bool)
     for a, b, _kind in spans:
-        mark[max(0, a - pad)] += 1
-        mark[min(n, b + pad)] -= 1
-    return np.cumsum(mark[:-1]) > 0
+        out[max(0, a - pad):min(n, b + pad)] = True
+    return out
+
+
+def _masked(series: _blocks.Series, keep: np.ndarray | None) -> _blocks.Series:
+    """``series`` with NaN where ``keep`` is False (None: unchanged)."""
+    if keep is None:
+        return series
+    return lambda a, b: np.where(keep[a:b], series(a, b), np.nan)
+
+
+def _scaled(r: np.ndarray, root) -> _blocks.Series:
+    """The series ``r / root``."""
+    return lambda a, b: r[a:b] / root
+
+
+def _nanmean(x: np.ndarray, keep: np.ndarray) -> float:
+    """``np.nanmean(x[keep])``, the same number (the kept samples, NaN as 0, summed as
+    one array, over the count of the others), without the copies ``np.nanmean`` makes
+    of ``x[keep]``: one array of the kept samples."""
+    kept = np.empty(int(np.count_nonzero(keep)))
+    missing = 0
+    m = 0
+    for a, b in _blocks.ranges(len(x)):
+        v = x[a:b][keep[a:b]]
+        nan = np.isnan(v)
+        missing += int(np.count_nonzero(nan))
+        v[nan] = 0.0
+        kept[m:m + len(v)] = v
+        m += len(v)
+    count = len(kept) - missing
+    return float(np.sum(kept) / count) if count else float("nan")
 
 
 def _nanmedian(v: np.ndarray) -> float:
@@ -531,15 +596,16 @@ def _nanmedian(v: np.ndarray) -> float:
     return float(np.median(v)) if v.size else float("nan")
 
 
-def _spikes(z: np.ndarray, k: float) -> list[tuple[int, int, str]]:
-    return [(int(i), int(i) + 1, "spike") for i in np.flatnonzero(np.abs(z) > k)]
+def _spikes(z: _blocks.Series, n: int, k: float) -> list[tuple[int, int, str]]:
+    return [(int(i), int(i) + 1, "spike") for i in _above(z, n, k)]
 
 
-def _bursts(z: np.ndarray, w: int, p_window: float, dof: float, k_spike: float,
-            isolated: np.ndarray, tail_dof: float,
-            raw: np.ndarray | None = None) -> list[tuple[int, int, str]]:
+def _bursts(z: _blocks.Series, n: int, valid: np.ndarray | None, w: int, p_window: float,
+            dof: float, k_spike: float, isolated: np.ndarray, tail_dof: float,
+            raw: _blocks.Series | None = None) -> list[tuple[int, int, str]]:
     """Stretches where the sliding energy exceeds its threshold, cut to the
-    maximum-likelihood segment of raised variance.
+    maximum-likelihood segment of raised variance (``valid``: the rows with a sample,
+    None for all).
 
     The energy sees z clipped at the spike threshold (one spike, however large, is
     a spike, not a burst); the change points do not see ``isolated`` samples (an
@@ -547,38 +613,51 @@ def _bursts(z: np.ndarray, w: int, p_window: float, dof: float, k_spike: float,
     (the record before whitening, when ``z`` is whitened) a burst ends where the
     later of the two says: a ringing burst's tail is partly predictable, so its
     prediction errors end before the shaking does."""
-    n = len(z)
-    valid = np.isfinite(z)
-    complete = bool(valid.all())
-    z2 = np.clip(z, -k_spike, k_spike)
-    z2 *= z2
-    if not complete:
-        z2[~valid] = 0.0
-    csum = np.empty(n + 1)
-    csum[0] = 0.0
-    np.cumsum(z2, out=csum[1:])
-    energy = csum[w:] - csum[:-w]  # window j covers samples j .. j+w-1
-    del csum
-    # a window of m valid samples: energy·ν_m/m ~ χ²(ν_m), ν_m = ν·m/w
-    if complete:
-        hot = energy > _sstats.chi2.isf(p_window, dof * w / w) * w / dof  # m = w below
-    else:
-        count = np.concatenate(([0], np.cumsum(valid)))
+
+    def squares(lo: int, hi: int) -> np.ndarray:
+        z2 = np.clip(z(lo, hi), -k_spike, k_spike)
+        z2 *= z2
+        if valid is not None:
+            z2[~valid[lo:hi]] = 0.0
+        return z2
+
+    hot = np.zeros(max(0, n - w + 1), dtype=bool)  # window j covers samples j .. j+w-1
+    limits: dict[int, float] = {}  # a window of m valid samples: energy·ν_m/m ~ χ²(ν_m)
+    limit_full = _sstats.chi2.isf(p_window, dof * w / w) * w / dof  # m = w
+    carry, count_carry = 0.0, 0
+    for a, b in _blocks.ranges(len(hot)):
+        # the running sums over samples a … b+w−2, from the sum before row a: the
+        # numbers of one running sum over the whole record
+        csum = np.empty(b - a + w)
+        csum[0] = carry
+        csum[1:] = squares(a, b + w - 1)
+        np.cumsum(csum, out=csum)
+        energy = csum[w:] - csum[:-w]
+        carry = csum[b - a]
+        del csum
+        if valid is None:
+            hot[a:b] = energy > limit_full
+            continue
+        count = np.empty(b - a + w, dtype=np.int64)
+        count[0] = count_carry
+        count[1:] = valid[a:b + w - 1]
+        np.cumsum(count, out=count)
         used = count[w:] - count[:-w]
-        counts = np.unique(used).tolist()
-        limits = {m: _sstats.chi2.isf(p_window, dof * m / w) * w / dof for m in counts
-                  if m > 0}
-        limit = np.array([limits.get(m, np.inf) for m in used.tolist()]) if len(limits) > 1 \
-            else np.full(len(used), next(iter(limits.values()), np.inf))
-        hot = energy > limit
-    del energy
+        count_carry = int(count[b - a])
+        counts, which = np.unique(used, return_inverse=True)
+        for m in counts.tolist():
+            if m > 0 and m not in limits:
+                limits[m] = _sstats.chi2.isf(p_window, dof * m / w) * w / dof
+        hot[a:b] = energy > np.array([limits.get(m, np.inf) for m in counts.tolist()])[which]
+    is_valid = np.ones(n, dtype=bool) if valid is None else valid
 
     def onset(lo: int, hi: int) -> np.ndarray:
-        return np.where(valid[lo:hi] & ~isolated[lo:hi], z2[lo:hi], np.nan)
+        return np.where(is_valid[lo:hi] & ~isolated[lo:hi], squares(lo, hi), np.nan)
 
     def tail(lo: int, hi: int) -> np.ndarray:
-        return np.where(np.isfinite(raw[lo:hi]) & ~isolated[lo:hi],
-                        np.clip(raw[lo:hi], -k_spike, k_spike) ** 2, np.nan)
+        x = raw(lo, hi)
+        return np.where(np.isfinite(x) & ~isolated[lo:hi],
+                        np.clip(x, -k_spike, k_spike) ** 2, np.nan)
 
     out = []
     # windows a .. b-1 flagged: samples a .. b+w-2 involved
@@ -603,35 +682,37 @@ def _inner_bursts(z, spans, windows, p_v, k_spike, isolated) -> list[tuple[int, 
     for a, b, kind in spans:
         if kind != "burst" or b - a < INNER_MIN_WINDOWS * w:
             continue
-        seg = z[a:b]
-        scale, rho = _energy_law(seg, w)
-        everywhere = np.ones(b - a, dtype=bool)
-        for s0, s1, _k in _burst_test(seg / np.sqrt(scale), rho, everywhere, windows, p_v,
-                                      k_spike, isolated[a:b], whiten=True):
+        seg = z(a, b)
+        valid = np.isfinite(seg)
+        scale, rho = _energy_law(_blocks.view(seg), b - a, w)
+        for s0, s1, _k in _burst_test(_blocks.view(seg / np.sqrt(scale)), b - a,
+                                      None if valid.all() else valid, rho, None, windows,
+                                      p_v, k_spike, isolated[a:b], whiten=True):
             if s0 >= w and windows[-1] <= s1 - s0 < (b - a) // 2:
                 out.append((a + s0, a + s1, "burst"))
     return out
 
 
-def _burst_test(z, rho, quiet, windows, p_v, k_spike, isolated, *,
+def _burst_test(z, n, valid, rho, quiet, windows, p_v, k_spike, isolated, *,
                 whiten: bool) -> list[tuple[int, int, str]]:
-    """The energy test at every window of ``windows`` on ``z`` (standardised by the
-    law of its ``quiet`` samples, autocorrelation ``rho``), or, with ``whiten``, on
-    its prediction errors, scaled by the law of their quiet samples; the Student-t
-    edges take their ν from the tested series' quiet samples."""
+    """The energy test at every window of ``windows`` on the series ``z`` (standardised
+    by the law of its ``quiet`` samples (None: all), autocorrelation ``rho``), or, with
+    ``whiten``, on its prediction errors, scaled by the law of their quiet samples; the
+    Student-t edges take their ν from the tested series' quiet samples."""
     e, rho_e = z, rho
     if whiten:
-        e = _whiten(z, rho, k_spike, isolated)
-        scale_e, rho_e = _energy_law(np.where(quiet, e, np.nan), windows[0])
-        e = e / np.sqrt(scale_e)
-    tail_dof = _tail_dof(e[quiet])
+        errors = _whiten(z, n, valid, rho, k_spike, isolated)
+        scale_e, rho_e = _energy_law(_masked(_blocks.view(errors), quiet), n, windows[0])
+        errors /= np.sqrt(scale_e)
+        e = _blocks.view(errors)
+    tail_dof = _tail_dof(_blocks.gather(e, n, quiet))
     return [span for v, p in zip(windows, p_v, strict=True)
-            for span in _bursts(e, v, p, _dof(rho_e, v), k_spike, isolated, tail_dof,
-                                z if whiten else None)]
+            for span in _bursts(e, n, valid, v, p, _dof(rho_e, v), k_spike, isolated,
+                                tail_dof, z if whiten else None)]
 
 
-def _whiten(z: np.ndarray, rho: np.ndarray, k_spike: float,
-            isolated: np.ndarray) -> np.ndarray:
+def _whiten(z: _blocks.Series, n: int, valid: np.ndarray | None, rho: np.ndarray,
+            k_spike: float, isolated: np.ndarray) -> np.ndarray:
     """The prediction errors of ``z`` under the autoregression AR(p) that fits its
     autocorrelation ``rho`` (Yule–Walker, p = min(:data:`WHITENING_ORDER`,
     len(rho) − 1)): white where the quiet noise is, while a burst's onset, which
@@ -640,26 +721,39 @@ def _whiten(z: np.ndarray, rho: np.ndarray, k_spike: float,
     The input is clipped at the spike threshold and its isolated outliers and
     missing samples are zeroed (the filter would smear one outlier over p + 1
     samples); missing samples stay missing. The filter is causal, so a burst
-    starts in the errors where it starts in ``z``."""
-    valid = np.isfinite(z)
+    starts in the errors where it starts in ``z``. Filtered a block at a time, each
+    block after the p samples before it: the numbers of one filter over the record."""
     order = min(WHITENING_ORDER, len(rho) - 1)
-    x = np.where(valid & ~isolated, np.clip(np.nan_to_num(z), -k_spike, k_spike), 0.0)
-    if order < 1 or not np.all(np.isfinite(rho[: order + 1])):
-        return np.where(valid, x, np.nan)
-    try:
-        a = _linalg.solve_toeplitz(rho[:order], rho[1:order + 1])
-    except (np.linalg.LinAlgError, ValueError):
-        return np.where(valid, x, np.nan)
-    if not np.all(np.isfinite(a)):
-        return np.where(valid, x, np.nan)
-    e = _signal.lfilter(np.concatenate(([1.0], -a)), [1.0], x)
-    return np.where(valid, e, np.nan)
+
+    def clipped(a: int, b: int) -> np.ndarray:
+        # missing samples (NaN) are not kept: no np.nan_to_num needed before the clip
+        keep = ~isolated[a:b] if valid is None else valid[a:b] & ~isolated[a:b]
+        return np.where(keep, np.clip(z(a, b), -k_spike, k_spike), 0.0)
+
+    out = np.empty(n)
+    coefficients = None
+    if order >= 1 and np.all(np.isfinite(rho[: order + 1])):
+        try:
+            ar = _linalg.solve_toeplitz(rho[:order], rho[1:order + 1])
+        except (np.linalg.LinAlgError, ValueError):
+            ar = None
+        if ar is not None and np.all(np.isfinite(ar)):
+            coefficients = np.concatenate(([1.0], -ar))
+    for a, b in _blocks.ranges(n):
+        if coefficients is None:
+            out[a:b] = clipped(a, b)
+            continue
+        before = min(order, a)
+        out[a:b] = _signal.lfilter(coefficients, [1.0], clipped(a - before, b))[before:]
+    if valid is not None:
+        out[~valid] = np.nan
+    return out
 
 
-def _energy_law(z: np.ndarray, w: int) -> tuple[float, np.ndarray]:
-    """Scale s and autocorrelation ρ_0 … ρ_{w−1} of a quiet record, which set the
-    law of its window energy: Σ_window z² ≈ s·(w/ν)·χ²(ν) (Satterthwaite), ν from
-    :func:`_dof`.
+def _energy_law(z: _blocks.Series, n: int, w: int) -> tuple[float, np.ndarray]:
+    """Scale s and autocorrelation ρ_0 … ρ_{w−1} of a quiet record (the series ``z``
+    of ``n`` rows, NaN = missing or left out), which set the law of its window
+    energy: Σ_window z² ≈ s·(w/ν)·χ²(ν) (Satterthwaite), ν from :func:`_dof`.
 
     Real sensor noise is not white: correlated samples (a sensor's own filter,
     bias wander faster than the baseline) make the window energy vary more than
@@ -669,24 +763,42 @@ def _energy_law(z: np.ndarray, w: int) -> tuple[float, np.ndarray]:
     z² over the median of χ²(ν)/ν: σ̂·√s is the RMS of the quiet noise even where
     the MAD misjudges it (heavy tails, quantization), and both tests use it.
     Both are robust to a few events: ρ is computed from z clipped at ±3, s from
-    a median.
+    a median. Two passes over blocks: the valid samples, their clipped mean and the
+    complete windows' mean z², then the lag products.
     """
-    valid = np.isfinite(z)
-    m = int(valid.sum())
-    z = np.where(valid, z, 0.0)
-    c = np.clip(z, -3.0, 3.0)
-    c = np.where(valid, c - c[valid].mean() if m else 0.0, 0.0)
-    acf = _lag_products(c, w)
-    pairs = (len(z) - np.arange(w)).astype(float) if m == len(z) else _valid_pairs(valid, w)
+    valid = np.empty(n, dtype=bool)
+    clipped = np.empty(n)  # the valid samples clipped, gathered for their mean
+    m = 0
+    means = []
+    full = n // w
+    for a, b in _blocks.ranges(n, w):
+        x = z(a, b)
+        ok = np.isfinite(x)
+        valid[a:b] = ok
+        x = np.where(ok, x, 0.0)
+        k = int(np.count_nonzero(ok))
+        clipped[m:m + k] = np.clip(x[ok], -3.0, 3.0)
+        m += k
+        rows = min(b, full * w) - a  # the complete windows' mean z² (windows at rows i·w)
+        if rows > 0:
+            squares = (x[:rows] ** 2).reshape(rows // w, w)
+            means.append(squares[ok[:rows].reshape(rows // w, w).all(axis=1)].mean(axis=1))
+    centre = clipped[:m].mean() if m else 0.0
+    del clipped
+
+    def centred(a: int, b: int) -> np.ndarray:
+        ok = valid[a:b]
+        return np.where(ok, np.clip(np.where(ok, z(a, b), 0.0), -3.0, 3.0) - centre, 0.0)
+
+    acf = _blocks.lag_products(centred, n, w)
+    pairs = (n - np.arange(w)).astype(float) if m == n else _valid_pairs(valid, w)
     rho = acf / np.maximum(pairs, 1.0) / (acf[0] / max(pairs[0], 1.0)) if acf[0] > 0 \
         else np.zeros(w)
     dof = _dof(rho, w)
-    full = len(z) // w
-    blocks = (z[: full * w] ** 2).reshape(full, w)
-    complete = valid[: full * w].reshape(full, w).all(axis=1)
-    if not complete.any():
+    means = np.concatenate(means) if means else np.zeros(0)
+    if not means.size:
         return 1.0, rho
-    median = float(np.median(blocks[complete].mean(axis=1)))
+    median = float(np.median(means))
     expected = float(_sstats.chi2.median(dof)) / dof
     return (median / expected if median > 0 else 1.0), rho
 
@@ -703,7 +815,7 @@ def _valid_pairs(valid: np.ndarray, lags: int) -> np.ndarray:
     n = len(valid)
     start, stop = true_runs(~valid)
     if start.size > PAIR_RUNS:
-        return _lag_products(valid.astype(float), lags)
+        return _blocks.lag_products(lambda a, b: valid[a:b].astype(float), n, lags)
     k = np.arange(lags)
 
     def missing_below(end: np.ndarray) -> np.ndarray:  # missing samples in [0, end)
@@ -720,34 +832,6 @@ def _valid_pairs(valid: np.ndarray, lags: int) -> np.ndarray:
     return ((n - k) - missing_below(n - k) - (total - missing_below(k)) + both).astype(float)
 
 
-#: Bytes of block transforms :func:`_lag_products` holds at once.
-LAG_GROUP_BYTES = 32 << 20
-
-
-def _lag_products(a: np.ndarray, lags: int) -> np.ndarray:
-    """Σ_i a_i·a_(i+k) for k = 0 … lags − 1, by FFT over blocks of 8·lags samples (at
-    least 1024): n·log(lags) work, where one FFT of the whole record costs n·log(n)
-    for the few lags the energy law needs."""
-    n = len(a)
-    block = max(8 * lags, 1024)
-    size = 1 << int(np.ceil(np.log2(block + lags)))
-    count = -(-n // block)
-    padded = np.zeros(count * block + lags)
-    padded[:n] = a
-    heads = padded[: count * block].reshape(count, block)
-    spans = np.lib.stride_tricks.sliding_window_view(padded, block + lags)[::block]
-    # the blocks' transforms a group at a time (all at once they took 4 arrays of the
-    # record's length), their lag sums added block after block as a sum over axis 0 adds
-    total = np.zeros(lags)
-    rows = max(1, LAG_GROUP_BYTES // (16 * size))
-    for g in range(0, count, rows):
-        products = np.conj(np.fft.rfft(heads[g:g + rows], size, axis=1)) * np.fft.rfft(
-            spans[g:g + rows], size, axis=1)
-        for row in np.fft.irfft(products, size, axis=1)[:, :lags]:
-            total += row
-    return total
-
-
 def _dof(rho: np.ndarray, w: int) -> float:
     """Satterthwaite degrees of freedom of the energy of ``w`` samples with
     autocorrelation ``rho`` (ρ_0 … ρ_{w−1} at least)."""
@@ -756,10 +840,10 @@ def _dof(rho: np.ndarray, w: int) -> float:
 
 
 def _tail_dof(z: np.ndarray) -> float:
-    """Degrees of freedom ν of the Student-t with the excess kurtosis of ``z``
+    """Degrees of freedom ν of the Student-t with the excess kurtosis of the finite
+    samples ``z`` (:func:`imunoise._blocks.gather`'s: an array of our own, overwritten)
     (6/(ν − 4)), at least :data:`CHANGE_POINT_DOF`: Gaussian-like noise keeps the
     Gaussian likelihood's precision, heavy-tailed noise gets bounded influence."""
-    z = z[np.isfinite(z)]
     if z.size < 8:
         return CHANGE_POINT_DOF
     excess = _excess_kurtosis(z)
@@ -768,9 +852,11 @@ def _tail_dof(z: np.ndarray) -> float:
 
 def _excess_kurtosis(z: np.ndarray) -> float:
     """``scipy.stats.kurtosis(z)`` of finite samples, the same operations (its central
-    moments m2 = mean(d²), m4 = mean((d²)²)) without its checks and copies."""
+    moments m2 = mean(d²), m4 = mean((d²)²)) without its checks and copies (``z`` is
+    overwritten)."""
     mean = z.mean()
-    square = z - mean
+    square = z
+    square -= mean
     square *= square
     m2 = square.mean()
     if m2 <= (np.finfo(np.float64).eps * mean) ** 2:

@@ -25,7 +25,7 @@ import numpy as np
 from imunoise import _schema
 from imunoise.readers.log import ImuLog
 
-__all__ = ["BLOCK_ROWS", "PARSE_BYTES", "STREAM_BYTES", "blocks", "column", "describe",
+__all__ = ["BLOCK_ROWS", "PARSE_BYTES", "STREAM_BYTES", "adev", "blocks", "column", "describe",
            "is_mapped", "open_mapped", "release", "release_log", "trim_heap", "workdir_for"]
 
 #: VN logs larger than this are streamed by default (parsed once into memory maps).
@@ -177,6 +177,17 @@ class _Moments:
         self.sxx += sums[0]
         self.stt += sums[1]
         self.stx += sums[2]
+
+
+def adev(arr: np.ndarray, fs: float, taus, streamed: bool, block: int = BLOCK_ROWS):
+    """:func:`imunoise.adev` of a sensor's samples ``arr``; ``streamed``: a column at
+    a time (:func:`imunoise.allan.adev_by_column`: one column and the core's arrays for
+    it in memory, not the sensor's map and its phase), the same result."""
+    from imunoise import allan
+
+    if not streamed or arr.ndim == 1:
+        return allan.adev(arr, fs, taus=taus)
+    return allan.adev_by_column(lambda j: column(arr, j, block), arr.shape[1], fs, taus=taus)
 
 
 def _yaw_centre(ypr: np.ndarray, block: int) -> float | None:

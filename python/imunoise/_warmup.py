@@ -58,7 +58,7 @@ from scipy import stats as _stats
 from imunoise import _stream, _summary
 from imunoise._channels import rate_columns
 from imunoise._simulate import simulate
-from imunoise.allan import adev
+from imunoise.allan import adev, adev_by_column
 from imunoise.noise import fit, model_variance
 from imunoise.readers.log import ImuLog
 
@@ -390,8 +390,10 @@ def _null_p_values(cols, fs, t, bias, duration, seed) -> np.ndarray:
     taus = taus[taus < duration / 2]  # as the significance rule: longer is drift
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # a poorly followed curve still bounds the wander
-        half = adev(np.column_stack([cols.rows(j, cols.n // 2, cols.n)
-                                     for j in np.flatnonzero(ok)]), fs)
+        # a column at a time: one half-column and the Allan core's arrays for it
+        chosen = np.flatnonzero(ok)
+        half = adev_by_column(lambda c: cols.stacked([chosen[c]], cols.n // 2, cols.n)[:, 0],
+                              len(chosen), fs)
         model = fit(half, warn_coverage=False)
     k_floor = _random_walk_bound(half, model)
     rng = np.random.default_rng(seed)
@@ -452,17 +454,22 @@ def _upper(model, term: str, c: int) -> float:
     return value + 2 * std if value > 0 and np.isfinite(std) else value
 
 
-def _transient(amp, tau, n, fs) -> np.ndarray:
-    """The fitted transients A e^{-t/τ} at every sample, (n, k); 0 where none was fitted."""
-    t = np.arange(n) / fs
+def _transient(amp, tau, a, b, fs) -> np.ndarray:
+    """The fitted transients A e^{-t/τ} at samples a … b − 1, (b − a, k); 0 where none
+    was fitted."""
+    t = np.arange(a, b) / fs
     finite = np.isfinite(tau) & (tau > 0)
     return np.where(finite, amp * np.exp(-t[:, None] / np.where(finite, tau, 1.0)), 0.0)
 
 
 def _residual(cols, amp, tau, fs, j: int) -> np.ndarray:
     """Channel ``j`` of ``cols`` without its fitted transient (:func:`_transient`), one
-    channel in memory at a time."""
-    return cols[j] - _transient(amp[j:j + 1], tau[j:j + 1], cols.n, fs)[:, 0]
+    channel in memory at a time (the transient a block of rows at a time)."""
+    out = cols.owned(j)
+    for a in range(0, len(out), _stream.BLOCK_ROWS):
+        b = min(len(out), a + _stream.BLOCK_ROWS)
+        out[a:b] -= _transient(amp[j:j + 1], tau[j:j + 1], a, b, fs)[:, 0]
+    return out
 
 
 def _fit_exponential(t, y, duration):

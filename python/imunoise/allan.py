@@ -74,6 +74,7 @@ autocorrelation", Proc. 18th EFTF (2004).
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from types import MappingProxyType
@@ -700,6 +701,38 @@ def _deviation(
         kind, overlapping, tau, m, var, terms, alpha, identified, edf, fs=fs,
         confidence=confidence, one_d=one_d, missing=missing, gaps=gaps, n_samples=n,
     )
+
+
+def adev_by_column(column: Callable[[int], np.ndarray], k: int, fs: float, *,
+                   taus: TauSpec = "octave", confidence: float = ONE_SIGMA) -> AllanResult:
+    """:func:`adev` of the (n, k) samples whose column j is ``column(j)`` (a 1-D
+    float64 array, read when its turn comes), one column and the core's working
+    arrays for it in memory rather than all k: the core analyses each channel on its
+    own, so the result is that of the stacked array. Should the columns keep
+    different taus (gaps that leave one channel too few terms at the longest), the
+    stacked array is analysed instead."""
+    with warnings.catch_warnings(record=True) as said:
+        warnings.simplefilter("always")
+        results = [adev(column(j), fs, taus=taus, confidence=confidence) for j in range(k)]
+    if any(not np.array_equal(r.m, results[0].m) for r in results):
+        return adev(np.column_stack([column(j) for j in range(k)]), fs, taus=taus,
+                    confidence=confidence)
+    for message in dict.fromkeys((str(w.message), w.category) for w in said):
+        _warn.warn(*message)  # once each, as the stacked array's call says it
+    first = results[0]
+
+    def stacked(name: str) -> np.ndarray:
+        return np.column_stack([getattr(r, name) for r in results])
+
+    terms = stacked("n")
+    return AllanResult(
+        kind=first.kind, overlapping=first.overlapping, taus=first.taus, m=first.m,
+        dev=stacked("dev"), var=stacked("var"),
+        n=terms[:, 0].copy() if np.all(terms == terms[:, :1]) else terms,
+        edf=stacked("edf"), ci_low=stacked("ci_low"), ci_high=stacked("ci_high"),
+        alpha=stacked("alpha"), alpha_identified=stacked("alpha_identified"), fs=first.fs,
+        confidence=first.confidence, n_samples=first.n_samples,
+        missing=np.array([r.missing for r in results], dtype=np.int64), gaps=first.gaps)
 
 
 def _keep_gapped(kind, m, var, terms, alpha, identified, edf, fs, user_given):

@@ -64,12 +64,12 @@ import numpy as np
 import numpy.typing as npt
 from scipy import stats as _stats
 
-from imunoise import _schema, _summary, _warn
+from imunoise import _schema, _stream, _summary, _warn
 from imunoise import numbers as _numbers
 from imunoise._core import allan as _core_allan
 from imunoise._runs import true_runs
 from imunoise._validate import no_infinity, positive_finite, sample_rate, samples
-from imunoise.allan import ONE_SIGMA, AllanResult, adev, chi2_interval
+from imunoise.allan import ONE_SIGMA, AllanResult, adev, adev_by_column, chi2_interval
 from imunoise.taus import averaging_factors
 
 if TYPE_CHECKING:
@@ -330,6 +330,7 @@ def dynamic_adev(
     """
     data, one_d = samples(x)
     no_infinity(data)
+    _stream.release(data)  # a memory map's pages: read again a column at a time
     fs = sample_rate(fs)
     n = data.shape[0]
     width = n // 10 if window is None else _samples_of("window", window, fs)
@@ -348,7 +349,11 @@ def dynamic_adev(
             f"least {shortest / fs:g} s ({shortest} samples) for this record"
         )
     m = _window_factors(taus, fs, width)
-    whole = adev(data[:, 0] if one_d else data, fs, taus=m / fs, confidence=confidence)
+    if _stream.is_mapped(data) and not one_d:  # a column at a time, not the map and its phase
+        whole = adev_by_column(lambda j: _stream.column(data, j), data.shape[1], fs,
+                               taus=m / fs, confidence=confidence)
+    else:
+        whole = adev(data[:, 0] if one_d else data, fs, taus=m / fs, confidence=confidence)
     if not np.array_equal(whole.m, m):
         m = np.intersect1d(m, whole.m)
     starts = np.arange(0, n - width + 1, stride, dtype=np.int64)
@@ -381,20 +386,20 @@ def _phase(y: np.ndarray, mean: np.ndarray, any_missing: bool
     and the running count of missing samples (None when the record has none:
     ``any_missing``). Summed in blocks of :data:`_BLOCK` whose totals are added
     pairwise, so the error grows with the block, not the record."""
-    centred = y - mean
+    n, ch = y.shape
+    pad = (-n) % _BLOCK
+    # one array: c = [0, running sums], the sums in place over its blocks
+    out = np.zeros((ch, 1 + n + pad))
+    blocks = out[:, 1:].reshape(ch, -1, _BLOCK)  # a view: one row per channel
+    np.subtract(y.T, mean[:, None], out=out[:, 1:n + 1])
     missing = np.isnan(y) if any_missing else None
     if missing is not None:
-        centred[missing] = 0.0
-    n, ch = centred.shape
-    pad = (-n) % _BLOCK
-    blocks = np.concatenate([centred.T, np.zeros((ch, pad))], axis=1).reshape(ch, -1, _BLOCK)
-    del centred
-    inner = np.cumsum(blocks, axis=2)
-    inner += np.concatenate([np.zeros((ch, 1)), np.cumsum(blocks.sum(axis=2), axis=1)[:, :-1]],
-                            axis=1)[:, :, None]
-    del blocks
-    c = np.zeros((ch, n + 1))
-    c[:, 1:] = inner.reshape(ch, -1)[:, :n]
+        out[:, 1:n + 1][missing.T] = 0.0
+    totals = blocks.sum(axis=2)
+    np.cumsum(blocks, axis=2, out=blocks)
+    blocks += np.concatenate([np.zeros((ch, 1)), np.cumsum(totals, axis=1)[:, :-1]],
+                             axis=1)[:, :, None]
+    c = out[:, :n + 1]
     if missing is None:
         return c, None
     bad = np.zeros((ch, n + 1), dtype=np.int64)
@@ -420,16 +425,24 @@ def _window_sums(data, m, starts, width, stride):
     n, ch = data.shape
     any_missing = bool(np.isnan(data).any())
     mean = np.nanmean(data, axis=0) if any_missing else data.mean(axis=0)
+    _stream.release(data)
     sums = np.empty((len(starts), len(m), ch))
     counts = np.empty((len(starts), len(m), ch))
     block_edges = np.arange(0, n + 1, stride, dtype=np.int64)
     per_tau: dict[int, list[tuple[np.ndarray, np.ndarray]]] = {}
+    mapped = _stream.is_mapped(data)
     for j in range(ch):
-        c, bad = _phase(data[:, j:j + 1], mean[j:j + 1], any_missing)
+        # a memory map's column read a block at a time (its pages given back)
+        column = _stream.column(data, j)[:, None] if mapped else data[:, j:j + 1]
+        c, bad = _phase(column, mean[j:j + 1], any_missing)
+        del column
+        # the second differences of every tau in two arrays reused (fresh ones per tau
+        # cost the kernel a channel length of page faults each)
+        buffer, twice = np.empty((1, n + 1)), np.empty((1, n + 1))
         for t, mm in enumerate(int(v) for v in m):
             k = n + 1 - 2 * mm
-            second = c[:, 2 * mm:] + c[:, :k]
-            second -= 2.0 * c[:, mm:mm + k]
+            second = np.add(c[:, 2 * mm:], c[:, :k], out=buffer[:, :k])
+            second -= np.multiply(c[:, mm:mm + k], 2.0, out=twice[:, :k])
             second *= second
             last = starts + width + 1 - 2 * mm
             edges = np.minimum(block_edges, k)
@@ -450,7 +463,7 @@ def _window_sums(data, m, starts, width, stride):
                 block_p, block_n = prefix[:, 2 * w:2 * w + e], terms[:, 2 * w:2 * w + e]
                 per_tau.setdefault(t, []).append((np.diff(block_p, axis=1).T,
                                                   np.diff(block_n, axis=1).T))
-        del c, bad
+        del c, bad, buffer, twice
     blocks = tuple((t, np.hstack([p for p, _n in parts]), np.hstack([q for _p, q in parts]))
                    for t, parts in per_tau.items())
     return sums, counts, blocks

@@ -191,8 +191,9 @@ def time_series(
 
     Parameters
     ----------
-    y : ndarray, (n,) or (n, k), or ImuLog
-        Samples of one sensor, or a log: then one column of panels per channel
+    y : ndarray, (n,) or (n, k), list of k arrays (n,), or ImuLog
+        Samples of one sensor (a list: its columns, not stacked into a copy), or a
+        log: then one column of panels per channel
         (titled with the channel and its unit), at the log's rate, with the log's
         longest :data:`SHADED_GAPS` gaps shaded.
     fs : float
@@ -233,8 +234,14 @@ def time_series(
                          f"ImuLog); got {channels!r}")
     if fs is None:
         raise ValueError("fs must be given for an array (the sample rate, Hz); got None")
-    y = np.asarray(y, dtype=np.float64).reshape(len(y), -1)
-    names = list(names) if names is not None else axis_names(y.shape[1])
+    if isinstance(y, list) and all(isinstance(c, np.ndarray) and c.ndim == 1 for c in y):
+        if len({len(c) for c in y}) > 1:
+            raise ValueError(f"y's columns must have one length; got {[len(c) for c in y]}")
+        k = len(y)
+    else:
+        y = np.asarray(y, dtype=np.float64).reshape(len(y), -1)
+        k = y.shape[1]
+    names = list(names) if names is not None else axis_names(k)
     return _series_figure([("", unit, names, y)], fs, title, columns, gaps or ())
 
 
@@ -263,10 +270,9 @@ def _series_figure(blocks, fs: float, title: str, columns: int, gaps) -> Figure:
     """One column of panels per block ``(heading, unit, axis names, (n,) or (n, k))``;
     a block without a heading labels its panels ``name [unit]``."""
     new_figure = _plt()
-    blocks = [(head, unit, names, np.asarray(v, dtype=np.float64).reshape(len(v), -1))
-              for head, unit, names, v in blocks]
-    rows = max(v.shape[1] for *_, v in blocks)
-    n = len(blocks[0][3])
+    blocks = [(head, unit, names, _columns(v)) for head, unit, names, v in blocks]
+    rows = max(len(v) for *_, v in blocks)
+    n = len(blocks[0][3][0])
     duration = n / fs
     scale, tunit = (1.0, "s") if duration < 600 else (60.0, "min")
     if duration >= 3 * 3600:
@@ -277,10 +283,10 @@ def _series_figure(blocks, fs: float, title: str, columns: int, gaps) -> Figure:
         fig = new_figure(figsize=size)
         grid = fig.subplots(rows, len(blocks), sharex=True, squeeze=False)
         for b, (head, unit, names, y) in enumerate(blocks):
-            k = y.shape[1]
+            k = len(y)
             for j in range(k):
                 ax = grid[j, b]
-                _draw_series(ax, 0.0, fs * scale, y[:, j], AXIS_COLORS[j % 4], columns)
+                _draw_series(ax, 0.0, fs * scale, y[j], AXIS_COLORS[j % 4], columns)
                 for start, length in gaps:
                     # at least a visible sliver, however short the gap
                     width = max(length, duration / columns) / scale
@@ -302,6 +308,14 @@ def _series_figure(blocks, fs: float, title: str, columns: int, gaps) -> Figure:
         if title:
             fig.suptitle(title)
     return fig
+
+
+def _columns(v) -> list[np.ndarray]:
+    """The columns of ``v``: (n,) or (n, k) samples, or a list of (n,) columns."""
+    if isinstance(v, list):
+        return [np.asarray(c, dtype=np.float64) for c in v]
+    arr = np.asarray(v, dtype=np.float64).reshape(len(v), -1)
+    return [arr[:, j] for j in range(arr.shape[1])]
 
 
 def histograms(

@@ -68,7 +68,7 @@ from scipy import optimize as _optimize
 from scipy import signal as _signal
 from scipy import stats as _stats
 
-from imunoise import _schema, _summary
+from imunoise import _schema, _stream, _summary
 from imunoise._runs import true_runs
 from imunoise._validate import (
     confidence_level,
@@ -380,7 +380,8 @@ def psd(
             f"{longest}): a spectrum needs unbroken stretches"
         )
     user_band = None if band is None else _check_band(band, fs)
-    largest = float(np.nanmax(np.abs(data)))
+    largest = float(max(np.nanmax(data), -np.nanmin(data)))  # max |x|, without |x|'s copy
+    _stream.release(data)  # the scans' pages of a memory map (read again by segments)
     with np.errstate(over="ignore"):
         f, p = _welch(data, fs, seg, starts) if largest < 1e150 else (None, None)
     if p is None or not np.all(np.isfinite(p)):
@@ -482,7 +483,11 @@ def _segment_starts(present: np.ndarray, seg: int) -> np.ndarray:
     """Starts of Welch's segments (``seg`` samples, overlapping by half) that hold no
     missing sample; ``present`` (n,) is False where a row misses one."""
     starts = (seg - seg // 2) * np.arange(_segment_count(len(present), seg))
-    missing = np.concatenate(([0], np.cumsum(~present)))
+    if present.all():
+        return starts
+    # missing rows before each row (32-bit counts where they fit: a long record's)
+    missing = np.zeros(len(present) + 1, dtype=np.int32 if len(present) < 2**31 else np.int64)
+    np.cumsum(~present, out=missing[1:])
     return starts[missing[starts + seg] == missing[starts]]
 
 
@@ -505,12 +510,34 @@ def _welch(data: np.ndarray, fs: float, seg: int, starts: np.ndarray):
     pieces = starts.size * seg * data.shape[1] // WELCH_PIECE if complete else \
         starts.size * seg // (1 << 22)
     p = 0.0
-    for chunk in np.array_split(starts, max(1, pieces)):
-        pieces = np.lib.stride_tricks.sliding_window_view(data, seg, axis=0)[chunk]
-        f, q = _signal.welch(pieces, fs=fs, window="hann", nperseg=seg, noverlap=0,
-                             detrend="constant", scaling="density", axis=-1)
-        p = p + q.sum(axis=0).T
-    return f[1:], (p / starts.size)[1:]
+    window = _signal.get_window("hann", seg)
+    scale = 1.0 / (fs * np.sum(window * window))
+    # at most one piece per segment (more left empty pieces, whose spectra do not add);
+    # a channel at a time (a segment of a long record is large)
+    for chunk in np.array_split(starts, min(starts.size, max(1, pieces))):
+        part = np.empty((seg // 2 + 1, data.shape[1]))
+        for c in range(data.shape[1]):
+            pieces = np.lib.stride_tricks.sliding_window_view(data[:, c], seg)[chunk]
+            _stream.release(data)  # a memory map's pages: those of the next piece only
+            part[:, c] = _periodograms(pieces, window, scale).sum(axis=0)
+        p = p + part
+    return np.fft.rfftfreq(seg, 1.0 / fs)[1:], (p / starts.size)[1:]
+
+
+def _periodograms(segments: np.ndarray, window: np.ndarray, scale: float) -> np.ndarray:
+    """One-sided Hann periodograms (density) of ``segments`` (k, L), each less its mean:
+    ``scipy.signal.welch`` of one segment, without its per-call set-up (a window and
+    its sums per call: a third of the time on a long record's segments)."""
+    x = segments - segments.mean(axis=-1, keepdims=True)
+    x *= window
+    spectrum = np.fft.rfft(x, axis=-1)
+    del x
+    p = spectrum.real ** 2
+    p += spectrum.imag ** 2
+    del spectrum
+    p *= scale
+    p[..., 1:-1 if segments.shape[-1] % 2 == 0 else None] *= 2.0  # both sides but 0, Nyquist
+    return p
 
 
 def _welch_edf(seg: int, starts: np.ndarray) -> float:

@@ -520,7 +520,8 @@ class Distribution:
 
 
 @old_call_forms(keyword_only=("bins",))
-def distribution(x, *, bins="auto", qq_points: int = 1001, extent: str = "bulk") -> Distribution:
+def distribution(x, *, bins="auto", qq_points: int = 1001, extent: str = "bulk",
+                 overwrite_input: bool = False) -> Distribution:
     r"""Histogram with quantization-aware bins, normal fit and normality tests.
 
     Parameters
@@ -542,6 +543,9 @@ def distribution(x, *, bins="auto", qq_points: int = 1001, extent: str = "bulk")
     qq_points : int
         Number of Q–Q points (sample quantiles at probabilities
         :math:`p_i = (i + 0.5)/m`), so plots stay light for 10⁷ samples.
+    overwrite_input : bool
+        Allow a float64 ``x`` to be sorted in place (as ``numpy.median``'s option):
+        the one sort then needs no copy of the samples. The result is the same.
 
     Returns
     -------
@@ -581,10 +585,15 @@ def distribution(x, *, bins="auto", qq_points: int = 1001, extent: str = "bulk")
         raise ValueError(f"x must be 1-D; got shape {arr.shape}")
     if np.isinf(arr).any():
         raise ValueError("x must be finite or NaN (a missing sample); it contains inf")
+    if not isinstance(overwrite_input, bool):
+        raise TypeError(f"overwrite_input must be True or False; got {overwrite_input!r}")
+    owned = overwrite_input and arr is x  # x itself, not a float64 copy of it
     nan = np.isnan(arr)
     missing = int(np.count_nonzero(nan))
     if missing:
         arr = arr[~nan]
+        owned = True
+    del nan
     if len(arr) < 3:
         extra = f" ({missing} NaN left out)" if missing else ""
         raise ValueError(f"x needs at least 3 valid samples; got {len(arr)}{extra}")
@@ -594,7 +603,13 @@ def distribution(x, *, bins="auto", qq_points: int = 1001, extent: str = "bulk")
         raise ValueError(f'extent must be "bulk" or "all"; got {extent!r}')
 
     n = len(arr)
-    xs = np.sort(arr)
+    means = _batch_means(arr)  # in time order, before the sort
+    if owned:
+        arr.sort()
+        xs = arr
+    else:
+        xs = np.sort(arr)
+    del arr
     step = _step_of_levels(xs)
     shown = _bulk(xs) if extent == "bulk" else xs
     if step is None:
@@ -650,7 +665,7 @@ def distribution(x, *, bins="auto", qq_points: int = 1001, extent: str = "bulk")
         qq_theoretical=_sstats.norm.ppf(p),
         qq_sample=xs[lo] + (h - lo) * (xs[hi] - xs[lo]),
         missing=missing,
-        **_fit_uncertainty(arr, sigma),
+        **_fit_uncertainty(means, n, sigma),
         **off_scale,
     )
 
@@ -696,7 +711,7 @@ def _bulk(xs: np.ndarray) -> np.ndarray:
     """The sorted samples ``xs`` within the histogram's range: the central
     1 − 2·:data:`BULK_TAIL` widened by :data:`BULK_MARGIN` of its width on each side.
     When the bulk has no width (one level holds 99 %), every sample."""
-    q_lo, q_hi = np.quantile(xs, [BULK_TAIL, 1.0 - BULK_TAIL])
+    q_lo, q_hi = sorted_quantiles(xs, [BULK_TAIL, 1.0 - BULK_TAIL])
     width = q_hi - q_lo
     if not width > 0:
         return xs
@@ -705,21 +720,48 @@ def _bulk(xs: np.ndarray) -> np.ndarray:
     return xs[i:j]
 
 
+def sorted_quantiles(xs: np.ndarray, q) -> np.ndarray:
+    """``np.quantile(xs, q)`` (its default, linear method) of the sorted samples ``xs``
+    (no NaN), the same numbers without its partitioned copy of ``xs``: the order
+    statistics either side of (n − 1)·q, interpolated as numpy's ``_lerp`` does (from
+    the upper one when the weight is at least 1/2)."""
+    n = len(xs)
+    virtual = (n - 1) * np.asarray(q, dtype=np.float64)
+    below = np.floor(virtual)
+    previous = np.clip(below, 0, n - 1).astype(np.intp)
+    following = np.clip(below + 1, 0, n - 1).astype(np.intp)
+    top = virtual >= n - 1
+    previous[top] = following[top] = n - 1
+    gamma = virtual - np.where(top, -1.0, np.maximum(below, 0.0))
+    a, b = xs[previous], xs[following]
+    diff = b - a
+    return np.where(gamma >= 0.5, b - diff * (1 - gamma), a + diff * gamma)
+
+
 #: Batches of the batch-means standard error of the normal fit's mean.
 UNCERTAINTY_BATCHES = 20
 
 
-def _fit_uncertainty(v: np.ndarray, sigma: float) -> dict[str, float]:
-    """``mu_std`` (batch means over the samples ``v`` in time order) and ``sigma_std``."""
+def _batch_means(v: np.ndarray) -> np.ndarray | None:
+    """The means of :data:`UNCERTAINTY_BATCHES` equal batches of the samples ``v`` in
+    time order; None when a batch would hold fewer than 10."""
     b = UNCERTAINTY_BATCHES
     size = len(v) // b
     if size < 10:
+        return None
+    return v[: b * size].reshape(b, size).mean(axis=1)
+
+
+def _fit_uncertainty(means: np.ndarray | None, n: int, sigma: float) -> dict[str, float]:
+    """``mu_std`` (from the batch means ``means`` of ``n`` samples, :func:`_batch_means`)
+    and ``sigma_std``."""
+    if means is None:
         return {"mu_std": float("nan"), "sigma_std": float("nan")}
-    means = v[: b * size].reshape(b, size).mean(axis=1)
+    b = len(means)
     mu_std = float(np.std(means, ddof=1) / np.sqrt(b))
     with np.errstate(over="ignore"):  # a ratio above 1e154 is more than len(v) anyway
         ratio = float(np.square(np.float64(sigma) / mu_std)) if mu_std > 0 else np.inf
-    n_eff = min(float(len(v)), ratio)
+    n_eff = min(float(n), ratio)
     return {"mu_std": mu_std, "sigma_std": sigma / np.sqrt(2.0 * max(n_eff - 1.0, 1.0))}
 
 
@@ -827,6 +869,16 @@ def unwrap_about_circular_mean(angle_deg: np.ndarray) -> np.ndarray:
     ok = np.isfinite(a)
     if not ok.any():
         return a.copy()
-    r = np.radians(a[ok])
-    centre = float(np.degrees(np.arctan2(np.mean(np.sin(r)), np.mean(np.cos(r)))))
-    return centre + (a - centre + 180.0) % 360.0 - 180.0
+    # in place, one array at a time: a channel of a long log is large
+    r = a[ok]
+    sin_mean = np.mean(np.sin(np.radians(r, out=r), out=r))
+    r[:] = a[ok]
+    cos_mean = np.mean(np.cos(np.radians(r, out=r), out=r))
+    centre = float(np.degrees(np.arctan2(sin_mean, cos_mean)))
+    del r
+    out = a - centre  # centre + (a − centre + 180°) mod 360° − 180°, one array
+    out += 180.0
+    np.remainder(out, 360.0, out=out)
+    np.add(centre, out, out=out)
+    out -= 180.0
+    return out

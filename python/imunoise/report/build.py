@@ -88,8 +88,10 @@ class Context:
         for sensor in SAMPLE_SENSORS:
             y = getattr(self.short, sensor)
             if y is not None:
+                # streamed: the column read is the distribution's own, sorted in place
                 out[sensor] = {sensor_label(sensor, j, y.shape[1]): stats.distribution(
-                    _stream.column(y, j, self.block) if self.streamed else y[:, j])
+                    _stream.column(y, j, self.block), overwrite_input=True)
+                    if self.streamed else stats.distribution(y[:, j])
                     for j in range(y.shape[1])}
         return out
 
@@ -113,16 +115,25 @@ class Context:
         ypr = self.short.ypr
         if not self.streamed:
             return stats.attitude_angles(ypr)
-        angles = {name: _stream.column(ypr, j, self.block)
-                  for j, name in enumerate(_schema.ATTITUDE_NAMES)}
-        angles["yaw"] = stats.unwrap_about_circular_mean(angles["yaw"])
+        # yaw first: unwrapped before the other two are read
+        angles = {"yaw": stats.unwrap_about_circular_mean(_stream.column(ypr, 0, self.block))}
+        for j, name in enumerate(_schema.ATTITUDE_NAMES[1:], start=1):
+            angles[name] = _stream.column(ypr, j, self.block)
         return angles
 
     @cached_property
     def attitude_distributions(self) -> dict[str, stats.Distribution]:
         """Normal fit of each attitude angle of the short log (missing samples left out)."""
-        return {name: stats.distribution(v[np.isfinite(v)])
-                for name, v in (self.attitude() or {}).items()}
+        if not self.streamed or not self.has_attitude:
+            return {name: stats.distribution(v[np.isfinite(v)], overwrite_input=True)
+                    for name, v in (self.attitude() or {}).items()}
+        out = {}  # an angle at a time
+        for j, name in enumerate(_schema.ATTITUDE_NAMES):
+            v = _stream.column(self.short.ypr, j, self.block)
+            if name == "yaw":
+                v = stats.unwrap_about_circular_mean(v)
+            out[name] = stats.distribution(v[np.isfinite(v)], overwrite_input=True)
+        return out
 
     @property
     def distributions(self) -> dict[str, stats.Distribution]:
@@ -137,7 +148,8 @@ class Context:
         for sensor in ALLAN_SENSORS:
             y = getattr(self.long, sensor)
             if y is not None:
-                out[sensor] = _allan.adev(y, self.long.fs, taus=self.taus_per_decade)
+                out[sensor] = _stream.adev(y, self.long.fs, self.taus_per_decade,
+                                           self.streamed, self.block)
                 _stream.release(y)  # a memory map's pages, before the next sensor's
         return out
 

@@ -170,8 +170,8 @@ def distribution_fits(ctx: Context, doc: Doc) -> None:
 def attitude(ctx: Context, doc: Doc) -> None:
     """Yaw, pitch and roll of the short log: statistics, time series, histograms
     with the normal fit, and why a filter's output need not be normal."""
+    dists = ctx.attitude_distributions  # first: it reads the angles on its own
     angles = ctx.attitude()
-    dists = ctx.attitude_distributions
     doc.p("Yaw, pitch and roll are the output of the sensor's attitude filter, not "
           "measurements: the filter blends the gyro, accelerometer and magnetometer, so its "
           "output is smoothed, correlated from sample to sample and follows slow magnetic "
@@ -182,13 +182,14 @@ def attitude(ctx: Context, doc: Doc) -> None:
           "(−180°, 180°].")
     rows = []
     for name, v in angles.items():
-        ok = v[np.isfinite(v)]
+        ok = v if np.isfinite(v).all() else v[np.isfinite(v)]
         mean = float(ok.mean())
         if name == "yaw":  # back into (−180°, 180°]
             mean = stats.heading(mean)
         d = dists[name]
-        rows.append([name, "deg", format_number(mean), format_number(float(ok.std(ddof=1))),
-                     format_number(float(ok.var(ddof=1))), format_number(float(ok.min())),
+        var = ok.var(ddof=1)  # std is its square root (numpy's std computes it so)
+        rows.append([name, "deg", format_number(mean), format_number(float(np.sqrt(var))),
+                     format_number(float(var)), format_number(float(ok.min())),
                      format_number(float(ok.max())), *(format_number(x) for x in (
                          d.ks_statistic, d.ks_pvalue, d.ad_statistic, d.skewness,
                          d.excess_kurtosis))])
@@ -199,9 +200,8 @@ def attitude(ctx: Context, doc: Doc) -> None:
         caption="Attitude statistics and normality (short log; std and variance with ddof = 1)",
     )
     names = list(angles)
-    stacked = np.column_stack([angles[n] for n in names])
-    fig = plot.time_series(stacked, ctx.short.fs, title="attitude (short log)", unit="deg",
-                           names=names)
+    fig = plot.time_series([angles[n] for n in names], ctx.short.fs,  # not stacked: a copy
+                           title="attitude (short log)", unit="deg", names=names)
     ctx.add_figure(doc, fig, "timeseries_attitude",
                    "Yaw (about its circular mean), pitch and roll of the short log [deg]")
     fig = plot.histograms([dists[n] for n in names], title="attitude distribution (short log)",
@@ -323,12 +323,14 @@ def power_spectral_density(ctx: Context, doc: Doc) -> None:
             continue
         if np.count_nonzero(~np.isnan(y).any(axis=1)) < 256:
             continue
+        _stream.release(y)
         try:  # segments with a missing sample are left out
             s = spectrum.psd(y, ctx.short.fs)
         except ValueError:  # no unbroken stretch of 16 samples
             continue
         model = ctx.models.get(sensor) if ctx.one_log else noise.fit(
-            _allan.adev(y, ctx.short.fs, taus=ctx.taus_per_decade), warn_coverage=False)
+            _stream.adev(y, ctx.short.fs, ctx.taus_per_decade, ctx.streamed, ctx.block),
+            warn_coverage=False)
         _stream.release(y)
         unit = CHANNELS[sensor][1]
         doc.h(3, sensor)
@@ -456,14 +458,23 @@ def events_section(ctx: Context, doc: Doc) -> None:
         ctx.add_figure(doc, fig, f"events_{sensor}",
                        f"{sensor} of the short log, events shaded, peak in sigmas above")
         kept = []
+        inside = found.mask
         for j, axis in enumerate(axis_names(y.shape[1])):
             with_ = list(ctx.sensor_distributions[sensor].values())[j]  # the same samples
+            # one channel at a time, not the sensor: streamed, its column read is ours,
+            # and the events are made missing in it in place
             col = _stream.column(y, j, ctx.block) if ctx.streamed else y[:, j]
-            z = found.exclude(col)  # one channel copied at a time, not the sensor
-            without = stats.distribution(z[np.isfinite(z)])
+            std = np.nanstd(col, ddof=1)
+            z = col if ctx.streamed else np.array(col, dtype=np.float64)
+            del col
+            z[inside] = np.nan  # found.exclude(col)
+            std_without = np.nanstd(z, ddof=1)
+            z = z[np.isfinite(z)]
+            without = stats.distribution(z, overwrite_input=True)
+            del z
             kept.append(without)
             rows.append([f"{sensor} {axis}", *(numbers.cell(v) for v in (
-                np.nanstd(col, ddof=1), np.nanstd(z, ddof=1), with_.excess_kurtosis,
+                std, std_without, with_.excess_kurtosis,
                 without.excess_kurtosis, with_.ks_statistic, without.ks_statistic))])
         _stream.release(y)
         fig = plot.histograms(kept, title=f"{sensor} without events (short log)",
@@ -510,9 +521,20 @@ def long_log_events(ctx: Context, doc: Doc) -> None:
         taus = _decade_taus(with_)
         if not taus.size:
             continue
-        both = _allan.adev(getattr(log, sensor), log.fs, taus=taus)
-        without = _allan.adev(found.exclude(getattr(log, sensor), pad=EVENT_PAD), log.fs,
-                              taus=both.taus)
+        y = getattr(log, sensor)
+        both = _stream.adev(y, log.fs, taus, ctx.streamed, ctx.block)
+        _stream.release(y)
+        if ctx.streamed:  # a column at a time, the events made missing in it
+            inside = found.padded_mask(EVENT_PAD)
+
+            def excluded(j: int, y=y, inside=inside) -> np.ndarray:
+                col = _stream.column(y, j, ctx.block)
+                col[inside] = np.nan
+                return col
+
+            without = _allan.adev_by_column(excluded, y.shape[1], log.fs, taus=both.taus)
+        else:
+            without = _allan.adev(found.exclude(y, pad=EVENT_PAD), log.fs, taus=both.taus)
         # the taus both have (the grid's own, whole samples; gaps may cost the longest)
         taus, a, b = np.intersect1d(both.taus, without.taus, return_indices=True)
         dev, lo, hi = (np.reshape(v, (len(both.taus), -1))[a] for v in (
