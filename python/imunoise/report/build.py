@@ -89,10 +89,15 @@ class Context:
             y = getattr(self.short, sensor)
             if y is not None:
                 # streamed: the column read is the distribution's own, sorted in place
-                out[sensor] = {sensor_label(sensor, j, y.shape[1]): stats.distribution(
-                    _stream.column(y, j, self.block), overwrite_input=True)
-                    if self.streamed else stats.distribution(y[:, j])
-                    for j in range(y.shape[1])}
+                def one(j, y=y):
+                    if self.streamed:
+                        return stats.distribution(_stream.column(y, j, self.block),
+                                                  overwrite_input=True)
+                    return stats.distribution(y[:, j])
+
+                found = _stream.each_channel(one, y.shape[1])
+                out[sensor] = {sensor_label(sensor, j, y.shape[1]): d
+                               for j, d in enumerate(found)}
         return out
 
     @cached_property

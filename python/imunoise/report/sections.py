@@ -457,11 +457,10 @@ def events_section(ctx: Context, doc: Doc) -> None:
                           unit=CHANNELS[sensor][1])
         ctx.add_figure(doc, fig, f"events_{sensor}",
                        f"{sensor} of the short log, events shaded, peak in sigmas above")
-        kept = []
         inside = found.mask
-        for j, axis in enumerate(axis_names(y.shape[1])):
-            with_ = list(ctx.sensor_distributions[sensor].values())[j]  # the same samples
-            # one channel at a time, not the sensor: streamed, its column read is ours,
+
+        def quiet(j, y=y, inside=inside):
+            # a channel at a time, not the sensor: streamed, its column read is ours,
             # and the events are made missing in it in place
             col = _stream.column(y, j, ctx.block) if ctx.streamed else y[:, j]
             std = np.nanstd(col, ddof=1)
@@ -470,9 +469,13 @@ def events_section(ctx: Context, doc: Doc) -> None:
             z[inside] = np.nan  # found.exclude(col)
             std_without = np.nanstd(z, ddof=1)
             z = z[np.isfinite(z)]
-            without = stats.distribution(z, overwrite_input=True)
-            del z
-            kept.append(without)
+            return std, std_without, stats.distribution(z, overwrite_input=True)
+
+        per_axis = _stream.each_channel(quiet, y.shape[1])
+        kept = [without for _, _, without in per_axis]
+        for j, axis in enumerate(axis_names(y.shape[1])):
+            with_ = list(ctx.sensor_distributions[sensor].values())[j]  # the same samples
+            std, std_without, without = per_axis[j]
             rows.append([f"{sensor} {axis}", *(numbers.cell(v) for v in (
                 std, std_without, with_.excess_kurtosis,
                 without.excess_kurtosis, with_.ks_statistic, without.ks_statistic))])
