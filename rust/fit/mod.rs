@@ -9,8 +9,8 @@
 //! Gauss–Markov bias terms of variance qₖ² and correlation time τcₖ (three: a
 //! MEMS sensor's own filter, a bump of correlated bias, and slow wander), and
 //! up to [`search::MAX_TONES`] sinusoids (tones) of variance s² (amplitude √2·s)
-//! and frequency f₀ and at most one resonance (damped oscillator, second-order Gauss–Markov) of
-//! variance r², frequency f_r and damping time τr (`basis`). The estimator
+//! and frequency f₀ and at most one resonance (damped oscillator, second-order
+//! Gauss–Markov) of variance r², frequency f_r and damping time τr (`basis`). The estimator
 //! (`estimate`) is a weighted least-squares fit of ln σ̂² with weights from the
 //! EDF, the share of an octave each tau stands for, and a model-discrepancy
 //! variance fitted by maximum likelihood; the structure (`search`) is chosen by

@@ -1076,10 +1076,7 @@ pub fn select(
                 .collect();
             let shape = (times.as_slice(), base.sine, base.resonance);
             if let Some(moved) = with_motion(data, fs, ieee, shape, base.solution.d2, true)? {
-                let reduced = eliminate(data, fs, ieee, moved)?;
-                if reduced.score() < best.score() {
-                    best = reduced;
-                }
+                keep_lower(data, fs, ieee, moved, &mut best)?;
             }
         }
     }
@@ -1141,52 +1138,30 @@ fn add_resonance(
         let Some(res) = with_resonance(data, fs, ieee, (&base.gm_tau, base.sine), d2, true)? else {
             continue;
         };
-        let reduced = eliminate(data, fs, ieee, res.clone())?;
-        if reduced.score() < best.score() {
-            best = reduced;
-        }
+        keep_lower(data, fs, ieee, res.clone(), &mut best)?;
         if base.sine.is_empty() {
-            best = tones_beside_resonance(data, fs, ieee, &res, max_tones, best)?;
+            // Tones on top, the resonance searched again after each (see `add_tones`).
+            let on_top = (res.gm_tau.clone(), Tones::NONE, res.resonance);
+            let budget = (res.solution.d2, max_tones);
+            add_tones(data, fs, ieee, on_top, budget, &mut best)?;
         }
     }
     Ok(best)
 }
 
-/// Tones searched one at a time on top of `res` (a structure with a resonance and
-/// no tone), up to `max_tones`; after each, the resonance is searched again with
-/// the tones in place. Held fixed, a broad resonance that took a line's power
-/// leaves the line little to gain: on the VN-100 gyro X a 16.6 Hz band of Q 6
-/// beside its 13.4 Hz line. Each structure, reduced, replaces `best` when it
-/// scores lower.
-fn tones_beside_resonance(
+/// `c` reduced by [`eliminate`], put in `best` when it scores lower; returned.
+fn keep_lower(
     data: &Data,
     fs: f64,
     ieee: [bool; IEEE_TERMS],
-    res: &Candidate,
-    max_tones: usize,
-    mut best: Candidate,
+    c: Candidate,
+    best: &mut Candidate,
 ) -> CoreResult<Candidate> {
-    let keep = |c: Candidate, best: &mut Candidate| -> CoreResult<()> {
-        let reduced = eliminate(data, fs, ieee, c)?;
-        if reduced.score() < best.score() {
-            *best = reduced;
-        }
-        Ok(())
-    };
-    let mut at = (res.gm_tau.clone(), Tones::NONE, res.solution.d2);
-    while at.1.len() < max_tones {
-        let start = (at.0.as_slice(), at.1, res.resonance);
-        let Some(toned) = with_sine(data, fs, ieee, start, at.2, true)? else {
-            break;
-        };
-        at = (toned.gm_tau.clone(), toned.sine, toned.solution.d2);
-        let moved = with_resonance(data, fs, ieee, (&at.0, at.1), at.2, true)?;
-        keep(toned, &mut best)?;
-        if let Some(moved) = moved {
-            keep(moved, &mut best)?;
-        }
+    let reduced = eliminate(data, fs, ieee, c)?;
+    if reduced.score() < best.score() {
+        *best = reduced.clone();
     }
-    Ok(best)
+    Ok(reduced)
 }
 
 /// Structures besides the best one that a resonance may complete.
@@ -1205,7 +1180,11 @@ struct Bases<'a> {
 /// toned structure, reduced, replaces `best` when it scores lower. The next
 /// tone is searched on top of the last whether or not that one won: two lines
 /// each leave the other's misfit, so the first of them alone can lose and the
-/// pair win. Returns the toned structure that scored lowest, won or not.
+/// pair win. Where `start` has a resonance, it is searched again after each
+/// tone with the tones in place: held fixed, a broad resonance that took a
+/// line's power leaves the line little to gain (on the VN-100 gyro X a 16.6 Hz
+/// band of Q 6 beside its 13.4 Hz line). Returns the toned structure that
+/// scored lowest, won or not.
 fn add_tones(
     data: &Data,
     fs: f64,
@@ -1223,12 +1202,16 @@ fn add_tones(
         };
         // The next tone is searched at the discrepancy this structure settled on.
         current = (toned.gm_tau.clone(), toned.sine, toned.solution.d2);
-        let reduced = eliminate(data, fs, ieee, toned)?;
-        if reduced.score() < best.score() {
-            *best = reduced.clone();
-        }
+        let moved = match resonance {
+            Some(_) => with_resonance(data, fs, ieee, (&current.0, current.1), current.2, true)?,
+            None => None,
+        };
+        let reduced = keep_lower(data, fs, ieee, toned, best)?;
         if lowest.as_ref().is_none_or(|c| reduced.score() < c.score()) {
             lowest = Some(reduced);
+        }
+        if let Some(moved) = moved {
+            keep_lower(data, fs, ieee, moved, best)?;
         }
     }
     Ok(lowest)
