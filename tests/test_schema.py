@@ -16,10 +16,11 @@ def test_fit_constants_are_the_rust_ones():
     assert noise.GM_MAX == core_fit.MAX_GAUSS_MARKOV == 3
     assert noise.TONES_MAX == core_fit.MAX_TONES == 2
     # IEEE terms, (σ², ln τc) per Gauss–Markov slot, (A²/2, ln f0) per tone slot, then
-    # the resonance's (σ², ln f_r, ln τr), then the bounded motion's (σθ², ln τc)
+    # the resonance's (σ², ln f_r, ln τr, skew), then the bounded motion's (σθ², ln τc)
     assert core_fit.SINE_SLOT == 5 + 2 * noise.GM_MAX
     assert core_fit.RESONANCE_SLOT == core_fit.SINE_SLOT + 2 * noise.TONES_MAX
-    assert core_fit.MOTION_SLOT == core_fit.RESONANCE_SLOT + 3
+    assert core_fit.SKEW_SLOT == core_fit.RESONANCE_SLOT + 3
+    assert core_fit.MOTION_SLOT == core_fit.RESONANCE_SLOT + 4
     assert core_fit.PARAMETERS == core_fit.MOTION_SLOT + 2
     assert noise.FLICKER == pytest.approx(math.sqrt(2 * math.log(2) / math.pi), rel=1e-15)
 

@@ -109,7 +109,7 @@ def simulate(n_samples: int, fs: float, Q: float = 0.0, N: float = 0.0, B: float
              K: float = 0.0, R: float = 0.0, *, channels: int = 1, seed=None,
              gm: Sequence[tuple[float, float]] = (),
              sinusoid: tuple[float, float] | Sequence[tuple[float, float]] | None = None,
-             resonance: tuple[float, float, float] | None = None,
+             resonance: tuple[float, ...] | None = None,
              motion: tuple[float, float] | None = None) -> np.ndarray:
     """Rate noise with the given IEEE 952 coefficients.
 
@@ -135,13 +135,17 @@ def simulate(n_samples: int, fs: float, Q: float = 0.0, N: float = 0.0, B: float
         A tone A·sin(2π·f0·t + ϕ) of peak amplitude A (rate) and frequency f0
         (Hz), a random phase ϕ per channel: IEEE 952 Annex C's sinusoidal term,
         Allan variance A²·sin⁴(πf0τ)/(πf0τ)²; several tones add.
-    resonance : (sigma, f_r, tau_r), optional
-        A damped oscillator (second-order Gauss–Markov process): the real part
-        of the complex AR1 z[t] = ρe^(iθ)·z[t−1] + w[t], ρ = exp(−1/(fs·tau_r)),
-        θ = 2π·f_r/fs, started stationary, so that its autocovariance is
-        sigma²·ρ^|h|·cos(θh): standard deviation ``sigma`` (rate), centre
-        frequency ``f_r`` (Hz, at most fs/2) and damping time ``tau_r`` (s) —
-        the process of the ``"resonance"`` term of :func:`imunoise.fit`.
+    resonance : (sigma, f_r, tau_r) or (sigma, f_r, tau_r, skew), optional
+        A damped oscillator (second-order Gauss–Markov process), started
+        stationary, with autocovariance sigma²·ρ^|h|·(cos θh + skew·κ·sin θ|h|),
+        ρ = exp(−1/(fs·tau_r)), θ = 2π·f_r/fs, κ = sinh(1/(fs·tau_r))/sin θ:
+        standard deviation ``sigma`` (rate), frequency ``f_r`` (Hz, at most fs/2),
+        damping time ``tau_r`` (s) and ``skew`` in [−1, 1] (default 0; beyond, the
+        spectrum would be negative somewhere) — the process of the
+        ``"resonance"`` term of :func:`imunoise.fit`. With skew 0 it is the real
+        part of the complex AR1 z[t] = ρe^(iθ)·z[t−1] + w[t]; otherwise the
+        ARMA(2, 1) process with that autocovariance (a digital Butterworth
+        low-pass filter's output has skew 1).
     motion : (sigma, tau_c), optional
         A bounded motion of the mount: the rate (θ[t] − θ[t−1])·fs of an angle
         (velocity, for an accelerometer) θ that is a stationary AR1 of standard
@@ -247,29 +251,43 @@ def _size_and_rate(value, name: str, article: str, members: tuple[str, str],
     return size, rate
 
 
-def _check_resonance(resonance, fs: float) -> tuple[float, float, float] | None:
+def _check_resonance(resonance, fs: float) -> tuple[float, float, float, float] | None:
     if resonance is None:
         return None
     try:
-        sigma, f_r, tau_r = (float(v) for v in resonance)
+        values = [float(v) for v in resonance]
+        if len(values) not in (3, 4):
+            raise ValueError
     except (TypeError, ValueError):
-        raise TypeError(f"resonance must be a (sigma, f_r, tau_r) triple or None; got "
-                        f"{resonance!r}") from None
+        raise TypeError(f"resonance must be a (sigma, f_r, tau_r) triple, a (sigma, f_r, "
+                        f"tau_r, skew) quadruple or None; got {resonance!r}") from None
+    sigma, f_r, tau_r = values[:3]
+    skew = values[3] if len(values) == 4 else 0.0
     if not (math.isfinite(sigma) and sigma >= 0):
         raise ValueError(f"resonance sigma must be finite and >= 0; got {sigma!r}")
     if not (math.isfinite(f_r) and 0 < f_r <= fs / 2):
         raise ValueError(f"resonance f_r must be in (0, fs/2 = {fs / 2:g}] Hz; got {f_r!r}")
     if not (math.isfinite(tau_r) and tau_r > 0):
         raise ValueError(f"resonance tau_r must be finite and > 0 s; got {tau_r!r}")
-    return sigma, f_r, tau_r
+    if not abs(skew) <= 1:
+        raise ValueError(f"resonance skew must be in [-1, 1] (a non-negative spectrum); "
+                         f"got {skew!r}")
+    return sigma, f_r, tau_r, skew
 
 
 def damped_oscillator(n: int, fs: float, sigma: float, f_r: float, tau_r: float,
-                      rng: np.random.Generator) -> np.ndarray:
-    """Stationary damped oscillator: Re z of z[t] = ρe^(iθ)·z[t−1] + w[t] with
-    autocovariance sigma²·ρ^|h|·cos(θh) (E|z|² = 2 sigma²)."""
+                      skew: float, rng: np.random.Generator) -> np.ndarray:
+    """Stationary damped oscillator with autocovariance
+    sigma²·ρ^|h|·(cos θh + skew·κ·sin θ|h|): for skew 0 (or at fs/2, where the
+    quadrature part vanishes) Re z of z[t] = ρe^(iθ)·z[t−1] + w[t]
+    (E|z|² = 2 sigma²), else :func:`_arma21`."""
     from scipy.signal import lfilter
 
+    from imunoise.noise._terms import quadrature_bound
+
+    bound = quadrature_bound(f_r, tau_r, fs)
+    if skew and math.isfinite(bound):
+        return _arma21(n, fs, sigma, f_r, tau_r, skew * bound, rng)
     pole = math.exp(-1.0 / (fs * tau_r)) * complex(math.cos(2 * math.pi * f_r / fs),
                                                    math.sin(2 * math.pi * f_r / fs))
     scale = sigma * math.sqrt(-math.expm1(-2.0 / (fs * tau_r)))  # σ·√(1 − ρ²) per part
@@ -300,3 +318,50 @@ def gauss_markov(n: int, fs: float, sigma: float, tau_c: float,
     w = rng.standard_normal(n) * (sigma * math.sqrt(-math.expm1(-2.0 / (fs * tau_c))))
     w[0] = rng.standard_normal() * sigma  # start in the stationary distribution
     return lfilter([1.0], [1.0, -phi], w)
+
+
+def _arma21(n: int, fs: float, sigma: float, f_r: float, tau_r: float, beta: float,
+            rng: np.random.Generator) -> np.ndarray:
+    """The ARMA(2, 1) process x[t] = a1·x[t−1] + a2·x[t−2] + e[t] + m·e[t−1] whose
+    autocovariance is γ(h) = sigma²·ρ^|h|·(cos θh + beta·sin θ|h|).
+
+    γ follows the AR(2) recursion of the poles ρe^(±iθ) (a1 = 2ρ cos θ, a2 = −ρ²)
+    from lag 2 on, so w = x − a1·x[−1] − a2·x[−2] is an MA(1) with autocovariances
+    c0 = σe²(1 + m²), c1 = σe²·m (Σᵢⱼ φᵢφⱼγ(k + i − j), φ = (1, −a1, −a2)): the
+    invertible root |m| ≤ 1 of m² c1 − m c0 + c1 = 0. x = y + m·y[−1] with y the
+    AR(2) driven by e, started from its stationary distribution."""
+    from scipy.signal import lfilter
+
+    rho = math.exp(-1.0 / (fs * tau_r))
+    theta = 2 * math.pi * f_r / fs
+    a1, a2 = 2 * rho * math.cos(theta), -rho * rho
+
+    def gamma(h: int) -> float:
+        h = abs(h)
+        return sigma**2 * rho**h * (math.cos(theta * h) + beta * math.sin(theta * h))
+
+    phi = (1.0, -a1, -a2)
+    c0, c1 = (sum(phi[i] * phi[j] * gamma(k + i - j) for i in range(3) for j in range(3))
+              for k in (0, 1))
+    if abs(c1) <= 1e-15 * abs(c0):
+        m, var_e = 0.0, c0
+    else:
+        disc = math.sqrt(max(c0 * c0 - 4 * c1 * c1, 0.0))
+        m = (c0 - disc) / (2 * c1)
+        var_e = c1 / m
+    # y's stationary (y[−1], y[−2]): variance γy(0), lag-one covariance γy(1).
+    g0 = (1 - a2) * var_e / ((1 + a2) * ((1 - a2) ** 2 - a1 * a1))
+    g1 = a1 * g0 / (1 - a2)
+    start = rng.multivariate_normal([0.0, 0.0], [[g0, g1], [g1, g0]])
+    e = rng.standard_normal(n) * math.sqrt(var_e)
+    zi = lfilter_zi_ar2(a1, a2, start)
+    y = lfilter([1.0], [1.0, -a1, -a2], e, zi=zi)[0]
+    previous = np.concatenate(([start[0]], y[:-1]))
+    return y + m * previous
+
+
+def lfilter_zi_ar2(a1: float, a2: float, past: np.ndarray) -> np.ndarray:
+    """The direct-form-II-transposed state of 1/(1 − a1·B − a2·B²) whose next
+    output continues the past outputs ``past`` = (y[−1], y[−2])."""
+    y1, y2 = past
+    return np.array([a1 * y1 + a2 * y2, a2 * y1])

@@ -218,8 +218,8 @@ def _ekf_axes(model, sensor: str, input_unit, min_samples: float) -> dict:
         # A resonance (like a tone) is no bias state; what it adds to the white
         # floor (its spectrum at zero frequency) is measurement noise. A bounded
         # motion is the test mount's, not the sensor's: no state, no noise.
-        for sigma, f_r, tau_r in parts.resonance(c):
-            white2 += resonance_white_density(sigma, f_r, tau_r, model.fs)
+        for sigma, f_r, tau_r, skew in parts.resonance(c):
+            white2 += resonance_white_density(sigma, f_r, tau_r, model.fs, skew)
         states = []
         for sigma, tau_c in parts.gauss_markov(c):
             if tau_c * model.fs < min_samples:

@@ -11,7 +11,7 @@ use pyo3::prelude::*;
 
 use crate::fit::{
     self, Options, FLICKER_FACTOR, IEEE_TERMS, IEEE_TERM_NAMES, MAX_GM, MAX_TONES, MOTION_SLOT,
-    PARAMETERS, RESONANCE_SLOT, SINE_SLOT,
+    PARAMETERS, RESONANCE_SLOT, SINE_SLOT, SKEW_SLOT,
 };
 
 /// The fit of one channel, as `_core.fit.NoiseFit`.
@@ -21,15 +21,15 @@ struct PyNoiseFit {
     ieee: Py<PyArray1<f64>>,
     /// (k, 2) rows of (q², τc), one per Gauss–Markov term.
     gm: Py<PyArray2<f64>>,
-    /// (k, 2) rows of (s², f₀), k ≤ 1: the tone.
+    /// (k, 2) rows of (s², f₀), k ≤ MAX_TONES: the tones.
     sine: Py<PyArray2<f64>>,
-    /// (k, 3) rows of (r², f_r, τr), k ≤ 1: the resonance.
+    /// (k, 4) rows of (r², f_r, τr, skew), k ≤ 1: the resonance.
     resonance: Py<PyArray2<f64>>,
     /// (k, 2) rows of (σθ², τc), k ≤ 1: the bounded motion.
     motion: Py<PyArray2<f64>>,
     /// PARAMETERS × PARAMETERS covariance of (Q²…R², then q², ln τc per slot,
-    /// then s², ln f₀, then r², ln f_r, ln τr, then σθ², ln τc; NaN variance of
-    /// ln f_r at fs/2).
+    /// then s², ln f₀ per tone slot, then r², ln f_r, ln τr, skew, then σθ², ln τc;
+    /// NaN variance of ln f_r at fs/2 and of the skew at ±1).
     cov: Py<PyArray2<f64>>,
     /// δ, the relative model discrepancy.
     discrepancy: f64,
@@ -92,13 +92,15 @@ fn fit_noise<'py>(
     let r = py.detach(|| fit::fit_noise(&taus, &var, &edf, fs, &opts))?;
     let gm_rows: Vec<Vec<f64>> = r.gm.iter().map(|&(q2, tc)| vec![q2, tc]).collect();
     let sine_rows: Vec<Vec<f64>> = r.sine.iter().map(|&(s2, f0)| vec![s2, f0]).collect();
-    let res_rows: Vec<Vec<f64>> = r.resonance.iter().map(|&(a, f, t)| vec![a, f, t]).collect();
+    let res_rows: Vec<Vec<f64>> = (r.resonance.iter())
+        .map(|&(a, f, t, skew)| vec![a, f, t, skew])
+        .collect();
     let motion_rows: Vec<Vec<f64>> = r.motion.iter().map(|&(v, tc)| vec![v, tc]).collect();
     Ok(PyNoiseFit {
         ieee: r.ieee.to_vec().into_pyarray(py).unbind(),
         gm: to_matrix(gm_rows, 2)?.into_pyarray(py).unbind(),
         sine: to_matrix(sine_rows, 2)?.into_pyarray(py).unbind(),
-        resonance: to_matrix(res_rows, 3)?.into_pyarray(py).unbind(),
+        resonance: to_matrix(res_rows, 4)?.into_pyarray(py).unbind(),
         motion: to_matrix(motion_rows, 2)?.into_pyarray(py).unbind(),
         cov: to_matrix(r.cov, PARAMETERS)?.into_pyarray(py).unbind(),
         discrepancy: r.discrepancy,
@@ -121,7 +123,7 @@ fn noise_terms<'py>(
     ieee: Vec<f64>,
     gm: Vec<(f64, f64)>,
     sine: Vec<(f64, f64)>,
-    resonance: Vec<(f64, f64, f64)>,
+    resonance: Vec<(f64, f64, f64, f64)>,
     motion: Vec<(f64, f64)>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     if ieee.len() != IEEE_TERMS {
@@ -142,12 +144,17 @@ fn noise_terms<'py>(
             "sine frequencies must be finite and > 0 Hz; got {f0}"
         )));
     }
-    if let Some(&(_, f, t)) = resonance
+    if let Some(&(_, f, t, _)) = resonance
         .iter()
         .find(|r| !(r.1.is_finite() && r.1 > 0.0 && r.2.is_finite() && r.2 > 0.0))
     {
         return Err(PyValueError::new_err(format!(
             "resonance frequency and damping time must be finite and > 0; got {f} Hz, {t} s"
+        )));
+    }
+    if let Some(&(_, _, _, skew)) = resonance.iter().find(|r| r.3.is_nan() || r.3.abs() > 1.0) {
+        return Err(PyValueError::new_err(format!(
+            "resonance skew must be in [-1, 1] (a non-negative spectrum); got {skew}"
         )));
     }
     if let Some(&(_, t)) = motion.iter().find(|m| !(m.1.is_finite() && m.1 > 0.0)) {
@@ -168,6 +175,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("PARAMETERS", PARAMETERS)?;
     m.add("SINE_SLOT", SINE_SLOT)?;
     m.add("RESONANCE_SLOT", RESONANCE_SLOT)?;
+    m.add("SKEW_SLOT", SKEW_SLOT)?;
     m.add("MOTION_SLOT", MOTION_SLOT)?;
     m.add("FLICKER_FACTOR", FLICKER_FACTOR)?;
     m.add_class::<PyNoiseFit>()?;

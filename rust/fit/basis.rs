@@ -108,6 +108,51 @@ pub fn sinusoid(m: f64, nu: f64) -> f64 {
 /// [`sinusoid`] as u → 0, to [`gauss_markov`] as θ → 0, and θ = π is the AR1
 /// with φ = −ρ (a band peaked at fs/2).
 pub fn resonance(m: f64, u: f64, theta: f64) -> f64 {
+    resonance_parts(m, u, theta).0.max(0.0)
+}
+
+/// Allan variance at cluster size `m` of a resonance with a quadrature part:
+/// autocovariance γ(h) = ρ^|h|·(cos θh + β sin θ|h|), the general stationary
+/// second-order process with one zero (ARMA(2,1)), with β = `skew` · κ,
+/// κ = [`quadrature_bound`]. A sensor's own second-order low-pass filter is one
+/// (its output's autocovariance has β = cot ψ, tan ψ = (1 + ρ²)/(1 − ρ²)·tan θ;
+/// a digital Butterworth filter, whose zeros sit at fs/2, has skew 1), which the
+/// plain resonance (skew 0) draws only roughly. Since the lag sum is linear in γ
+/// with real coefficients and sin θh = Im e^(iθh), σ²(m) is the real part of
+/// [`resonance`]'s complex form plus β times its imaginary part.
+///
+/// Its spectrum, Re[(1 − iβ)(1 − z²)/|1 − z e^(−iω)|²], is non-negative at every
+/// frequency exactly when |skew| ≤ 1; at skew 1 it touches zero at fs/2 (a
+/// low-pass filter's zero), at −1 at zero frequency (the rate of a bounded
+/// oscillation: no white noise at long τ). At θ = π the quadrature part vanishes.
+pub fn skewed_resonance(m: f64, u: f64, theta: f64, skew: f64) -> f64 {
+    let (cosine, sine) = resonance_parts(m, u, theta);
+    let bound = quadrature_bound(u, theta);
+    let quadrature = if bound.is_finite() {
+        skew * bound * sine
+    } else {
+        0.0
+    };
+    (cosine + quadrature).max(0.0)
+}
+
+/// κ = sinh u / sin θ, the largest |β| of a [`skewed_resonance`] with a
+/// non-negative spectrum (the numerator of the spectrum, a cosine polynomial of
+/// degree one, touches zero at ω = 0 or π there). Infinite at θ = 0 or π, where
+/// the quadrature part vanishes.
+pub fn quadrature_bound(u: f64, theta: f64) -> f64 {
+    let s = theta.sin().abs();
+    if s < 1e-12 {
+        f64::INFINITY
+    } else {
+        u.sinh() / s
+    }
+}
+
+/// The Allan variances at cluster size `m` of the autocovariances ρ^|h| cos θh
+/// and ρ^|h| sin θ|h|: the real and imaginary parts of
+/// [m(1 − z²) − z(1 − zᵐ)(3 − zᵐ)] / (m² (1 − z)²) at z = e^(−u + iθ).
+pub fn resonance_parts(m: f64, u: f64, theta: f64) -> (f64, f64) {
     let w = Complex64::new(u, -theta);
     let r = w.norm();
     let d = -expm1(-w); // 1 − z
@@ -118,7 +163,8 @@ pub fn resonance(m: f64, u: f64, theta: f64) -> f64 {
         let e = -expm1(-w * m); // 1 − zᵐ
         d * (2.0 - d) * m - z * e * (2.0 + e)
     };
-    (numerator / (d * d * (m * m))).re.max(0.0)
+    let form = numerator / (d * d * (m * m));
+    (form.re, form.im)
 }
 
 /// The numerator m(1 − z²) − z(1 − zᵐ)(3 − zᵐ) of the Gauss–Markov form at
@@ -258,6 +304,67 @@ mod tests {
                         "rho {rho} nu {nu} m {m}: {got} vs {want}"
                     );
                 }
+            }
+        }
+    }
+
+    #[test]
+    fn skewed_resonance_matches_the_autocovariance_sum() {
+        let two_pi = 2.0 * std::f64::consts::PI;
+        for &rho in &[0.2f64, 0.5, 0.9, 0.99, 0.999] {
+            for &nu in &[1e-3, 0.013, 0.1, 0.25, 0.37, 0.49] {
+                let (u, theta) = (-rho.ln(), two_pi * nu);
+                let bound = quadrature_bound(u, theta);
+                for skew in [-1.0, -0.3, 0.5, 1.0] {
+                    let beta = skew * bound;
+                    let g = |h: usize| {
+                        let h = h as f64;
+                        rho.powf(h) * ((theta * h).cos() + beta * (theta * h).sin())
+                    };
+                    for &m in &[1usize, 2, 3, 5, 7, 10, 64, 300, 2000] {
+                        let want = direct_from(m, g);
+                        let got = skewed_resonance(m as f64, u, theta, skew);
+                        let scale = resonance(m as f64, u, theta) + want.abs();
+                        assert!(
+                            (got - want).abs() <= 1e-9 * scale + 1e-13,
+                            "rho {rho} nu {nu} skew {skew} m {m}: {got} vs {want}"
+                        );
+                    }
+                }
+            }
+        }
+    }
+
+    /// Σₕ ρ^|h|(cos θh + β sin θ|h|)e^(−iωh), summed directly.
+    fn skewed_spectrum(rho: f64, theta: f64, beta: f64, omega: f64) -> f64 {
+        let mut s = 1.0;
+        let mut h = 1.0;
+        while rho.powf(h) > 1e-16 {
+            let g = rho.powf(h) * ((theta * h).cos() + beta * (theta * h).sin());
+            s += 2.0 * g * (omega * h).cos();
+            h += 1.0;
+        }
+        s
+    }
+
+    #[test]
+    fn the_quadrature_bound_is_where_the_spectrum_touches_zero() {
+        for &(rho, theta) in &[(0.5f64, 0.4), (0.9, 1.0), (0.97, 2.0), (0.3, 2.9)] {
+            let u = -rho.ln();
+            let bound = quadrature_bound(u, theta);
+            let lowest = |beta: f64| {
+                (0..=2000)
+                    .map(|k| skewed_spectrum(rho, theta, beta, PI * k as f64 / 2000.0))
+                    .fold(f64::INFINITY, f64::min)
+            };
+            let peak = skewed_spectrum(rho, theta, 0.0, theta);
+            // Skew 1 puts the zero at fs/2 (a low-pass filter's), −1 at 0.
+            assert!(skewed_spectrum(rho, theta, bound, PI).abs() <= 1e-9 * peak);
+            assert!(skewed_spectrum(rho, theta, -bound, 0.0).abs() <= 1e-9 * peak);
+            for sign in [1.0, -1.0] {
+                assert!(lowest(sign * bound) >= -1e-9 * peak, "{rho} {theta}");
+                assert!(lowest(sign * bound) <= 1e-3 * peak, "{rho} {theta}");
+                assert!(lowest(sign * 1.05 * bound) < 0.0, "{rho} {theta}");
             }
         }
     }

@@ -2,7 +2,7 @@
 //!
 //! ```text
 //! σ²(τ) = 3Q²/τ² + N²/τ + (2 ln2/π)·B² + K²τ/3 + R²τ²/2 + Σₖ qₖ²·g(τ; τcₖ)
-//!         + s²·h(τ; f₀) + r²·o(τ; f_r, τr)
+//!         + s²·h(τ; f₀) + r²·o(τ; f_r, τr, s)
 //! ```
 //!
 //! the IEEE Std 952 / 1293 terms plus up to [`MAX_GM`] = 3 first-order
@@ -10,7 +10,9 @@
 //! MEMS sensor's own filter, a bump of correlated bias, and slow wander), and
 //! up to [`search::MAX_TONES`] sinusoids (tones) of variance s² (amplitude √2·s)
 //! and frequency f₀ and at most one resonance (damped oscillator, second-order
-//! Gauss–Markov) of variance r², frequency f_r and damping time τr (`basis`). The estimator
+//! Gauss–Markov) of variance r², frequency f_r, damping time τr and skew s in
+//! [−1, 1], its quadrature part (0 for a plain resonance; a sensor's
+//! second-order filter has one) (`basis`). The estimator
 //! (`estimate`) is a weighted least-squares fit of ln σ̂² with weights from the
 //! EDF, the share of an octave each tau stands for, and a model-discrepancy
 //! variance fitted by maximum likelihood; the structure (`search`) is chosen by
@@ -44,20 +46,27 @@ pub use search::MAX_TONES;
 /// First slot of the tones in the parameter covariance: s², then ln f₀, per tone.
 pub const SINE_SLOT: usize = IEEE_TERMS + 2 * MAX_GM;
 
-/// First slot of the resonance in the parameter covariance: r², ln f_r, ln τr.
+/// First slot of the resonance in the parameter covariance: r², ln f_r, ln τr, s.
 pub const RESONANCE_SLOT: usize = SINE_SLOT + 2 * MAX_TONES;
 
+/// Slot of the resonance's skew s in the parameter covariance.
+pub const SKEW_SLOT: usize = RESONANCE_SLOT + 3;
+
 /// First slot of the bounded motion in the parameter covariance: σθ², ln τc.
-pub const MOTION_SLOT: usize = RESONANCE_SLOT + 3;
+pub const MOTION_SLOT: usize = RESONANCE_SLOT + 4;
 
 /// Slots of the parameter covariance: Q², N², B², K², R², then (q², ln τc) per
-/// Gauss–Markov term, then (s², ln f₀) per tone, then (r², ln f_r, ln τr) of
+/// Gauss–Markov term, then (s², ln f₀) per tone, then (r², ln f_r, ln τr, s) of
 /// the resonance, then (σθ², ln τc) of the bounded motion.
 pub const PARAMETERS: usize = MOTION_SLOT + 2;
 
-/// The tone (s², f₀), resonance (r², f_r, τr) and bounded motion (σθ², τc) terms
-/// of a model: up to [`MAX_TONES`] tones, at most one of the others.
-pub type Oscillators<'a> = (&'a [(f64, f64)], &'a [(f64, f64, f64)], &'a [(f64, f64)]);
+/// A fitted resonance: variance r², frequency f_r (Hz), damping time τr (s) and
+/// skew in [−1, 1] (`basis::skewed_resonance`; 0 for a plain one).
+pub type ResonanceFit = (f64, f64, f64, f64);
+
+/// The tone (s², f₀), resonance and bounded motion (σθ², τc) terms of a model:
+/// up to [`MAX_TONES`] tones, at most one of the others.
+pub type Oscillators<'a> = (&'a [(f64, f64)], &'a [ResonanceFit], &'a [(f64, f64)]);
 
 /// What [`fit_noise`] may use.
 #[derive(Debug, Clone, Copy)]
@@ -100,9 +109,9 @@ pub struct NoiseFit {
     pub gm: Vec<(f64, f64)>,
     /// Variance s² and frequency f₀ (Hz) of each tone, by increasing frequency.
     pub sine: Vec<(f64, f64)>,
-    /// Variance r², frequency f_r (Hz) and damping time τr (s) of the
+    /// Variance r², frequency f_r (Hz), damping time τr (s) and skew of the
     /// resonance, if the model has one.
-    pub resonance: Vec<(f64, f64, f64)>,
+    pub resonance: Vec<ResonanceFit>,
     /// Variance σθ² of the bounded angle (or velocity) and its correlation time
     /// τc (s), if the model has a bounded motion.
     pub motion: Vec<(f64, f64)>,
@@ -199,9 +208,18 @@ fn fixed_structure(data: &Data, fs: f64, opts: &Options) -> CoreResult<Candidate
         current = toned.or(current);
     }
     if opts.resonance {
+        // The resonance with and without a quadrature part; the lower BIC is its fit.
         let (times, sine, _, d2) = shape(&current);
-        let res = search::with_resonance(data, fs, opts.ieee, (&times, sine), d2, false)?;
-        current = res.or(current);
+        let mut fitted: Option<Candidate> = None;
+        for skewed in [false, true] {
+            let shape = (times.as_slice(), sine, skewed);
+            if let Some(c) = search::with_resonance(data, fs, opts.ieee, shape, d2, false)? {
+                if fitted.as_ref().is_none_or(|f| c.bic < f.bic) {
+                    fitted = Some(c);
+                }
+            }
+        }
+        current = fitted.or(current);
     }
     if opts.motion {
         let (times, sine, res, d2) = shape(&current);
@@ -271,8 +289,18 @@ fn prune_insignificant(data: &Data, fs: f64, mut best: Candidate) -> CoreResult<
             .collect();
         let sine_slots = (fit.sine.iter().enumerate()).map(|(k, s)| (SINE_SLOT + 2 * k, s.0));
         let res_slots = fit.resonance.iter().map(|r| (RESONANCE_SLOT, r.0));
+        // A quadrature part the data do not constrain: the plain resonance.
+        let quadrature = (fit.resonance.iter())
+            .filter(|r| r.3 != 0.0)
+            .map(|r| (SKEW_SLOT, r.3.abs()));
         let motion_slots = fit.motion.iter().map(|r| (MOTION_SLOT, r.0));
-        let mut order = weak(sine_slots.chain(res_slots).chain(motion_slots).collect());
+        let mut order = weak(
+            quadrature
+                .chain(sine_slots)
+                .chain(res_slots)
+                .chain(motion_slots)
+                .collect(),
+        );
         order.extend(weak(gm_slots));
         order.extend(weak(ieee_slots));
         for (slot, _) in order {
@@ -280,7 +308,7 @@ fn prune_insignificant(data: &Data, fs: f64, mut best: Candidate) -> CoreResult<
             let mut times: Vec<f64> = fit.gm.iter().map(|g| g.1).collect();
             let tones: Vec<f64> = fit.sine.iter().map(|s| s.1).collect();
             let mut sine = search::Tones::from_slice(&tones);
-            let mut resonance = fit.resonance.first().map(|r| (r.1, r.2));
+            let mut resonance = (best.resonance).filter(|_| !fit.resonance.is_empty());
             let mut motion = fit.motion.first().map(|r| r.1);
             if slot < IEEE_TERMS {
                 ieee[slot] = false;
@@ -288,6 +316,8 @@ fn prune_insignificant(data: &Data, fs: f64, mut best: Candidate) -> CoreResult<
                 sine = sine.without((slot - SINE_SLOT) / 2);
             } else if slot == RESONANCE_SLOT {
                 resonance = None;
+            } else if slot == SKEW_SLOT {
+                resonance = resonance.map(|r| search::Resonance { skewed: false, ..r });
             } else if slot == MOTION_SLOT {
                 motion = None;
             } else {
@@ -326,13 +356,17 @@ fn summarise(data: &Data, fs: f64, c: &Candidate) -> NoiseFit {
         .collect();
     sine.sort_by(|a, b| a.1.total_cmp(&b.1));
     let res_column = tone_column + c.sine.len();
-    let resonance: Vec<(f64, f64, f64)> = c
+    let res_columns = c.resonance.map_or(0, search::Resonance::columns);
+    let resonance: Vec<ResonanceFit> = c
         .resonance
-        .map(|(f, t)| (theta[res_column], f, t))
+        .map(|r| {
+            let (r2, skew) = r.variance_and_skew(&theta[res_column..], fs);
+            (r2, r.freq, r.tau, skew)
+        })
         .filter(|r| r.0 > 0.0)
         .into_iter()
         .collect();
-    let motion_column = res_column + usize::from(c.resonance.is_some());
+    let motion_column = res_column + res_columns;
     let motion: Vec<(f64, f64)> = c
         .motion
         .map(|t| (theta[motion_column], t))
@@ -359,14 +393,14 @@ fn summarise(data: &Data, fs: f64, c: &Candidate) -> NoiseFit {
         discrepancy: c.solution.d2.sqrt(),
         chi2,
         n_eff: data.n_eff(),
-        parameters: search::parameters(theta, c.resonance.is_some(), c.motion.is_some()),
+        parameters: search::parameters(theta, c.resonance, c.motion.is_some()),
         bic: c.bic,
     }
 }
 
 /// Model Allan variance of every term at `taus`: row i holds the five IEEE
 /// terms, then one value per Gauss–Markov term (q², τc), then one per tone
-/// (s², f₀), then one per resonance (r², f_r, τr), then one per bounded motion
+/// (s², f₀), then one per resonance (r², f_r, τr, skew), then one per bounded motion
 /// (σθ², τc).
 pub fn terms(
     taus: &[f64],
@@ -387,9 +421,9 @@ pub fn terms(
                 sine.iter()
                     .map(|&(s2, f0)| s2 * basis::sinusoid(t * fs, f0 / fs)),
             );
-            row.extend(resonance.iter().map(|&(r2, f, tr)| {
+            row.extend(resonance.iter().map(|&(r2, f, tr, skew)| {
                 let (u, theta) = basis::resonance_rates(f, tr, fs);
-                r2 * basis::resonance(t * fs, u, theta)
+                r2 * basis::skewed_resonance(t * fs, u, theta, skew)
             }));
             row.extend(
                 motion
@@ -426,12 +460,19 @@ fn covariance(
     let at_nyquist = resonance
         .first()
         .is_some_and(|r| r.1 >= 0.5 * fs * (1.0 - 1e-9));
+    // A skew on its bound ±1 (the spectrum touches zero) is not free either:
+    // its variance is NaN too.
+    let skewed = resonance.first().is_some_and(|r| r.3 != 0.0);
+    let on_skew_bound = resonance.first().is_some_and(|r| r.3.abs() >= 1.0 - 1e-9);
     if !resonance.is_empty() {
         slots.push(RESONANCE_SLOT);
         if !at_nyquist {
             slots.push(RESONANCE_SLOT + 1);
         }
         slots.push(RESONANCE_SLOT + 2);
+        if skewed && !on_skew_bound {
+            slots.push(SKEW_SLOT);
+        }
     }
     if !motion.is_empty() {
         slots.push(MOTION_SLOT);
@@ -445,9 +486,9 @@ fn covariance(
             let gmv =
                 |q2: f64, tc: f64| q2 * basis::gauss_markov(data.m[i], basis::gm_rate(tc, fs));
             let tone = |s2: f64, f0: f64| s2 * basis::sinusoid(data.m[i], f0 / fs);
-            let osc = |r2: f64, f: f64, tr: f64| {
+            let osc = |r2: f64, f: f64, tr: f64, skew: f64| {
                 let (u, theta) = basis::resonance_rates(f, tr, fs);
-                r2 * basis::resonance(data.m[i], u, theta)
+                r2 * basis::skewed_resonance(data.m[i], u, theta, skew)
             };
             let moving = |v: f64, tc: f64| v * basis::motion(t, data.m[i], basis::gm_rate(tc, fs));
             let model: f64 = (0..IEEE_TERMS).map(|j| b[j] * ieee[j]).sum::<f64>()
@@ -455,7 +496,7 @@ fn covariance(
                 + sine.iter().map(|&(s2, f0)| tone(s2, f0)).sum::<f64>()
                 + resonance
                     .iter()
-                    .map(|&(r2, f, tr)| osc(r2, f, tr))
+                    .map(|&(r2, f, tr, skew)| osc(r2, f, tr, skew))
                     .sum::<f64>()
                 + motion.iter().map(|&(v, tc)| moving(v, tc)).sum::<f64>();
             let grad = slots
@@ -471,12 +512,18 @@ fn covariance(
                             (moving(v, tc * h.exp()) - moving(v, tc * (-h).exp())) / (2.0 * h)
                         }
                     } else if s >= RESONANCE_SLOT {
-                        let (r2, f, tr) = resonance[0];
+                        let (r2, f, tr, skew) = resonance[0];
                         let (e, ie) = (h.exp(), (-h).exp());
                         match s - RESONANCE_SLOT {
-                            0 => osc(1.0, f, tr),
-                            1 => (osc(r2, f * e, tr) - osc(r2, f * ie, tr)) / (2.0 * h),
-                            _ => (osc(r2, f, tr * e) - osc(r2, f, tr * ie)) / (2.0 * h),
+                            0 => osc(1.0, f, tr, skew),
+                            1 => (osc(r2, f * e, tr, skew) - osc(r2, f * ie, tr, skew)) / (2.0 * h),
+                            2 => (osc(r2, f, tr * e, skew) - osc(r2, f, tr * ie, skew)) / (2.0 * h),
+                            // Linear in the skew: r²·κ times the quadrature form.
+                            _ => {
+                                let (u, theta) = basis::resonance_rates(f, tr, fs);
+                                let bound = basis::quadrature_bound(u, theta);
+                                r2 * bound * basis::resonance_parts(data.m[i], u, theta).1
+                            }
                         }
                     } else if s >= SINE_SLOT {
                         let (s2, f0) = sine[(s - SINE_SLOT) / 2];
@@ -499,31 +546,41 @@ fn covariance(
             (data.omega[i] / (data.v[i] + d2), grad)
         })
         .collect();
-    let k = slots.len();
-    let fisher: Vec<Vec<f64>> = (0..k)
-        .map(|a| {
-            (0..k)
-                .map(|b| rows.iter().map(|(w, g)| w * g[a] * g[b]).sum())
-                .collect()
-        })
+    let fisher = |keep: &[usize]| -> Vec<Vec<f64>> {
+        keep.iter()
+            .map(|&a| {
+                keep.iter()
+                    .map(|&b| rows.iter().map(|(w, g)| w * g[a] * g[b]).sum())
+                    .collect()
+            })
+            .collect()
+    };
+    // Near fs/2 a resonance's frequency and skew are nearly unidentified (its
+    // curve is even in f_r − fs/2, and the quadrature part vanishes there), and
+    // the information can be singular in them: they are then left out (NaN).
+    let all: Vec<usize> = (0..slots.len()).collect();
+    let without_oscillator: Vec<usize> = (0..slots.len())
+        .filter(|&a| slots[a] != SKEW_SLOT && slots[a] != RESONANCE_SLOT + 1)
         .collect();
     let mut cov = vec![vec![0.0; PARAMETERS]; PARAMETERS];
-    match nnls::invert_spd(&fisher) {
-        Some(inv) => {
-            for (a, &sa) in slots.iter().enumerate() {
-                for (b, &sb) in slots.iter().enumerate() {
-                    cov[sa][sb] = inv[a][b];
+    for &s in &slots {
+        cov[s][s] = f64::NAN;
+    }
+    for keep in [all, without_oscillator] {
+        if let Some(inv) = nnls::invert_spd(&fisher(&keep)) {
+            for (a, &ka) in keep.iter().enumerate() {
+                for (b, &kb) in keep.iter().enumerate() {
+                    cov[slots[ka]][slots[kb]] = inv[a][b];
                 }
             }
-        }
-        None => {
-            for &s in &slots {
-                cov[s][s] = f64::NAN;
-            }
+            break;
         }
     }
     if at_nyquist {
         cov[RESONANCE_SLOT + 1][RESONANCE_SLOT + 1] = f64::NAN;
+    }
+    if on_skew_bound {
+        cov[SKEW_SLOT][SKEW_SLOT] = f64::NAN;
     }
     cov
 }
@@ -679,7 +736,7 @@ mod tests {
         // rate random walk noise: the VN-100 gyro's pattern at 100 Hz.
         let ieee = [0.0, 1e-6, 0.0, 1e-10, 0.0];
         let tone = [(2e-5, 10.0)];
-        let res = [(4e-4, 30.0, 0.02)];
+        let res = [(4e-4, 30.0, 0.02, 0.0)];
         for per_decade in [10.0, 20.0] {
             let taus = grid(per_decade, 0.01, 1000.0);
             let var: Vec<f64> = terms(&taus, FS, &ieee, &[], (&tone, &res, &[]))
@@ -689,7 +746,7 @@ mod tests {
             let fit = fit_exact(&taus, &var);
             assert_eq!(fit.resonance.len(), 1, "{per_decade}: {fit:?}");
             assert_eq!(fit.sine.len(), 1, "{per_decade}: {fit:?}");
-            let (r2, f, tr) = fit.resonance[0];
+            let (r2, f, tr, _) = fit.resonance[0];
             assert!((r2 / res[0].0 - 1.0).abs() < 0.02, "{per_decade}: {fit:?}");
             assert!((f / res[0].1 - 1.0).abs() < 0.01, "{per_decade}: {f}");
             assert!((tr / res[0].2 - 1.0).abs() < 0.02, "{per_decade}: {tr}");
@@ -697,6 +754,37 @@ mod tests {
             for s in RESONANCE_SLOT..RESONANCE_SLOT + 3 {
                 assert!(fit.cov[s][s].is_finite() && fit.cov[s][s] > 0.0, "{s}");
             }
+        }
+    }
+
+    #[test]
+    fn a_second_order_filter_is_a_resonance_with_its_quadrature() {
+        // A band of Q ½ at 7 Hz with the quadrature of a low-pass filter, a third
+        // of the way to its bound, on white noise and rate random walk: the plain
+        // resonance (skew 0) cannot draw it, the skewed one is recovered.
+        let ieee = [0.0, 1e-6, 0.0, 1e-10, 0.0];
+        let (f_r, tau_r) = (7.0, 0.5 / (std::f64::consts::PI * 7.0));
+        let skew = 1.0 / 3.0;
+        let res = [(4e-4, f_r, tau_r, skew)];
+        for per_decade in [10.0, 20.0] {
+            let taus = grid(per_decade, 0.01, 1000.0);
+            let var: Vec<f64> = terms(&taus, FS, &ieee, &[], (&[], &res, &[]))
+                .iter()
+                .map(|r| r.iter().sum())
+                .collect();
+            let fit = fit_exact(&taus, &var);
+            assert_eq!(fit.resonance.len(), 1, "{per_decade}: {fit:?}");
+            let (r2, f, tr, b) = fit.resonance[0];
+            assert!((r2 / res[0].0 - 1.0).abs() < 0.02, "{per_decade}: {fit:?}");
+            assert!((f / f_r - 1.0).abs() < 0.02, "{per_decade}: {f}");
+            assert!((tr / tau_r - 1.0).abs() < 0.02, "{per_decade}: {tr}");
+            assert!((b / skew - 1.0).abs() < 0.05, "{per_decade}: {b} vs {skew}");
+            assert!(
+                fit.cov[SKEW_SLOT][SKEW_SLOT] > 0.0,
+                "{:?}",
+                fit.cov[SKEW_SLOT]
+            );
+            assert!((fit.ieee[1] / ieee[1] - 1.0).abs() < 0.02, "{:?}", fit.ieee);
         }
     }
 

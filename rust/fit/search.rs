@@ -102,8 +102,75 @@ const RES_TOL: f64 = 1e-3;
 /// Most loss evaluations of the refinement of a resonance.
 const RES_EVALS: usize = 120;
 
-/// A resonance's frequency f_r (Hz) and damping time τr (s).
-pub type Resonance = (f64, f64);
+/// Lowest quality factor of a resonance with a quadrature part: a
+/// Butterworth second-order low-pass has Q = πf_rτr = ½ (poles at 135°), and a
+/// sensor's filter that is one is what the quadrature part is for. A skewed
+/// resonance refined onto this bound is dropped.
+const SKEWED_Q_MIN: f64 = 0.4;
+
+/// Quality factors of the grid of a resonance with a quadrature part: the
+/// plain grid's and a Butterworth filter's.
+const SKEWED_Q: [f64; 5] = [0.5, 1.0, 2.0, 4.0, 8.0];
+
+/// A resonance: its frequency f_r (Hz), its damping time τr (s) and whether it
+/// has a quadrature part (`basis::skewed_resonance`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Resonance {
+    pub freq: f64,
+    pub tau: f64,
+    /// With a quadrature part: two columns, the edges skew = ±1 of its cone, so
+    /// that NNLS keeps the spectrum non-negative (a coefficient on each: r² their
+    /// sum, the skew their difference over it). Without: one column, skew 0.
+    pub skewed: bool,
+}
+
+impl Resonance {
+    /// Columns of the design the resonance takes.
+    pub fn columns(self) -> usize {
+        1 + usize::from(self.skewed)
+    }
+
+    /// Quality factor Q = πf_rτr.
+    pub fn quality(self) -> f64 {
+        std::f64::consts::PI * self.freq * self.tau
+    }
+
+    /// (u, θ) at rate `fs` (`basis::resonance_rates`).
+    pub fn rates(self, fs: f64) -> (f64, f64) {
+        basis::resonance_rates(self.freq, self.tau, fs)
+    }
+
+    /// Whether the quadrature part vanishes (θ = π: the resonance at fs/2).
+    fn at_nyquist(self, fs: f64) -> bool {
+        let (u, theta) = self.rates(fs);
+        !basis::quadrature_bound(u, theta).is_finite()
+    }
+
+    /// Allan variance of column `which` (< [`Self::columns`]) at cluster size
+    /// `m`: the plain form, or the cone's edge skew = +1 (0) or −1 (1). At fs/2
+    /// the quadrature part vanishes and the second edge is a zero column.
+    pub fn column(self, m: f64, fs: f64, which: usize) -> f64 {
+        let (u, theta) = self.rates(fs);
+        match (self.skewed, which) {
+            (false, _) => basis::resonance(m, u, theta),
+            (true, 0) => basis::skewed_resonance(m, u, theta, 1.0),
+            (true, _) if self.at_nyquist(fs) => 0.0,
+            (true, _) => basis::skewed_resonance(m, u, theta, -1.0),
+        }
+    }
+
+    /// Variance r² and skew from the coefficients of its columns.
+    pub fn variance_and_skew(self, coef: &[f64], fs: f64) -> (f64, f64) {
+        if !self.skewed {
+            return (coef[0], 0.0);
+        }
+        let r2 = coef[0] + coef[1];
+        if r2 <= 0.0 || self.at_nyquist(fs) {
+            return (r2, 0.0);
+        }
+        (r2, (coef[0] - coef[1]) / r2)
+    }
+}
 
 /// Fewest periods of a tone in the longest tau: slower ones would explain the
 /// scatter of the last few, least independent estimates (their bump at
@@ -195,18 +262,18 @@ pub type Extras = (Tones, Option<Resonance>, Option<f64>);
 
 /// Columns of a structure beyond the IEEE terms and its Gauss–Markov times.
 fn extra_columns((sine, resonance, motion): Extras) -> usize {
-    sine.len() + usize::from(resonance.is_some()) + usize::from(motion.is_some())
+    sine.len() + resonance.map_or(0, Resonance::columns) + usize::from(motion.is_some())
 }
 
 /// The basis of a structure: IEEE columns, one column per GM time, then one per
-/// tone, then the resonance if any, then the bounded motion if any.
+/// tone, then the resonance's if any, then the bounded motion if any.
 pub fn design(data: &Data, fs: f64, gm_tau: &[f64], extras: Extras) -> Mat<f64> {
     let (sine, resonance, motion) = extras;
     let g = gm_tau.len();
     let tone = IEEE_TERMS + g;
     let osc = tone + sine.len();
+    let after = osc + resonance.map_or(0, Resonance::columns);
     let k = tone + extra_columns(extras);
-    let rates = resonance.map(|(f, t)| basis::resonance_rates(f, t, fs));
     Mat::from_fn(data.len(), k, |i, j| {
         if j < IEEE_TERMS {
             basis::ieee(data.taus[i])[j]
@@ -214,8 +281,8 @@ pub fn design(data: &Data, fs: f64, gm_tau: &[f64], extras: Extras) -> Mat<f64> 
             basis::gauss_markov(data.m[i], basis::gm_rate(gm_tau[j - IEEE_TERMS], fs))
         } else if j < osc {
             basis::sinusoid(data.m[i], sine.as_slice()[j - tone] / fs)
-        } else if let (Some((u, theta)), true) = (rates, j == osc) {
-            basis::resonance(data.m[i], u, theta)
+        } else if let (Some(r), true) = (resonance, j < after) {
+            r.column(data.m[i], fs, j - osc)
         } else {
             let u = basis::gm_rate(motion.unwrap_or(1.0), fs);
             basis::motion(data.taus[i], data.m[i], u)
@@ -514,15 +581,19 @@ impl Searcher<'_> {
         golden(fine * (-step).exp(), hi, fine, FREQ_TOL, loss)
     }
 
-    /// Best resonance on the grid of frequencies × [`RES_Q`] with these times,
-    /// and its loss (None when the curve is too short for one).
-    fn coarse_resonance(&self, times: &[f64]) -> Option<(Resonance, f64)> {
+    /// Best resonance (with a quadrature part when `skewed`) on the grid of
+    /// frequencies × [`RES_Q`] (× [`SKEWED_Q`]) with these times, and its loss
+    /// (None when the curve is too short for one).
+    fn coarse_resonance(&self, times: &[f64], skewed: bool) -> Option<(Resonance, f64)> {
+        let qualities: &[f64] = if skewed { &SKEWED_Q } else { &RES_Q };
         resonance_grid(self.data, self.fs)
             .into_iter()
-            .flat_map(|f| {
-                RES_Q
-                    .iter()
-                    .map(move |q| (f, q / (std::f64::consts::PI * f)))
+            .flat_map(|freq| {
+                qualities.iter().map(move |q| Resonance {
+                    freq,
+                    tau: q / (std::f64::consts::PI * freq),
+                    skewed,
+                })
             })
             .map(|r| (r, self.loss_full(times, self.sine, Some(r))))
             .min_by(|a, b| a.1.total_cmp(&b.1))
@@ -531,30 +602,36 @@ impl Searcher<'_> {
     /// Refinement of (ln f_r, ln τr) by Nelder–Mead from the grid point (the
     /// two are correlated with each other and with the Q and N terms, which
     /// coordinate searches follow slowly), f_r kept ≤ fs/2 and
-    /// Q = πf_rτr in [[`RES_Q_MIN`], [`RES_Q_MAX`]].
-    fn refine_resonance(&self, times: &[f64], (f, tau): Resonance) -> Resonance {
+    /// Q = πf_rτr in [[`RES_Q_MIN`] (or [`SKEWED_Q_MIN`]), [`RES_Q_MAX`]].
+    fn refine_resonance(&self, times: &[f64], start: Resonance) -> Resonance {
         let pi = std::f64::consts::PI;
         let top = (0.5 * self.fs).ln();
+        let q_min = if start.skewed {
+            SKEWED_Q_MIN
+        } else {
+            RES_Q_MIN
+        };
         let clamp = |p: [f64; 2]| -> [f64; 2] {
             let lf = p[0].min(top);
-            let q_lo = (RES_Q_MIN / pi).ln() - lf;
+            let q_lo = (q_min / pi).ln() - lf;
             let q_hi = (RES_Q_MAX / pi).ln() - lf;
             [lf, p[1].clamp(q_lo, q_hi)]
         };
-        let loss = |p: [f64; 2]| {
-            let p = clamp(p);
-            self.loss_full(times, self.sine, Some((p[0].exp(), p[1].exp())))
+        let at = |p: [f64; 2]| Resonance {
+            freq: p[0].exp(),
+            tau: p[1].exp(),
+            ..start
         };
+        let loss = |p: [f64; 2]| self.loss_full(times, self.sine, Some(at(clamp(p))));
         let step = std::f64::consts::LN_10 / RES_PER_DECADE;
-        let start = [f.ln(), tau.ln()];
+        let start = [start.freq.ln(), start.tau.ln()];
         let starts = [
             start,
             [start[0] - step, start[1]],
             [start[0], start[1] + 0.3],
         ];
         let best = nelder_mead(starts, RES_TOL, RES_EVALS, loss);
-        let p = clamp(best);
-        (p[0].exp(), p[1].exp())
+        at(clamp(best))
     }
 
     /// Best `count` correlation times (ascending); for three, `seed` is the best
@@ -629,16 +706,19 @@ pub struct Candidate {
     pub bic: f64,
 }
 
-/// Number of free parameters of a solution: non-zero variances, a time (or
-/// frequency) for every Gauss–Markov term, tone or bounded motion in use, and one
-/// more (frequency and damping) for a resonance in use, whose variance is the
-/// last of `theta` when `resonance` (the one before last when `motion` too).
-pub fn parameters(theta: &[f64], resonance: bool, motion: bool) -> usize {
+/// Number of free parameters of a solution: non-zero coefficients (a skewed
+/// resonance's two are its variance and quadrature), a time (or frequency) for
+/// every Gauss–Markov term, tone or bounded motion in use, and two (frequency
+/// and damping) for a resonance in use, whose columns come before the bounded
+/// motion's, last of `theta`.
+pub fn parameters(theta: &[f64], resonance: Option<Resonance>, motion: bool) -> usize {
     let used = theta.iter().filter(|t| **t > 0.0).count();
-    let times = theta[IEEE_TERMS..].iter().filter(|t| **t > 0.0).count();
-    let res_column = theta.len().wrapping_sub(1 + usize::from(motion));
-    let damping = usize::from(resonance && theta.get(res_column).is_some_and(|t| *t > 0.0));
-    used + times + damping
+    let res_columns = resonance.map_or(0, Resonance::columns);
+    let res_start = theta.len() - res_columns - usize::from(motion);
+    let in_use = |range: std::ops::Range<usize>| theta[range].iter().filter(|t| **t > 0.0).count();
+    let times = in_use(IEEE_TERMS..res_start) + in_use(res_start + res_columns..theta.len());
+    let oscillator = in_use(res_start..res_start + res_columns).min(1);
+    used + times + 2 * oscillator
 }
 
 /// BIC by which each component beyond the IEEE terms (a Gauss–Markov term, a
@@ -693,7 +773,7 @@ pub fn candidate(
         d2,
         None,
     )?;
-    let p = parameters(&solution.theta, resonance.is_some(), motion.is_some());
+    let p = parameters(&solution.theta, resonance, motion.is_some());
     let bic = solution.loss + p as f64 * data.n_eff().max(2.0).ln();
     Ok(Candidate {
         gm_tau,
@@ -843,17 +923,18 @@ pub fn with_sine(
     Ok((!on_bound(&better)).then_some(better))
 }
 
-/// Add a resonance to the Gauss–Markov times `gm_tau` and tone `sine`: grid,
-/// refinement, the times and the tone's frequency polished with it in place;
-/// refined again at the discrepancy the fit settles on when that moved by more
-/// than a factor of two. None when the curve is too short for one or, when
-/// `gated`, the grid's best gains less than a quarter of the BIC penalty of its
-/// three parameters (the tone's gate) or it is refined onto a bound of its Q.
+/// Add a resonance (with a quadrature part when `skewed`) to the Gauss–Markov
+/// times `gm_tau` and tones `sine`: grid, refinement, the times and the tones'
+/// frequencies polished with it in place; refined again at the discrepancy the
+/// fit settles on when that moved by more than a factor of two. None when the
+/// curve is too short for one or, when `gated`, the grid's best gains less than
+/// a quarter of the BIC penalty of its three parameters (the tone's gate) or it
+/// is refined onto a bound of its Q.
 pub fn with_resonance(
     data: &Data,
     fs: f64,
     ieee: [bool; IEEE_TERMS],
-    (gm_tau, sine): (&[f64], Tones),
+    (gm_tau, sine, skewed): (&[f64], Tones, bool),
     d2: f64,
     gated: bool,
 ) -> CoreResult<Option<Candidate>> {
@@ -867,7 +948,7 @@ pub fn with_resonance(
         resonance: None,
         motion: None,
     };
-    let Some((res, loss)) = searcher.coarse_resonance(gm_tau) else {
+    let Some((res, loss)) = searcher.coarse_resonance(gm_tau, skewed) else {
         return Ok(None);
     };
     if gated && loss > searcher.loss(gm_tau) - 0.75 * data.n_eff().max(2.0).ln() {
@@ -890,10 +971,11 @@ pub fn with_resonance(
         let sine = s.refine_tones(&times, sine);
         candidate(data, fs, ieee, times, (sine, Some(res), None), d2)
     };
+    let q_min = if skewed { SKEWED_Q_MIN } else { RES_Q_MIN };
     let on_bound = |c: &Candidate| {
-        c.resonance.is_some_and(|(f, t)| {
-            let q = std::f64::consts::PI * f * t;
-            q >= 0.99 * RES_Q_MAX || q <= 1.01 * RES_Q_MIN
+        c.resonance.is_some_and(|r| {
+            let q = r.quality();
+            q >= 0.99 * RES_Q_MAX || q <= 1.01 * q_min
         })
     };
     let first = polish(d2, gm_tau.to_vec(), sine, res)?;
@@ -1135,15 +1217,18 @@ fn add_resonance(
         bases.push(t.clone());
     }
     for base in &bases {
-        let Some(res) = with_resonance(data, fs, ieee, (&base.gm_tau, base.sine), d2, true)? else {
-            continue;
-        };
-        keep_lower(data, fs, ieee, res.clone(), &mut best)?;
-        if base.sine.is_empty() {
-            // Tones on top, the resonance searched again after each (see `add_tones`).
-            let on_top = (res.gm_tau.clone(), Tones::NONE, res.resonance);
-            let budget = (res.solution.d2, max_tones);
-            add_tones(data, fs, ieee, on_top, budget, &mut best)?;
+        for skewed in [false, true] {
+            let shape = (base.gm_tau.as_slice(), base.sine, skewed);
+            let Some(res) = with_resonance(data, fs, ieee, shape, d2, true)? else {
+                continue;
+            };
+            keep_lower(data, fs, ieee, res.clone(), &mut best)?;
+            if base.sine.is_empty() {
+                // Tones on top, the resonance searched again after each (see `add_tones`).
+                let on_top = (res.gm_tau.clone(), Tones::NONE, res.resonance);
+                let budget = (res.solution.d2, max_tones);
+                add_tones(data, fs, ieee, on_top, budget, &mut best)?;
+            }
         }
     }
     Ok(best)
@@ -1203,7 +1288,10 @@ fn add_tones(
         // The next tone is searched at the discrepancy this structure settled on.
         current = (toned.gm_tau.clone(), toned.sine, toned.solution.d2);
         let moved = match resonance {
-            Some(_) => with_resonance(data, fs, ieee, (&current.0, current.1), current.2, true)?,
+            Some(r) => {
+                let shape = (current.0.as_slice(), current.1, r.skewed);
+                with_resonance(data, fs, ieee, shape, current.2, true)?
+            }
             None => None,
         };
         let reduced = keep_lower(data, fs, ieee, toned, best)?;

@@ -34,7 +34,8 @@ def _curve(taus, *, tone=(), resonance=()):
     """Allan variance of one tone (s², f0) or resonance (σ², f_r, τr) alone, from the
     Rust closed forms."""
     t = np.ascontiguousarray(taus, dtype=float)
-    return core_fit.noise_terms(t, FS, NO_IEEE, [], list(tone), list(resonance))[:, -1]
+    oscillators = [tuple(r) if len(r) == 4 else (*r, 0.0) for r in resonance]
+    return core_fit.noise_terms(t, FS, NO_IEEE, [], list(tone), oscillators)[:, -1]
 
 
 @pytest.fixture(scope="module")
@@ -84,7 +85,7 @@ def test_resonance_is_selected_and_recovered(resonant):
     model = quiet_fit(resonant)
     for c in range(2):
         assert len(model.components.resonance(c)) == 1, model
-        sigma, f_r, tau_r = model.components.resonance(c)[0]
+        sigma, f_r, tau_r, _ = model.components.resonance(c)[0]
         stds = [float(np.atleast_1d(a)[c]) for a in (
             model.components.resonance_sigma_std, model.components.resonance_freq_std,
             model.components.resonance_tau_std)]
@@ -152,7 +153,7 @@ def test_the_ekf_export_folds_the_resonance_into_the_white_noise(resonant):
     model = quiet_fit(resonant)
     axes = export.ekf_dict(gyro=model)["gyroscope"]["axes"]
     for c, name in enumerate(["ch0", "ch1"]):
-        sigma, f_r, tau_r = model.components.resonance(c)[0]
+        sigma, f_r, tau_r, _ = model.components.resonance(c)[0]
         want = math.sqrt(float(model.components.N[c]) ** 2
                          + resonance_white_density(sigma, f_r, tau_r, FS))
         assert axes[name]["white_noise_density"] == pytest.approx(want, rel=1e-12)
@@ -184,7 +185,7 @@ def test_bootstrap_simulates_and_refits_the_resonance():
                           resonance=(t["sigma"], t["f_r"], t["tau_r"]))
     model = quiet_fit(imunoise.adev(x, FS, taus=10), uncertainty="bootstrap", replicates=6, seed=2)
     assert len(model.components.resonance(0)) == 1
-    sigma, f_r, tau_r = model.components.resonance(0)[0]
+    sigma, f_r, tau_r, _ = model.components.resonance(0)[0]
     parts = model.components
     stds = [float(a) for a in (parts.resonance_sigma_std, parts.resonance_freq_std,
                                parts.resonance_tau_std)]
@@ -205,7 +206,7 @@ def test_a_line_beside_a_band_near_nyquist_is_found(seed):
     r = imunoise.adev(x, fs, taus=20)
     model = quiet_fit(r)
     (amplitude, f0), = model.components.sine()
-    (_, f_r, _), = model.components.resonance()
+    (_, f_r, _, _), = model.components.resonance()
     assert f0 == pytest.approx(13.44, rel=2e-3) and amplitude == pytest.approx(1.5e-3, rel=0.2)
     assert f_r == pytest.approx(17.47, rel=0.02)
     assert float(model.coverage) >= 0.85

@@ -13,12 +13,14 @@ MAX_TONES: int
 """Most tones a model may have."""
 PARAMETERS: int
 """Slots of the covariance: Q²…R², then (q², ln τc) per Gauss–Markov term, then
-(s², ln f₀) per tone slot, then (r², ln f_r, ln τr) of the resonance, then
+(s², ln f₀) per tone slot, then (r², ln f_r, ln τr, skew) of the resonance, then
 (σθ², ln τc) of the bounded motion."""
 SINE_SLOT: int
 """Slot of the first tone's variance s² (its ln f₀ follows, then the next tone's)."""
 RESONANCE_SLOT: int
-"""Slot of the resonance's variance r² (its ln f_r, ln τr follow)."""
+"""Slot of the resonance's variance r² (its ln f_r, ln τr, skew follow)."""
+SKEW_SLOT: int
+"""Slot of the resonance's skew in [−1, 1], its quadrature part."""
 MOTION_SLOT: int
 """Slot of the bounded motion's variance σθ² (its ln τc follows)."""
 FLICKER_FACTOR: float
@@ -39,15 +41,15 @@ class NoiseFit:
         """(k, 2) rows of (s², f₀), k ≤ MAX_TONES: the tones."""
     @property
     def resonance(self) -> npt.NDArray[np.float64]:
-        """(k, 3) rows of (r², f_r, τr), k ≤ 1: the resonance."""
+        """(k, 4) rows of (r², f_r, τr, skew), k ≤ 1: the resonance."""
     @property
     def motion(self) -> npt.NDArray[np.float64]:
         """(k, 2) rows of (σθ², τc), k ≤ 1: the bounded motion."""
     @property
     def cov(self) -> npt.NDArray[np.float64]:
         """(PARAMETERS, PARAMETERS) covariance of (Q²…R², then q², ln τc per slot,
-        then s², ln f₀ per tone slot, then r², ln f_r, ln τr, then σθ², ln τc; NaN variance of
-        ln f_r at fs/2)."""
+        then s², ln f₀ per tone slot, then r², ln f_r, ln τr, skew, then σθ², ln τc; NaN
+        variance of ln f_r at fs/2 and of the skew at ±1)."""
     @property
     def discrepancy(self) -> float:
         """δ, the relative model discrepancy."""
@@ -87,9 +89,9 @@ def noise_terms(
     ieee: list[float],
     gm: list[tuple[float, float]],
     sine: list[tuple[float, float]] = ...,
-    resonance: list[tuple[float, float, float]] = ...,
+    resonance: list[tuple[float, float, float, float]] = ...,
     motion: list[tuple[float, float]] = ...,
 ) -> npt.NDArray[np.float64]:
     """Allan variance of each model term at ``taus``: (len(taus), 5 + len(gm) +
     len(sine) + len(resonance) + len(motion)), ``sine`` as (s², f₀) pairs,
-    ``resonance`` as (r², f_r, τr) triples, ``motion`` as (σθ², τc) pairs."""
+    ``resonance`` as (r², f_r, τr, skew) quadruples, ``motion`` as (σθ², τc) pairs."""

@@ -130,14 +130,19 @@ class Components(PerTerm):
         (2,) or (channels, 2), by increasing frequency; NaN in unused slots.
     sine_amplitude_std, sine_freq_std : ndarray
         Their standard uncertainties.
-    resonance_sigma, resonance_freq, resonance_tau : ndarray
+    resonance_sigma, resonance_freq, resonance_tau, resonance_skew : ndarray
         A damped oscillator (second-order Gauss–Markov process, autocovariance
-        σ²·ρ^|h|·cos(2πf_r h/fs), ρ = exp(−1/(fs·τr))): standard deviation
-        (rate), centre frequency f_r (Hz) and damping time τr (s; quality factor
-        π·f_r·τr); NaN where a channel has none.
-    resonance_sigma_std, resonance_freq_std, resonance_tau_std : ndarray
+        σ²·ρ^|h|·(cos θh + s·κ·sin θ|h|), θ = 2πf_r/fs, ρ = exp(−1/(fs·τr)),
+        κ = sinh(1/(fs·τr))/sin θ): standard deviation (rate), frequency f_r (Hz),
+        damping time τr (s; quality factor π·f_r·τr) and skew s in [−1, 1], its
+        quadrature part; NaN where a channel has none. s = 0 is the plain
+        resonance; a sensor's own second-order low-pass filter has s > 0 (a
+        digital Butterworth filter s = 1, Q = ½); at s = ±1 the spectrum touches
+        zero at fs/2 (+1, a low-pass filter's zero) or at 0 Hz (−1, the rate of a
+        bounded oscillation).
+    resonance_sigma_std, resonance_freq_std, resonance_tau_std, resonance_skew_std : ndarray
         Their standard uncertainties (the frequency's is NaN when it sits on the
-        fs/2 bound of the search).
+        fs/2 bound of the search, the skew's when it is ±1).
     motion_sigma, motion_tau : ndarray
         A bounded motion of the mount: its angle (velocity, for an accelerometer)
         wanders as a Gauss–Markov process of standard deviation σθ (rate·s) and
@@ -152,8 +157,8 @@ class Components(PerTerm):
     cov : ndarray
         ``"wls"``: covariance of (Q², N², B², K², R², then σ², ln τc of each
         Gauss–Markov slot, then A²/2, ln f0 of each tone slot, then σ², ln f_r,
-        ln τr of the resonance, then σθ², ln τc of the motion), shape (20, 20) or
-        (channels, 20, 20); NaN for ``"slopes"``.
+        ln τr, skew of the resonance, then σθ², ln τc of the motion), shape (21, 21) or
+        (channels, 21, 21); NaN for ``"slopes"``.
     fs : float
         Sample rate of the data (Hz): the terms' sampled forms depend on it.
     """
@@ -170,9 +175,11 @@ class Components(PerTerm):
     resonance_sigma: np.ndarray
     resonance_freq: np.ndarray
     resonance_tau: np.ndarray
+    resonance_skew: np.ndarray
     resonance_sigma_std: np.ndarray
     resonance_freq_std: np.ndarray
     resonance_tau_std: np.ndarray
+    resonance_skew_std: np.ndarray
     motion_sigma: np.ndarray
     motion_tau: np.ndarray
     motion_sigma_std: np.ndarray
@@ -192,11 +199,12 @@ class Components(PerTerm):
         f0 = np.reshape(self.sine_freq, (-1, TONES_MAX))[channel]
         return [(float(a), float(f)) for a, f in zip(amp, f0, strict=True) if np.isfinite(a)]
 
-    def resonance(self, channel: int = 0) -> list[tuple[float, float, float]]:
-        """The (sigma, f_r, tau_r) of the resonance of ``channel``: one triple, or none."""
-        sigma, f_r, tau_r = (float(np.atleast_1d(a)[channel]) for a in
-                             (self.resonance_sigma, self.resonance_freq, self.resonance_tau))
-        return [(sigma, f_r, tau_r)] if np.isfinite(sigma) else []
+    def resonance(self, channel: int = 0) -> list[tuple[float, float, float, float]]:
+        """The (sigma, f_r, tau_r, skew) of the resonance of ``channel``: one, or none."""
+        sigma, f_r, tau_r, skew = (float(np.atleast_1d(a)[channel]) for a in
+                                   (self.resonance_sigma, self.resonance_freq,
+                                    self.resonance_tau, self.resonance_skew))
+        return [(sigma, f_r, tau_r, skew)] if np.isfinite(sigma) else []
 
     def motion(self, channel: int = 0) -> list[tuple[float, float]]:
         """The (sigma, tau_c) of the bounded motion of ``channel``: one pair, or none."""
@@ -217,7 +225,8 @@ class Components(PerTerm):
         parts = [t for t in TERMS if bool(np.atleast_1d(self.supported[t])[channel])]
         parts += [f"GM({_summary.number(tc)} s)" for _, tc in self.gauss_markov(channel)]
         parts += [f"tone {_summary.number(f0)} Hz" for _, f0 in self.sine(channel)]
-        parts += [f"resonance {_summary.number(f)} Hz" for _, f, _ in self.resonance(channel)]
+        parts += [f"resonance {_summary.number(f)} Hz" + (f" (skew {skew:.2g})" if skew else "")
+                  for _, f, _, skew in self.resonance(channel)]
         parts += [f"motion({_summary.number(tc)} s)" for _, tc in self.motion(channel)]
         return " + ".join(parts) or "none"
 
@@ -282,6 +291,9 @@ class Components(PerTerm):
                         one(self.resonance_freq_std)))
             out.append(("τr", "resonance damping time", "s", one(self.resonance_tau),
                         one(self.resonance_tau_std)))
+            skew = one(self.resonance_skew)
+            if np.any(np.isfinite(skew) & (skew != 0)):
+                out.append(("s_r", "resonance skew", "", skew, one(self.resonance_skew_std)))
         if np.isfinite(one(self.motion_sigma)).any():
             out.append(("σθ", "bounded motion (angle)", "Q", one(self.motion_sigma),
                         one(self.motion_sigma_std)))
@@ -305,8 +317,8 @@ class Components(PerTerm):
                              for c in channels]
         d["sine"] = [[{"amplitude": a, "frequency": f0} for a, f0 in self.sine(c)]
                      for c in channels]
-        d["resonance"] = [[{"sigma": sg, "frequency": f, "tau_r": tr}
-                           for sg, f, tr in self.resonance(c)] for c in channels]
+        d["resonance"] = [[{"sigma": sg, "frequency": f, "tau_r": tr, "skew": skew}
+                           for sg, f, tr, skew in self.resonance(c)] for c in channels]
         d["motion"] = [[{"sigma": sg, "tau_c": tc} for sg, tc in self.motion(c)]
                        for c in channels]
         return d

@@ -5,7 +5,8 @@ A datasheet quotes what the curve shows, not which components made it:
 
 - ``N``, the white-noise density: the fitted N together with every Gauss–Markov
   term faster than 1 s (white at the τ = 1 s read-off: σ²(1+φ)/((1−φ)·fs)) and a
-  resonance damped faster than 1 s (its spectrum at zero frequency). What a
+  resonance damped faster than 1 s (its spectrum at zero frequency, quadrature
+  included: a sensor's second-order filter passes its input's white noise). What a
   filter's white-noise input should be.
 - ``K``, the rate random walk: the fitted K together with every slower
   Gauss–Markov term's short-τ random-walk rate √(2σ²/τc) (its +½ slope).
@@ -38,6 +39,7 @@ from imunoise.noise._terms import (
     PARAMS,
     RES_SLOT,
     SINE_SLOT,
+    SKEW_SLOT,
     TERMS,
     gm_white_density,
     is_log_time,
@@ -75,28 +77,35 @@ def _propagated(components, taus, term: str) -> tuple[np.ndarray, np.ndarray]:
         active = np.flatnonzero(np.diag(cov[c]) > 0)
         grad = np.zeros(PARAMS)
         for j in active:
-            h = 1e-4 if is_log_time(j) else 1e-4 * p[j]
             up, down = p.copy(), p.copy()
-            up[j] += h
-            down[j] = max(down[j] - h, 0.0) if not is_log_time(j) else down[j] - h
+            if j == SKEW_SLOT:  # either sign, within [−1, 1]
+                h = 1e-4
+                up[j], down[j] = min(p[j] + h, 1.0), max(p[j] - h, -1.0)
+            else:
+                h = 1e-4 if is_log_time(j) else 1e-4 * p[j]
+                up[j] += h
+                down[j] = max(down[j] - h, 0.0) if not is_log_time(j) else down[j] - h
             grad[j] = (value_of(term, up, taus, fs) - value_of(term, down, taus, fs)) / (
                 up[j] - down[j])
-        stds[c] = math.sqrt(max(float(grad @ cov[c] @ grad), 0.0))
+        # Over the free parameters only: one not free (a frequency at fs/2, a skew at
+        # ±1) has a NaN variance and no covariance.
+        g = grad[active]
+        stds[c] = math.sqrt(max(float(g @ cov[c][np.ix_(active, active)] @ g), 0.0))
     return values, stds
 
 
 def parameters(components, channel: int) -> np.ndarray:
     """(Q², N², B², K², R², then σ², ln τc per Gauss–Markov slot, then A²/2,
-    ln f0 per tone slot, then σ², ln f_r, ln τr of the resonance, then σθ², ln τc of
-    the bounded motion) of a channel."""
+    ln f0 per tone slot, then σ², ln f_r, ln τr, skew of the resonance, then σθ², ln τc
+    of the bounded motion) of a channel."""
     p = np.zeros(PARAMS)
     p[:5] = [float(components.value(t)[channel]) ** 2 for t in TERMS]
     for k, (sigma, tau_c) in enumerate(components.gauss_markov(channel)):
         p[5 + 2 * k], p[6 + 2 * k] = sigma**2, math.log(tau_c)
     for k, (amplitude, f0) in enumerate(components.sine(channel)):
         p[SINE_SLOT + 2 * k], p[SINE_SLOT + 2 * k + 1] = amplitude**2 / 2, math.log(f0)
-    for sigma, f_r, tau_r in components.resonance(channel):
-        p[RES_SLOT], p[RES_SLOT + 1], p[RES_SLOT + 2] = sigma**2, math.log(f_r), math.log(tau_r)
+    for sigma, f_r, tau_r, skew in components.resonance(channel):
+        p[RES_SLOT:SKEW_SLOT + 1] = sigma**2, math.log(f_r), math.log(tau_r), skew
     for sigma, tau_c in components.motion(channel):
         p[MOTION_SLOT], p[MOTION_SLOT + 1] = sigma**2, math.log(tau_c)
     return p
@@ -117,9 +126,8 @@ def model_floor(p: np.ndarray, taus: np.ndarray, fs: float) -> tuple[float, floa
     the resonance are neither white nor a walk, so N and K leave them out.
     """
     gm = _gauss_markov(p)
-    tone = [(p[SINE_SLOT], math.exp(p[SINE_SLOT + 1]))] if p[SINE_SLOT] > 0 else []
-    osc = ([(p[RES_SLOT], math.exp(p[RES_SLOT + 1]), math.exp(p[RES_SLOT + 2]))]
-           if p[RES_SLOT] > 0 else [])
+    tone = [(p[s], math.exp(p[s + 1])) for s in range(SINE_SLOT, RES_SLOT, 2) if p[s] > 0]
+    osc = [_resonance(p)] if p[RES_SLOT] > 0 else []
     moving = [(p[MOTION_SLOT], math.exp(p[MOTION_SLOT + 1]))] if p[MOTION_SLOT] > 0 else []
     grid = np.geomspace(taus[0], taus[-1], _B_GRID)
     dev = np.sqrt(_core_fit.noise_terms(grid, fs, list(p[:5]), gm, tone, osc, moving)
@@ -130,7 +138,8 @@ def model_floor(p: np.ndarray, taus: np.ndarray, fs: float) -> tuple[float, floa
         # the curve without its oscillators: a tone's comb has a zero at every period
         smooth = np.sqrt(_core_fit.noise_terms(grid, fs, list(p[:5]), gm, [], [], moving)
                          .sum(axis=1))
-        slope = np.gradient(np.log(smooth), np.log(grid))
+        with np.errstate(divide="ignore", invalid="ignore"):  # 0 without other terms: no floor
+            slope = np.gradient(np.log(smooth), np.log(grid))
         # only where the curve has fallen into it: a head that rises or stays flat
         # and then falls is a filter's or a fast Gauss–Markov term's hump, no bias
         # floor (a sensor low-pass filtered at 100 Hz read B 40× the truth there)
@@ -145,6 +154,11 @@ def model_floor(p: np.ndarray, taus: np.ndarray, fs: float) -> tuple[float, floa
     return float(grid[i]), float(dev[i])
 
 
+def _resonance(p: np.ndarray) -> tuple[float, float, float, float]:
+    """(σ², f_r, τr, skew) of the resonance of ``p``."""
+    return p[RES_SLOT], math.exp(p[RES_SLOT + 1]), math.exp(p[RES_SLOT + 2]), p[SKEW_SLOT]
+
+
 def _gauss_markov(p: np.ndarray) -> list[tuple[float, float]]:
     """(σ², τc) of each Gauss–Markov slot of ``p`` in use."""
     return [(p[5 + 2 * k], math.exp(p[6 + 2 * k])) for k in range(GM_MAX) if p[5 + 2 * k] > 0]
@@ -157,8 +171,8 @@ def value_of(term: str, p: np.ndarray, taus: np.ndarray, fs: float) -> float:
         return 0.0 if floor is None else floor[1] / FLICKER
     total = p[1] if term == "N" else p[3]
     if term == "N" and p[RES_SLOT] > 0 and p[RES_SLOT + 2] <= 0.0:  # τr ≤ 1 s
-        total += resonance_white_density(1.0, math.exp(p[RES_SLOT + 1]),
-                                         math.exp(p[RES_SLOT + 2]), fs) * p[RES_SLOT]
+        r2, f_r, tau_r, skew = _resonance(p)
+        total += resonance_white_density(1.0, f_r, tau_r, fs, skew) * r2
     for q2, tau_c in _gauss_markov(p):
         if term == "N" and tau_c <= 1.0:
             total += q2 * gm_white_density(1.0, tau_c, fs)

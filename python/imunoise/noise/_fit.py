@@ -26,6 +26,7 @@ from imunoise.noise._terms import (
     PARAMS,
     RES_SLOT,
     SINE_SLOT,
+    SKEW_SLOT,
     TERMS,
     TONES_MAX,
     term_variances,
@@ -158,7 +159,8 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
         structure with the lowest BIC (the fewest terms that describe the
         curve). A sequence fits exactly those terms (``"GM"`` up to three times
         for Gauss–Markov terms, ``"sine"`` up to twice for tones, ``"resonance"`` once for
-        a damped oscillator, ``"motion"`` once for a bounded motion); a term the
+        a damped oscillator — with a skew, a second-order filter's quadrature part,
+        where that lowers the BIC —, ``"motion"`` once for a bounded motion); a term the
         data push below zero is still 0.
     tau_range : (float, float), optional
         Only use taus in [min, max] seconds.
@@ -232,8 +234,8 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
     gm_std = np.full((channels, GM_MAX, 2), np.nan)
     sine = np.full((channels, TONES_MAX, 2), np.nan)  # amplitude, f0 per tone slot
     sine_std = np.full((channels, TONES_MAX, 2), np.nan)
-    osc = np.full((channels, 3), np.nan)  # sigma, f_r, tau_r
-    osc_std = np.full((channels, 3), np.nan)
+    osc = np.full((channels, 4), np.nan)  # sigma, f_r, tau_r, skew
+    osc_std = np.full((channels, 4), np.nan)
     moving = np.full((channels, 2), np.nan)  # sigma of the angle, tau_c
     moving_std = np.full((channels, 2), np.nan)
     stats = np.full((channels, 3), np.nan)  # discrepancy, chi2, n_eff
@@ -316,9 +318,11 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
         resonance_sigma=shaped(osc[:, 0]),
         resonance_freq=shaped(osc[:, 1]),
         resonance_tau=shaped(osc[:, 2]),
+        resonance_skew=shaped(osc[:, 3]),
         resonance_sigma_std=shaped(osc_std[:, 0]),
         resonance_freq_std=shaped(osc_std[:, 1]),
         resonance_tau_std=shaped(osc_std[:, 2]),
+        resonance_skew_std=shaped(osc_std[:, 3]),
         motion_sigma=shaped(moving[:, 0]),
         motion_tau=shaped(moving[:, 1]),
         motion_sigma_std=shaped(moving_std[:, 0]),
@@ -409,7 +413,7 @@ def _record_length(result) -> int:
 
 def _bootstrap_std(result, n, coef, markov, oscillators, replicates, rng, options):
     """Standard deviation of each coefficient (and Gauss–Markov σ, τc, tone A, f0,
-    resonance σ, f_r, τr, motion σθ, τc, and the datasheet values Q…R) over fits to
+    resonance σ, f_r, τr, skew, motion σθ, τc, and the datasheet values Q…R) over fits to
     records simulated from the model with the rate and taus of ``result`` and its
     length ``n``; ``oscillators`` is (tones, resonances, motions)."""
     from imunoise._simulate import simulate
@@ -432,7 +436,8 @@ def _bootstrap_std(result, n, coef, markov, oscillators, replicates, rng, option
     tone = np.stack([np.reshape(parts.sine_amplitude, (-1, TONES_MAX)),
                      np.reshape(parts.sine_freq, (-1, TONES_MAX))], axis=-1)
     osc = np.stack([np.atleast_1d(a) for a in (parts.resonance_sigma, parts.resonance_freq,
-                                               parts.resonance_tau)], axis=-1)
+                                               parts.resonance_tau,
+                                               parts.resonance_skew)], axis=-1)
     moving = np.stack([np.atleast_1d(parts.motion_sigma), np.atleast_1d(parts.motion_tau)],
                       axis=-1)
     sheet = np.stack([refit.value(t) for t in TERMS], axis=1)
@@ -482,16 +487,19 @@ def _fit_wls(t, v, e, fs, mask, gm_count, oscillators, select):
         sine[k] = amplitude, f0
         sine_std[k] = (math.sqrt(max(cov[slot, slot], 0.0)) / amplitude,
                        f0 * math.sqrt(max(cov[slot + 1, slot + 1], 0.0)))
-    osc = np.full(3, np.nan)
-    osc_std = np.full(3, np.nan)
-    for r2, f_r, tau_r in r.resonance:
-        # u(σ) = u(σ²)/(2σ); f_r, τr from their logarithms (NaN: f_r on the fs/2 bound).
+    osc = np.full(4, np.nan)
+    osc_std = np.full(4, np.nan)
+    for r2, f_r, tau_r, skew in r.resonance:
+        # u(σ) = u(σ²)/(2σ); f_r, τr from their logarithms (NaN: f_r on the fs/2
+        # bound); the skew as it is (0 without a quadrature part, NaN at ±1).
         sigma = math.sqrt(r2)
-        osc[:] = sigma, f_r, tau_r
+        osc[:] = sigma, f_r, tau_r, skew
+        u_skew = cov[SKEW_SLOT, SKEW_SLOT]
         osc_std[:] = (math.sqrt(max(cov[RES_SLOT, RES_SLOT], 0.0)) / (2 * sigma),
                       f_r * math.sqrt(cov[RES_SLOT + 1, RES_SLOT + 1]) if np.isfinite(
                           cov[RES_SLOT + 1, RES_SLOT + 1]) else np.nan,
-                      tau_r * math.sqrt(max(cov[RES_SLOT + 2, RES_SLOT + 2], 0.0)))
+                      tau_r * math.sqrt(max(cov[RES_SLOT + 2, RES_SLOT + 2], 0.0)),
+                      math.sqrt(max(u_skew, 0.0)) if np.isfinite(u_skew) else np.nan)
     moving = np.full(2, np.nan)
     moving_std = np.full(2, np.nan)
     for v2, tau_c in r.motion:

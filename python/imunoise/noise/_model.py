@@ -188,7 +188,7 @@ class NoiseModel(PerTerm):
         gm = len(parts.gauss_markov(channel))
         extra = "".join(f", tone {_summary.number(f0)} Hz" for _, f0 in parts.sine(channel))
         extra += "".join(f", resonance {_summary.number(f)} Hz"
-                         for _, f, _ in parts.resonance(channel))
+                         for _, f, _, _ in parts.resonance(channel))
         extra += "".join(f", bounded motion τc {_summary.number(tc)} s"
                          for _, tc in parts.motion(channel))
         return ((" ".join(terms) or "no term resolved") + (f", {gm} GM" if gm else "") + extra

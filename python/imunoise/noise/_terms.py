@@ -43,7 +43,9 @@ SINE_SLOT: int = _core_fit.SINE_SLOT
 """Slot of the first tone's variance A²/2 in the covariance (its ln f0 follows, then
 the next tone's)."""
 RES_SLOT: int = _core_fit.RESONANCE_SLOT
-"""Slot of the resonance's variance σ² in the covariance (ln f_r, ln τr follow)."""
+"""Slot of the resonance's variance σ² in the covariance (ln f_r, ln τr, skew follow)."""
+SKEW_SLOT: int = _core_fit.SKEW_SLOT
+"""Slot of the resonance's skew in the covariance."""
 MOTION_SLOT: int = _core_fit.MOTION_SLOT
 """Slot of the bounded motion's variance σθ² in the covariance (ln τc follows)."""
 
@@ -56,20 +58,34 @@ def gm_white_density(sigma: float, tau_c: float, fs: float) -> float:
     return sigma**2 * (1 + phi) / ((1 - phi) * fs)
 
 
-def resonance_white_density(sigma: float, f_r: float, tau_r: float, fs: float) -> float:
+def resonance_white_density(sigma: float, f_r: float, tau_r: float, fs: float,
+                            skew: float = 0.0) -> float:
     """N² (rate²·s) that a sampled resonance of standard deviation ``sigma``,
-    frequency ``f_r`` and damping time ``tau_r`` contributes at τ ≫ τr:
-    σ²·Re[(1+z)/(1−z)]/fs, z = exp(−1/(fs·τr) + 2πi·f_r/fs), the −½ asymptote of
-    its Allan variance (its spectrum at zero frequency)."""
+    frequency ``f_r``, damping time ``tau_r`` and ``skew`` contributes at τ ≫ τr:
+    σ²·Re[(1 − iβ)(1+z)/(1−z)]/fs, z = exp(−1/(fs·τr) + 2πi·f_r/fs),
+    β = skew·:func:`quadrature_bound`, the −½ asymptote of its Allan variance (its
+    spectrum at zero frequency: a low-pass filter's skew > 0 raises it, skew −1
+    makes it 0)."""
     z = complex(math.exp(-1.0 / (fs * tau_r)), 0.0) * complex(
         math.cos(2 * math.pi * f_r / fs), math.sin(2 * math.pi * f_r / fs))
-    return sigma**2 * ((1 + z) / (1 - z)).real / fs
+    bound = quadrature_bound(f_r, tau_r, fs)
+    beta = skew * bound if math.isfinite(bound) else 0.0
+    return sigma**2 * (complex(1.0, -beta) * (1 + z) / (1 - z)).real / fs
+
+
+def quadrature_bound(f_r: float, tau_r: float, fs: float) -> float:
+    """κ, the largest |β| of a resonance of frequency ``f_r`` and damping time
+    ``tau_r`` sampled at ``fs`` whose spectrum is non-negative (autocovariance
+    ρ^|h|(cos θh + β sin θ|h|), β = skew·κ): sinh(u)/sin θ, u = 1/(fs·τr),
+    θ = 2π·f_r/fs (infinite at fs/2, where the quadrature part vanishes)."""
+    s = abs(math.sin(2 * math.pi * f_r / fs))
+    return math.inf if s < 1e-12 else math.sinh(1.0 / (fs * tau_r)) / s
 
 
 def is_log_time(slot: int) -> bool:
     """Whether covariance slot ``slot`` holds a logarithm (ln τc, ln f0, ln f_r, ln τr)."""
-    return (slot > RES_SLOT and slot != MOTION_SLOT) or (5 <= slot < RES_SLOT
-                                                          and (slot - 5) % 2 == 1)
+    return slot in (RES_SLOT + 1, RES_SLOT + 2, MOTION_SLOT + 1) or (
+        5 <= slot < RES_SLOT and (slot - 5) % 2 == 1)
 
 
 FLAT_SLOPE = -0.25
@@ -85,15 +101,17 @@ def term_variances(taus, fs: float, coef, markov=(), tone=(), resonance=(),
     """Allan variance of each model term at ``taus``: (len(taus), 5 + len(markov) +
     len(tone) + len(resonance) + len(motion)), from the one implementation of the
     model (Rust); ``coef`` holds Q…R, ``markov`` (sigma, tau_c) pairs, ``tone``
-    (amplitude, f0) pairs, ``resonance`` (sigma, f_r, tau_r) triples, ``motion``
-    (sigma, tau_c) pairs of a bounded motion (sigma of its angle, rate·s)."""
+    (amplitude, f0) pairs, ``resonance`` (sigma, f_r, tau_r, skew) quadruples (or
+    triples, skew 0), ``motion`` (sigma, tau_c) pairs of a bounded motion (sigma of
+    its angle, rate·s)."""
     t = np.ascontiguousarray(np.atleast_1d(np.asarray(taus, dtype=float)))
     with np.errstate(over="ignore"):  # a coefficient near 1e154 squares to inf, not an error
         squares = np.square(np.asarray(coef, dtype=float)).tolist()
     return _core_fit.noise_terms(t, float(fs), squares,
                              [(s * s, tc) for s, tc in markov],
                              [(a * a / 2, f0) for a, f0 in tone],
-                             [(s * s, f, tr) for s, f, tr in resonance],
+                             [(r[0] * r[0], r[1], r[2], r[3] if len(r) > 3 else 0.0)
+                              for r in resonance],
                              [(s * s, tc) for s, tc in motion])
 
 

@@ -103,17 +103,17 @@ def model_sentences(model: NoiseModel, sensor: str,
                                              sensor=sensor)
             parts.append(f"a tone of amplitude {format_number(value, value_std)} "
                          f"{b_unit.label} at {format_number(f0, f0_std)} Hz")
-        for sigma, f_r, tau_r in parts_of.resonance(c):
+        for sigma, f_r, tau_r, skew in parts_of.resonance(c):
             stds = [float(np.atleast_1d(a)[c]) for a in (
                 parts_of.resonance_sigma_std, parts_of.resonance_freq_std,
-                parts_of.resonance_tau_std)]
+                parts_of.resonance_tau_std, parts_of.resonance_skew_std)]
             value, value_std = _units.convert(np.array([sigma, stds[0]]), "B", b_unit.name,
                                              sensor=sensor)
             parts.append(f"a resonance (damped oscillation, a band rather than a line) of "
                          f"σ = {format_number(value, value_std)} {b_unit.label} at "
                          f"{format_number(f_r, stds[1])} Hz, damping time "
                          f"{format_number(tau_r, stds[2])} s (quality factor "
-                         f"{math.pi * f_r * tau_r:.2g})")
+                         f"{math.pi * f_r * tau_r:.2g})" + _skew_words(skew, stds[3]))
         parts += _motion_sentence(model, c, sensor, n_unit,
                                   _units.unit_info("Q", chosen.get("Q"), sensor))
         parts += _correlated_white_sentence(model, c)
@@ -121,6 +121,15 @@ def model_sentences(model: NoiseModel, sensor: str,
             parts += _readoff_agreement(model, c, term, unit, sensor)
         out.append("; ".join(parts) + ".")
     return out
+
+
+def _skew_words(skew: float, skew_std: float) -> str:
+    """What a resonance's quadrature part adds to its sentence ("" without one)."""
+    if not skew:
+        return ""
+    shape = (" — the shape of a second-order low-pass filter, as a sensor's own output "
+             "filter is" if skew > 0 else "")
+    return f", skew {format_number(skew, skew_std)}{shape}"
 
 
 def _motion_sentence(model: NoiseModel, c: int, sensor: str, n_unit, q_unit) -> list[str]:
