@@ -97,7 +97,7 @@ def structure(model):
     terms = [t for t in imunoise.noise.TERMS if bool(parts.supported[t])]
     gm = [f"GM({tc:.3g} s)" for _, tc in parts.gauss_markov()]
     tone = [f"sine({f0:.3g} Hz)" for _, f0 in parts.sine()]
-    res = [f"res({f:.3g} Hz, Q {math.pi * f * tr:.2g}" + (f", β {b:.2g})" if b else ")")
+    res = [f"res({f:.3g} Hz, Q {math.pi * f * tr:.2g}" + (f", skew {b:.2g})" if b else ")")
            for _, f, tr, b in parts.resonance()]
     return "+".join(terms + gm + tone + res)
 
