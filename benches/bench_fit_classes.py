@@ -15,6 +15,10 @@ Classes (each three axes, independent noise):
   angle increments, a short-τ disturbance (Gauss–Markov 0.04 s), lines at 1.2
   and 2.1 Hz, on a parked vehicle rocking (angle Gauss–Markov, τc 25 s);
 * ``rlg still``: the same gyro on a bench, without the rocking or the hump;
+* ``rlg accel``: its accelerometers, integer 125 µg·s velocity increments, on the
+  parked vehicle: white 20 µg/√Hz, flicker, the engine's hump (Gauss–Markov
+  0.04 s), the tilt's g·θ (Gauss–Markov 25 s), the body's bounded sway
+  (velocity, τc 2 s) and the two lines;
 * ``increments``: 400 Hz, 1 h, angle increments of 1 µrad;
 * ``counts``: 200 Hz, 1 h, rate rounded to a 1e-3 LSB;
 * ``slow``: 5 Hz, 10 h, N + B + K;
@@ -39,6 +43,7 @@ import numpy as np
 from scipy.signal import butter, lfilter
 
 ARCSEC = np.pi / 180 / 3600
+G = 9.80665
 
 
 def coverage(taus, dev, edf, model_dev, limit):
@@ -79,6 +84,19 @@ def rlg(seed, *, still=False):
     return counted(np.stack(axes, 1), fs, 0.1 * ARCSEC), fs, 8.7e-7 if not still else 5.8e-7
 
 
+def rlg_accel(seed):
+    fs, n = 100.0, int(30.8 * 60 * 100)
+    rng = np.random.default_rng(100 + seed)
+    t = np.arange(n) / fs
+    axes = []
+    for k in range(3):
+        x = imunoise.simulate(n, fs, N=2e-4, B=5e-5, seed=50 + 3 * seed + k,
+                              gm=[(5e-3, 0.04), (G * 3.7e-4, 25.0)], motion=(1e-3, 2.0))
+        axes.append(x + 2e-3 * np.sin(2 * np.pi * 1.2 * t + rng.uniform(0, 6))
+                    + 1e-3 * np.sin(2 * np.pi * 2.1 * t + rng.uniform(0, 6)))
+    return counted(np.stack(axes, 1), fs, 125e-6 * G), fs, 2e-4
+
+
 def lowpass(x, fs, fc, order):
     b, a = butter(order, fc / (fs / 2))
     return lfilter(b, a, x, axis=0)
@@ -97,6 +115,7 @@ def classes():
     out = {
         "rlg": lambda s: rlg(s),
         "rlg still": lambda s: rlg(s, still=True),
+        "rlg accel": rlg_accel,
         "increments": lambda s: (counted(imunoise.simulate(
             1_440_000, 400.0, N=5e-6, B=1e-6, K=1e-8, channels=3, seed=s), 400.0, 1e-6),
             400.0, 5e-6),

@@ -469,8 +469,12 @@ def _cmd_adev(args) -> int:
     return 0
 
 
+#: Samples from which ``imunoise fit`` reads a channel's resolution (its levels).
+_STEP_SAMPLES = 1_000_000
+
+
 def _cmd_fit(args) -> int:
-    from imunoise import allan, noise, report
+    from imunoise import allan, noise, report, stats
 
     log = _read(args)
     sensors = [args.sensor] if args.sensor else [s for s in ALLAN_SENSORS
@@ -490,8 +494,10 @@ def _cmd_fit(args) -> int:
             model, s, units="datasheet" if args.datasheet_units else None)
         print(f"# {s}")
         _print_table(head, rows)
+        data = np.asarray(getattr(log, s))
+        steps = [stats.quantization_step(data[:_STEP_SAMPLES, c]) for c in range(data.shape[1])]
         for sentence in report.model_sentences(
-                model, s, units="datasheet" if args.datasheet_units else None):
+                model, s, units="datasheet" if args.datasheet_units else None, steps=steps):
             print(sentence.replace("**", ""))
         print(_plan_line(model, log, s))
         if args.plot:

@@ -81,8 +81,10 @@ from imunoise.noise._terms import (
     TONES_MAX,
     gm_white_density,
     model_variance,
+    resolution_noise,
     resonance_white_density,
 )
 
 __all__ = ["TERMS", "FLICKER", "GM_MAX", "TONES_MAX", "Components", "NoiseModel", "Prediction",
-           "fit", "format_table", "gm_white_density", "model_variance", "resonance_white_density"]
+           "fit", "format_table", "gm_white_density", "model_variance", "resolution_noise",
+           "resonance_white_density"]

@@ -73,6 +73,26 @@ def resonance_white_density(sigma: float, f_r: float, tau_r: float, fs: float,
     return sigma**2 * (complex(1.0, -beta) * (1 + z) / (1 - z)).real / fs
 
 
+def resolution_noise(step: float, fs: float) -> tuple[float, float]:
+    """(N, Q) that a record whose samples are whole multiples of ``step`` (rate
+    units: its count, LSB or print resolution) owes to that resolution at rate ``fs``.
+
+    - Rounding each rate sample to ``step`` adds white noise of variance step²/12
+      per sample: N = step/√(12·fs) (rate·√s).
+    - Counting an integrated angle (or velocity) — increments, as ring-laser and
+      fibre-optic gyros output — adds the angle's rounding error, white in angle:
+      Q = step/(fs·√12) (rate·s), IEEE 952's quantization noise.
+
+    Both hold where the signal moves by at least a count between samples (noise or
+    dither); slower, the rounding error is correlated and smaller at long τ. Which
+    one a record has, its curve tells (slope −½ or −1 at the shortest taus)."""
+    if not (math.isfinite(step) and step > 0):
+        raise ValueError(f"step must be finite and > 0; got {step!r}")
+    if not (math.isfinite(fs) and fs > 0):
+        raise ValueError(f"fs must be finite and > 0; got {fs!r}")
+    return step / math.sqrt(12.0 * fs), step / (fs * math.sqrt(12.0))
+
+
 def quadrature_bound(f_r: float, tau_r: float, fs: float) -> float:
     """κ, the largest |β| of a resonance of frequency ``f_r`` and damping time
     ``tau_r`` sampled at ``fs`` whose spectrum is non-negative (autocovariance

@@ -11,7 +11,7 @@ import numpy as np
 from imunoise import datasheet
 from imunoise import units as _units
 from imunoise._schema import axis_names
-from imunoise.noise import NoiseModel, gm_white_density
+from imunoise.noise import NoiseModel, gm_white_density, resolution_noise
 from imunoise.report.formatting import format_number
 
 __all__ = ["comparison_rows", "datasheet_rows", "lab_rows", "model_sentences"]
@@ -69,15 +69,22 @@ def lab_rows(models: dict[str, NoiseModel], spec,
 
 
 def model_sentences(model: NoiseModel, sensor: str,
-                    units: str | dict | None = None) -> list[str]:
+                    units: str | dict | None = None, *, steps=None) -> list[str]:
     """One sentence per axis: the fitted components, how well the model follows the curve
     (and, below :data:`POOR_COVERAGE`, that its coefficients only summarise it),
-    the Gauss–Markov terms, and whether the model's N and B agree with the
-    datasheet read-offs of the curve, in ``units`` (as for :meth:`NoiseModel.table`;
-    σ and amplitudes in the unit of B). Emphasis is Markdown ``**``."""
+    the Gauss–Markov terms, whether the model's N and B agree with the
+    datasheet read-offs of the curve and, given ``steps`` (per axis, the samples'
+    resolution in input units — :func:`imunoise.stats.quantization_step` —, None
+    where unknown), what that resolution adds to N and Q; in ``units`` (as for
+    :meth:`NoiseModel.table`; σ and amplitudes in the unit of B). Emphasis is
+    Markdown ``**``."""
+    if steps is not None and len(steps) != model.channels:
+        raise ValueError(f"steps must have one value per channel ({model.channels}); "
+                         f"got {len(steps)}")
     chosen = _units.unit_choice(units, sensor)
     b_unit = _units.unit_info("B", chosen.get("B"), sensor)
     n_unit = _units.unit_info("N", chosen.get("N"), sensor)
+    q_unit = _units.unit_info("Q", chosen.get("Q"), sensor)
     out = []
     for c, axis in enumerate(axis_names(model.channels)):
         parts = [f"{axis}: fitted components {model.components.structure(c)}"]
@@ -114,9 +121,10 @@ def model_sentences(model: NoiseModel, sensor: str,
                          f"{format_number(f_r, stds[1])} Hz, damping time "
                          f"{format_number(tau_r, stds[2])} s (quality factor "
                          f"{math.pi * f_r * tau_r:.2g})" + _skew_words(skew, stds[3]))
-        parts += _motion_sentence(model, c, sensor, n_unit,
-                                  _units.unit_info("Q", chosen.get("Q"), sensor))
+        parts += _motion_sentence(model, c, sensor, n_unit, q_unit)
         parts += _correlated_white_sentence(model, c)
+        if steps is not None:
+            parts += _resolution_sentence(model, c, steps[c], sensor, (b_unit, n_unit, q_unit))
         for term, unit in (("N", n_unit), ("B", b_unit)):
             parts += _readoff_agreement(model, c, term, unit, sensor)
         out.append("; ".join(parts) + ".")
@@ -153,6 +161,54 @@ def _motion_sentence(model: NoiseModel, c: int, sensor: str, n_unit, q_unit) -> 
             text += (f"; under it the sensor's own white noise does not show: N is not "
                      f"resolved, at most {format_number(float(bound))} {n_unit.label}")
         out.append(text)
+    return out
+
+
+#: Share of N (in amplitude) that the samples' resolution adds above which the
+#: sentence says so; from :data:`RESOLUTION_LIMITS` on, that it limits N.
+RESOLUTION_SHOWN = 0.1
+RESOLUTION_LIMITS = 0.3
+
+#: Q more than this multiple of what the samples' count explains is the sensor's.
+Q_OWN = 3.0
+
+
+def _resolution_sentence(model: NoiseModel, c: int, step, sensor: str, units) -> list[str]:
+    """What the samples' resolution ``step`` (input units) adds to N — rounding each
+    sample — and how Q compares with counts of an integrated angle of that size
+    (:func:`imunoise.noise.resolution_noise`); nothing where the step is unknown, or
+    adds less than :data:`RESOLUTION_SHOWN` of N and Q is not resolved. On the
+    ADIS16405 accelerometers and a phone gyro, whose noise per sample is about one
+    count, the rounding is 20–30 % of N."""
+    if step is None or not (np.isfinite(step) and step > 0):
+        return []
+    b_unit, n_unit, q_unit = units
+    n_round, q_count = resolution_noise(float(step), model.fs)
+    n_now, q_now = float(model.value("N")[c]), float(model.value("Q")[c])
+    share = n_round / n_now if n_now > 0 else math.inf
+    out = []
+    if share >= RESOLUTION_SHOWN:
+        shown = _units.convert(float(step), "B", b_unit.name, sensor=sensor)
+        added = _units.convert(n_round, "N", n_unit.name, sensor=sensor)
+        text = (f"the samples are whole multiples of {float(shown):.3g} "
+                f"{b_unit.label}: rounding to it adds white noise of "
+                f"{float(added):.3g} {n_unit.label}"
+                + (f", {share:.0%} of N" if math.isfinite(share) else ""))
+        if share >= RESOLUTION_LIMITS:
+            text += (" — **the log's resolution limits the N measured here** (record with "
+                     "more digits, or the sensor's binary output)")
+        out.append(text)
+    if q_now > 0:
+        shown = _units.convert(float(step), "B", b_unit.name, sensor=sensor)
+        counted = _units.convert(q_count, "Q", q_unit.name, sensor=sensor)
+        ratio = q_now / q_count
+        times = f"{ratio:.0f}" if ratio >= 10 else f"{ratio:.2g}"
+        integral = "velocity" if sensor == "accel" else "angle"
+        out.append(f"counts of an integrated {integral} of the samples' resolution "
+                   f"({float(shown):.3g} {b_unit.label}) would give Q = "
+                   f"{float(counted):.3g} {q_unit.label}; the model's Q is {times}× that"
+                   + (": more than the log's resolution explains (the sensor's own "
+                      "quantization, or its filter)" if ratio > Q_OWN else ""))
     return out
 
 

@@ -255,7 +255,11 @@ def noise_coefficients(ctx: Context, doc: Doc) -> None:
     for sensor, m in ctx.models.items():
         header, rows = datasheet_rows(m, sensor, ctx.units, symbols=True)
         doc.table(header, rows, caption=f"{sensor} noise coefficients per axis")
-        for sentence in model_sentences(m, sensor, ctx.units):
+        # the samples' resolution, read off the short log's levels (the same sensor)
+        per_axis = ctx.sensor_distributions.get(sensor, {})
+        steps = ([d.step for d in per_axis.values()] if len(per_axis) == m.channels
+                 else None)
+        for sentence in model_sentences(m, sensor, ctx.units, steps=steps):
             doc.p(sentence)
         r = ctx.allan.get(sensor)
         if r is not None:  # how long to record for the coefficients (imunoise plan)
