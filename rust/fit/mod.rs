@@ -604,7 +604,17 @@ mod tests {
     }
 
     fn curve(taus: &[f64], ieee: &[f64; 5], gm: &[(f64, f64)]) -> Vec<f64> {
-        terms(taus, FS, ieee, gm, (&[], &[], &[]))
+        curve_with(taus, ieee, gm, (&[], &[], &[]))
+    }
+
+    /// The model's Allan variance at `taus`, every term summed.
+    fn curve_with(
+        taus: &[f64],
+        ieee: &[f64; 5],
+        gm: &[(f64, f64)],
+        oscillators: Oscillators,
+    ) -> Vec<f64> {
+        terms(taus, FS, ieee, gm, oscillators)
             .iter()
             .map(|r| r.iter().sum())
             .collect()
@@ -673,10 +683,7 @@ mod tests {
         let tone = [(2e-5, 17.0)];
         for per_decade in [5.0, 10.0, 20.0, 50.0] {
             let taus = grid(per_decade, 0.01, 1000.0);
-            let var: Vec<f64> = terms(&taus, FS, &ieee, &[], (&tone, &[], &[]))
-                .iter()
-                .map(|r| r.iter().sum())
-                .collect();
+            let var = curve_with(&taus, &ieee, &[], (&tone, &[], &[]));
             let fit = fit_exact(&taus, &var);
             assert_eq!(fit.sine.len(), 1, "{per_decade}: {fit:?}");
             assert!(fit.gm.is_empty(), "{per_decade}: {fit:?}");
@@ -698,10 +705,7 @@ mod tests {
         let tones = [(5e-9, 0.2), (4.5e-8, 3.3)];
         for per_decade in [10.0, 20.0] {
             let taus = grid(per_decade, 0.01, 180.0);
-            let var: Vec<f64> = terms(&taus, FS, &ieee, &[], (&tones, &[], &[]))
-                .iter()
-                .map(|r| r.iter().sum())
-                .collect();
+            let var = curve_with(&taus, &ieee, &[], (&tones, &[], &[]));
             let fit = fit_exact(&taus, &var);
             assert_eq!(fit.sine.len(), 2, "{per_decade}: {fit:?}");
             for (k, &(s2, f0)) in fit.sine.iter().enumerate() {
@@ -739,10 +743,7 @@ mod tests {
         let res = [(4e-4, 30.0, 0.02, 0.0)];
         for per_decade in [10.0, 20.0] {
             let taus = grid(per_decade, 0.01, 1000.0);
-            let var: Vec<f64> = terms(&taus, FS, &ieee, &[], (&tone, &res, &[]))
-                .iter()
-                .map(|r| r.iter().sum())
-                .collect();
+            let var = curve_with(&taus, &ieee, &[], (&tone, &res, &[]));
             let fit = fit_exact(&taus, &var);
             assert_eq!(fit.resonance.len(), 1, "{per_decade}: {fit:?}");
             assert_eq!(fit.sine.len(), 1, "{per_decade}: {fit:?}");
@@ -768,10 +769,7 @@ mod tests {
         let res = [(4e-4, f_r, tau_r, skew)];
         for per_decade in [10.0, 20.0] {
             let taus = grid(per_decade, 0.01, 1000.0);
-            let var: Vec<f64> = terms(&taus, FS, &ieee, &[], (&[], &res, &[]))
-                .iter()
-                .map(|r| r.iter().sum())
-                .collect();
+            let var = curve_with(&taus, &ieee, &[], (&[], &res, &[]));
             let fit = fit_exact(&taus, &var);
             assert_eq!(fit.resonance.len(), 1, "{per_decade}: {fit:?}");
             let (r2, f, tr, b) = fit.resonance[0];
