@@ -354,13 +354,13 @@ def _arma21(n: int, fs: float, sigma: float, f_r: float, tau_r: float, beta: flo
     g1 = a1 * g0 / (1 - a2)
     start = rng.multivariate_normal([0.0, 0.0], [[g0, g1], [g1, g0]])
     e = rng.standard_normal(n) * math.sqrt(var_e)
-    zi = lfilter_zi_ar2(a1, a2, start)
+    zi = _ar2_state(a1, a2, start)
     y = lfilter([1.0], [1.0, -a1, -a2], e, zi=zi)[0]
     previous = np.concatenate(([start[0]], y[:-1]))
     return y + m * previous
 
 
-def lfilter_zi_ar2(a1: float, a2: float, past: np.ndarray) -> np.ndarray:
+def _ar2_state(a1: float, a2: float, past: np.ndarray) -> np.ndarray:
     """The direct-form-II-transposed state of 1/(1 − a1·B − a2·B²) whose next
     output continues the past outputs ``past`` = (y[−1], y[−2])."""
     y1, y2 = past
