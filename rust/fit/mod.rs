@@ -29,6 +29,7 @@
 pub mod basis;
 pub mod estimate;
 pub mod nnls;
+pub mod oscillators;
 pub mod search;
 pub mod special;
 
