@@ -121,17 +121,15 @@ def term_variances(taus, fs: float, coef, markov=(), tone=(), resonance=(),
     """Allan variance of each model term at ``taus``: (len(taus), 5 + len(markov) +
     len(tone) + len(resonance) + len(motion)), from the one implementation of the
     model (Rust); ``coef`` holds Q…R, ``markov`` (sigma, tau_c) pairs, ``tone``
-    (amplitude, f0) pairs, ``resonance`` (sigma, f_r, tau_r, skew) quadruples (or
-    triples, skew 0), ``motion`` (sigma, tau_c) pairs of a bounded motion (sigma of
-    its angle, rate·s)."""
+    (amplitude, f0) pairs, ``resonance`` (sigma, f_r, tau_r, skew) quadruples,
+    ``motion`` (sigma, tau_c) pairs of a bounded motion (sigma of its angle, rate·s)."""
     t = np.ascontiguousarray(np.atleast_1d(np.asarray(taus, dtype=float)))
     with np.errstate(over="ignore"):  # a coefficient near 1e154 squares to inf, not an error
         squares = np.square(np.asarray(coef, dtype=float)).tolist()
     return _core_fit.noise_terms(t, float(fs), squares,
                              [(s * s, tc) for s, tc in markov],
                              [(a * a / 2, f0) for a, f0 in tone],
-                             [(r[0] * r[0], r[1], r[2], r[3] if len(r) > 3 else 0.0)
-                              for r in resonance],
+                             [(s * s, f, tr, skew) for s, f, tr, skew in resonance],
                              [(s * s, tc) for s, tc in motion])
 
 
