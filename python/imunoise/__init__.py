@@ -5,7 +5,7 @@ fitting, log readers for VectorNav VN-100 (ASCII and binary), CSV and ROS bags,
 plots and reports. Start with ``imunoise.adev(x, fs)``.
 """
 
-from imunoise import export, units
+from imunoise import _cpu, export, units
 from imunoise._core import __version__
 from imunoise._events import Events, events
 from imunoise._simulate import simulate
@@ -38,6 +38,8 @@ from imunoise.scale import batch
 from imunoise.spectrum import Spectrum, psd
 from imunoise.stats import describe, distribution
 from imunoise.writers.vn import write_vn_ascii, write_vn_binary
+
+_cpu.apply_environment()
 
 __all__ = [
     "__version__",

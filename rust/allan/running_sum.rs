@@ -91,7 +91,7 @@ fn scalar_run(chunk: &mut [f64], start: (f64, f64), mean: f64) {
 
 #[cfg(target_arch = "x86_64")]
 fn avx512() -> bool {
-    std::arch::is_x86_feature_detected!("avx512f")
+    crate::simd::level() >= crate::simd::Level::Avx512
 }
 
 #[cfg(target_arch = "x86_64")]

@@ -15,6 +15,7 @@ use crate::error::CoreError;
 mod allan;
 mod fit;
 mod interrupt;
+mod simd;
 mod vn;
 
 impl From<CoreError> for PyErr {
@@ -113,5 +114,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     add_submodule(m, "allan", allan::register)?;
     add_submodule(m, "vn", vn::register)?;
     add_submodule(m, "fit", fit::register)?;
+    add_submodule(m, "simd", simd::register)?;
     Ok(())
 }

@@ -5,11 +5,12 @@
 //! columns differ by up to 10²⁰ in norm). The sub-problems are at most 18
 //! columns by a few dozen rows and a fit solves thousands of them, so the QR is
 //! an unblocked one on a buffer the whole NNLS reuses: faer's blocked QR spent
-//! more time allocating and dispatching than factorising at this size (faer
-//! still inverts the Fisher matrix below). Reference: Lawson & Hanson, *Solving
-//! Least Squares Problems* (1974), ch. 23.
+//! more time allocating and dispatching than factorising at this size, and its
+//! matrix products dispatch on the CPU (AVX-512, AVX2 or portable kernels that
+//! round differently), where this loop gives the same bits on every CPU. The
+//! Fisher matrix is inverted by the same QR. Reference: Lawson & Hanson,
+//! *Solving Least Squares Problems* (1974), ch. 23.
 
-use faer::linalg::solvers::SolveLstsq;
 use faer::Mat;
 
 use crate::error::{CoreError, CoreResult};
@@ -17,6 +18,68 @@ use crate::error::{CoreError, CoreResult};
 /// Relative size below which a diagonal entry of R makes the sub-problem
 /// numerically rank deficient.
 const RANK_TOL: f64 = 1e-12;
+
+/// The same for the Fisher matrix's inverse, whose columns are scaled to unit
+/// diagonal first.
+const INVERSE_RANK_TOL: f64 = 1e-13;
+
+/// Householder QR, in place, of the n × p column-major matrix at the front of
+/// `work`, every later n-row column of `work` (right-hand sides) reflected with
+/// it; R stays above the diagonal. R's diagonal, or `None` for a zero or
+/// non-finite column.
+fn householder(work: &mut [f64], n: usize, p: usize) -> Option<Vec<f64>> {
+    let mut diag = vec![0.0; p];
+    for c in 0..p {
+        let (done, rest) = work.split_at_mut((c + 1) * n);
+        let v = &mut done[c * n + c..];
+        let norm = v.iter().map(|x| x * x).sum::<f64>().sqrt();
+        if norm == 0.0 || !norm.is_finite() {
+            return None;
+        }
+        let alpha = if v[0] > 0.0 { -norm } else { norm };
+        v[0] -= alpha;
+        let vv = v.iter().map(|x| x * x).sum::<f64>();
+        diag[c] = alpha;
+        if vv == 0.0 {
+            continue;
+        }
+        let beta = 2.0 / vv;
+        // Reflect every later column and the right-hand sides.
+        for col in rest.chunks_exact_mut(n) {
+            let tail = &mut col[c..];
+            let s = beta * v.iter().zip(tail.iter()).map(|(x, y)| x * y).sum::<f64>();
+            for (t, x) in tail.iter_mut().zip(v.iter()) {
+                *t -= s * x;
+            }
+        }
+    }
+    Some(diag)
+}
+
+/// Whether R (its diagonal) is numerically full rank: no pivot below
+/// `tol` times the largest.
+fn full_rank(diag: &[f64], tol: f64) -> bool {
+    let rmax = diag.iter().fold(0.0_f64, |m, d| m.max(d.abs()));
+    !(rmax.is_nan() || rmax <= 0.0 || diag.iter().any(|d| d.abs() <= tol * rmax))
+}
+
+/// Solves R x = y by back-substitution, R from [`householder`] (its rows of
+/// length n in `work`, its diagonal `diag`); `None` if x is not finite.
+fn back_substitute(work: &[f64], n: usize, diag: &[f64], y: &[f64]) -> Option<Vec<f64>> {
+    let p = diag.len();
+    let mut x = vec![0.0; p];
+    for c in (0..p).rev() {
+        let mut s = y[c];
+        for d in c + 1..p {
+            s -= work[d * n + c] * x[d];
+        }
+        x[c] = s / diag[c];
+        if !x[c].is_finite() {
+            return None;
+        }
+    }
+    Some(x)
+}
 
 /// Least squares restricted to the columns in `passive`; `None` when that
 /// sub-problem is not numerically full rank. `work` is scratch space.
@@ -43,48 +106,11 @@ fn solve_passive(
         work.extend_from_slice(a.col_as_slice(j));
     }
     work.extend_from_slice(b);
-    let mut diag = vec![0.0; p];
-    for c in 0..p {
-        let (done, rest) = work.split_at_mut((c + 1) * n);
-        let v = &mut done[c * n + c..];
-        let norm = v.iter().map(|x| x * x).sum::<f64>().sqrt();
-        if norm == 0.0 || !norm.is_finite() {
-            return None;
-        }
-        let alpha = if v[0] > 0.0 { -norm } else { norm };
-        v[0] -= alpha;
-        let vv = v.iter().map(|x| x * x).sum::<f64>();
-        diag[c] = alpha;
-        if vv == 0.0 {
-            continue;
-        }
-        let beta = 2.0 / vv;
-        // Reflect every later column and the right-hand side.
-        for col in rest.chunks_exact_mut(n) {
-            let tail = &mut col[c..];
-            let s = beta * v.iter().zip(tail.iter()).map(|(x, y)| x * y).sum::<f64>();
-            for (t, x) in tail.iter_mut().zip(v.iter()) {
-                *t -= s * x;
-            }
-        }
-    }
-    let rmax = diag.iter().fold(0.0_f64, |m, d| m.max(d.abs()));
-    if rmax.is_nan() || rmax <= 0.0 || diag.iter().any(|d| d.abs() <= RANK_TOL * rmax) {
+    let diag = householder(work, n, p)?;
+    if !full_rank(&diag, RANK_TOL) {
         return None;
     }
-    // Back-substitution: R x = Qᵀb, with R above the diagonal in the buffer.
-    let qtb = &work[p * n..];
-    let mut x = vec![0.0; p];
-    for c in (0..p).rev() {
-        let mut s = qtb[c];
-        for d in c + 1..p {
-            s -= work[d * n + c] * x[d];
-        }
-        x[c] = s / diag[c];
-        if !x[c].is_finite() {
-            return None;
-        }
-    }
+    let x = back_substitute(work, n, &diag, &work[p * n..])?;
     for (c, &j) in cols.iter().enumerate() {
         out[j] = x[c];
     }
@@ -183,7 +209,8 @@ pub fn nnls(a: &Mat<f64>, b: &[f64], allowed: &[bool]) -> CoreResult<Vec<f64>> {
 }
 
 /// Invert the symmetric positive definite k × k matrix `m` (row-major);
-/// `None` when it is singular.
+/// `None` when it is singular. The same unblocked QR as the sub-problems: its
+/// operations do not depend on the CPU, so neither do the fit's uncertainties.
 pub fn invert_spd(m: &[Vec<f64>]) -> Option<Vec<Vec<f64>>> {
     let k = m.len();
     if k == 0 {
@@ -194,18 +221,24 @@ pub fn invert_spd(m: &[Vec<f64>]) -> Option<Vec<Vec<f64>>> {
     if d.iter().any(|v| *v == 0.0 || !v.is_finite()) {
         return None;
     }
-    let a = Mat::from_fn(k, k, |i, j| m[i][j] / (d[i] * d[j]));
-    let qr = a.qr();
-    let r = qr.thin_R();
-    let rmax = (0..k).map(|c| r[(c, c)].abs()).fold(0.0, f64::max);
-    if rmax.is_nan() || rmax <= 0.0 || (0..k).any(|c| r[(c, c)].abs() <= 1e-13 * rmax) {
+    // Column-major: the scaled matrix, then the identity's k columns.
+    let mut work = Vec::with_capacity(2 * k * k);
+    for j in 0..k {
+        work.extend((0..k).map(|i| m[i][j] / (d[i] * d[j])));
+    }
+    for j in 0..k {
+        work.extend((0..k).map(|i| if i == j { 1.0 } else { 0.0 }));
+    }
+    let diag = householder(&mut work, k, k)?;
+    if !full_rank(&diag, INVERSE_RANK_TOL) {
         return None;
     }
-    let eye = Mat::from_fn(k, k, |i, j| if i == j { 1.0 } else { 0.0 });
-    let inv = qr.solve_lstsq(&eye);
+    let columns: Vec<Vec<f64>> = (0..k)
+        .map(|j| back_substitute(&work, k, &diag, &work[(k + j) * k..(k + j + 1) * k]))
+        .collect::<Option<_>>()?;
     Some(
         (0..k)
-            .map(|i| (0..k).map(|j| inv[(i, j)] / (d[i] * d[j])).collect())
+            .map(|i| (0..k).map(|j| columns[j][i] / (d[i] * d[j])).collect())
             .collect(),
     )
 }

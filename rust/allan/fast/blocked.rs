@@ -77,8 +77,8 @@ impl Sweep<'_> {
     fn task_sums(&self, start: usize, end: usize) -> Vec<f64> {
         #[cfg(target_arch = "x86_64")]
         {
-            if std::arch::is_x86_feature_detected!("avx2") {
-                // SAFETY: the CPU supports AVX2 (checked just above).
+            if crate::simd::level() >= crate::simd::Level::Avx2 {
+                // SAFETY: the CPU supports AVX2 (the level never exceeds the CPU's).
                 return unsafe { self.task_sums_avx2(start, end) };
             }
         }

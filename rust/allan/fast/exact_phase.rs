@@ -17,7 +17,8 @@
 //! the whole computation), so rounding recovers it exactly.
 
 use rustfft::num_complex::Complex;
-use rustfft::FftPlanner;
+
+use crate::simd::FftPlans;
 
 use crate::allan::phase::least_squares_line;
 
@@ -145,9 +146,9 @@ fn autocorrelation(q: &[i64], bits: u32, max_lag: usize) -> Option<Vec<i128>> {
     let n = q.len();
     let limbs = bits.div_ceil(LIMB_BITS) as usize;
     let size = (n + max_lag + 1).next_power_of_two();
-    let mut planner = FftPlanner::<f64>::new();
-    let forward = planner.plan_fft_forward(size);
-    let inverse = planner.plan_fft_inverse(size);
+    let mut plans = FftPlans::new();
+    let forward = plans.forward(size);
+    let inverse = plans.inverse(size);
     let mask = (1i64 << LIMB_BITS) - 1;
     let spectra: Vec<Vec<Complex<f64>>> = (0..limbs)
         .map(|a| {

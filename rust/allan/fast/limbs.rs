@@ -7,6 +7,11 @@
 //! Limbs are redundant between normalisations: a lane may hold more than 52 bits
 //! in l₀ and l₁ (each product adds below 2⁵² to both), which is exact as long as
 //! no limb leaves ±2⁶³; [`Limbs::normalise`] carries them back below 2⁵².
+//!
+//! Every kernel gives the same bits on every [`Level`]: the integer kernels are
+//! exact, and [`weighted_terms`] rounds in the same order on both paths.
+
+use crate::simd::{self, Level};
 
 /// Bits of one limb.
 const LIMB_BITS: u32 = 52;
@@ -14,6 +19,11 @@ const MASK: i64 = (1 << LIMB_BITS) - 1;
 /// 2⁵² and 2¹⁰⁴ as f64.
 const LIMB_1: f64 = 4503599627370496.0;
 const LIMB_2: f64 = LIMB_1 * LIMB_1;
+
+/// Terms summed side by side in [`weighted_terms`]: one accumulator per lane of
+/// an AVX-512 register, and the same eight in the scalar kernel, so that both
+/// round alike.
+const LANES: usize = 8;
 
 /// Largest factor a product may have: below 2⁵², where IFMA reads its inputs.
 pub const MAX_FACTOR: i64 = MASK;
@@ -184,13 +194,17 @@ impl Limbs {
 /// Σ_u w[h−1−u]·(f + a[u] + b[h−1−u] − 2c[u]) over u < h = a.len(), each term
 /// the exact integer rounded once (NaN if a term is negative). a, b, c and w
 /// have length h; every limb of a, b, c below 2⁶⁰ in magnitude.
+///
+/// The rounding order is part of the result: term u goes to accumulator
+/// u mod [`LANES`] while whole groups of eight remain, the accumulators are
+/// added in order, and the remaining terms one by one.
 pub fn weighted_terms(f: [i64; 3], a: LimbSlice, b: LimbSlice, c: LimbSlice, w: &[f64]) -> f64 {
     #[cfg(target_arch = "x86_64")]
     if avx512() {
         // SAFETY: the CPU has the features; lengths are asserted inside.
         return unsafe { x86::weighted_terms(f, a, b, c, w) };
     }
-    weighted_terms_scalar(f, a, b, c, w, 0, 0.0)
+    weighted_terms_scalar(f, a, b, c, w)
 }
 
 fn scaled_rows_scalar<const R: usize>(
@@ -223,38 +237,62 @@ fn pair_products_scalar<const R: usize>(
     }
 }
 
-fn weighted_terms_scalar(
+/// Term u of [`weighted_terms`], rounded once, times its weight.
+#[inline(always)]
+fn weighted_term(
+    f: [i64; 3],
+    a: LimbSlice,
+    b: LimbSlice,
+    c: LimbSlice,
+    w: &[f64],
+    u: usize,
+) -> f64 {
+    let v = a.l0.len() - 1 - u;
+    let t = [
+        f[0] + a.l0[u] + b.l0[v] - 2 * c.l0[u],
+        f[1] + a.l1[u] + b.l1[v] - 2 * c.l1[u],
+        f[2] + a.l2[u] + b.l2[v] - 2 * c.l2[u],
+    ];
+    to_f64(t) * w[v]
+}
+
+fn weighted_terms_scalar(f: [i64; 3], a: LimbSlice, b: LimbSlice, c: LimbSlice, w: &[f64]) -> f64 {
+    let h = a.l0.len();
+    let body = h - h % LANES;
+    let mut lanes = [0.0f64; LANES];
+    for group in (0..body).step_by(LANES) {
+        for (lane, acc) in lanes.iter_mut().enumerate() {
+            *acc += weighted_term(f, a, b, c, w, group + lane);
+        }
+    }
+    weighted_tail(f, a, b, c, w, body, lanes)
+}
+
+/// The accumulators added in lane order, then the terms from `from` on.
+fn weighted_tail(
     f: [i64; 3],
     a: LimbSlice,
     b: LimbSlice,
     c: LimbSlice,
     w: &[f64],
     from: usize,
-    start: f64,
+    lanes: [f64; LANES],
 ) -> f64 {
-    let h = a.l0.len();
-    let mut total = start;
-    for u in from..h {
-        let v = h - 1 - u;
-        let t = [
-            f[0] + a.l0[u] + b.l0[v] - 2 * c.l0[u],
-            f[1] + a.l1[u] + b.l1[v] - 2 * c.l1[u],
-            f[2] + a.l2[u] + b.l2[v] - 2 * c.l2[u],
-        ];
-        total += to_f64(t) * w[v];
+    let mut total = lanes.iter().fold(0.0, |s, x| s + x);
+    for u in from..a.l0.len() {
+        total += weighted_term(f, a, b, c, w, u);
     }
     total
 }
 
 #[cfg(target_arch = "x86_64")]
 fn ifma() -> bool {
-    std::arch::is_x86_feature_detected!("avx512ifma") && avx512()
+    simd::level() >= Level::Ifma
 }
 
 #[cfg(target_arch = "x86_64")]
 fn avx512() -> bool {
-    std::arch::is_x86_feature_detected!("avx512f")
-        && std::arch::is_x86_feature_detected!("avx512dq")
+    simd::level() >= Level::Avx512
 }
 
 #[cfg(target_arch = "x86_64")]
@@ -395,19 +433,25 @@ mod x86 {
             let t2 = _mm512_add_epi64(t2, _mm512_srai_epi64::<52>(t1));
             let t1 = _mm512_and_si512(t1, mask);
             lowest = _mm512_min_epi64(lowest, t2);
-            let value = _mm512_fmadd_pd(
-                _mm512_cvtepi64_pd(t2),
-                two,
-                _mm512_fmadd_pd(_mm512_cvtepi64_pd(t1), one, _mm512_cvtepi64_pd(t0)),
+            // The scalar kernel's operations, unfused: c·2¹⁰⁴ + (b·2⁵² + a), then
+            // one product and one sum per lane.
+            let value = _mm512_add_pd(
+                _mm512_mul_pd(_mm512_cvtepi64_pd(t2), two),
+                _mm512_add_pd(
+                    _mm512_mul_pd(_mm512_cvtepi64_pd(t1), one),
+                    _mm512_cvtepi64_pd(t0),
+                ),
             );
             let wv = _mm512_permutexvar_pd(reverse, _mm512_loadu_pd(w.as_ptr().add(v)));
-            acc = _mm512_fmadd_pd(value, wv, acc);
+            acc = _mm512_add_pd(acc, _mm512_mul_pd(value, wv));
             u += 8;
         }
         if _mm512_reduce_min_epi64(lowest) < 0 {
             return f64::NAN;
         }
-        weighted_terms_scalar(f, a, b, c, w, u, _mm512_reduce_add_pd(acc))
+        let mut lanes = [0.0f64; LANES];
+        _mm512_storeu_pd(lanes.as_mut_ptr(), acc);
+        weighted_tail(f, a, b, c, w, u, lanes)
     }
 }
 
@@ -525,11 +569,8 @@ mod tests {
             .sum();
         assert!((got - want).abs() <= 1e-14 * want, "{got} vs {want}");
         let (sa, sb, sc) = (la.slice(0..h), lb.slice(0..h), lc.slice(0..h));
-        let portable = weighted_terms_scalar(split(f), sa, sb, sc, &w, 0, 0.0);
-        assert!(
-            (portable - want).abs() <= 1e-14 * want,
-            "{portable} vs {want}"
-        );
+        let portable = weighted_terms_scalar(split(f), sa, sb, sc, &w);
+        assert_eq!(portable.to_bits(), got.to_bits());
         // A negative term is a failed computation.
         let mut c2 = c.clone();
         c2[5] += 1 << 30;

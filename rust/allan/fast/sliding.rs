@@ -5,14 +5,15 @@
 use std::cell::RefCell;
 
 use rustfft::num_complex::Complex;
-use rustfft::FftPlanner;
+
+use crate::simd::FftPlans;
 
 /// Below this many multiply-adds the direct loop beats three FFTs.
 const DIRECT_WORK: usize = 1 << 14;
 
 thread_local! {
     // Plans are cached per thread: the blocks of one tau reuse a few sizes.
-    static PLANNER: RefCell<FftPlanner<f64>> = RefCell::new(FftPlanner::new());
+    static PLANS: RefCell<FftPlans> = RefCell::new(FftPlans::new());
 }
 
 /// out[p] = Σ_k w[k]·x[p + k], p = 0 … x.len() − w.len() (empty when w is longer).
@@ -29,12 +30,13 @@ pub fn sliding_dot(x: &[f64], w: &[f64]) -> Vec<f64> {
     // Linear convolution of x with reversed w; a cyclic one of any length
     // ≥ x.len() is exact at the indices read (wrapped terms meet w's padding).
     let size = x.len().next_power_of_two();
-    let (forward, inverse) = PLANNER.with(|planner| {
-        let mut planner = planner.borrow_mut();
-        (
-            planner.plan_fft_forward(size),
-            planner.plan_fft_inverse(size),
-        )
+    let (forward, inverse) = PLANS.with(|plans| {
+        let mut plans = plans.borrow_mut();
+        // A level forced since the plans were made: plan again at the new one.
+        if !plans.is_current() {
+            *plans = FftPlans::new();
+        }
+        (plans.forward(size), plans.inverse(size))
     });
     // Both real inputs go through one complex transform: z = x + i·g·rev(w).
     // Separating the two spectra again costs digits of the smaller one, so w
