@@ -244,7 +244,8 @@ def test_ctrl_c_stops_theoh():
 
 def test_ctrl_c_in_the_cli_exits_130(tmp_path):
     log = tmp_path / "big.csv"
-    y = np.random.default_rng(1).normal(size=(400_000, 3))
+    # Long enough to be running 1.5 s in on the fastest path (IFMA: ≈ 2 s for 400,000).
+    y = np.random.default_rng(1).normal(size=(1_000_000, 3))
     np.savetxt(log, y, delimiter=",", header="gyro_x,gyro_y,gyro_z", comments="", fmt="%.6f")
     child = (
         "import sys, imunoise.allan as allan\n"
