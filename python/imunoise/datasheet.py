@@ -133,8 +133,10 @@ class Comparison:
     (the one-sided 95 % interval straddles the limit); for a ``typical`` value
     ``"typical"`` (within a factor :data:`TYPICAL_FACTOR` of it), ``"above
     typical"`` or ``"below typical"``; ``"not resolved"`` when the data do not
-    resolve that term (e.g. too short a log for B). ``remark`` says it in
-    words ("within a factor 1.5 of typical", "2.3× typical", "no uncertainty").
+    resolve that term (e.g. too short a log for B), except that a ``max`` the
+    value's 95 % upper bound (``upper``, the model's :attr:`NoiseModel.upper`)
+    stays below is a ``"pass"``. ``remark`` says it in words ("within a factor 1.5
+    of typical", "2.3× typical", "no uncertainty", "not resolved, at most …").
     """
 
     spec: Spec
@@ -182,7 +184,8 @@ class Comparison:
             word = r["verdict"] + (f" ({r['remark']})" if r.get("remark") else "")
             body.append([
                 r["sensor"], f"{r['quantity']} ({r['term']})", r["axis"],
-                _numbers.format_value(r["measured"], r["std"]),
+                (_numbers.format_value(r["measured"], r["std"]) if np.isfinite(r["measured"])
+                 else _numbers.upper_bound(r.get("upper"))),
                 f"{bound} {r['spec']:g} {r['label']}",
                 _numbers.cell(r["ratio"], r["ratio_std"]),
                 word,
@@ -291,6 +294,8 @@ def compare(models, spec="vn100", *, sensor: str = "gyro", input_units: dict | N
         eq, eq_std = model.value(item.term), model.std(item.term)
         values = _units.convert(eq, item.term, info.name, sensor=item.sensor, input_unit=iu)
         stds = _units.convert(eq_std, item.term, info.name, sensor=item.sensor, input_unit=iu)
+        uppers = _units.convert(np.atleast_1d(model.upper[item.term]), item.term, info.name,
+                                sensor=item.sensor, input_unit=iu)
         sup = (eq > 0) & np.isfinite(eq)
         for i, ax in enumerate(axis_names(model.channels, axes)):
             measured = float(values[i])
@@ -298,6 +303,11 @@ def compare(models, spec="vn100", *, sensor: str = "gyro", input_units: dict | N
             ratio = measured / item.value if ok else math.nan
             word, remark = verdict(measured if ok else math.nan, float(stds[i]),
                                    item.value, item.limit)
+            upper = math.nan if ok else float(uppers[i])
+            if not ok and math.isfinite(upper):
+                # Not resolved, but bounded: below a maximum the bound passes it.
+                word = "pass" if item.limit == "max" and upper <= item.value else word
+                remark = f"not resolved, at most {upper:.3g} {info.label} (95 %)"
             rows.append({
                 "sensor": item.sensor,
                 "term": item.term,
@@ -311,6 +321,7 @@ def compare(models, spec="vn100", *, sensor: str = "gyro", input_units: dict | N
                 "std": float(stds[i]) if ok else math.nan,
                 "ratio": ratio,
                 "ratio_std": float(stds[i]) / item.value if ok else math.nan,
+                "upper": upper,
                 "verdict": word,
                 "remark": remark,
             })

@@ -15,9 +15,12 @@ key                              noise-model coefficient  unit
 (N in rad/√s is numerically rad/s/√Hz, K in rad/s/√s is rad/s²/√Hz.) Kalibr's
 model has no Gauss–Markov state, so the values written are the model's
 datasheet values (``model.N``, ``model.K``: the numbers every view prints): Gauss–Markov terms
-faster than 1 s are folded into the white noise, slower ones into the random
-walk (the walk that bounds them over times shorter than τc). The
-:func:`ekf_dict` export keeps them as bias states instead. The
+faster than 1 s are folded into the white noise, a slow one whose hump lies beyond
+the record into the random walk (over the record it rises like one); a bump within
+the record is no walk and stays out. The :func:`ekf_dict` export keeps the
+Gauss–Markov terms as bias states instead. A value the data do not resolve is
+written as its 95 % upper bound (``model.upper``), with a warning: 0 would tell
+an estimator "no such noise". The
 files hold one number per sensor, so the axes are combined: ``combine="max"``
 (default, the worst axis: conservative, what Kalibr's authors recommend when in
 doubt) or ``"rms"`` (√ of the mean square over axes). Kalibr's documentation
@@ -69,15 +72,33 @@ def write_atomic(path, text: str) -> Path:
     return _atomic.write_text(path, text)
 
 
+def _value_or_bound(model, term: str, sensor: str) -> np.ndarray:
+    """The datasheet value of ``term`` per axis, its 95 % upper bound where the data
+    do not resolve it (an estimator needs a number, and 0 would mean "none"), with a
+    warning naming the axes; NaN only where there is neither."""
+    values = np.atleast_1d(model.value(term)).astype(float)
+    missing = ~np.atleast_1d(model.resolved(term))
+    if missing.any():
+        bounds = np.atleast_1d(model.upper[term])
+        values = np.where(missing, bounds, values)
+        axes = ", ".join(str(i) for i in np.flatnonzero(missing))
+        _warn.warn(
+            f"the {sensor} model does not resolve {term} on axis {axes}; writing its 95 % "
+            "upper bound (model.upper), the largest value the measured curve allows",
+            RuntimeWarning,
+        )
+    return values
+
+
 def _combine(model, term: str, combine: str, sensor: str, input_unit) -> float:
     # The model's datasheet value: Kalibr's white + random-walk model has no
     # Gauss–Markov state, so fast ones count as white noise and slow ones as walk.
-    values = model.value(term)
-    sup = values > 0
+    values = _value_or_bound(model, term, sensor)
+    sup = np.isfinite(values)
     scale = _units.input_scale(sensor, input_unit)
     if not sup.any():
         _warn.warn(
-            f"the {sensor} model has no resolved {term} on any axis; writing 0 "
+            f"the {sensor} model has no {term} and no bound on it on any axis; writing 0 "
             f"(an estimator may need a small positive value)",
             RuntimeWarning,
         )
@@ -213,6 +234,7 @@ def _ekf_axes(model, sensor: str, input_unit, min_samples: float) -> dict:
     # Gauss–Markov term is a state of its own, not part of K); the datasheet
     # values the other views print go beside it.
     parts = model.components
+    sheet = {t: _value_or_bound(model, t, sensor) for t in ("N", "B", "K")}
     for c, name in enumerate(names):
         white2 = float(parts.value("N")[c]) ** 2
         # A resonance (like a tone) is no bias state; what it adds to the white
@@ -231,12 +253,18 @@ def _ekf_axes(model, sensor: str, input_unit, min_samples: float) -> dict:
                 "correlation_time": tau_c,
                 "driving_noise_density": sigma * math.sqrt(2.0 / tau_c) * scale,
             })
+        # The walk's driving noise: the fitted K; where the data do not resolve K,
+        # its bound (a slow Gauss–Markov term standing in for K is a state above).
+        walk = float(parts.value("K")[c])
+        if not model.resolved("K")[c]:
+            walk = float(sheet["K"][c])
         axes[name] = {
             "white_noise_density": math.sqrt(white2) * scale,
-            "random_walk": float(parts.value("K")[c]) * scale,
-            "bias_instability": float(model.value("B")[c]) * scale,
+            "random_walk": walk * scale,
+            "bias_instability": float(sheet["B"][c]) * scale,
             "gauss_markov": states,
-            "datasheet": {t: float(model.value(t)[c]) * scale for t in ("N", "B", "K")},
+            "datasheet": {t: float(sheet[t][c]) * scale for t in ("N", "B", "K")},
+            "upper_bounds": [t for t in ("N", "B", "K") if not model.resolved(t)[c]],
         }
     return axes
 
@@ -258,7 +286,9 @@ def ekf_dict(gyro=None, accel=None, *, gyro_unit: str | None = None,
     into the white noise. These state-space values come from the fitted
     components (``model.components``); ``datasheet`` holds the model's datasheet
     values N, B, K (``model.N``…, the numbers the report and the other exports
-    print) in the same SI units, for reference.
+    print) in the same SI units, for reference. Where the data do not resolve N,
+    B or K, the value written is its 95 % upper bound (``model.upper``), with a
+    warning, and ``upper_bounds`` names those terms.
     """
     if gyro is None and accel is None:
         raise ValueError("gyro and accel are both None; pass at least one NoiseModel")
@@ -298,6 +328,7 @@ def ekf_yaml(gyro=None, accel=None, **kwargs) -> str:
                 lines.append(f"      {key}: {_scalar(a[key])}")
             lines.append("      datasheet: {" + ", ".join(
                 f"{k}: {_scalar(v)}" for k, v in a["datasheet"].items()) + "}")
+            lines.append("      upper_bounds: [" + ", ".join(a["upper_bounds"]) + "]")
             if not a["gauss_markov"]:
                 lines.append("      gauss_markov: []")
                 continue

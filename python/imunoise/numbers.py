@@ -145,6 +145,14 @@ def interval_cells(value, low, high) -> tuple[str, str, str]:
     return one(value), one(low), one(high)
 
 
+def upper_bound(bound, *, digits: int = 3) -> str:
+    """A value the data do not resolve: ``< bound`` (its upper bound to ``digits``
+    significant digits), or ``not resolved`` where there is no bound."""
+    if not _finite(bound):
+        return NOT_RESOLVED
+    return f"< {_significant(float(bound), digits)}"
+
+
 def cell(value, std=None, *, digits: int = 4) -> str:
     """A table cell: as :func:`format_value`, with "—" for a missing value."""
     return format_value(value, std, digits=digits, missing=EMPTY)

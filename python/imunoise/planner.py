@@ -189,7 +189,14 @@ def _coefficients(source, sensor: str) -> tuple[dict[str, float], str]:
     if isinstance(source, Mapping):
         return {k: float(source.get(k, 0.0)) for k in PLAN_TERMS}, ""
     if hasattr(source, "components") and hasattr(source, "N"):  # a NoiseModel
-        return {k: float(np.nanmedian(np.atleast_1d(getattr(source, k)))) for k in PLAN_TERMS}, ""
+        # The median over the axes that resolve the term; a term no axis resolves
+        # (NaN) is planned as absent, as a datasheet that omits it.
+        out = {}
+        for k in PLAN_TERMS:
+            values = np.atleast_1d(getattr(source, k)).astype(float)
+            values = values[np.isfinite(values)]
+            out[k] = float(np.median(values)) if values.size else 0.0
+        return out, ""
     from imunoise._simulate_log import noise_of_spec
     from imunoise.datasheet import load_spec
 

@@ -63,7 +63,8 @@ def test_bad_options():
 )
 @example(np.array([7.93270207e307, 7.93270207e307]), "slopes")  # K² overflowed a float
 def test_arbitrary_variances_never_crash(var, method):
-    """Any variance vector either fits (finite, non-negative) or raises ValueError."""
+    """Any variance vector either fits (each value finite and > 0, or NaN with a
+    non-negative bound or none) or raises ValueError."""
     taus = 0.1 * 2.0 ** np.arange(var.size)
     try:
         m = imunoise.fit(_result(taus, var), method=method)
@@ -72,7 +73,11 @@ def test_arbitrary_variances_never_crash(var, method):
         return
     for k in "QNBKR":
         v = float(getattr(m, k))
-        assert np.isfinite(v) and v >= 0
+        if m.resolved(k)[0]:
+            assert np.isfinite(v) and v > 0
+        else:
+            assert np.isnan(v)
+            assert not float(m.upper[k]) < 0
 
 
 @pytest.mark.parametrize(

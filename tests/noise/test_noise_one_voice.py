@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 from helpers.data import shared_file
 from helpers.noise_fit import clean_five_term_fits, quiet_fit
-from imunoise import export, units
+from imunoise import export, numbers, units
 from imunoise.noise import gm_white_density
 from imunoise.report import model_text
 
@@ -23,10 +23,10 @@ FS = 40.0
 @pytest.fixture(scope="module")
 def fast_gm_model():
     """White noise + a Gauss–Markov term of τc = 0.1 s (a sensor filter, white at
-    τ = 1 s) + a slow one (τc = 200 s): the datasheet N and K differ from the
-    fitted components'."""
+    τ = 1 s) + a slow one (τc = 5000 s, its hump beyond the 1 h record, a walk
+    over it): the datasheet N and K differ from the fitted components'."""
     x = imunoise.simulate(int(3600 * FS), FS, N=2e-4, channels=3, seed=5,
-                          gm=[(1.5e-3, 0.1), (2e-4, 200.0)])
+                          gm=[(1.5e-3, 0.1), (3e-4, 5000.0)])
     return quiet_fit(imunoise.adev(x, FS, taus=10))
 
 
@@ -38,8 +38,12 @@ def test_values_are_the_datasheet_values_not_the_components(fast_gm_model):
             gm_white_density(s, tc, FS) for s, tc in parts.gauss_markov(c) if tc <= 1.0)
         assert float(m.N[c]) == pytest.approx(math.sqrt(white), rel=1e-12)
         walk = float(parts.K[c]) ** 2 + sum(
-            2 * s * s / tc for s, tc in parts.gauss_markov(c) if tc > 1.0)
-        assert float(m.K[c]) == pytest.approx(math.sqrt(walk), rel=1e-12)
+            2 * s * s / tc for s, tc in parts.gauss_markov(c)
+            if tc > 1.0 and 1.8926 * tc > m.taus[-1])
+        if walk > 0:
+            assert float(m.K[c]) == pytest.approx(math.sqrt(walk), rel=1e-12)
+        else:  # no walk in the model: not resolved, never 0
+            assert np.isnan(m.K[c]) and m.upper["K"][c] > 0
         # the fast term makes the datasheet N larger than the fitted white noise
         assert parts.gauss_markov(c) and float(m.N[c]) > float(parts.N[c])
         assert m.supported["N"][c] and np.isfinite(m.N_std[c]) and m.N_std[c] > 0
@@ -51,7 +55,7 @@ def test_every_view_prints_the_same_numbers(fast_gm_model):
     table = {r["term"]: r for r in m.table("gyro", units=si)}
     for t in ("N", "B", "K"):
         for c, ax in enumerate("XYZ"):
-            assert table[t][ax] == pytest.approx(float(m.value(t)[c]), rel=1e-12)
+            np.testing.assert_allclose(table[t][ax], float(m.value(t)[c]), rtol=1e-12)
             assert table[t][ax + "_supported"] == bool(m.supported[t][c])
     # datasheet units: the default table is the value converted, nothing else
     deg = m.in_units("gyro")
@@ -63,7 +67,8 @@ def test_every_view_prints_the_same_numbers(fast_gm_model):
     # Kalibr: the worst axis of the same N and K
     kal = export.kalibr_dict(gyro=m)
     assert kal["gyroscope_noise_density"] == pytest.approx(float(np.max(m.N)), rel=1e-12)
-    assert kal["gyroscope_random_walk"] == pytest.approx(float(np.max(m.K)), rel=1e-12)
+    walk = np.where(m.resolved("K"), m.K, m.upper["K"])  # the bound where not resolved
+    assert kal["gyroscope_random_walk"] == pytest.approx(float(np.max(walk)), rel=1e-12)
     # EKF: the datasheet values beside the state-space ones
     ekf = export.ekf_dict(gyro=m)["gyroscope"]["axes"]
     for c, ax in enumerate("xyz"):
@@ -87,14 +92,25 @@ def test_not_resolved_means_one_thing():
     # white noise alone: no flat part and no walk, in every view
     x = imunoise.simulate(200_000, FS, N=1e-3, channels=3, seed=3)
     m = quiet_fit(imunoise.adev(x, FS, taus=10))
-    assert not np.any(m.supported["B"]) and np.all(m.B == 0) and np.all(np.isnan(m.B_std))
+    assert not np.any(m.supported["B"]) and np.all(np.isnan(m.B)) and np.all(np.isnan(m.B_std))
+    # never 0: NaN, with the largest value the curve allows, in every view
+    assert np.all(m.upper["B"] > 0) and np.all(np.isnan(m.upper["N"]))
     rows = {r["term"]: r for r in m.table()}
     assert all(not rows["B"][ax + "_supported"] for ax in "XYZ")
-    assert "not resolved" in m.table_text()
+    bounds = [numbers.upper_bound(rows["B"][ax + "_upper"]) for ax in "XYZ"]
+    assert all(b.startswith("< ") for b in bounds)
+    assert all(b in m.table_text() for b in bounds)
     header, body = model_text.datasheet_rows(m, "gyro")
     b_row = next(r for r in body if r[1] == "B")
-    assert b_row[3:] == ["not resolved"] * 3
+    assert all(cell.startswith("< ") for cell in b_row[3:])
     assert "B=" not in repr(m)
+    # the exports need a number: the bound, with a warning, not 0
+    with pytest.warns(RuntimeWarning, match="does not resolve K on axis 0, 1, 2; writing its "
+                                            "95 % upper bound"):
+        kal = export.kalibr_dict(gyro=m)
+    assert kal["gyroscope_random_walk"] == pytest.approx(float(np.max(m.upper["K"])))
+    d = json.loads(export.model_json(m))
+    assert d["B"]["value"] == [None] * 3 and d["B"]["upper"] == pytest.approx(list(m.upper["B"]))
 
 
 def test_old_spellings_warn_and_name_the_new_one(fast_gm_model):

@@ -12,7 +12,7 @@ import pytest
 from helpers.noise_fit import allan
 from hypothesis import given
 from hypothesis import strategies as st
-from imunoise import export, units
+from imunoise import export, numbers, units
 
 DEG = math.pi / 180
 G = 9.80665
@@ -100,7 +100,11 @@ def test_in_units_and_table(gyro_model):
         assert row_n[ax] == pytest.approx(n / DEG * 60, rel=0.05)
         assert row_n[ax + "_supported"]
     text = model.table_text("gyro")
-    assert "°/√h" in text and "X" in text and "not resolved" in text  # R is not resolved
+    # R is not resolved: its 95 % bound, never 0
+    assert "°/√h" in text and "X" in text and "R rate ramp" in text
+    r_row = next(r for r in rows if r["term"] == "R")
+    assert all(not r_row[ax + "_supported"] and r_row[ax + "_upper"] > 0 for ax in "XYZ")
+    assert numbers.upper_bound(r_row["X_upper"]) in text
     with pytest.raises(ValueError, match="axes"):
         model.table("gyro", axes=["X", "Y"])
 
@@ -124,8 +128,12 @@ def test_compare_verdicts(gyro_model, accel_model):
         assert b["ratio_std"] == pytest.approx(b["std"] / b["spec"])
         assert by[("accel", "N", ax)]["verdict"] == "above typical"  # a typical value is no limit
         assert by[("accel", "N", ax)]["ratio"] == pytest.approx(2.0, rel=0.05)
-        # accel white noise only: bias instability not resolved, not a number
-        assert by[("accel", "B", ax)]["verdict"] == "not resolved"
+        # accel white noise only: bias instability not resolved, not a number; its 95 %
+        # bound passes the datasheet's maximum where it lies below it
+        b = by[("accel", "B", ax)]
+        assert np.isnan(b["measured"]) and b["upper"] > 0
+        assert b["verdict"] == ("pass" if b["upper"] <= b["spec"] else "not resolved")
+        assert b["remark"].startswith("not resolved, at most ")
     assert cmp.passed  # no max/min limit is clearly exceeded
     assert "above typical (2× typical)" in cmp.text() and "not resolved" in cmp.text()
     # the ratio is rounded to its uncertainty like the measured value (GUM), not to noise digits
@@ -188,7 +196,7 @@ def test_kalibr_round_trip(tmp_path, gyro_model, accel_model):
     mg, _, _ = gyro_model
     ma, _ = accel_model
     path = tmp_path / "imu.yaml"
-    with pytest.warns(RuntimeWarning, match="no resolved K"):
+    with pytest.warns(RuntimeWarning, match="does not resolve K"):
         text = mg.to_kalibr(accel=ma, path=path, rostopic="/vn100/imu")
     assert path.read_text(encoding="utf-8") == text
     assert [p.name for p in tmp_path.iterdir()] == ["imu.yaml"]  # no temp file left
@@ -197,9 +205,10 @@ def test_kalibr_round_trip(tmp_path, gyro_model, accel_model):
     assert float(v["accelerometer_noise_density"]) == pytest.approx(np.max(ma.N), rel=1e-6)
     assert float(v["update_rate"]) == 40.0
     assert v["rostopic"] == "/vn100/imu"
-    # Random walk of a white-noise-only accel is unresolved -> 0 with a warning
-    assert float(v["accelerometer_random_walk"]) == 0.0
-    with pytest.warns(RuntimeWarning, match="no resolved K"):
+    # Random walk of a white-noise-only accel is unresolved -> its 95 % bound, not 0
+    assert float(v["accelerometer_random_walk"]) == pytest.approx(np.max(ma.upper["K"]),
+                                                                   rel=1e-6)
+    with pytest.warns(RuntimeWarning, match="does not resolve K"):
         rms = export.kalibr_dict(mg, ma, combine="rms")
     assert rms["gyroscope_noise_density"] == pytest.approx(np.sqrt(np.mean(mg.N**2)))
     assert rms["gyroscope_noise_density"] <= np.max(mg.N)
@@ -208,7 +217,7 @@ def test_kalibr_round_trip(tmp_path, gyro_model, accel_model):
 def test_openvins_and_json(tmp_path, gyro_model, accel_model):
     mg, _, _ = gyro_model
     ma, _ = accel_model
-    with pytest.warns(RuntimeWarning, match="no resolved K"):
+    with pytest.warns(RuntimeWarning, match="does not resolve K"):
         p = export.write_openvins(tmp_path / "kalibr_imu_chain.yaml", mg, ma)
     text = p.read_text(encoding="utf-8")
     assert text.startswith("%YAML:1.0") and "\nimu0:\n" in text and "T_i_b" in text

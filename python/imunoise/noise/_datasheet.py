@@ -8,13 +8,22 @@ A datasheet quotes what the curve shows, not which components made it:
   resonance damped faster than 1 s (its spectrum at zero frequency, quadrature
   included: a sensor's second-order filter passes its input's white noise). What a
   filter's white-noise input should be.
-- ``K``, the rate random walk: the fitted K together with every slower
-  Gauss–Markov term's short-τ random-walk rate √(2σ²/τc) (its +½ slope).
+- ``K``, the rate random walk: a walk that keeps rising to the end of the record.
+  The fitted K, together with the short-τ random-walk rate √(2σ²/τc) of a
+  Gauss–Markov term whose hump (its Allan variance's peak, τ ≈ 1.89 τc) lies
+  beyond the longest fitted tau: over the record it rises like a walk, and an
+  estimator's walk over that span is its rate. A Gauss–Markov term whose hump lies
+  within the fitted taus is a bump, a bias state of its own: it shapes B and is
+  never added to K (taken as K it would inflate an EKF's bias process noise by
+  the bump's height over the walk's).
 - ``B``, the bias instability: the floor of the model's deviation over the
   fitted taus divided by √(2 ln2/π) ≈ 0.6643 (:func:`model_floor`: the minimum,
-  or, where the curve falls again past a slow bump, the valley before it) — 0
-  when the curve never flattens (no part with a log-log slope above −¼).
+  or, where the curve falls again past a slow bump, the valley before it); not
+  resolved where the curve never flattens (no part with a log-log slope above −¼).
 - ``Q`` and ``R`` are the fitted coefficients.
+
+What the data cannot show is not resolved: NaN, never 0, with
+:func:`upper_bounds` the largest value the measured curve allows.
 
 A bounded motion of the mount (the platform's, not the sensor's) is part of the
 curve B is read from, but neither N nor K: under it a sensor's own white noise may
@@ -35,6 +44,7 @@ from imunoise.noise._terms import (
     FLAT_SLOPE,
     FLICKER,
     GM_MAX,
+    GM_PEAK,
     MOTION_SLOT,
     PARAMS,
     RES_SLOT,
@@ -44,6 +54,7 @@ from imunoise.noise._terms import (
     gm_white_density,
     is_log_time,
     resonance_white_density,
+    term_variances,
 )
 
 #: Points of the log-spaced grid over the fitted taus on which B's minimum is sought.
@@ -164,11 +175,18 @@ def _gauss_markov(p: np.ndarray) -> list[tuple[float, float]]:
     return [(p[5 + 2 * k], math.exp(p[6 + 2 * k])) for k in range(GM_MAX) if p[5 + 2 * k] > 0]
 
 
+def walks_beyond(tau_c: float, taus: np.ndarray) -> bool:
+    """Whether a Gauss–Markov term of correlation time ``tau_c`` still rises at the
+    longest fitted tau (its hump lies beyond the record), and so may stand in for K."""
+    return GM_PEAK * tau_c > float(taus[-1])
+
+
 def value_of(term: str, p: np.ndarray, taus: np.ndarray, fs: float) -> float:
-    """The datasheet value of ``term`` for the parameter vector ``p``."""
+    """The datasheet value of ``term`` for the parameter vector ``p``; NaN where
+    not resolved."""
     if term == "B":
         floor = model_floor(p, taus, fs)
-        return 0.0 if floor is None else floor[1] / FLICKER
+        return math.nan if floor is None else floor[1] / FLICKER
     total = p[1] if term == "N" else p[3]
     if term == "N" and p[RES_SLOT] > 0 and p[RES_SLOT + 2] <= 0.0:  # τr ≤ 1 s
         r2, f_r, tau_r, skew = _resonance(p)
@@ -176,6 +194,63 @@ def value_of(term: str, p: np.ndarray, taus: np.ndarray, fs: float) -> float:
     for q2, tau_c in _gauss_markov(p):
         if term == "N" and tau_c <= 1.0:
             total += q2 * gm_white_density(1.0, tau_c, fs)
-        elif term == "K" and tau_c > 1.0:
+        elif term == "K" and tau_c > 1.0 and walks_beyond(tau_c, taus):
             total += 2.0 * q2 / tau_c
-    return math.sqrt(max(total, 0.0))
+    return math.sqrt(total) if total > 0 else math.nan
+
+
+#: Confidence of the bound on a value the data do not resolve.
+UPPER_CONFIDENCE = 0.95
+
+
+def upper_bounds(taus, var, edf) -> dict[str, np.ndarray]:
+    """``{term: (channels,)}``: the largest value of each of Q, N, B, K, R that the
+    measured Allan variance allows at 95 % confidence.
+
+    The rule: the term alone may not exceed the measured variance's one-sided upper
+    confidence limit σ̂²·edf/χ²_α(edf) at any fitted tau, so its bound is
+    min_τ √(limit(τ)/f(τ)) with f its Allan variance per unit coefficient² (3/τ²,
+    1/τ, 2 ln2/π, τ/3, τ²/2). Every other term only adds to the curve, so the bound
+    holds whatever they are. α is 5 % shared over the octaves the taus span
+    (Bonferroni: estimates an octave apart are nearly independent, neighbours
+    within one are not), so the bound holds at 95 % over the whole curve.
+    ``var``, ``edf``: (taus, channels).
+    """
+    from scipy import stats
+
+    taus = np.asarray(taus, float)
+    var, edf = np.asarray(var, float), np.asarray(edf, float)
+    octaves = max(1.0, math.log2(taus[-1] / taus[0])) if taus.size > 1 else 1.0
+    alpha = (1.0 - UPPER_CONFIDENCE) / octaves
+    ok = np.isfinite(var) & (var > 0) & np.isfinite(edf) & (edf > 0)
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        limit = np.where(ok, var * edf / stats.chi2.ppf(alpha, np.where(ok, edf, 1.0)), np.inf)
+    out = {}
+    for term in TERMS:
+        unit = [1.0 if t == term else 0.0 for t in TERMS]
+        per_unit = term_variances(taus, 1.0, unit)[:, TERMS.index(term), None]
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+            bound = np.sqrt(np.min(limit / per_unit, axis=0))
+        out[term] = np.where(np.isfinite(bound), bound, np.nan)
+    return out
+
+
+def datasheet_notes(components, taus, channel: int, method: str) -> tuple[str, ...]:
+    """What a reader of channel ``channel``'s K needs to know: which slow
+    Gauss–Markov terms stand in for it (hump beyond the record) and which are bumps
+    within the record, bias states of their own left out of it."""
+    if method != "wls":
+        return ()
+    taus = np.asarray(taus, float)
+    notes = []
+    for _, tau_c in components.gauss_markov(channel):
+        if tau_c <= 1.0:
+            continue
+        if walks_beyond(tau_c, taus):
+            notes.append(f"K includes a Gauss–Markov term of τc {tau_c:.3g} s whose hump "
+                         f"(τ ≈ {GM_PEAK * tau_c:.3g} s) lies beyond the longest tau "
+                         f"({taus[-1]:.3g} s): over the record it rises like a random walk")
+        else:
+            notes.append(f"a Gauss–Markov bump of τc {tau_c:.3g} s lies within the record: "
+                         "a bias state of its own (the EKF export keeps it), not part of K")
+    return tuple(notes)

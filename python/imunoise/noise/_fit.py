@@ -17,7 +17,7 @@ from imunoise import _warn
 from imunoise._core import fit as _core_fit
 from imunoise._deprecation import old_call_forms
 from imunoise.noise._components import Components
-from imunoise.noise._datasheet import datasheet_values
+from imunoise.noise._datasheet import datasheet_notes, datasheet_values, upper_bounds
 from imunoise.noise._model import NoiseModel
 from imunoise.noise._readoff import coverage, fit_slopes, measured, readoffs
 from imunoise.noise._terms import (
@@ -334,10 +334,13 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
     if uncertainty == "bootstrap":
         sheet = {k: (v, sheet_std[:, i]) for i, (k, (v, _)) in enumerate(sheet.items())}
     resolved = {k: (v > 0) & np.isfinite(v) for k, (v, _) in sheet.items()}
+    bounds = upper_bounds(taus, np.square(dev_all), edf_raw)
     model = NoiseModel(
-        **{k: shaped(v) for k, (v, _) in sheet.items()},
+        **{k: shaped(np.where(resolved[k], v, np.nan)) for k, (v, _) in sheet.items()},
         **{k + "_std": shaped(np.where(resolved[k], e, np.nan)) for k, (_, e) in sheet.items()},
         supported={k: shaped(v) for k, v in resolved.items()},
+        upper={k: shaped(np.where(resolved[k], np.nan, bounds[k])) for k in TERMS},
+        notes=tuple(datasheet_notes(components, taus, c, method) for c in range(channels)),
         components=components,
         method=method,
         kind=result.kind,
@@ -440,12 +443,12 @@ def _bootstrap_std(result, n, coef, markov, oscillators, replicates, rng, option
                                                parts.resonance_skew)], axis=-1)
     moving = np.stack([np.atleast_1d(parts.motion_sigma), np.atleast_1d(parts.motion_tau)],
                       axis=-1)
-    sheet = np.stack([refit.value(t) for t in TERMS], axis=1)
+    sheet = np.stack([refit.value(t) for t in TERMS], axis=1)  # NaN: not resolved
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN: no tone
         return (values.std(axis=0, ddof=1), np.nanstd(gm, axis=0, ddof=1),
                 np.nanstd(tone, axis=0, ddof=1), np.nanstd(osc, axis=0, ddof=1),
-                np.nanstd(moving, axis=0, ddof=1), sheet.std(axis=0, ddof=1))
+                np.nanstd(moving, axis=0, ddof=1), np.nanstd(sheet, axis=0, ddof=1))
 
 
 def _readonly(a):

@@ -40,11 +40,21 @@ class NoiseModel(PerTerm):
     ``N``, ``B``, ``K``, ``Q``, ``R`` are the numbers a datasheet quotes from the
     model's curve — the same numbers in every view (the repr, :meth:`table`, the
     report, ``imunoise fit``, :func:`imunoise.compare` and the Kalibr, OpenVINS
-    and EKF exports). They are computed from all fitted components together: a
-    Gauss–Markov term faster than 1 s is white noise at the τ = 1 s read-off and
-    adds to N; a slower one's +½ slope adds to K; B is the flat minimum of the
-    whole curve divided by 0.6643 (see ``imunoise.noise._datasheet``). The fit's
-    own parameters are :attr:`components`. All arrays are read-only.
+    and EKF exports). They are computed from all fitted components together:
+
+    ====  ==================================================================
+    N     the white rate noise level, the −½ line at τ = 1 s: the fitted N with
+          every Gauss–Markov term faster than 1 s (white at that read-off)
+    B     the model curve's flat minimum / 0.6643 over the fitted taus
+    K     a random walk that keeps rising to the end of the record: the fitted K
+          with any Gauss–Markov term whose hump (τ ≈ 1.89 τc) lies beyond the
+          longest tau (:attr:`notes` says so); a bump within the record is a
+          bias state of its own, never added to K
+    Q, R  the fitted coefficients
+    ====  ==================================================================
+
+    A value the data cannot show is NaN with :attr:`upper` its 95 % bound, never
+    0. The fit's own parameters are :attr:`components`. All arrays are read-only.
 
     Attributes
     ----------
@@ -52,14 +62,27 @@ class NoiseModel(PerTerm):
         Datasheet values: quantization (rate·s), white-noise density / angle or
         velocity random walk (rate·√s = rate/√Hz), bias instability (rate), rate
         random walk (rate/√s) and rate ramp (rate/s). Shape () for a one-channel
-        result, (channels,) otherwise. 0 where not resolved.
+        result, (channels,) otherwise. NaN where the data do not resolve the value
+        (never 0: a downstream filter would read 0 as "none"); :attr:`upper` then
+        bounds it.
     Q_std, N_std, B_std, K_std, R_std : ndarray
         Standard uncertainties, propagated from the fit's covariance (NaN where
         not resolved).
     supported : dict[str, ndarray of bool]
         Whether each datasheet value is resolved by the data (``False``: the
-        value is 0 and means "not resolved", not "absent"). The one meaning of
+        value is NaN, "not resolved", not "absent"). The one meaning of
         "not resolved" in every view.
+    upper : dict[str, ndarray]
+        Where a value is not resolved, the largest value the measured curve allows
+        at 95 % confidence (the term alone stays below the Allan variance's
+        one-sided upper confidence limit at every fitted tau, the 5 % shared over
+        the octaves the taus span); NaN where the value is resolved. Tables print
+        it as ``< bound``, and the Kalibr, OpenVINS and EKF exports use it, with a
+        warning, where they need a number.
+    notes : tuple of tuple of str
+        Per channel, what a reader of the datasheet values needs to know: a slow
+        Gauss–Markov term standing in for K (its hump lies beyond the record), or a
+        bump within the record kept out of K.
     components : Components
         The fitted components: IEEE coefficients of the fit, Gauss–Markov terms
         (σ, τc), the tone (A, f0) and the resonance (σ, f_r, τr), with their
@@ -108,6 +131,8 @@ class NoiseModel(PerTerm):
     chi2: np.ndarray = field(repr=False)
     n_eff: np.ndarray = field(repr=False)
     readoff: dict[str, dict[str, np.ndarray]] = field(repr=False)
+    upper: dict[str, np.ndarray] = field(repr=False)
+    notes: tuple[tuple[str, ...], ...] = field(repr=False)
 
     # -- per term (channels, one_channel, value, std: PerTerm) ---------------
     def resolved(self, term: str) -> np.ndarray:
@@ -244,8 +269,9 @@ class NoiseModel(PerTerm):
         Returns
         -------
         dict
-            ``{term: {"value", "std", "unit", "label", "supported"}}`` with arrays
-            shaped like the model's values.
+            ``{term: {"value", "std", "upper", "unit", "label", "supported"}}`` with
+            arrays shaped like the model's values (``value`` NaN and ``upper`` its
+            95 % bound where not supported).
         """
         units = _units.unit_choice(units, sensor)
         unknown = set(units) - set(TERMS)
@@ -259,6 +285,8 @@ class NoiseModel(PerTerm):
             out[term] = {
                 "value": _units.convert(getattr(self, term), term, info.name, sensor=sensor,
                                         input_unit=input_unit),
+                "upper": _units.convert(np.reshape(self.upper[term], shape), term, info.name,
+                                        sensor=sensor, input_unit=input_unit),
                 "std": _units.convert(np.where(supported, getattr(self, term + "_std"), np.nan),
                                       term, info.name, sensor=sensor, input_unit=input_unit),
                 "unit": info.name,
@@ -280,9 +308,11 @@ class NoiseModel(PerTerm):
         Each row is a dict with ``term``, ``quantity``, ``unit``, ``label``,
         ``missing`` (the text of an axis without the value: ``not resolved`` for
         a datasheet value, ``—`` for a component the axis's model does not have)
-        and, per axis name (default X, Y, Z…), the value, ``<axis>_std`` and
-        ``<axis>_supported``. Render it with :func:`format_table`. ``units`` as
-        for :meth:`in_units` (``"datasheet"``: °/s/√Hz, °/h, µg/√Hz, µg).
+        and, per axis name (default X, Y, Z…), the value (NaN where not
+        resolved), ``<axis>_std``, ``<axis>_upper`` (a datasheet value's 95 % bound
+        where not resolved) and ``<axis>_supported``. Render it with
+        :func:`format_table`. ``units`` as for :meth:`in_units` (``"datasheet"``:
+        °/s/√Hz, °/h, µg/√Hz, µg).
         """
         axes = _schema.axis_names(self.channels, axes)
         conv = self.in_units(sensor, units=units, input_unit=input_unit)
@@ -292,10 +322,12 @@ class NoiseModel(PerTerm):
             c = conv[term]
             row = {"term": term, "quantity": SENSOR_NAMES[sensor].get(term, NAMES[term]),
                    "unit": c["unit"], "label": c["label"], "missing": _numbers.NOT_RESOLVED}
-            vals, stds, sup = (np.atleast_1d(c[k]) for k in ("value", "std", "supported"))
+            vals, stds, ups, sup = (np.atleast_1d(c[k])
+                                    for k in ("value", "std", "upper", "supported"))
             for i, ax in enumerate(axes):
                 row[ax] = float(vals[i])
                 row[ax + "_std"] = float(stds[i])
+                row[ax + "_upper"] = float(ups[i])
                 row[ax + "_supported"] = bool(sup[i])
             rows.append(row)
         # σ and A in B's unit (a rate), a motion's σθ in Q's (rate·s)
@@ -310,7 +342,7 @@ class NoiseModel(PerTerm):
                 return float(_units.convert(v, as_term, shown, sensor=sensor,
                                             input_unit=input_unit))
 
-            row = {"term": term, "quantity": "component: " + quantity, "missing": "—",
+            row = {"term": term, "quantity": "component: " + quantity, "missing": _numbers.EMPTY,
                    "unit": shown, "label": conv[as_term]["label"] if as_term else unit}
             for i, ax in enumerate(axes):
                 v, e = float(values[i]), float(stds[i])
@@ -390,14 +422,16 @@ class NoiseModel(PerTerm):
 
     def to_dict(self) -> dict:
         """Plain-Python view of the model (lists and floats), e.g. for JSON: the
-        datasheet values under their names, the fitted components under
-        ``"components"``."""
+        datasheet values under their names (``None`` where not resolved, with
+        ``"upper"`` the bound), the fitted components under ``"components"``."""
         d = {"method": self.method, "kind": self.kind, "fs": self.fs,
              "overlapping": self.overlapping, "channels": self.channels,
              "taus": self.taus.tolist(), "units": dict(_INPUT_UNITS)}
         for term in TERMS:
-            d[term] = {"value": self.value(term).tolist(), "std": finite_list(self.std(term)),
+            d[term] = {"value": finite_list(self.value(term)), "std": finite_list(self.std(term)),
+                       "upper": finite_list(np.atleast_1d(self.upper[term])),
                        "supported": self.resolved(term).tolist()}
+        d["notes"] = [list(n) for n in self.notes]
         d["components"] = self.components.to_dict()
         d["coverage"] = np.atleast_1d(self.coverage).tolist()
         d["discrepancy"] = np.atleast_1d(self.discrepancy).tolist()
@@ -423,20 +457,29 @@ _MOVED_FIELDS = frozenset({
 LAB_TERMS = ("N", "B", "K")
 
 
+def table_cell(row: dict, axis: str, number) -> str:
+    """One axis's cell of a :meth:`NoiseModel.table` row: ``number(value, std)``
+    where resolved, else ``< bound`` for a datasheet value the data do not resolve
+    (``not resolved`` without a bound) and ``—`` for a component the axis lacks."""
+    if row[axis + "_supported"]:
+        return number(row[axis], row[axis + "_std"])
+    if row.get("missing") == _numbers.NOT_RESOLVED:
+        return _numbers.upper_bound(row.get(axis + "_upper"))
+    return row.get("missing", _numbers.NOT_RESOLVED)
+
+
 def format_table(rows: list[dict], axes: Sequence[str], *, datasheet: bool = False) -> str:
     """Render :meth:`NoiseModel.table` rows as fixed-width text.
 
-    Terms the data do not resolve print as ``not resolved`` (the report's and
-    ``imunoise fit``'s wording too), a component an axis's model does not have
-    as ``—``; values carry ``± std``, rounded to it
+    Terms the data do not resolve print as ``< bound`` (their 95 % upper bound;
+    ``not resolved`` without one: the report's and ``imunoise fit``'s wording
+    too), a component an axis's model does not have as ``—``; values carry ``± std``, rounded to it
     (:func:`imunoise.numbers.format_value`). With ``datasheet`` (rows of
     :meth:`NoiseModel.lab_table`), two more columns: the datasheet's value in the
     row's unit and as the datasheet prints it.
     """
     def cell(row, ax):
-        if not row[ax + "_supported"]:
-            return row.get("missing", _numbers.NOT_RESOLVED)
-        return _numbers.format_value(row[ax], row[ax + "_std"])
+        return table_cell(row, ax, _numbers.format_value)
 
     header = ["coefficient", "unit", *axes]
     body = [[f"{r['term']} {r['quantity']}", r["label"], *(cell(r, a) for a in axes)]

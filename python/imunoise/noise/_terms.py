@@ -30,6 +30,11 @@ SENSOR_NAMES = {
 # straight line is read (IEEE 952 Annex C).
 SLOPE = {"Q": -1.0, "N": -0.5, "B": 0.0, "K": 0.5, "R": 1.0}
 READ_TAU = {"Q": math.sqrt(3.0), "N": 1.0, "K": 3.0, "R": math.sqrt(2.0)}
+GM_PEAK = 1.8926
+"""τ/τc where a first-order Gauss–Markov term's Allan variance peaks (IEEE 952
+Annex C): its hump. Below it the term rises like a random walk, above it falls
+like white noise."""
+
 GM_MAX: int = _core_fit.MAX_GAUSS_MARKOV
 """Most first-order Gauss–Markov terms a model may have."""
 

@@ -12,6 +12,7 @@ from imunoise import datasheet
 from imunoise import units as _units
 from imunoise._schema import axis_names
 from imunoise.noise import NoiseModel, gm_white_density, resolution_noise
+from imunoise.noise._model import table_cell
 from imunoise.report.formatting import format_number
 
 __all__ = ["comparison_rows", "datasheet_rows", "lab_rows", "model_sentences"]
@@ -37,11 +38,7 @@ def datasheet_rows(model: NoiseModel, sensor: str, units: str | dict | None = No
     out = []
     for r in model.table(sensor, axes=axes, units=units):
         cells = [r["quantity"], r["term"], r["label"] if symbols else r["unit"]]
-        for a in axes:
-            if not r[f"{a}_supported"]:
-                cells.append(r["missing"])
-            else:
-                cells.append(format_number(r[a], r[f"{a}_std"]))
+        cells += [table_cell(r, a, format_number) for a in axes]
         out.append(cells)
     return ["quantity", "term", "unit", *axes], out
 
@@ -60,8 +57,7 @@ def lab_rows(models: dict[str, NoiseModel], spec,
         axes = axes or names
         for r in model.lab_table(sensor, spec=spec, units=units, axes=names):
             cells = [sensor, f"{r['quantity']} ({r['term']})", r["label"]]
-            cells += [format_number(r[a], r[f"{a}_std"]) if r[f"{a}_supported"]
-                      else r["missing"] for a in names]
+            cells += [table_cell(r, a, format_number) for a in names]
             cells += [""] * (len(axes) - len(names))
             cells += [format_number(r["spec"]), r["spec_text"]]
             out.append(cells)
@@ -151,8 +147,9 @@ def _motion_sentence(model: NoiseModel, c: int, sensor: str, n_unit, q_unit) -> 
         value, value_std = _units.convert(np.array([sigma, sigma_std]), "Q", q_unit.name,
                                           sensor=sensor)
         white = math.sqrt(2.0 * sigma**2 / tau_c)  # its density below τc
-        n_now = float(model.value("N")[c])
-        bound = _units.convert(math.hypot(n_now, white), "N", n_unit.name, sensor=sensor)
+        n_now = float(model.value("N")[c])  # NaN where not resolved
+        bound = _units.convert(math.hypot(n_now if n_now > 0 else 0.0, white), "N",
+                               n_unit.name, sensor=sensor)
         text = (f"**a bounded motion of the mount** (the platform's angle wanders by "
                 f"σ = {format_number(value, value_std)} {q_unit.label} over "
                 f"τc = {format_number(tau_c, tau_std)} s and comes back: white below τc, "

@@ -58,6 +58,7 @@ def _base_row(path: str) -> dict:
     for t in _TERM_ORDER:
         row[t] = np.nan
         row[f"{t}_std"] = np.nan
+        row[f"{t}_upper"] = np.nan
         row[f"{t}_supported"] = False
     row["verdict"] = None
     row["error"] = None
@@ -100,6 +101,7 @@ def analyse_log(path: str, spec=None, fs: float | None = None) -> list[dict]:
                 for t in _TERM_ORDER:
                     row[t] = float(np.atleast_1d(m.value(t))[j])
                     row[f"{t}_std"] = float(np.atleast_1d(m.std(t))[j])
+                    row[f"{t}_upper"] = float(np.atleast_1d(m.upper[t])[j])
                     row[f"{t}_supported"] = bool(np.atleast_1d(m.supported[t])[j])
                 v = verdicts.get((s, axis), {})
                 if v:
@@ -167,8 +169,9 @@ def batch(
         ``paths``: ``path, sensor, axis, format, samples, fs, duration_s``, the
         parse issue counts ``issues_<kind>``, the fitted coefficients ``N, B, K,
         Q, R`` in the log's units (rad/s or m/s² per √s ... as
-        :class:`~imunoise.noise.NoiseModel`), their standard uncertainties
-        ``<term>_std`` and ``<term>_supported``, the datasheet ``verdict`` (worst
+        :class:`~imunoise.noise.NoiseModel`; NaN where not resolved), their standard
+        uncertainties ``<term>_std``, ``<term>_upper`` (the 95 % bound where not
+        resolved) and ``<term>_supported``, the datasheet ``verdict`` (worst
         over the specified terms in datasheet.VERDICTS order: fail first, not
         resolved last) and per term
         ``verdict_<term>``, and ``error``. A log that cannot be analysed has one
