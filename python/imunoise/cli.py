@@ -257,6 +257,10 @@ def _add_recording_commands(sub) -> None:
                        help="8-bit checksum on the sensor's sentences")
     rc.add_argument("--keep-config", action="store_true",
                     help="leave the settings on the sensor (default: restore the previous ones)")
+    rc.add_argument("--outage-timeout", type=_positive_float, default=2.0, metavar="SECONDS",
+                    help="seconds without a byte after which the sensor counts as gone and "
+                    "is set up again until it answers; the time lost is kept in OUTPUT.gaps "
+                    "(default: %(default)s, at least three periods of the slowest output)")
 
     em = sub.add_parser("emulate", help="a VN-100 emulator on a pseudo-terminal (tests, demos)",
                         description="Serve an emulated VN-100 at PATH (a symlink to a "
@@ -794,7 +798,7 @@ def _cmd_thermal(args) -> int:
 
 
 def _cmd_record(args) -> int:
-    from imunoise.recording import binary_output, record
+    from imunoise.recording import DeviceError, binary_output, record
 
     seconds = (args.hours * 3600 if args.hours else args.minutes * 60 if args.minutes
                else args.seconds)
@@ -813,8 +817,12 @@ def _cmd_record(args) -> int:
             binary.append(binary_output(float(rate), fields))
         except ValueError as exc:
             _fail(f"--binary {text}: {exc}")
-    rec = record(args.port, args.output, seconds=seconds, baud=baud, ascii=args.ascii,
-                 rate=args.rate, binary=binary, crc=args.crc, keep_config=args.keep_config)
+    try:
+        rec = record(args.port, args.output, seconds=seconds, baud=baud, ascii=args.ascii,
+                     rate=args.rate, binary=binary, crc=args.crc,
+                     keep_config=args.keep_config, outage_timeout=args.outage_timeout)
+    except DeviceError as exc:  # the message names the port; SensorLost too
+        _fail(str(exc))
     print(f"recorded {rec.bytes} bytes in {duration(rec.seconds)} to {rec.path}"
           + (f"; {len(rec.outages)} port outage(s)" if rec.outages else "")
           + ("; previous settings restored" if rec.restored else ""))
