@@ -834,6 +834,7 @@ def _cmd_emulate(args) -> int:
     import time
 
     from imunoise.emulate import Emulator, Fault
+    from imunoise.emulate.device import MAX_SPEED
 
     faults = []
     for text in args.fault:
@@ -843,12 +844,18 @@ def _cmd_emulate(args) -> int:
             faults.append(Fault(kind, float(at), float(length or 0)))
         except ValueError as exc:
             _fail(f"--fault {text}: {exc}")
+    if args.speed > MAX_SPEED:  # before the port appears
+        _fail(f"--speed must be at most {MAX_SPEED:g} (sensor seconds per wall second); "
+              f"got {args.speed:g}")
     with Emulator(args.path, speed=args.speed, seed=args.seed, faults=faults,
                   keep_sent=False) as emu:
         print(f"VN-100 emulator on {emu.path} -> {os.path.realpath(emu.path)}; Ctrl-C to stop",
               flush=True)
         started = time.monotonic()
         while args.seconds is None or time.monotonic() - started < args.seconds:
+            if not emu.alive:  # a sensor that stopped is an error, not a quiet exit 0
+                _fail(f"the emulated sensor on {emu.path} stopped: "
+                      f"{emu.error or 'its thread ended'}")
             time.sleep(0.1)
     return 0
 
