@@ -42,3 +42,48 @@ def test_bad_input_gets_its_vnerr(emulator, raw, code):
         assert errors == [code], (error_name(code), bytes(received[-300:]))
     finally:
         port.close()
+
+
+def _emitted(seconds: float, **registers):
+    """What the emulated sensor sends in ``seconds`` of sensor time with the
+    register values given (no port: the encoder itself), read back."""
+    from imunoise.emulate.outputs import SampleSource, encode
+    from imunoise.emulate.registers import Registers
+    from imunoise.readers.vn import read_vn
+
+    regs = Registers()
+    for reg, value in registers.items():
+        regs.values[int(reg[1:])] = value
+    records = encode(regs, SampleSource(3), 0, round(seconds * 800))
+    return read_vn(b"".join(records), fs=float(regs.values[7][0]))
+
+
+@pytest.mark.parametrize("rate", [40, 200])
+def test_emitted_white_noise_has_the_datasheets_density_at_the_output_rate(rate):
+    # 800 Hz samples decimated without averaging made the density sqrt(800/rate) too
+    # high (4.5x at 40 Hz); averaged to the output rate it is the datasheet's. At
+    # tau = 0.25 s the white noise dominates (bias instability adds ~3 %).
+    import imunoise
+    import numpy as np
+
+    log = _emitted(300, r7=(rate,))
+    for sensor, density in (("gyro", np.radians(0.0035)), ("accel", 0.14e-3 * 9.80665)):
+        dev = imunoise.adev(getattr(log, sensor), log.fs, taus=np.array([0.25])).dev[0]
+        measured = dev * np.sqrt(0.25)
+        np.testing.assert_allclose(measured, density, rtol=0.12, err_msg=sensor)
+
+
+def test_attitude_and_field_move_like_a_still_sensors():
+    # constant before; now small noise and slow wander around the constant, no jumps
+    import numpy as np
+
+    log = _emitted(200, r7=(40,))
+    ypr, mag = np.asarray(log.ypr), np.asarray(log.mag)
+    assert np.all(ypr.std(axis=0) > 0.002) and np.all(ypr.std(axis=0) < 0.1)  # deg
+    assert np.all(np.ptp(ypr, axis=0) < 0.5)
+    np.testing.assert_allclose(ypr.mean(axis=0), (-77.7, -1.3, 0.15), atol=0.05)
+    assert np.all(mag.std(axis=0) > 1e-4) and np.all(mag.std(axis=0) < 5e-3)  # Gauss
+    np.testing.assert_allclose(mag.mean(axis=0), (0.045, 0.247, -0.338), atol=1e-3)
+    # wander: the 10 s means move more than white noise alone would move them
+    tens = ypr[: len(ypr) // 400 * 400].reshape(-1, 400, 3).mean(axis=1)
+    assert np.all(tens.std(axis=0) > ypr.std(axis=0) / np.sqrt(400))
