@@ -96,18 +96,33 @@ def write_register(session: Session, reg: int, fields: tuple[str, ...]) -> None:
     body = f"VNWRG,{reg:02d}," + ",".join(fields)
     reply, _ = session.command(body)
     echo = reply.fields[1:]
-    back = read_register(session, reg)
+    try:
+        back = read_register(session, reg)
+    except DeviceError as exc:  # the write went through: not a refused write (no code)
+        raise DeviceError(f"register {reg}: written, but reading it back failed: {exc}"
+                          ) from None
     for what, got in (("echoed", echo), ("read back", back)):
         if _normal(got) != _normal(fields):
             raise DeviceError(f"register {reg}: wrote {','.join(fields)} but the sensor "
                               f"{what} {','.join(got)}")
 
 
-def apply(session: Session, wanted: dict[int, tuple[str, ...]]) -> None:
-    """Write every register of ``wanted`` (in :data:`OUTPUT_REGISTERS` order)."""
+def apply(session: Session, wanted: dict[int, tuple[str, ...]],
+          touched: set[int] | None = None) -> None:
+    """Write every register of ``wanted`` (in :data:`OUTPUT_REGISTERS` order);
+    ``touched`` receives each register that may have changed (written, or a write
+    lost or echoed wrong; not one the sensor refused with ``$VNERR``), so a restore
+    writes back those and no others."""
     for reg in OUTPUT_REGISTERS:
         if reg in wanted:
-            write_register(session, reg, wanted[reg])
+            if touched is not None:
+                touched.add(reg)
+            try:
+                write_register(session, reg, wanted[reg])
+            except DeviceError as exc:
+                if exc.code is not None and touched is not None:
+                    touched.discard(reg)  # refused: the sensor kept its value
+                raise
             if reg == 30:
                 session.crc = wanted[30][4] == "3"
 
@@ -126,8 +141,8 @@ def restore(session: Session, previous: dict[int, tuple[str, ...]], changed) -> 
             try:
                 write_register(session, reg, previous[reg])
             except (DeviceError, OSError, serial.SerialException) as exc:
-                failed.append(f"register {reg} not restored to {','.join(previous[reg])}: "
-                              f"{exc}")
+                failed.append(f"restoring register {reg} to {','.join(previous[reg])} "
+                              f"failed: {exc}")
                 continue
             if reg == 30:
                 session.crc = previous[30][4] == "3"

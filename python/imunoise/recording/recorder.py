@@ -173,6 +173,8 @@ class _Recorder:
         self.identity: dict = {}
         self.previous: dict = {}
         self.wanted: dict = {}
+        self.touched: set[int] = set()  # registers written (or tried): those restored
+        self.restore_failed = False
         self.notes: list[str] = []
         self.outages: list[Outage] = []
         self.lost: Outage | None = None  # the outage the record ended in
@@ -198,8 +200,6 @@ class _Recorder:
             if first:
                 self.identity = config.read_identity(session)
                 self.previous = config.read_outputs(session, self.notes)
-                for note in self.notes:
-                    warnings.warn(note, stacklevel=3)
                 self.wanted = config.wanted_outputs(self.previous, **self.options)
                 lacking = [r for r in self.wanted if r in config.OPTIONAL_REGISTERS
                            and r not in self.previous]
@@ -211,7 +211,9 @@ class _Recorder:
                     raise ValueError("with these settings the sensor sends nothing "
                                      "(ASCII output off, no binary output): nothing to "
                                      "record")
-            config.apply(session, self.wanted)
+                for note in self.notes:  # once the record will be made: one line if not
+                    warnings.warn(note, stacklevel=3)
+            config.apply(session, self.wanted, self.touched)
             session.command("VNASY,1")
         except BaseException:
             try:
@@ -231,8 +233,10 @@ class _Recorder:
         the way (the resume is always sent); returns the steps that failed."""
         problems: list[str] = []
         try:
-            if not self.keep_config and self.wanted:
-                problems += config.restore(session, self.previous, self.wanted)
+            if not self.keep_config and self.touched:
+                failed = config.restore(session, self.previous, self.touched)
+                self.restore_failed = bool(failed)
+                problems += failed
         finally:
             try:
                 if answered:
@@ -339,8 +343,7 @@ class _Recorder:
         self.notes += problems
         for problem in problems:
             warnings.warn(problem, stacklevel=3)
-        return bool(self.wanted) and not self.keep_config and not any(
-            "not restored" in p for p in problems)
+        return bool(self.touched) and not self.keep_config and not self.restore_failed
 
 
 def record(port, output, *, seconds: float | None = None, baud: int | str = 115200,
