@@ -87,3 +87,12 @@ def test_attitude_and_field_move_like_a_still_sensors():
     # wander: the 10 s means move more than white noise alone would move them
     tens = ypr[: len(ypr) // 400 * 400].reshape(-1, 400, 3).mean(axis=1)
     assert np.all(tens.std(axis=0) > ypr.std(axis=0) / np.sqrt(400))
+
+
+@pytest.mark.parametrize("speed", [0, -1, float("nan"), float("inf"), 1e300, 1001])
+def test_speed_outside_its_bounds_is_refused_before_the_port_appears(tmp_path, speed):
+    from imunoise.emulate import Emulator
+
+    with pytest.raises(ValueError, match=r"speed must be .* in \(0, 1000\]"):
+        Emulator(tmp_path / "port", speed=speed)
+    assert not (tmp_path / "port").exists()

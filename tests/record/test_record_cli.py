@@ -16,6 +16,16 @@ from imunoise.cli import main
     (["record", "p", "-o", "x.vn", "--rate", "33"], "rate must be one of"),
     (["plan", "--target", "2"], "target must be a relative uncertainty in (0, 1)"),
     (["emulate", "p", "--fault", "melt@1"], "fault kind must be one of"),
+    # bounds said before anything is written to a sensor or a port made
+    (["record", "p", "-o", "x.vn", "--binary", "1e-300:common=TimeStartup"],
+     "binary rate must be 800 Hz divided by a whole number from 1 to 65535"),
+    (["record", "p", "-o", "x.vn", "--binary", "800:common=0x10029"],
+     "mask of group common must be within 0x0001 ... 0xFFFF (16 bits); got 0x10029"),
+    (["record", "p", "-o", "x.vn", "--binary", "nan:common=TimeStartup"], "got nan"),
+    (["record", "p", "-o", "x.vn", "--outage-timeout", "0"], "--outage-timeout"),
+    (["emulate", "p", "--speed", "1e300"], "--speed must be at most 1000"),
+    (["emulate", "p", "--speed", "inf"], "--speed: expected a positive number"),
+    (["emulate", "p", "--speed", "0"], "--speed: expected a positive number"),
 ])
 def test_errors_are_one_line_with_status_2(argv, message, capsys, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
