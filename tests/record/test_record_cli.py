@@ -45,3 +45,15 @@ def test_record_from_the_emulator_and_plan(emulator, tmp_path, capsys):
     assert out.stat().st_size > 0 and emu.registers[7] == (40,)
     assert main(["plan", "--spec", "vn100", "--sensor", "gyro"]) == 0
     assert "needs N" in capsys.readouterr().out
+
+
+def test_a_wrong_baud_rate_is_one_line_naming_the_port(emulator, tmp_path, capsys):
+    # the emulator at 57600 Bd sends what a 115200 Bd reader sees: garbage, no reply
+    emu = emulator(speed=5, seed=12, baud=57600)
+    before = emu.registers
+    out = tmp_path / "x.vn"
+    assert main(["record", emu.path, "-o", str(out), "--seconds", "1", "--rate", "20"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("imunoise: error: ") and "\n" not in err and "Traceback" not in err
+    assert emu.path in err and "no reply to $VNASY,0" in err and "wrong baud rate?" in err
+    assert emu.registers == before and list(tmp_path.glob("x.vn*")) == []
