@@ -9,6 +9,7 @@ import os
 import time
 
 import imunoise
+import numpy as np
 import pytest
 from helpers.fake_sensor import FACTORY
 from imunoise.cli import main
@@ -202,7 +203,8 @@ def test_a_sensor_gone_for_good_ends_the_record_with_its_loss_kept(fake_sensor, 
     assert (kept.offset, kept.start, kept.end) == (loss["offset"], loss["start"], loss["end"])
     # every second accounted for: what was recorded plus what was lost is the record
     log = imunoise.read(out)
-    assert len(log) / 40 + loss["seconds"] == pytest.approx(meta["seconds"], abs=0.3)
+    received = int(np.isfinite(log.gyro[:, 0]).sum())
+    assert received / 40 + loss["seconds"] == pytest.approx(meta["seconds"], abs=0.3)
 
 
 def _plain_file(tmp_path):
@@ -222,3 +224,40 @@ def test_a_port_that_is_no_serial_port_is_named(tmp_path, capsys, make, says):
     assert code == 2
     the_error(lines, str(port), says)
     assert not (tmp_path / "x.txt").exists()
+
+
+def test_a_sensor_gone_for_good_with_settings_changed_says_they_stay(fake_sensor, tmp_path,
+                                                                     capsys):
+    fake = fake_sensor(gone_after=1.0, gone="hangup")
+    out = tmp_path / "gone.txt"
+    code, lines = run(["record", fake.path, "-o", out, "--seconds", 2.5, "--rate", 20,
+                       "--outage-timeout", 0.5], capsys)
+    assert code == 2 and len(lines) == 1
+    the_error(lines, fake.path, "lost", "its settings were not restored")
+    meta = json.loads((tmp_path / "gone.txt.meta.json").read_text())
+    assert meta["restored"] is False and meta["ended_in_outage"] is True
+    assert any("not restored" in note for note in meta["notes"])
+
+
+def test_a_sensor_silent_for_a_while_is_one_outage_and_the_record_goes_on(fake_sensor,
+                                                                          tmp_path, capsys):
+    # silent 1.2 s, then back: set up again, the silence one outage (not one per
+    # reconnection), the record complete and the settings restored
+    fake = fake_sensor(gone_after=1.0, back_after=1.2)
+    out = tmp_path / "back.txt"
+    code, lines = run(["record", fake.path, "-o", out, "--seconds", 4, "--rate", 20,
+                       "--outage-timeout", 0.4], capsys)
+    assert code == 0 and lines == []
+    left_as_found(fake)
+    meta = json.loads((tmp_path / "back.txt.meta.json").read_text())
+    assert meta["outages"] == 1 and meta["ended_in_outage"] is False and meta["restored"]
+    (loss,) = meta["outage_list"]
+    assert fake.gone_at - 0.2 <= loss["start"] <= fake.gone_at + 0.1
+    assert fake.back_at <= loss["end"] <= fake.back_at + 1.0  # the first byte after
+    assert [(o.offset, o.start, o.end) for o in outages(out)] == [
+        (loss["offset"], loss["start"], loss["end"])]
+    log = imunoise.read(out)
+    (gap,) = log.gaps.rows()
+    assert gap[1] == pytest.approx(loss["seconds"], abs=2 / 20)
+    received = int(np.isfinite(log.gyro[:, 0]).sum())  # the gap's samples are NaN rows
+    assert received / 20 + loss["seconds"] == pytest.approx(meta["seconds"], abs=0.4)

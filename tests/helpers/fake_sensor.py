@@ -13,7 +13,9 @@ register 7's rate while its output is on, and keeps every command it was sent
 - ``error_on_write``: registers whose write is refused with ``$VNERR,07``;
 - ``gone_after`` seconds after the first ``$VNASY,1``: the sensor goes for good,
   either ``gone="silent"`` (the port stays, nothing comes: a sensor without
-  power behind its USB adapter) or ``gone="hangup"`` (the port disappears).
+  power behind its USB adapter) or ``gone="hangup"`` (the port disappears);
+  with ``back_after`` (silent only) it answers and streams again that many
+  seconds later.
 """
 
 from __future__ import annotations
@@ -37,12 +39,14 @@ _YMR = ("VNYMR,-077.700,-001.300,+000.150,+0.0450,+0.2470,-0.3380,+00.000,+00.00
 
 class FakeSensor:
     def __init__(self, path, *, refuse=(), mute=False, bad_checksums=False, echo_wrong=(),
-                 error_on_write=(), gone_after: float | None = None, gone: str = "silent"):
+                 error_on_write=(), gone_after: float | None = None, gone: str = "silent",
+                 back_after: float | None = None):
         self.path = os.fspath(path)
         self.registers = dict(FACTORY)
         self.refuse, self.mute, self.bad = set(refuse), mute, bad_checksums
         self.echo_wrong, self.error_on_write = set(echo_wrong), set(error_on_write)
-        self.gone_after, self.gone_kind = gone_after, gone
+        self.gone_after, self.gone_kind, self.back_after = gone_after, gone, back_after
+        self.back_at: float | None = None  # when it came back (time.time())
         self.received: list[str] = []  # every command's body, in order
         self.streaming = True
         self.resumed_at: float | None = None  # first $VNASY,1
@@ -65,7 +69,7 @@ class FakeSensor:
 
     @property
     def gone(self) -> bool:
-        return self.gone_at is not None
+        return self.gone_at is not None and self.back_at is None
 
     # --- the sensor -------------------------------------------------------------------
 
@@ -119,9 +123,13 @@ class FakeSensor:
     def _run(self) -> None:
         due = time.monotonic()
         while not self._stop.is_set():
-            if (self.gone_after is not None and not self.gone and self.resumed_at is not None
+            if (self.gone_after is not None and self.gone_at is None
+                    and self.resumed_at is not None
                     and time.monotonic() - self.resumed_at >= self.gone_after):
                 self._go()
+            if (self.back_after is not None and self.gone
+                    and time.time() - self.gone_at >= self.back_after):
+                self.back_at = time.time()
             if self._master < 0:
                 time.sleep(0.01)
                 continue

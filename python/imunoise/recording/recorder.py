@@ -234,7 +234,10 @@ class _Recorder:
         problems: list[str] = []
         try:
             if not self.keep_config and self.touched:
-                failed = config.restore(session, self.previous, self.touched)
+                if answered:
+                    failed = config.restore(session, self.previous, self.touched)
+                else:  # each write would wait for a reply that does not come
+                    failed = ["settings not restored: the sensor does not answer"]
                 self.restore_failed = bool(failed)
                 problems += failed
         finally:
@@ -329,15 +332,17 @@ class _Recorder:
                                   f"record ended: its settings were not restored")
             return False
         problems: list[str] = []
+        answered = True
         try:
             try:
                 _, tail = self.session.command("VNASY,0")
                 if self.writer is not None:
                     self.write(tail)
             except _port_errors() as exc:
+                answered = isinstance(exc, DeviceError) and exc.code is not None
                 problems.append(f"{os.fspath(self.port)}: output not paused at the end "
                                 f"($VNASY,0): {exc}")
-            problems += self._restore(self.session, answered=True)
+            problems += self._restore(self.session, answered)
         finally:
             self.session.serial.close()
         self.notes += problems
