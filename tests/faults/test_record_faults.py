@@ -261,3 +261,16 @@ def test_a_sensor_silent_for_a_while_is_one_outage_and_the_record_goes_on(fake_s
     assert gap[1] == pytest.approx(loss["seconds"], abs=2 / 20)
     received = int(np.isfinite(log.gyro[:, 0]).sum())  # the gap's samples are NaN rows
     assert received / 20 + loss["seconds"] == pytest.approx(meta["seconds"], abs=0.4)
+
+
+def test_the_api_raises_sensor_lost_with_what_was_recorded(fake_sensor, tmp_path):
+    from imunoise.recording import DeviceError, SensorLost, record
+
+    fake = fake_sensor(gone_after=0.5, gone="hangup")
+    with pytest.raises(SensorLost, match="lost") as info:
+        record(fake.path, tmp_path / "api.txt", seconds=2, outage_timeout=0.3)
+    assert isinstance(info.value, DeviceError)
+    rec = info.value.recording
+    assert rec.bytes == (tmp_path / "api.txt").stat().st_size > 0
+    assert len(rec.outages) == 1 and rec.outages[0].offset == rec.bytes
+    assert rec.outages[0].seconds > 1.0

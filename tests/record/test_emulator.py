@@ -96,3 +96,20 @@ def test_speed_outside_its_bounds_is_refused_before_the_port_appears(tmp_path, s
     with pytest.raises(ValueError, match=r"speed must be .* in \(0, 1000\]"):
         Emulator(tmp_path / "port", speed=speed)
     assert not (tmp_path / "port").exists()
+
+
+def test_a_sensor_thread_that_dies_is_an_error_not_a_quiet_exit(tmp_path, monkeypatch, capsys):
+    # --speed 1e300 once overflowed the clock inside the thread: the command waited on
+    # and exited 0 with a port that no longer answered
+    from imunoise.cli import main
+    from imunoise.emulate import device
+
+    def overflow(self) -> None:
+        raise OverflowError("cannot convert float infinity to integer")
+
+    monkeypatch.setattr(device.Emulator, "_step", overflow)
+    assert main(["emulate", str(tmp_path / "port"), "--seconds", "10"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("imunoise: error: the emulated sensor on ") and "\n" not in err
+    assert "stopped: cannot convert float infinity to integer" in err
+    assert not (tmp_path / "port").exists()  # the port is removed on the way out
