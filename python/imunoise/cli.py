@@ -802,6 +802,9 @@ def _cmd_record(args) -> int:
 
     seconds = (args.hours * 3600 if args.hours else args.minutes * 60 if args.minutes
                else args.seconds)
+    if seconds is not None and not np.isfinite(seconds):  # --hours 1e306 overflows
+        flag = "--hours" if args.hours else "--minutes"
+        _fail(f"{flag} is too large to be a length; got {args.hours or args.minutes:g}")
     baud = args.baud
     if baud != "auto":
         try:

@@ -26,6 +26,9 @@ from imunoise.cli import main
     (["emulate", "p", "--speed", "1e300"], "--speed must be at most 1000"),
     (["emulate", "p", "--speed", "inf"], "--speed: expected a positive number"),
     (["emulate", "p", "--speed", "0"], "--speed: expected a positive number"),
+    (["emulate", "p", "--fault", "vanish@1:1e300"], "seconds within (0, 3.1536e+07]"),
+    (["emulate", "p", "--fault", "corrupt@inf"], "fault time must be within 0"),
+    (["record", "p", "-o", "x.vn", "--hours", "1e306"], "--hours is too large"),
 ])
 def test_errors_are_one_line_with_status_2(argv, message, capsys, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)

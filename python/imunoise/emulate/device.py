@@ -47,6 +47,8 @@ _CORRUPT_AT = 10
 #: time in 3.6 s, 800 000 IMU samples a second, already more than a pty carries
 #: at 800 Hz binary; 1e300 overflowed the sensor's clock and killed its thread.
 MAX_SPEED = 1000.0
+#: Latest fault time and longest pause or vanish (s of sensor time): a year.
+MAX_FAULT_SECONDS = 365 * 86400.0
 
 
 @dataclass(frozen=True)
@@ -62,10 +64,13 @@ class Fault:
     def __post_init__(self) -> None:
         if self.kind not in FAULT_KINDS:
             raise ValueError(f"fault kind must be one of {FAULT_KINDS}; got {self.kind!r}")
-        if not self.at >= 0:
-            raise ValueError(f"fault time must be >= 0 s; got {self.at!r}")
-        if self.kind in ("pause", "vanish") and not self.seconds > 0:
-            raise ValueError(f"a {self.kind} fault needs seconds > 0; got {self.seconds!r}")
+        # bounded: a wait beyond the thread's longest timeout (2^63 ns) killed the thread
+        if not 0 <= self.at <= MAX_FAULT_SECONDS:
+            raise ValueError(f"fault time must be within 0 ... {MAX_FAULT_SECONDS:g} s; "
+                             f"got {self.at!r}")
+        if self.kind in ("pause", "vanish") and not 0 < self.seconds <= MAX_FAULT_SECONDS:
+            raise ValueError(f"a {self.kind} fault needs seconds within (0, "
+                             f"{MAX_FAULT_SECONDS:g}]; got {self.seconds!r}")
 
 
 @dataclass(frozen=True)
