@@ -260,7 +260,7 @@ def _add_recording_commands(sub) -> None:
     rc.add_argument("--outage-timeout", type=_positive_float, default=2.0, metavar="SECONDS",
                     help="seconds without a byte after which the sensor counts as gone and "
                     "is set up again until it answers; the time lost is kept in OUTPUT.gaps "
-                    "(default: %(default)s, at least three periods of the slowest output)")
+                    "(default: %(default)s, at least three periods of the fastest output)")
 
     em = sub.add_parser("emulate", help="a VN-100 emulator on a pseudo-terminal (tests, demos)",
                         description="Serve an emulated VN-100 at PATH (a symlink to a "

@@ -47,7 +47,7 @@ __all__ = ["OUTAGE_TIMEOUT", "Recording", "SensorLost", "check_output", "record"
 RETRY_EVERY = 0.2
 #: Seconds without a byte after which the sensor counts as gone (default of
 #: ``outage_timeout``); never less than :data:`OUTAGE_PERIODS` periods of the
-#: slowest output, whose silence between two records is no outage.
+#: fastest output (any byte counts), whose silence between two records is no outage.
 OUTAGE_TIMEOUT = 2.0
 OUTAGE_PERIODS = 3
 
@@ -385,7 +385,7 @@ def record(port, output, *, seconds: float | None = None, baud: int | str = 1152
         Set it to end the record cleanly from another thread.
     outage_timeout : float
         Seconds without a byte after which the sensor counts as gone (at least three
-        periods of the slowest output): the port is reopened and the sensor set up
+        periods of the fastest output): the port is reopened and the sensor set up
         again until it answers, the time lost kept as an outage.
 
     Returns
@@ -422,8 +422,10 @@ def record(port, output, *, seconds: float | None = None, baud: int | str = 1152
     except DeviceError as exc:
         raise _named(exc, port) from None
     settings = {**rec.previous, **rec.wanted}
-    slowest = min(output_rates(settings).values())
-    rec.silence = max(outage_timeout, OUTAGE_PERIODS / slowest)
+    # the fastest output sets the longest normal silence: any byte counts, and a
+    # slow binary output beside it (0.012 Hz) must not stretch the timeout to 4 min
+    fastest = max(output_rates(settings).values())
+    rec.silence = max(outage_timeout, OUTAGE_PERIODS / fastest)
     stop_event = stop or threading.Event()
     started = time.monotonic()
 
