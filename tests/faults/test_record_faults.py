@@ -7,6 +7,7 @@ from __future__ import annotations
 import json
 import os
 import time
+from pathlib import Path
 
 import imunoise
 import numpy as np
@@ -105,6 +106,7 @@ def _inside_a_file(tmp_path):
     (_inside_a_file, "is not a folder"),
     pytest.param(_read_only_folder, "cannot create files", marks=pytest.mark.skipif(
         os.geteuid() == 0, reason="root writes in a read-only folder")),
+    (lambda t: Path("/proc/x.txt"), "cannot create files"),  # a folder that takes none, root too
 ])
 def test_an_output_that_cannot_be_written_leaves_the_sensor_untouched(fake_sensor, tmp_path,
                                                                       capsys, monkeypatch,
