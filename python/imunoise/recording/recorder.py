@@ -456,11 +456,13 @@ def record(port, output, *, seconds: float | None = None, baud: int | str = 1152
                     break
             rec.end_outage()
         finally:
-            restored = rec.finish()
-            if rec.live is not None:
-                snapshot = rec.live.close()
-            if rec.writer is not None:
-                rec.writer.close()
+            try:
+                restored = rec.finish()
+            finally:  # the log is closed (and synced) even if the last write failed
+                if rec.live is not None:
+                    snapshot = rec.live.close()
+                if rec.writer is not None:
+                    rec.writer.close()
     elapsed = time.monotonic() - started
     rec.write_meta(seconds=elapsed, bytes=rec.writer.size, restored=restored)
     result = Recording(path=rec.writer.path, bytes=rec.writer.size, seconds=elapsed,
