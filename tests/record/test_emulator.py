@@ -113,3 +113,14 @@ def test_a_sensor_thread_that_dies_is_an_error_not_a_quiet_exit(tmp_path, monkey
     assert err.startswith("imunoise: error: the emulated sensor on ") and "\n" not in err
     assert "stopped: cannot convert float infinity to integer" in err
     assert not (tmp_path / "port").exists()  # the port is removed on the way out
+
+
+def test_the_quaternion_is_the_attitude_of_the_yaw_pitch_roll_beside_it():
+    import numpy as np
+    from imunoise.emulate.outputs import SampleSource
+    from scipy.spatial.transform import Rotation
+
+    out = SampleSource(4).take(np.arange(19, 800 * 60, 20), 20)
+    expected = Rotation.from_euler("ZYX", out["ypr"], degrees=True).as_quat()  # x, y, z, w
+    np.testing.assert_allclose(out["quaternion"], expected, atol=1e-12)
+    assert np.ptp(out["quaternion"], axis=0).max() > 1e-5  # moves with them

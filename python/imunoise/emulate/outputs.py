@@ -14,8 +14,9 @@ attitude: pitch and roll follow the tilt the accelerometer's noise shows and yaw
 the heading the magnetometer's shows, both with time constant
 :data:`ATTITUDE_TAU` and the gyro's rate integrated in between, so they carry
 small noise and slow wander consistent with the gyro, accelerometer and
-magnetometer (the filter restarts every block, like the flicker). Temperature,
-pressure and the quaternion are constant.
+magnetometer (the filter restarts every block, like the flicker); the
+quaternion is that of the same yaw, pitch and roll. Temperature and pressure are
+constant.
 
 Each output averages the IMU samples of its period (the ASCII type at register
 7's rate, a binary output at 800 Hz / RateDivisor): taking every k-th sample
@@ -47,7 +48,6 @@ ATTITUDE_TAU = 2.0
 _CHANNELS = ("gyro", "accel", "mag", "ypr")
 _TEMPERATURE = 25.0  # degC
 _PRESSURE = 101.3  # kPa
-_QUATERNION = (0.0, 0.0, 0.0, 1.0)
 _CACHED = 2  # blocks kept: the current one and the one an average may reach back into
 
 
@@ -119,8 +119,18 @@ class SampleSource:
         out = {k: v.reshape(n, window, 3).mean(axis=1) for k, v in parts.items()}
         out["temperature"] = np.full(n, _TEMPERATURE)
         out["pressure"] = np.full(n, _PRESSURE)
-        out["quaternion"] = np.tile(_QUATERNION, (n, 1))
+        out["quaternion"] = _quaternion(out["ypr"])
         return out
+
+
+def _quaternion(ypr: np.ndarray) -> np.ndarray:
+    """(qx, qy, qz, qw), scalar last as the VN-100 sends it, of the 3-2-1 rotation
+    of yaw, pitch, roll (deg): the same attitude as the Euler angles beside it."""
+    half = np.radians(ypr) / 2
+    cy, cp, cr = np.cos(half).T
+    sy, sp, sr = np.sin(half).T
+    return np.column_stack([sr * cp * cy - cr * sp * sy, cr * sp * cy + sr * cp * sy,
+                            cr * cp * sy - sr * sp * cy, cr * cp * cy + sr * sp * sy])
 
 
 def _due(start: int, stop: int, step: int) -> np.ndarray:
