@@ -33,8 +33,8 @@ port, out, seconds, live = sys.argv[1], sys.argv[2], float(sys.argv[3]), sys.arg
 done = {}
 import imunoise.recording.recorder as rr
 original = rr._Recorder.connect
-def connect(self, first):
-    data = original(self, first)
+def connect(self, first, **options):
+    data = original(self, first, **options)
     if first:
         done["t0"], done["r0"] = time.monotonic(), resource.getrusage(resource.RUSAGE_SELF)
     return data

@@ -257,6 +257,10 @@ def _add_recording_commands(sub) -> None:
                        help="8-bit checksum on the sensor's sentences")
     rc.add_argument("--keep-config", action="store_true",
                     help="leave the settings on the sensor (default: restore the previous ones)")
+    rc.add_argument("--outage-timeout", type=_positive_float, default=2.0, metavar="SECONDS",
+                    help="seconds without a byte after which the sensor counts as gone and "
+                    "is set up again until it answers; the time lost is kept in OUTPUT.gaps "
+                    "(default: %(default)s, at least three periods of the fastest output)")
 
     em = sub.add_parser("emulate", help="a VN-100 emulator on a pseudo-terminal (tests, demos)",
                         description="Serve an emulated VN-100 at PATH (a symlink to a "
@@ -794,10 +798,13 @@ def _cmd_thermal(args) -> int:
 
 
 def _cmd_record(args) -> int:
-    from imunoise.recording import binary_output, record
+    from imunoise.recording import DeviceError, binary_output, record
 
     seconds = (args.hours * 3600 if args.hours else args.minutes * 60 if args.minutes
                else args.seconds)
+    if seconds is not None and not np.isfinite(seconds):  # --hours 1e306 overflows
+        flag = "--hours" if args.hours else "--minutes"
+        _fail(f"{flag} is too large to be a length; got {args.hours or args.minutes:g}")
     baud = args.baud
     if baud != "auto":
         try:
@@ -813,8 +820,12 @@ def _cmd_record(args) -> int:
             binary.append(binary_output(float(rate), fields))
         except ValueError as exc:
             _fail(f"--binary {text}: {exc}")
-    rec = record(args.port, args.output, seconds=seconds, baud=baud, ascii=args.ascii,
-                 rate=args.rate, binary=binary, crc=args.crc, keep_config=args.keep_config)
+    try:
+        rec = record(args.port, args.output, seconds=seconds, baud=baud, ascii=args.ascii,
+                     rate=args.rate, binary=binary, crc=args.crc,
+                     keep_config=args.keep_config, outage_timeout=args.outage_timeout)
+    except DeviceError as exc:  # the message names the port; SensorLost too
+        _fail(str(exc))
     print(f"recorded {rec.bytes} bytes in {duration(rec.seconds)} to {rec.path}"
           + (f"; {len(rec.outages)} port outage(s)" if rec.outages else "")
           + ("; previous settings restored" if rec.restored else ""))
@@ -826,6 +837,7 @@ def _cmd_emulate(args) -> int:
     import time
 
     from imunoise.emulate import Emulator, Fault
+    from imunoise.emulate.device import MAX_SPEED
 
     faults = []
     for text in args.fault:
@@ -835,12 +847,18 @@ def _cmd_emulate(args) -> int:
             faults.append(Fault(kind, float(at), float(length or 0)))
         except ValueError as exc:
             _fail(f"--fault {text}: {exc}")
+    if args.speed > MAX_SPEED:  # before the port appears
+        _fail(f"--speed must be at most {MAX_SPEED:g} (sensor seconds per wall second); "
+              f"got {args.speed:g}")
     with Emulator(args.path, speed=args.speed, seed=args.seed, faults=faults,
                   keep_sent=False) as emu:
         print(f"VN-100 emulator on {emu.path} -> {os.path.realpath(emu.path)}; Ctrl-C to stop",
               flush=True)
         started = time.monotonic()
         while args.seconds is None or time.monotonic() - started < args.seconds:
+            if not emu.alive:  # a sensor that stopped is an error, not a quiet exit 0
+                _fail(f"the emulated sensor on {emu.path} stopped: "
+                      f"{emu.error or 'its thread ended'}")
             time.sleep(0.1)
     return 0
 

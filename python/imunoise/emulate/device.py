@@ -34,7 +34,7 @@ from imunoise.emulate.outputs import SampleSource, check_selection, encode
 from imunoise.emulate.registers import IMU_RATE, RegisterError, Registers
 from imunoise.recording.protocol import parse_reply, sentence
 
-__all__ = ["FAULT_KINDS", "Emulator", "Event", "Fault"]
+__all__ = ["FAULT_KINDS", "MAX_SPEED", "Emulator", "Event", "Fault"]
 
 FAULT_KINDS = ("corrupt", "pause", "vanish", "reset")
 #: Output bytes queued before the emulator waits for the reader.
@@ -43,6 +43,12 @@ _QUEUE = 1 << 16
 _STEP = 0.02
 #: Byte of a record flipped by a ``corrupt`` fault (inside the fields / payload).
 _CORRUPT_AT = 10
+#: Fastest time compression (sensor seconds per wall second): an hour of sensor
+#: time in 3.6 s, 800 000 IMU samples a second, already more than a pty carries
+#: at 800 Hz binary; 1e300 overflowed the sensor's clock and killed its thread.
+MAX_SPEED = 1000.0
+#: Latest fault time and longest pause or vanish (s of sensor time): a year.
+MAX_FAULT_SECONDS = 365 * 86400.0
 
 
 @dataclass(frozen=True)
@@ -58,10 +64,13 @@ class Fault:
     def __post_init__(self) -> None:
         if self.kind not in FAULT_KINDS:
             raise ValueError(f"fault kind must be one of {FAULT_KINDS}; got {self.kind!r}")
-        if not self.at >= 0:
-            raise ValueError(f"fault time must be >= 0 s; got {self.at!r}")
-        if self.kind in ("pause", "vanish") and not self.seconds > 0:
-            raise ValueError(f"a {self.kind} fault needs seconds > 0; got {self.seconds!r}")
+        # bounded: a wait beyond the thread's longest timeout (2^63 ns) killed the thread
+        if not 0 <= self.at <= MAX_FAULT_SECONDS:
+            raise ValueError(f"fault time must be within 0 ... {MAX_FAULT_SECONDS:g} s; "
+                             f"got {self.at!r}")
+        if self.kind in ("pause", "vanish") and not 0 < self.seconds <= MAX_FAULT_SECONDS:
+            raise ValueError(f"a {self.kind} fault needs seconds within (0, "
+                             f"{MAX_FAULT_SECONDS:g}]; got {self.seconds!r}")
 
 
 @dataclass(frozen=True)
@@ -100,7 +109,8 @@ class Emulator:
     path : str or path-like
         Where the port appears (a symlink to ``/dev/pts/N``); must not exist.
     speed : float
-        Sensor seconds per wall second (time compression), > 0.
+        Sensor seconds per wall second (time compression), > 0 and at most
+        :data:`MAX_SPEED`.
     seed : int, optional
         Seed of the simulated samples.
     faults : sequence of Fault
@@ -112,8 +122,9 @@ class Emulator:
 
     def __init__(self, path, *, speed: float = 1.0, seed=None, faults=(), keep_sent=True,
                  baud: int = 115200):
-        if not speed > 0:
-            raise ValueError(f"speed must be > 0; got {speed!r}")
+        if not (isinstance(speed, int | float) and 0 < speed <= MAX_SPEED):
+            raise ValueError(f"speed must be a number of sensor seconds per wall second "
+                             f"in (0, {MAX_SPEED:g}]; got {speed!r}")
         self.path = os.fspath(path)
         if os.path.lexists(self.path):
             raise ValueError(f"path {self.path!r} exists; the emulator makes it")
@@ -131,6 +142,7 @@ class Emulator:
         self._stop = threading.Event()
         self._lock = threading.Lock()
         self._master = self._slave = -1
+        self.error: BaseException | None = None  # what stopped the sensor's thread
         self._open_pty()
         self._thread = threading.Thread(target=self._run, name="vn100-emulator", daemon=True)
         self._started = time.monotonic()
@@ -317,12 +329,24 @@ class Emulator:
         records = encode(state.registers, self._source, start, stop, state.clock_zero)
         state.streamed += stop - start
         while state.resumed and self.faults and self.faults[0].at * IMU_RATE < state.streamed:
+            if self.faults[0].kind == "corrupt" and not records:
+                # a step too short to hold a record (a fast loop, a slow output): the
+                # fault waits for one, else it was logged with nothing damaged
+                break
             records = self._fault(self.faults.pop(0), records, start, stop)
             if self._master < 0:
                 return
         self._queue(b"".join(records))
 
     def _run(self) -> None:
+        # an exception would end the thread silently and leave a port that no longer
+        # answers: it is kept for :attr:`alive` and the caller (``imunoise emulate``)
+        try:
+            self._serve()
+        except BaseException as exc:  # noqa: BLE001 - reported through self.error
+            self.error = exc
+
+    def _serve(self) -> None:
         while not self._stop.is_set() and self._master >= 0:
             self._step()
             if self._master < 0:  # the port vanished and the emulator was stopped meanwhile
@@ -345,6 +369,11 @@ class Emulator:
     def tick(self) -> int:
         """The next IMU tick the sensor will send (800 per sensor second)."""
         return self._state.tick
+
+    @property
+    def alive(self) -> bool:
+        """The sensor still runs (False once closed or after :attr:`error`)."""
+        return self._thread.is_alive()
 
     def sent_bytes(self) -> bytes:
         """A copy of every byte sent so far."""

@@ -3,6 +3,6 @@ files, live view. See :mod:`imunoise.recording.recorder`."""
 
 from imunoise.recording.config import binary_output
 from imunoise.recording.protocol import DeviceError
-from imunoise.recording.recorder import Recording, record
+from imunoise.recording.recorder import Recording, SensorLost, record
 
-__all__ = ["DeviceError", "Recording", "binary_output", "record"]
+__all__ = ["DeviceError", "Recording", "SensorLost", "binary_output", "record"]

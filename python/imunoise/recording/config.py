@@ -4,21 +4,40 @@ The output settings are the asynchronous ASCII type and rate (registers 6, 7), t
 three binary outputs (75–77) and the communication protocol control (30, whose
 SerialChecksum field chooses XOR-8 or CRC-16). Every write's echo is checked and
 every written register read back (:func:`apply`); :func:`restore` writes the
-settings read before (:func:`read_outputs`) back the same way.
+settings read before (:func:`read_outputs`) back the same way, each register on
+its own: one that fails does not keep the others from being restored.
+
+The binary outputs (75–77) are optional: firmware without them answers
+``$VNERR`` (invalid register) and is recorded with its ASCII output alone.
 """
 
 from __future__ import annotations
 
-from imunoise.recording.protocol import ADOF_RATES, ADOR_MESSAGES, IMU_RATE, DeviceError
+import math
+
+from imunoise.recording.protocol import (
+    ADOF_RATES,
+    ADOR_MESSAGES,
+    IMU_RATE,
+    DeviceError,
+    error_name,
+)
 from imunoise.recording.session import Session
 
-__all__ = ["IDENTITY", "OUTPUT_REGISTERS", "ascii_type", "apply", "binary_output",
-           "read_identity", "read_outputs", "restore", "wanted_outputs"]
+__all__ = ["IDENTITY", "OPTIONAL_REGISTERS", "OUTPUT_REGISTERS", "ascii_type", "apply",
+           "binary_output", "read_identity", "read_outputs", "restore", "wanted_outputs"]
 
 #: Identity registers read into the metadata: number -> name.
 IDENTITY = {1: "model", 2: "hardware_revision", 3: "serial_number", 4: "firmware"}
 #: Registers that hold the output settings, in the order they are written.
 OUTPUT_REGISTERS = (30, 75, 76, 77, 7, 6)
+#: Output registers a sensor may lack (binary outputs: not on old firmware).
+OPTIONAL_REGISTERS = (75, 76, 77)
+#: Largest RateDivisor register 75 holds (a 16-bit field): the slowest binary output
+#: runs at IMU_RATE / MAX_DIVISOR Hz.
+MAX_DIVISOR = 0xFFFF
+#: Largest field mask of a binary group (one 16-bit word per group).
+MAX_MASK = 0xFFFF
 #: ASCII types by name (``"VNYMR"``) -> register 6 value.
 _ADOR_OF = {name: ador for ador, name in ADOR_MESSAGES.items()}
 
@@ -45,9 +64,30 @@ def read_identity(session: Session) -> dict[str, str]:
     return {name: ",".join(read_register(session, reg)) for reg, name in IDENTITY.items()}
 
 
-def read_outputs(session: Session) -> dict[int, tuple[str, ...]]:
-    """The output settings now on the sensor: register -> fields."""
-    return {reg: read_register(session, reg) for reg in OUTPUT_REGISTERS}
+def read_outputs(session: Session, notes: list[str] | None = None,
+                 ) -> dict[int, tuple[str, ...]]:
+    """The output settings now on the sensor: register -> fields.
+
+    An optional register (:data:`OPTIONAL_REGISTERS`) the sensor refuses with
+    ``$VNERR`` is left out and said in ``notes`` (when given): old firmware has no
+    binary outputs, and its ASCII output can still be recorded. A missing reply
+    still raises: a sensor that stops answering is no firmware's choice."""
+    values: dict[int, tuple[str, ...]] = {}
+    refused: dict[int, str] = {}
+    for reg in OUTPUT_REGISTERS:
+        try:
+            values[reg] = read_register(session, reg)
+        except DeviceError as exc:
+            if reg not in OPTIONAL_REGISTERS or exc.code is None:
+                raise
+            refused[reg] = error_name(exc.code)
+    if refused and notes is not None:
+        regs = ", ".join(map(str, refused))
+        why = "; ".join(sorted(set(refused.values())))
+        notes.append(f"registers {regs} (binary outputs) not read: the sensor answered "
+                     f"$VNERR {why} (firmware without binary outputs?); left alone, the "
+                     f"ASCII output alone is recorded")
+    return values
 
 
 def write_register(session: Session, reg: int, fields: tuple[str, ...]) -> None:
@@ -56,29 +96,57 @@ def write_register(session: Session, reg: int, fields: tuple[str, ...]) -> None:
     body = f"VNWRG,{reg:02d}," + ",".join(fields)
     reply, _ = session.command(body)
     echo = reply.fields[1:]
-    back = read_register(session, reg)
+    try:
+        back = read_register(session, reg)
+    except DeviceError as exc:  # the write went through: not a refused write (no code)
+        raise DeviceError(f"register {reg}: written, but reading it back failed: {exc}"
+                          ) from None
     for what, got in (("echoed", echo), ("read back", back)):
         if _normal(got) != _normal(fields):
             raise DeviceError(f"register {reg}: wrote {','.join(fields)} but the sensor "
                               f"{what} {','.join(got)}")
 
 
-def apply(session: Session, wanted: dict[int, tuple[str, ...]]) -> None:
-    """Write every register of ``wanted`` (in :data:`OUTPUT_REGISTERS` order)."""
+def apply(session: Session, wanted: dict[int, tuple[str, ...]],
+          touched: set[int] | None = None) -> None:
+    """Write every register of ``wanted`` (in :data:`OUTPUT_REGISTERS` order);
+    ``touched`` receives each register that may have changed (written, or a write
+    lost or echoed wrong; not one the sensor refused with ``$VNERR``), so a restore
+    writes back those and no others."""
     for reg in OUTPUT_REGISTERS:
         if reg in wanted:
-            write_register(session, reg, wanted[reg])
+            if touched is not None:
+                touched.add(reg)
+            try:
+                write_register(session, reg, wanted[reg])
+            except DeviceError as exc:
+                if exc.code is not None and touched is not None:
+                    touched.discard(reg)  # refused: the sensor kept its value
+                raise
             if reg == 30:
                 session.crc = wanted[30][4] == "3"
 
 
-def restore(session: Session, previous: dict[int, tuple[str, ...]], changed) -> None:
-    """Write back the ``previous`` value of every register in ``changed``."""
+def restore(session: Session, previous: dict[int, tuple[str, ...]], changed) -> list[str]:
+    """Write back the ``previous`` value of every register in ``changed``; returns
+    what failed, one line per register (empty: all restored).
+
+    Each register is tried whatever happened to the one before: a refused or lost
+    write must not leave the others changed."""
+    import serial
+
+    failed = []
     for reg in OUTPUT_REGISTERS:
         if reg in changed and reg in previous:
-            write_register(session, reg, previous[reg])
+            try:
+                write_register(session, reg, previous[reg])
+            except (DeviceError, OSError, serial.SerialException) as exc:
+                failed.append(f"restoring register {reg} to {','.join(previous[reg])} "
+                              f"failed: {exc}")
+                continue
             if reg == 30:
                 session.crc = previous[30][4] == "3"
+    return failed
 
 
 def ascii_type(name: str) -> int:
@@ -94,10 +162,16 @@ def binary_output(rate: float, fields: str) -> tuple[str, ...]:
     (``"common=0x0029"`` or ``"common=TimeStartup+AngularRate+Accel,imu=Temp"``)."""
     from imunoise._core import vn as _core_vn
 
-    divisor = IMU_RATE / rate if rate > 0 else 0.0
-    if not (divisor >= 1 and abs(divisor - round(divisor)) < 1e-9):
-        raise ValueError(f"binary rate must be {IMU_RATE} Hz divided by a whole number; "
-                         f"got {rate!r}")
+    # Checked before anything is written: a rate the sensor cannot run (1e-300 Hz
+    # gave a divisor of 8e302 that was sent as is) must not reach it.
+    slowest = IMU_RATE / MAX_DIVISOR
+    bound = (f"{IMU_RATE} Hz divided by a whole number from 1 to {MAX_DIVISOR} "
+             f"({slowest:.4g} ... {IMU_RATE} Hz)")
+    if not (isinstance(rate, int | float) and math.isfinite(rate) and rate > 0):
+        raise ValueError(f"binary rate must be a finite number of Hz, {bound}; got {rate!r}")
+    divisor = IMU_RATE / rate
+    if not (1 <= round(divisor) <= MAX_DIVISOR and abs(divisor - round(divisor)) < 1e-9):
+        raise ValueError(f"binary rate must be {bound}; got {rate!r}")
     divisor = round(divisor)
     table = _core_vn.vn_binary_fields()
     words: dict[int, int] = {}
@@ -112,7 +186,15 @@ def binary_output(rate: float, fields: str) -> tuple[str, ...]:
         for name in names.split("+"):
             name = name.strip()
             if name.lower().startswith("0x"):
-                mask |= int(name, 16)
+                try:
+                    value = int(name, 16)
+                except ValueError:
+                    raise ValueError(f"binary field mask {name!r} is not a hex number") from None
+                # one 16-bit word per group on the wire: a wider mask would be cut
+                if not 0 < value <= MAX_MASK:
+                    raise ValueError(f"binary field mask of group {group} must be within "
+                                     f"0x0001 ... 0x{MAX_MASK:04X} (16 bits); got {name}")
+                mask |= value
             elif name in known:
                 mask |= 1 << known[name]
             else:

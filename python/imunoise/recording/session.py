@@ -9,6 +9,8 @@ exactly after the echo of ``$VNASY,1``.
 
 from __future__ import annotations
 
+import os
+import stat
 import time
 
 from imunoise.recording.protocol import (
@@ -20,7 +22,7 @@ from imunoise.recording.protocol import (
     sentence,
 )
 
-__all__ = ["Session", "find_baud", "open_port"]
+__all__ = ["Session", "check_port", "find_baud", "open_port"]
 
 #: Seconds to wait for a reply.
 REPLY_TIMEOUT = 2.0
@@ -29,13 +31,39 @@ READ_TIMEOUT = 0.02
 _CHUNK = 1 << 16
 
 
+def check_port(port: str) -> None:
+    """:class:`DeviceError` naming ``port`` when it is no serial port: a regular
+    file, a folder or a FIFO (pyserial's own error for them, "(25, 'Inappropriate
+    ioctl for device')", names no port), or, on POSIX, nothing at all."""
+    try:
+        mode = os.stat(port).st_mode
+    except FileNotFoundError:
+        if os.name == "posix":
+            raise DeviceError(f"{port}: no such port") from None
+        return  # COM3 and the like are no files
+    except (OSError, ValueError):
+        return  # let the open say what is wrong
+    if not stat.S_ISCHR(mode):
+        kind = ("a folder" if stat.S_ISDIR(mode) else "a regular file" if stat.S_ISREG(mode)
+                else "not a character device")
+        raise DeviceError(f"{port}: not a serial port ({kind})")
+
+
 def open_port(port: str, baud: int):
-    """A pyserial port, 8N1, no flow control, raw."""
+    """A pyserial port, 8N1, no flow control, raw; :class:`DeviceError` naming the
+    port when it is not a serial port or cannot be opened."""
     try:
         import serial
     except ImportError:  # pragma: no cover - pyserial is a dependency
         raise ImportError("imunoise record needs pyserial: pip install pyserial") from None
-    return serial.Serial(port, baud, timeout=READ_TIMEOUT, write_timeout=REPLY_TIMEOUT)
+    check_port(port)
+    try:
+        return serial.Serial(port, baud, timeout=READ_TIMEOUT, write_timeout=REPLY_TIMEOUT)
+    except OSError as exc:  # SerialException is an OSError
+        reason = os.strerror(exc.errno) if isinstance(exc.errno, int) else str(exc)
+        if "Inappropriate ioctl" in reason:
+            reason = "not a serial port (a device that is not a terminal)"
+        raise DeviceError(f"{port}: cannot open the port: {reason}") from None
 
 
 class Session:
@@ -78,7 +106,11 @@ class Session:
                 return reply, bytes(buf[:end])
             searched = max(0, len(buf) - 400)  # a reply may straddle two reads
             if time.monotonic() > deadline:
-                raise DeviceError(f"no reply to ${body} within {timeout:g} s")
+                # what came instead says why: nothing (a silent or absent sensor), or
+                # bytes none of which is a checked reply (a wrong baud rate, line noise)
+                got = (f"{len(buf)} bytes came, none a valid reply (wrong baud rate? bad "
+                       f"checksums?)" if buf else "nothing came")
+                raise DeviceError(f"no reply to ${body} within {timeout:g} s: {got}")
             if not resent and time.monotonic() > started + timeout / 2:
                 # a command can be lost (line noise, a sensor still starting): once more;
                 # every command the recorder sends may be repeated without harm
@@ -109,9 +141,10 @@ def find_baud(port: str, rates=BAUD_RATES) -> int:
     """The baud rate at which the sensor on ``port`` answers ``$VNRRG,01``."""
     tried = []
     for baud in rates:
+        check_port(port)  # no such port, or not a serial one: no baud rate will do
         try:
             serial = open_port(port, baud)
-        except (OSError, ValueError):
+        except (DeviceError, ValueError):  # a rate this port cannot take
             tried.append(baud)
             continue
         try:

@@ -40,7 +40,11 @@ class RawWriter:
 
     @staticmethod
     def refuse_existing(path) -> None:
-        """``FileExistsError`` when ``path`` exists: a recording is never overwritten."""
+        """``FileExistsError`` when ``path`` exists: a recording is never overwritten
+        (``IsADirectoryError`` for a folder: a record is a file beside its side files)."""
+        if os.path.isdir(path):
+            raise IsADirectoryError(errno.EISDIR, "is a folder: give the record's file name",
+                                    os.fspath(path))
         if os.path.lexists(path):
             raise FileExistsError(errno.EEXIST, "exists: a recording is never overwritten; "
                                   "choose another output", os.fspath(path))
