@@ -84,6 +84,10 @@ def log_meta(*, fs: float, source: str, fmt: str, issues: ParseIssues,
 #: the arrays mean.
 REQUIRED = ("imunoise_columnar", "fs", "source", "format", "samples", "channels", "table",
             "messages", "issues", "gaps")
+#: Issue kinds every version of the metadata counts (later kinds, e.g.
+#: ``time_reset``, are zero where missing): a count that is gone is not zero.
+V1_KINDS = ("bad_checksum", "malformed_field", "unknown_message", "truncated_record",
+            "bytes_skipped", "device_error", "duplicate_time", "time_reversed")
 #: Where the issue locations of ``issues.first`` count from.
 _LOCATIONS = ("line", "byte", "message")
 #: Longest text field (source, format, table) accepted, characters.
@@ -148,7 +152,12 @@ def check_meta(meta, where, *, tied: bool = False) -> dict:
     for key in ("counts", "first", "location"):
         if key not in issues:
             raise bad(where, f"issues.{key}", "is missing")
-    for kind, n in _object(issues["counts"], where, "issues.counts").items():
+    counts = _object(issues["counts"], where, "issues.counts")
+    missing = [k for k in V1_KINDS if k not in counts]
+    if missing:
+        raise bad(where, "issues.counts", f"lacks the kinds {missing} (every version "
+                  "writes them)")
+    for kind, n in counts.items():
         if kind not in ISSUE_KINDS:
             raise bad(where, "issues.counts", f"has unknown kind {metafile._show(kind)}")
         metafile.count(n, where, f"issues.counts.{kind}")

@@ -160,7 +160,8 @@ def recording_meta(path) -> dict | None:
     """The metadata of the recording at ``path`` (``LOG.meta.json``), checked; ``None``
     without one. A malformed field is a :class:`ParseError` naming the file and the
     field: ``fs`` a rate (or null), ``started``/``seconds`` finite times >= 0,
-    ``bytes``/``baud`` counts, ``outages`` a count or a list, ``port``/``ascii``
+    ``bytes``/``baud`` counts, ``outages`` a count or a list (of objects or lists
+    of finite numbers), ``port``/``ascii``
     text (or null), ``identity`` an object of texts, ``previous``/``written``
     objects of lists of texts."""
     where = os.fspath(path) + META
@@ -183,6 +184,14 @@ def recording_meta(path) -> dict | None:
             metafile.count(meta[key], where, key)
     if "outages" in meta and not isinstance(meta["outages"], list):
         metafile.count(meta["outages"], where, "outages")
+    for i, item in enumerate(meta.get("outages") if isinstance(meta.get("outages"), list)
+                             else ()):
+        values = list(item.values()) if isinstance(item, dict) else item
+        if not isinstance(values, list) or not all(
+                isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v)
+                for v in values):
+            raise bad(where, f"outages[{i}]", f"must be an object or a list of finite numbers; "
+                      f"got {metafile._show(item)}")
     for key in ("port", "ascii"):
         if meta.get(key) is not None and not isinstance(meta[key], str):
             raise bad(where, key, f"must be a text or null; got {metafile._show(meta[key])}")

@@ -987,4 +987,7 @@ def load(out) -> ImuLog:
         raise FileNotFoundError(2, "no such file or directory", str(out))
     if not out.is_dir():
         _layout(out)  # a suffix convert does not write is an error naming the layouts
-    return read_columnar(out)
+    from imunoise.readers.read import naming
+
+    with naming(out):
+        return read_columnar(out)
