@@ -233,7 +233,8 @@ def _load_npy(path: Path, where) -> np.ndarray:
     """``np.load(path, mmap_mode="r")``, its errors naming the file."""
     try:
         return np.load(path, mmap_mode="r", allow_pickle=False)
-    except (ValueError, OSError, EOFError) as exc:  # a cut or damaged .npy
+    # a cut or damaged header: numpy raises ValueError, OSError, EOFError, TokenError
+    except Exception as exc:  # noqa: BLE001
         raise ParseError(f"not a readable .npy ({exc})", kind="malformed_field",
                          source=str(where)) from None
 
