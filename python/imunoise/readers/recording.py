@@ -108,13 +108,40 @@ def host_times(path) -> tuple[np.ndarray, np.ndarray]:
             np.asarray(ns, dtype=np.int64).astype(np.float64) / 1e9)
 
 
+def _times_span(path) -> float | None:
+    """Seconds from the first to the last complete line of ``LOG.times`` (``None``
+    without two); only those two lines are read: a day's recording has millions."""
+    side = os.fspath(path) + TIMES
+    try:
+        if not stat.S_ISREG(os.stat(side).st_mode):
+            return None  # host_times says what is wrong with it
+        with open(side, "rb") as f:
+            first = f.readline()
+            f.seek(max(0, os.fstat(f.fileno()).st_size - 4096))
+            tail = f.read().split(b"\n")[:-1]  # the last element: "" or a cut line
+    except (FileNotFoundError, NotADirectoryError):
+        return None
+    if not first.endswith(b"\n") or not tail:
+        return None
+    stamps = []
+    for line in (first[:-1], tail[-1]):
+        parts = line.split()
+        if len(parts) != 2 or not parts[1].isdigit() or len(parts[1]) > 19:
+            raise ParseError(f"its first and last lines must be '<byte offset> <host time, "
+                             f"Unix ns>'; got {line[:60]!r}", kind="malformed_field",
+                             source=side)
+        stamps.append(int(parts[1]) / 1e9)
+    return stamps[1] - stamps[0]
+
+
 def _span(path) -> float:
     """The longest an outage of the recording at ``path`` can be, s: its host-time
-    span (``LOG.times``, else ``seconds`` in the metadata) plus :data:`SPAN_SLACK`,
-    else :data:`MAX_OUTAGE`."""
-    _, seconds = host_times(path)
+    span (``LOG.times``, or ``seconds`` in the metadata if longer: an outage that
+    ends the record comes after the last chunk) plus :data:`SPAN_SLACK`, else
+    :data:`MAX_OUTAGE`."""
+    times = _times_span(path)
     meta = recording_meta(path) or {}
-    spans = [float(seconds[-1] - seconds[0])] if len(seconds) else []
+    spans = [times] if times is not None else []
     if "seconds" in meta:
         spans.append(meta["seconds"])
     return max(spans) + SPAN_SLACK if spans else MAX_OUTAGE
