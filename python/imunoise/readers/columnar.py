@@ -101,13 +101,13 @@ def _text(meta: dict, key: str, where, *, optional: bool = False) -> None:
     if not isinstance(value, str) or len(value) > _MAX_TEXT:
         raise metafile.bad_field(where, key, f"must be a text of at most {_MAX_TEXT} "
                                  f"characters{' or null' if optional else ''}; got "
-                                 f"{metafile._show(value)}")
+                                 f"{metafile.shown(value)}")
 
 
 def _object(value, where, field: str) -> dict:
     if not isinstance(value, dict):
         raise metafile.bad_field(where, field, f"must be a JSON object; got "
-                                 f"{metafile._show(value)}")
+                                 f"{metafile.shown(value)}")
     return value
 
 
@@ -125,12 +125,12 @@ def check_meta(meta, where, *, tied: bool = False) -> dict:
     """
     bad = metafile.bad_field
     if not isinstance(meta, dict):
-        raise ParseError(f"the metadata is not a JSON object; got {metafile._show(meta)}",
+        raise ParseError(f"the metadata is not a JSON object; got {metafile.shown(meta)}",
                          kind="malformed_field", source=str(where))
     version = meta.get("imunoise_columnar")
     if isinstance(version, bool) or version != META_VERSION:
         raise bad(where, "imunoise_columnar", f"must be {META_VERSION}; got "
-                  f"{metafile._show(version)}")
+                  f"{metafile.shown(version)}")
     for key in (*REQUIRED, *(("data",) if tied else ())):
         if key not in meta:
             raise bad(where, key, "is missing")
@@ -145,7 +145,7 @@ def check_meta(meta, where, *, tied: bool = False) -> dict:
             or any(not isinstance(c, str) or c not in known for c in channels)
             or len(set(channels)) != len(channels)):
         raise bad(where, "channels", f"must list channels of {known}, each once; got "
-                  f"{metafile._show(channels)}")
+                  f"{metafile.shown(channels)}")
     for name, n in _object(meta["messages"], where, "messages").items():
         metafile.count(n, where, f"messages.{name}")
     issues = _object(meta["issues"], where, "issues")
@@ -159,7 +159,7 @@ def check_meta(meta, where, *, tied: bool = False) -> dict:
                   "writes them)")
     for kind, n in counts.items():
         if kind not in ISSUE_KINDS:
-            raise bad(where, "issues.counts", f"has unknown kind {metafile._show(kind)}")
+            raise bad(where, "issues.counts", f"has unknown kind {metafile.shown(kind)}")
         metafile.count(n, where, f"issues.counts.{kind}")
     for kind, locations in _object(issues["first"], where, "issues.first").items():
         if kind not in ISSUE_KINDS or not isinstance(locations, list):
@@ -169,7 +169,7 @@ def check_meta(meta, where, *, tied: bool = False) -> dict:
             metafile.count(loc, where, f"issues.first.{kind}[{i}]")
     if issues["location"] not in _LOCATIONS:
         raise bad(where, "issues.location", f"must be one of {_LOCATIONS}; got "
-                  f"{metafile._show(issues['location'])}")
+                  f"{metafile.shown(issues['location'])}")
     gaps = _object(meta["gaps"], where, "gaps")
     index, lengths = gaps.get("index"), gaps.get("samples")
     if not isinstance(index, list) or not isinstance(lengths, list) or len(index) != len(
@@ -184,7 +184,7 @@ def check_meta(meta, where, *, tied: bool = False) -> dict:
                       f"inside the {samples} samples, after the one before")
         end = start + k
     if tied:
-        metafile._tie_fields(meta["data"], where)
+        metafile.tie_fields(meta["data"], where)
     return meta
 
 

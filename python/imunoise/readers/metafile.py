@@ -35,7 +35,8 @@ from imunoise import _atomic
 from imunoise.errors import ParseError
 
 __all__ = ["MAX_BYTES", "MAX_COUNT", "MAX_DEPTH", "MAX_FS", "SUFFIX", "bad_field", "check_tie",
-           "count", "legacy_path", "load", "meta_path", "parse", "rate", "tie_errors"]
+           "count", "legacy_path", "load", "meta_path", "parse", "rate", "shown", "tie_errors",
+           "tie_fields"]
 
 #: Suffix of a metadata file: ``F.meta.json`` describes ``F``.
 SUFFIX = ".meta.json"
@@ -140,48 +141,50 @@ def load(path) -> object | None:
 def count(value, where, field: str, *, most: int = MAX_COUNT) -> int:
     """``value`` if an integer in ``[0, most]`` (a JSON ``true`` is not one)."""
     if isinstance(value, bool) or not isinstance(value, int):
-        raise bad_field(where, field, f"must be an integer count; got {_show(value)}")
+        raise bad_field(where, field, f"must be an integer count; got {shown(value)}")
     if not 0 <= value <= most:
-        raise bad_field(where, field, f"must be a count in [0, {most}]; got {_show(value)}")
+        raise bad_field(where, field, f"must be a count in [0, {most}]; got {shown(value)}")
     return value
 
 
 def rate(value, where, field: str = "fs") -> float:
     """``value`` as a rate in Hz: a number (not ``true``) in ``(0, MAX_FS]``."""
     if isinstance(value, bool) or not isinstance(value, int | float):
-        raise bad_field(where, field, f"must be a rate in Hz (a number); got {_show(value)}")
+        raise bad_field(where, field, f"must be a rate in Hz (a number); got {shown(value)}")
     if isinstance(value, int) and value > MAX_FS:  # before float(): a huge int overflows
-        raise bad_field(where, field, f"must be a rate in (0, {MAX_FS:g}] Hz; got {_show(value)}")
+        raise bad_field(where, field, f"must be a rate in (0, {MAX_FS:g}] Hz; got {shown(value)}")
     if not (math.isfinite(value) and 0 < value <= MAX_FS):
-        raise bad_field(where, field, f"must be a rate in (0, {MAX_FS:g}] Hz; got {_show(value)}")
+        raise bad_field(where, field, f"must be a rate in (0, {MAX_FS:g}] Hz; got {shown(value)}")
     return float(value)
 
 
-def _show(value) -> str:
-    """``repr`` of a metadata value, shortened: a field may hold megabytes."""
+def shown(value) -> str:
+    """``repr`` of a metadata value for an error, shortened: a field may hold megabytes."""
     text = type(value).__name__ if isinstance(value, dict | list) else repr(value)
     if isinstance(value, int) and not isinstance(value, bool) and abs(value) > 10**30:
         return f"an integer of {len(str(abs(value)))} digits"
     return text if len(text) <= 60 else text[:57] + "..."
 
 
-def _tie_fields(tie, where) -> dict:
+def tie_fields(tie, where) -> dict:
+    """``tie`` if it is a fingerprint (``{"bytes", "mtime_ns", "sha256"}``), else a
+    :class:`ParseError` naming the field of ``where``."""
     if not isinstance(tie, dict):
         raise bad_field(where, "data", f"must be an object (bytes, mtime_ns, sha256); got "
-                        f"{_show(tie)}")
+                        f"{shown(tie)}")
     for key in ("bytes", "mtime_ns"):
         count(tie.get(key), where, f"data.{key}")
     digest = tie.get("sha256")
     if not (isinstance(digest, str) and len(digest) == 64
             and all(c in "0123456789abcdef" for c in digest)):
-        raise bad_field(where, "data.sha256", f"must be 64 hex digits; got {_show(digest)}")
+        raise bad_field(where, "data.sha256", f"must be 64 hex digits; got {shown(digest)}")
     return tie
 
 
 def tie_errors(tie, data: Path, where) -> str | None:
     """Why metadata ``where`` with the fingerprint ``tie`` does not describe the file
     ``data`` (``None`` when it does); a malformed ``tie`` is a :class:`ParseError`."""
-    tie = _tie_fields(tie, where)
+    tie = tie_fields(tie, where)
     if _atomic.same_content(data, tie):
         return None
     size = os.stat(data).st_size

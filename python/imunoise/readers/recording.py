@@ -197,7 +197,7 @@ def recording_meta(path) -> dict | None:
         return None
     bad = metafile.bad_field
     if not isinstance(meta, dict):
-        raise ParseError(f"the metadata is not a JSON object; got {metafile._show(meta)}",
+        raise ParseError(f"the metadata is not a JSON object; got {metafile.shown(meta)}",
                          kind="malformed_field", source=where)
     if meta.get("fs") is not None:
         metafile.rate(meta["fs"], where)
@@ -205,7 +205,7 @@ def recording_meta(path) -> dict | None:
         value = meta.get(key)
         if key in meta and (isinstance(value, bool) or not isinstance(value, int | float)
                             or not (math.isfinite(value) and 0 <= value <= 1e11)):
-            raise bad(where, key, f"must be a time in [0, 1e11] s; got {metafile._show(value)}")
+            raise bad(where, key, f"must be a time in [0, 1e11] s; got {metafile.shown(value)}")
     for key in ("bytes", "baud"):
         if key in meta:
             metafile.count(meta[key], where, key)
@@ -218,15 +218,15 @@ def recording_meta(path) -> dict | None:
                 isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v)
                 for v in values):
             raise bad(where, f"outages[{i}]", f"must be an object or a list of finite numbers; "
-                      f"got {metafile._show(item)}")
+                      f"got {metafile.shown(item)}")
     for key in ("port", "ascii"):
         if meta.get(key) is not None and not isinstance(meta[key], str):
-            raise bad(where, key, f"must be a text or null; got {metafile._show(meta[key])}")
+            raise bad(where, key, f"must be a text or null; got {metafile.shown(meta[key])}")
     if "identity" in meta:
         ident = meta["identity"]
         if not isinstance(ident, dict) or not all(isinstance(v, str) for v in ident.values()):
             raise bad(where, "identity", f"must be an object of texts; got "
-                      f"{metafile._show(ident)}")
+                      f"{metafile.shown(ident)}")
     for key in ("previous", "written"):
         if key in meta:
             regs = meta[key]
@@ -234,7 +234,7 @@ def recording_meta(path) -> dict | None:
                     isinstance(v, list) and all(isinstance(x, str) for x in v)
                     for v in regs.values()):
                 raise bad(where, key, f"must be an object of lists of texts (register -> "
-                          f"fields); got {metafile._show(regs)}")
+                          f"fields); got {metafile.shown(regs)}")
     return meta
 
 
