@@ -138,3 +138,15 @@ def test_outages_cannot_ask_for_more_rows_than_the_grid_bound(log):
         imunoise.read(log)
     assert info.value.source == str(side) and info.value.line == 2
     assert "more than 99x the 100 records" in str(info.value)
+
+
+def test_an_old_convert_metadata_under_the_shared_name_is_not_the_recordings(log, tmp_path):
+    # `convert run.vn -o run.csv` once wrote run.meta.json, the name of the metadata
+    # of a recording `run`; it describes run.csv, so the recording `run` does not use it
+    run = tmp_path / "run"
+    run.write_bytes(log.read_bytes())
+    (tmp_path / "run.meta.json").write_text(json.dumps({"imunoise_columnar": 1, "fs": 100}))
+    with pytest.warns(UserWarning) as caught:
+        got = imunoise.read(run)
+    assert got.fs == 40  # the reader's default, said in a warning; not the 100 Hz of run.csv
+    assert any("earlier imunoise convert wrote for run.csv" in str(w.message) for w in caught)

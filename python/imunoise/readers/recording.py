@@ -27,6 +27,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from imunoise import _warn
 from imunoise.errors import ParseError
 from imunoise.readers import metafile
 
@@ -199,6 +200,14 @@ def recording_meta(path) -> dict | None:
     if not isinstance(meta, dict):
         raise ParseError(f"the metadata is not a JSON object; got {metafile.shown(meta)}",
                          kind="malformed_field", source=where)
+    if "imunoise_columnar" in meta:
+        # the name earlier versions of convert gave the metadata of LOG.csv/LOG.npy: it
+        # describes one of those, not this recording (see imunoise.readers.metafile)
+        stem = os.path.basename(os.fspath(path))
+        _warn.warn(f"{where} is the metadata an earlier imunoise convert wrote for {stem}.csv "
+                   f"or {stem}.npy, not {stem}'s own; not used (rename it to "
+                   f"{stem}.csv.meta.json or {stem}.npy.meta.json, whichever it is)")
+        return None
     if meta.get("fs") is not None:
         metafile.rate(meta["fs"], where)
     for key in ("started", "seconds"):
