@@ -10,6 +10,14 @@ temporaries of processes that no longer run and warns about them.
 
 A replaced file keeps its permission bits; a new file gets the umask's (as
 ``open`` would give it). An output that is one of the inputs is refused.
+
+A data file and its metadata file (:func:`publish_pair`) cannot be renamed in one
+step, so the metadata carries the data's :func:`fingerprint` (bytes, modification
+time, SHA-256) and readers refuse metadata whose fingerprint is not the file's: a
+kill between the two renames leaves the new data beside the old metadata, which
+no reader takes for a pair. The two renames are made holding a lock on the
+directory, so two writers of one output publish their pairs one after the other,
+never interleaved.
 """
 
 from __future__ import annotations
@@ -17,6 +25,7 @@ from __future__ import annotations
 import contextlib
 import ctypes
 import errno
+import hashlib
 import os
 import re
 import secrets
@@ -30,10 +39,14 @@ from typing import BinaryIO
 __all__ = [
     "TEMP_TAG",
     "exchange_dir",
+    "fingerprint",
+    "publish_pair",
     "refuse_input",
     "remove_stale",
+    "same_content",
     "publish",
     "replacing",
+    "staged",
     "sync",
     "temporary_beside",
     "write_bytes",
@@ -211,6 +224,99 @@ def replacing(target, *, inputs: Iterable = ()) -> Iterator[BinaryIO]:
         _discard(tmp)
         raise
     _fsync_dir(target.parent)
+
+
+@contextlib.contextmanager
+def staged(target, *, inputs: Iterable = ()) -> Iterator[tuple[BinaryIO, Path]]:
+    """Like :func:`replacing`, but the finished temporary (flushed, fsync-ed) is left
+    for the caller to :func:`publish_pair`: yields ``(file, temporary)``. On an
+    exception the temporary is removed."""
+    target = Path(os.fspath(target))
+    refuse_input(target, inputs)
+    tmp = temporary_beside(target)
+    fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_BINARY", 0), 0o666)
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            yield fh, tmp
+            fh.flush()
+            os.fsync(fh.fileno())
+    except BaseException:
+        _discard(tmp)
+        raise
+
+
+#: Bytes hashed at a time by :func:`fingerprint` (bounds the memory it needs).
+_HASH_BLOCK = 1 << 22
+
+
+def fingerprint(path) -> dict:
+    """What identifies the content of the file at ``path``: ``{"bytes", "mtime_ns",
+    "sha256"}`` (JSON-able). A rename keeps all three; a copy keeps bytes and digest."""
+    digest = hashlib.sha256()
+    with open(path, "rb") as f:
+        st = os.fstat(f.fileno())
+        while block := f.read(_HASH_BLOCK):
+            digest.update(block)
+    return {"bytes": st.st_size, "mtime_ns": st.st_mtime_ns, "sha256": digest.hexdigest()}
+
+
+def same_content(path, mark: dict) -> bool:
+    """True when the file at ``path`` is the one :func:`fingerprint` described as
+    ``mark``: same size, and the same modification time (the fast path: the file
+    was not rewritten since) or, after a copy, the same SHA-256."""
+    st = os.stat(path)
+    if st.st_size != mark["bytes"]:
+        return False
+    if st.st_mtime_ns == mark["mtime_ns"]:
+        return True
+    return fingerprint(path)["sha256"] == mark["sha256"]
+
+
+@contextlib.contextmanager
+def _directory_lock(directory: Path) -> Iterator[None]:
+    """An exclusive advisory lock on ``directory`` (``flock``), where the system has one."""
+    try:
+        import fcntl
+    except ImportError:  # pragma: no cover - Windows: no flock
+        yield
+        return
+    fd = os.open(directory, os.O_RDONLY)
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX)
+        yield
+    finally:
+        os.close(fd)  # releases the lock
+
+
+def publish_pair(tmp, target, meta_of, meta_target) -> tuple[Path, Path]:
+    """Publish the finished temporary ``tmp`` as ``target`` with its metadata.
+
+    ``meta_of(fingerprint)`` gives the metadata's text, which must carry the
+    fingerprint of the data (see the module docstring); the metadata is written to
+    its own temporary first, then both are renamed, data first, holding the
+    directory's lock. On an exception both temporaries are removed."""
+    tmp, target, meta_target = Path(tmp), Path(target), Path(meta_target)
+    meta_tmp = None
+    try:
+        sync(tmp)
+        _keep_mode(tmp, target)
+        text = meta_of(fingerprint(tmp))
+        meta_tmp = temporary_beside(meta_target)
+        with open(meta_tmp, "xb") as fh:
+            fh.write(text.encode("utf-8"))
+            fh.flush()
+            os.fsync(fh.fileno())
+        _keep_mode(meta_tmp, meta_target)
+        with _directory_lock(target.parent):
+            os.replace(tmp, target)
+            os.replace(meta_tmp, meta_target)
+    except BaseException:
+        _discard(tmp)
+        if meta_tmp is not None:
+            _discard(meta_tmp)
+        raise
+    _fsync_dir(target.parent)
+    return target, meta_target
 
 
 def write_bytes(target, data: bytes, *, inputs: Iterable = ()) -> Path:

@@ -99,7 +99,7 @@ def test_csv_export_keeps_every_digit_of_epoch_time(tmp_path, capsys):
     # a plain CSV for other tools (header, rows); without the metadata beside it the
     # time column alone gives the same grid and rate
     assert out.read_text().startswith("time,gyro_x,")
-    assert (tmp_path / "rt.meta.json").is_file()
+    assert (tmp_path / "rt.csv.meta.json").is_file()
     bare = tmp_path / "bare.csv"
     bare.write_text(out.read_text())
     plain = imunoise.read(bare)
@@ -121,7 +121,7 @@ def test_npz_of_arbitrary_arrays_is_refused_with_what_to_do(tmp_path):
 def test_npy_without_metadata_is_refused_with_what_to_do(tmp_path):
     path = tmp_path / "mine.npy"
     np.save(path, np.zeros((10, 3)))
-    with pytest.raises(ValueError, match=r"mine\.npy.*mine\.meta\.json.*from_arrays"):
+    with pytest.raises(ValueError, match=r"mine\.npy.*mine\.npy\.meta\.json.*from_arrays"):
         imunoise.read(path)
 
 
@@ -145,7 +145,7 @@ def test_load_refuses_inconsistent_metadata_naming_the_field(field, value, tmp_p
     damaged.write_bytes(b"".join(raw[:100] + [b"$VNYMR,garbage*00\r\n"] + raw[101:200]))
     out = tmp_path / "o.npy"
     scale.convert(damaged, out, fs=40)
-    meta_file = tmp_path / "o.meta.json"
+    meta_file = tmp_path / "o.npy.meta.json"
     meta = json.loads(meta_file.read_text())
     assert meta["gaps"]["samples"]
     target, key = meta, field
@@ -239,12 +239,12 @@ def test_metadata_beside_a_csv_is_used_only_when_it_is_imunoise_and_fits(tmp_pat
     lines = out.read_text().splitlines(keepends=True)
     cut = tmp_path / "cut.csv"  # rows removed by hand: the metadata no longer fits
     cut.write_text("".join(lines[:1000] + lines[1100:]))
-    (tmp_path / "cut.meta.json").write_text((tmp_path / "rt.meta.json").read_text())
-    with pytest.warns(UserWarning, match="no longer match"):
+    (tmp_path / "cut.csv.meta.json").write_text((tmp_path / "rt.csv.meta.json").read_text())
+    with pytest.warns(UserWarning, match=r"cut\.csv\.meta\.json describes .* other data"):
         plain = imunoise.read(cut)
     assert len(plain.gaps) == 1 and plain.gaps.samples[0] == 100
     assert plain.fs == pytest.approx(log.fs, rel=1e-6)
-    mine = tmp_path / "mine.csv"  # someone else's mine.meta.json is not imunoise's
+    mine = tmp_path / "mine.csv"  # mine.meta.json is not read for mine.csv, whosever it is
     mine.write_text(out.read_text())
     (tmp_path / "mine.meta.json").write_text('{"author": "me"}')
     assert len(imunoise.read(mine)) == 13223

@@ -122,7 +122,7 @@ def test_cli_convert_streams(logs, tmp_path, capsys):
     out = tmp_path / "c.npy"
     assert main(["convert", str(logs["binary"]), "-o", str(out), "--chunk-mb", "0.01"]) == 0
     assert "14400 samples" in capsys.readouterr().out
-    meta = json.loads((tmp_path / "c.meta.json").read_text())
+    meta = json.loads((tmp_path / "c.npy.meta.json").read_text())
     assert meta["samples"] == 14400 and meta["format"] == "vn-binary"
     _same_log(imunoise.read(logs["binary"]), scale.load(out))
 

@@ -35,9 +35,10 @@ def _check(summary, runs):
 
 def test_signals_during_convert(faults, tmp_path):
     sources = [(DATA / "waves_F00294.bin", []), (DATA / "rugged_0513test.txt", ["--fs", "40"])]
-    summary = faults.convert_faults(2, 1, tmp_path, quiet=True, sources=sources,
-                                    outputs=(".csv",))
-    _check(summary, 2)
+    # the two outputs with metadata beside them (compared as pairs)
+    summary = faults.convert_faults(4, 1, tmp_path, quiet=True, sources=sources,
+                                    outputs=(".csv", ".npy"))
+    _check(summary, 4)
 
 
 @pytest.mark.skipif(not os.environ.get("IMUNOISE_FAULTS"), reason="slow: IMUNOISE_FAULTS=1")

@@ -17,8 +17,6 @@ guessed at: the error says to build the log with
 from __future__ import annotations
 
 import io
-import json
-import math
 import os
 from collections.abc import Callable, Mapping
 from pathlib import Path
@@ -26,11 +24,13 @@ from pathlib import Path
 import numpy as np
 
 from imunoise._schema import CHANNELS, column_names
+from imunoise.errors import ParseError
+from imunoise.readers import metafile
 from imunoise.readers.grid import Gaps
 from imunoise.readers.log import ISSUE_KINDS, ImuLog, ParseIssues
 from imunoise.readers.probe import Confidence, Probe
 
-__all__ = ["META_VERSION", "check_meta", "log_meta", "meta_path", "read_columnar", "sniff"]
+__all__ = ["META_VERSION", "REQUIRED", "check_meta", "log_meta", "read_columnar", "sniff"]
 
 #: Version of the metadata written with every output of ``convert``.
 META_VERSION = 1
@@ -58,11 +58,6 @@ def sniff(probe: Probe) -> Confidence:
     return Confidence.NO
 
 
-def meta_path(out: Path) -> Path:
-    """The metadata file of a ``.npy`` output: ``OUT.meta.json`` beside it."""
-    return out.with_name(out.stem + ".meta.json")
-
-
 def log_meta(*, fs: float, source: str, fmt: str, issues: ParseIssues,
              messages: Mapping[str, int], samples: int, channels, table, gaps: Gaps) -> dict:
     """The metadata every output of ``convert`` carries (JSON-able)."""
@@ -84,96 +79,136 @@ def log_meta(*, fs: float, source: str, fmt: str, issues: ParseIssues,
     }
 
 
-def _count(value, where: str, field: str) -> int:
-    if isinstance(value, bool) or not isinstance(value, int) or value < 0:
-        raise ValueError(f"{where}: metadata field {field!r} must be a count >= 0; got {value!r}")
+#: Fields every metadata of ``convert`` has (:func:`log_meta`); a missing one is an
+#: error. Other keys are ignored: a newer imunoise may add some, none changes what
+#: the arrays mean.
+REQUIRED = ("imunoise_columnar", "fs", "source", "format", "samples", "channels", "table",
+            "messages", "issues", "gaps")
+#: Issue kinds every version of the metadata counts (later kinds, e.g.
+#: ``time_reset``, are zero where missing): a count that is gone is not zero.
+V1_KINDS = ("bad_checksum", "malformed_field", "unknown_message", "truncated_record",
+            "bytes_skipped", "device_error", "duplicate_time", "time_reversed")
+#: Where the issue locations of ``issues.first`` count from.
+_LOCATIONS = ("line", "byte", "message")
+#: Longest text field (source, format, table) accepted, characters.
+_MAX_TEXT = 1 << 16
+
+
+def _text(meta: dict, key: str, where, *, optional: bool = False) -> None:
+    value = meta[key]
+    if optional and value is None:
+        return
+    if not isinstance(value, str) or len(value) > _MAX_TEXT:
+        raise metafile.bad_field(where, key, f"must be a text of at most {_MAX_TEXT} "
+                                 f"characters{' or null' if optional else ''}; got "
+                                 f"{metafile.shown(value)}")
+
+
+def _object(value, where, field: str) -> dict:
+    if not isinstance(value, dict):
+        raise metafile.bad_field(where, field, f"must be a JSON object; got "
+                                 f"{metafile.shown(value)}")
     return value
 
 
-def check_meta(meta, where: str) -> dict:
-    """``meta`` if it describes a log consistently, else ``ValueError`` naming the field.
+def check_meta(meta, where, *, tied: bool = False) -> dict:
+    """``meta`` if it describes a log consistently, else a
+    :class:`~imunoise.errors.ParseError` naming the file ``where`` and the field.
 
-    Checks the version, a positive finite ``fs``, counts that are integers >= 0
-    (samples, messages, issues), known channels and issue kinds, and gaps that
-    are sorted, non-overlapping and inside the samples.
+    Checks every field :func:`log_meta` writes, by type and range: the version,
+    a rate in (0, :data:`~imunoise.readers.metafile.MAX_FS`] Hz (``true`` is not
+    one), counts that are integers in [0, 2**63) (samples, messages, issues,
+    locations), known channels (each once) and issue kinds, a known location
+    unit, and gaps that are sorted, non-overlapping and inside the samples.
+    ``tied``: the metadata of a file beside it must carry the file's fingerprint
+    (``data``, see :mod:`imunoise.readers.metafile`).
     """
+    bad = metafile.bad_field
     if not isinstance(meta, dict):
-        raise ValueError(f"{where}: the metadata is not a JSON object")
-    if meta.get("imunoise_columnar") != META_VERSION:
-        raise ValueError(f"{where}: metadata field 'imunoise_columnar' must be {META_VERSION}; "
-                         f"got {meta.get('imunoise_columnar')!r}")
-    for key in ("fs", "source", "format", "samples", "channels", "issues"):
+        raise ParseError(f"the metadata is not a JSON object; got {metafile.shown(meta)}",
+                         kind="malformed_field", source=str(where))
+    version = meta.get("imunoise_columnar")
+    if isinstance(version, bool) or version != META_VERSION:
+        raise bad(where, "imunoise_columnar", f"must be {META_VERSION}; got "
+                  f"{metafile.shown(version)}")
+    for key in (*REQUIRED, *(("data",) if tied else ())):
         if key not in meta:
-            raise ValueError(f"{where}: metadata field {key!r} is missing")
-    fs = meta["fs"]
-    if isinstance(fs, bool) or not isinstance(fs, int | float) or not (
-            math.isfinite(fs) and fs > 0):
-        raise ValueError(f"{where}: metadata field 'fs' must be a positive finite rate in Hz; "
-                         f"got {fs!r}")
-    samples = _count(meta["samples"], where, "samples")
+            raise bad(where, key, "is missing")
+    metafile.rate(meta["fs"], where)
+    for key in ("source", "format"):
+        _text(meta, key, where)
+    _text(meta, "table", where, optional=True)
+    samples = metafile.count(meta["samples"], where, "samples")
     channels = meta["channels"]
-    if not isinstance(channels, list) or any(c not in ("time", *CHANNELS) for c in channels):
-        raise ValueError(f"{where}: metadata field 'channels' must list channels of "
-                         f"{('time', *CHANNELS)}; got {channels!r}")
-    for name, count in (meta.get("messages") or {}).items():
-        _count(count, where, f"messages.{name}")
-    issues = meta["issues"]
-    if not isinstance(issues, dict) or not isinstance(issues.get("counts"), dict):
-        raise ValueError(f"{where}: metadata field 'issues.counts' is missing")
-    for kind, count in issues["counts"].items():
+    known = ("time", *CHANNELS)
+    if (not isinstance(channels, list) or not channels
+            or any(not isinstance(c, str) or c not in known for c in channels)
+            or len(set(channels)) != len(channels)):
+        raise bad(where, "channels", f"must list channels of {known}, each once; got "
+                  f"{metafile.shown(channels)}")
+    for name, n in _object(meta["messages"], where, "messages").items():
+        metafile.count(n, where, f"messages.{name}")
+    issues = _object(meta["issues"], where, "issues")
+    for key in ("counts", "first", "location"):
+        if key not in issues:
+            raise bad(where, f"issues.{key}", "is missing")
+    counts = _object(issues["counts"], where, "issues.counts")
+    missing = [k for k in V1_KINDS if k not in counts]
+    if missing:
+        raise bad(where, "issues.counts", f"lacks the kinds {missing} (every version "
+                  "writes them)")
+    for kind, n in counts.items():
         if kind not in ISSUE_KINDS:
-            raise ValueError(f"{where}: metadata field 'issues.counts' has unknown kind {kind!r}")
-        _count(count, where, f"issues.counts.{kind}")
-    for kind, where_first in (issues.get("first") or {}).items():
-        if kind not in ISSUE_KINDS or not isinstance(where_first, list):
-            raise ValueError(f"{where}: metadata field 'issues.first.{kind}' is not a list of "
-                             "locations of a known kind")
-        for i, loc in enumerate(where_first):
-            _count(loc, where, f"issues.first.{kind}[{i}]")
-    gaps = meta.get("gaps")
-    if gaps is not None:
-        index, lengths = gaps.get("index"), gaps.get("samples")
-        if not isinstance(index, list) or not isinstance(lengths, list) or len(index) != len(
-                lengths):
-            raise ValueError(f"{where}: metadata fields 'gaps.index' and 'gaps.samples' must be "
-                             "lists of equal length")
-        end = 0
-        for i, (start, k) in enumerate(zip(index, lengths, strict=True)):
-            _count(start, where, f"gaps.index[{i}]")
-            if _count(k, where, f"gaps.samples[{i}]") == 0 or start < end or start + k > samples:
-                raise ValueError(f"{where}: metadata field 'gaps' row {i} ({start}, {k}) is not "
-                                 f"a run of missing samples inside the {samples} samples, after "
-                                 "the one before")
-            end = start + k
+            raise bad(where, "issues.counts", f"has unknown kind {metafile.shown(kind)}")
+        metafile.count(n, where, f"issues.counts.{kind}")
+    for kind, locations in _object(issues["first"], where, "issues.first").items():
+        if kind not in ISSUE_KINDS or not isinstance(locations, list):
+            raise bad(where, f"issues.first.{kind}", "is not a list of locations of a known "
+                      "kind")
+        for i, loc in enumerate(locations):
+            metafile.count(loc, where, f"issues.first.{kind}[{i}]")
+    if issues["location"] not in _LOCATIONS:
+        raise bad(where, "issues.location", f"must be one of {_LOCATIONS}; got "
+                  f"{metafile.shown(issues['location'])}")
+    gaps = _object(meta["gaps"], where, "gaps")
+    index, lengths = gaps.get("index"), gaps.get("samples")
+    if not isinstance(index, list) or not isinstance(lengths, list) or len(index) != len(
+            lengths):
+        raise bad(where, "gaps", "must hold lists 'index' and 'samples' of equal length")
+    end = 0
+    for i, (start, k) in enumerate(zip(index, lengths, strict=True)):
+        metafile.count(start, where, f"gaps.index[{i}]")
+        if metafile.count(k, where, f"gaps.samples[{i}]") == 0 or start < end or (
+                start + k > samples):
+            raise bad(where, f"gaps[{i}]", f"({start}, {k}) is not a run of missing samples "
+                      f"inside the {samples} samples, after the one before")
+        end = start + k
+    if tied:
+        metafile.tie_fields(meta["data"], where)
     return meta
 
 
 def _issues(meta: dict) -> ParseIssues:
     iss = meta["issues"]
-    return ParseIssues(counts=iss["counts"],
-                       first={k: tuple(v) for k, v in (iss.get("first") or {}).items()},
-                       location=iss.get("location", "line"))
+    return ParseIssues(counts=iss["counts"], first={k: tuple(v) for k, v in iss["first"].items()},
+                       location=iss["location"])
 
 
 def log_from_meta(meta: dict, arrays: Mapping[str, np.ndarray], where: str) -> ImuLog:
     """The :class:`ImuLog` of checked metadata and its channel arrays."""
     lengths = {ch: len(a) for ch, a in arrays.items()}
     if any(n != meta["samples"] for n in lengths.values()):
-        raise ValueError(f"{where}: the metadata says {meta['samples']} samples but the arrays "
-                         f"hold {lengths}")
+        raise ParseError(f"the metadata says {meta['samples']} samples but the arrays hold "
+                         f"{lengths}", kind="malformed_field", source=str(where))
     fs = float(meta["fs"])
-    gaps = meta.get("gaps")
+    gaps = meta["gaps"]
     # the gaps as convert found them: no pass over memory-mapped channels for NaN
-    gaps = None if gaps is None else Gaps(gaps["index"], gaps["samples"], fs)
-    return ImuLog(fs=fs, source=meta["source"], format=meta["format"], issues=_issues(meta),
-                  messages=meta.get("messages") or {}, gaps=gaps, **arrays)
-
-
-def _json(text, where: str) -> dict:
+    gaps = Gaps(gaps["index"], gaps["samples"], fs)
     try:
-        return json.loads(text)
-    except (ValueError, UnicodeDecodeError) as exc:
-        raise ValueError(f"{where}: the imunoise metadata is not valid JSON ({exc})") from None
+        return ImuLog(fs=fs, source=meta["source"], format=meta["format"],
+                      issues=_issues(meta), messages=meta["messages"], gaps=gaps, **arrays)
+    except ValueError as exc:  # the arrays' shapes: name the file they came from
+        raise ParseError(str(exc), kind="malformed_field", source=str(where)) from None
 
 
 def _flat(table: Mapping[str, np.ndarray], channels, where: str) -> dict[str, np.ndarray]:
@@ -183,36 +218,64 @@ def _flat(table: Mapping[str, np.ndarray], channels, where: str) -> dict[str, np
         names = column_names(ch)
         missing = [n for n in names if n not in table]
         if missing:
-            raise ValueError(f"{where}: the metadata lists channel {ch!r} but columns "
-                             f"{missing} are missing")
-        cols = [np.asarray(table[n], dtype=np.float64) for n in names]
-        arrays[ch] = cols[0] if len(cols) == 1 else np.column_stack(cols)
+            raise ParseError(f"the metadata lists channel {ch!r} but columns {missing} are "
+                             "missing", kind="malformed_field", source=str(where))
+        try:
+            cols = [np.asarray(table[n], dtype=np.float64).reshape(-1) for n in names]
+            arrays[ch] = cols[0] if len(cols) == 1 else np.column_stack(cols)
+        except ValueError as exc:  # columns of other lengths or of text
+            raise ParseError(f"the columns of channel {ch!r} do not make one array ({exc})",
+                             kind="malformed_field", source=str(where)) from None
     return arrays
 
 
+def _load_npy(path: Path, where) -> np.ndarray:
+    """``np.load(path, mmap_mode="r")``, its errors naming the file."""
+    try:
+        return np.load(path, mmap_mode="r", allow_pickle=False)
+    # a cut or damaged header: numpy raises ValueError, OSError, EOFError, TokenError
+    except Exception as exc:  # noqa: BLE001
+        raise ParseError(f"not a readable .npy ({exc})", kind="malformed_field",
+                         source=str(where)) from None
+
+
 def _read_dir(path: Path) -> ImuLog:
-    where = str(path)
-    meta = check_meta(_json((path / "meta.json").read_bytes(), where), where)
+    where = path / "meta.json"
+    meta = check_meta(metafile.load(where), where)
+    ties = _object(meta.get("data"), where, "data") if "data" in meta else None
+    if ties is None:
+        raise metafile.bad_field(where, "data", "is missing (a directory written by an earlier "
+                                 "imunoise: convert the log again)")
     missing = [ch for ch in meta["channels"] if not (path / f"{ch}.npy").is_file()]
     if missing:
-        raise ValueError(f"{where}: the metadata lists channels {missing} but their .npy files "
-                         "are missing")
-    arrays = {ch: np.load(path / f"{ch}.npy", mmap_mode="r") for ch in meta["channels"]}
-    return log_from_meta(meta, arrays, where)
+        raise ParseError(f"the metadata lists channels {missing} but their .npy files are "
+                         "missing", kind="malformed_field", source=str(where))
+    for ch in meta["channels"]:
+        metafile.check_tie(ties.get(f"{ch}.npy"), path / f"{ch}.npy", where)
+    arrays = {ch: _load_npy(path / f"{ch}.npy", path / f"{ch}.npy") for ch in meta["channels"]}
+    return log_from_meta(meta, arrays, path)
 
 
 def _read_npy(source, path: Path | None) -> ImuLog:
     where = "<bytes>" if path is None else str(path)
-    meta_file = None if path is None else meta_path(path)
-    if meta_file is None or not meta_file.is_file():
+    meta_file = None if path is None else metafile.meta_path(path)
+    meta = None if meta_file is None else metafile.load(meta_file)
+    if meta is None:
         beside = "" if meta_file is None else f" ({meta_file.name} beside it)"
-        raise ValueError(f"{where}: a .npy without the metadata imunoise convert writes"
-                         f"{beside}; {_FROM_ARRAYS}")
-    meta = check_meta(_json(meta_file.read_bytes(), str(meta_file)), str(meta_file))
-    rec = np.load(path, mmap_mode="r")
-    if rec.dtype.names is None or set(meta["channels"]) - set(rec.dtype.names):
-        raise ValueError(f"{where}: not the structured array of {meta['channels']} its "
-                         f"metadata describes")
+        legacy = None if path is None else metafile.legacy_path(path)
+        if legacy is not None and legacy.is_file():
+            beside += (f"; {legacy.name} is the name earlier versions gave the metadata of "
+                       f"{path.stem}.npy and {path.stem}.csv alike, so it cannot say which "
+                       f"it describes: convert the log again, or rename it to "
+                       f"{meta_file.name} if it is this file's")
+        raise ParseError(f"a .npy without the metadata imunoise convert writes{beside}; "
+                         f"{_FROM_ARRAYS}", kind="malformed_field", source=where)
+    meta = check_meta(meta, meta_file, tied=True)
+    metafile.check_tie(meta["data"], path, meta_file)
+    rec = _load_npy(path, where)
+    if rec.dtype.names is None or set(meta["channels"]) - set(rec.dtype.names) or rec.ndim != 1:
+        raise ParseError(f"not the structured array of {meta['channels']} its metadata "
+                         "describes", kind="malformed_field", source=where)
     return log_from_meta(meta, {ch: rec[ch] for ch in meta["channels"]}, where)
 
 
@@ -229,7 +292,7 @@ def _read_npz(source, path: Path | None) -> ImuLog:
     if META_KEY not in table:
         raise ValueError(f"{where}: an .npz of arrays {sorted(table)} without the metadata "
                          f"imunoise convert writes; {_FROM_ARRAYS}")
-    meta = check_meta(_json(str(table[META_KEY]), where), where)
+    meta = check_meta(metafile.parse(str(table[META_KEY]), where), where)
     return log_from_meta(meta, _flat(table, meta["channels"], where), where)
 
 
@@ -239,7 +302,11 @@ def _legacy_npz(table: Mapping[str, np.ndarray], where: str) -> ImuLog:
     if not [ch for ch in channels if ch != "time"]:
         raise ValueError(f"{where}: an .npz of arrays {sorted(table)} with no imunoise "
                          f"channel columns; {_FROM_ARRAYS}")
-    fs = float(np.asarray(table["fs"]).reshape(-1)[0])
+    fs_value = np.asarray(table["fs"]).reshape(-1)
+    if fs_value.size != 1 or fs_value.dtype.kind not in "iuf":
+        raise ParseError(f"entry 'fs' must be one rate in Hz; got {fs_value[:3]!r}",
+                         kind="malformed_field", source=where)
+    fs = metafile.rate(fs_value[0].item(), where, "fs")
     arrays = _flat(table, channels, where)
     valid = table.get("valid")
     gaps = None if valid is None else Gaps.from_valid(np.asarray(valid) > 0.5, fs)
@@ -265,7 +332,7 @@ def _read_parquet(source, path: Path | None) -> ImuLog:
     if raw is None:
         raise ValueError(f"{where}: a Parquet file without the metadata imunoise convert "
                          f"writes (key {META_KEY!r}); {_FROM_ARRAYS}")
-    meta = check_meta(_json(raw, where), where)
+    meta = check_meta(metafile.parse(raw, where), where)
     columns = {n: table.column(n).to_numpy() for n in table.column_names}
     return log_from_meta(meta, _flat(columns, meta["channels"], where), where)
 

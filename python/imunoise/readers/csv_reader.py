@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import csv
 import io
-import json
 import math
 import os
 import re
@@ -25,8 +24,9 @@ import numpy as np
 from imunoise import _warn
 from imunoise._schema import CHANNELS, COLUMN_SUFFIXES, G
 from imunoise.errors import ParseError
+from imunoise.readers import metafile
 from imunoise.readers._sentences import IssueTally, sentence_rows
-from imunoise.readers.columnar import check_meta, log_from_meta, meta_path
+from imunoise.readers.columnar import check_meta, log_from_meta
 from imunoise.readers.log import ImuLog, log_on_grid
 from imunoise.readers.probe import Confidence, Probe
 
@@ -694,21 +694,38 @@ class _Reader:
 
 
 def _convert_meta(name: str) -> dict | None:
-    """The metadata ``imunoise convert`` wrote beside a CSV (``OUT.meta.json``), checked;
-    ``None`` when there is none (or the file of that name is not imunoise's)."""
+    """The metadata ``imunoise convert`` wrote beside a CSV (``OUT.csv.meta.json``),
+    checked (a malformed one is a :class:`ParseError` naming it and the field);
+    ``None`` when there is none, or when it describes other bytes than the CSV's (the
+    CSV was edited or replaced: it is read as a plain CSV, with a warning)."""
     if name == _BYTES:
         return None
-    meta_file = meta_path(Path(name))
-    if not meta_file.is_file():
+    path = Path(name)
+    meta_file = metafile.meta_path(path)
+    meta = metafile.load(meta_file)
+    if meta is None:
+        _legacy_note(path)
         return None
-    where = str(meta_file)
+    meta = check_meta(meta, meta_file, tied=True)
+    why = metafile.tie_errors(meta["data"], path, meta_file)
+    if why is not None:
+        _warn.warn(f"{why}; its metadata is not used: read as a plain CSV")
+        return None
+    return meta
+
+
+def _legacy_note(path: Path) -> None:
+    """Say that the metadata an earlier version wrote under the shared name is not used."""
+    legacy = metafile.legacy_path(path)
     try:
-        meta = json.loads(meta_file.read_bytes())
-    except (ValueError, UnicodeDecodeError) as exc:
-        raise ValueError(f"{where}: the imunoise metadata is not valid JSON ({exc})") from None
-    if not isinstance(meta, dict) or "imunoise_columnar" not in meta:
-        return None  # someone else's file of that name
-    return check_meta(meta, where)
+        meta = metafile.load(legacy)
+    except ParseError:
+        return  # not imunoise's, or not readable: nothing of ours to mention
+    if isinstance(meta, dict) and "imunoise_columnar" in meta:
+        _warn.warn(f"{path}: {legacy.name} beside it is the metadata name earlier versions "
+                   f"gave {path.stem}.csv and {path.stem}.npy alike, so it is not used (read as "
+                   f"a plain CSV); rename it to {path.name}{metafile.SUFFIX} if it is this "
+                   "file's, or convert the log again")
 
 
 def _restore_meta(reader: _Reader, channels, time) -> ImuLog | None:

@@ -23,7 +23,10 @@ class Confidence(enum.IntEnum):
     GUESS = 1  # plausible content, e.g. delimited text
     CONTENT = 2  # the format's own records seen in the first bytes
     NAME = 3  # the file extension names the format
-    SIGNATURE = 4  # a magic number or a container's layout
+    # Records whose checksum (CRC-16) verifies: surer than a name or a header-like
+    # first line, since text between binary packets can look like a CSV header.
+    CHECKED = 4
+    SIGNATURE = 5  # a magic number or a container's layout
 
 
 class Probe:

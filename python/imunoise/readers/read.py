@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import os
 import stat
@@ -10,6 +11,7 @@ from collections.abc import Callable, Mapping, Sequence
 
 from imunoise import _warn
 from imunoise._deprecation import old_call_forms
+from imunoise.errors import ParseError
 from imunoise.readers import registry
 from imunoise.readers.log import ImuLog
 from imunoise.readers.probe import Confidence, Probe
@@ -160,7 +162,7 @@ def read(
         raise ValueError(f"format must be one of {choices}; got {format!r}")
     if is_stream(source):
         name = stream_name(source)
-        with warnings.catch_warnings(record=True) as caught:
+        with warnings.catch_warnings(record=True) as caught, naming(name):
             warnings.simplefilter("always")
             log = read(read_stream(source), format=format, strict=strict, fs=fs,
                        progress=progress, columns=columns, units=units, delimiter=delimiter,
@@ -180,8 +182,36 @@ def read(
                 f"{', '.join(layout)} describe a delimited text log; format must be 'auto' "
                 f"or 'csv' with them; got {format!r}"
             )
-        return registry.get("csv").read(source, strict=strict, fs=fs, progress=progress,
-                                        **layout)
-    if format == "auto":
-        format = detect_format(source)
-    return registry.get(format).read(source, strict=strict, fs=fs, progress=progress)
+        with naming(source):
+            return registry.get("csv").read(source, strict=strict, fs=fs, progress=progress,
+                                            **layout)
+    with naming(source):
+        if format == "auto":
+            format = detect_format(source)
+        return registry.get(format).read(source, strict=strict, fs=fs, progress=progress)
+
+
+@contextlib.contextmanager
+def naming(source):
+    """Every error of reading ``source`` names it: a :class:`ParseError` without a
+    file gets it, a ``ValueError`` whose text lacks the name gets it in front, and
+    ``OverflowError``/``RecursionError`` (a number or nesting in the file beyond what
+    can be computed) become a ``ParseError`` naming the file. Bytes have no name."""
+    if not isinstance(source, str | os.PathLike):
+        yield
+        return
+    name = os.fspath(source)
+    try:
+        yield
+    except ParseError as exc:
+        if exc.source is not None:
+            raise
+        raise ParseError(exc.reason, kind=exc.kind, line=exc.line, offset=exc.offset,
+                         source=name) from exc
+    except (OverflowError, RecursionError) as exc:
+        raise ParseError(f"{type(exc).__name__}: {exc}", kind="malformed_field",
+                         source=name) from exc
+    except ValueError as exc:
+        if name in str(exc):
+            raise
+        raise ValueError(f"{name}: {exc}") from exc

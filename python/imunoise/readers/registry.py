@@ -10,6 +10,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass
 
+from imunoise._core import vn as _core_vn
 from imunoise.readers import columnar, csv_reader, rosbag_reader
 from imunoise.readers.log import ImuLog
 from imunoise.readers.probe import Confidence, Probe
@@ -53,9 +54,29 @@ def _sniff_vn_ascii(probe: Probe) -> Confidence:
     return Confidence.CONTENT if n_ascii and n_sync <= n_ascii else Confidence.NO
 
 
+#: Binary packets whose CRC-16 verifies in the first bytes that make a source
+#: VN binary whatever its name or first lines (two, so that one chance match of
+#: a CRC in other binary data is not enough: about 1 in 65,536 per try).
+CHECKED_PACKETS = 2
+
+
+def _checked_packets(probe: Probe) -> int:
+    """Binary packets in the first bytes whose CRC-16 verifies (decoded by the
+    reader's own Rust parser; a packet cut by the end of the head is not counted)."""
+    if probe.is_dir or b"\xfa" not in probe.head:
+        return 0
+    rows = _core_vn.VnStream(False).feed(probe.head)
+    return sum(len(next(iter(cols.values()), ())) for name, cols in rows.tables.items()
+               if name.startswith("binary_"))
+
+
 def _sniff_vn_binary(probe: Probe) -> Confidence:
-    """More binary sync bytes than VN sentences (both framings may be interleaved)."""
+    """Binary packets that pass their CRC (a logger's text markers between them,
+    e.g. ``S,Booting from beginning!``, must not make the log a CSV); else more
+    binary sync bytes than VN sentences (both framings may be interleaved)."""
     n_ascii, n_sync = _vn_counts(probe)
+    if n_sync > n_ascii and _checked_packets(probe) >= CHECKED_PACKETS:
+        return Confidence.CHECKED
     return Confidence.CONTENT if n_sync > n_ascii else Confidence.NO
 
 

@@ -44,8 +44,9 @@ from types import MappingProxyType
 import numpy as np
 
 from imunoise._core import vn as _core_vn
+from imunoise.errors import ParseError
 from imunoise.readers import recording
-from imunoise.readers.grid import TimeGrid
+from imunoise.readers.grid import MAX_GRID_RATIO, TimeGrid
 from imunoise.readers.log import ISSUE_KINDS, ImuLog, ParseIssues, log_on_grid
 
 #: channel -> candidate column triples (compensated first), names without group prefix.
@@ -325,6 +326,10 @@ def _with_outages(tables: VnTables, path: str, cut, fs: float | None) -> VnTable
         return tables
     stream = _core_vn.VnStream(False)
     before, rows, done = [], 0, 0
+    records = len(next(iter(tables.tables[name].values()), ()))
+    # the grid's own bound (MAX_GRID_RATIO), checked before the rows are listed: an
+    # outage of 1e12 s must be an error naming its line, not a MemoryError
+    room, side = (MAX_GRID_RATIO - 1) * records, path + recording.GAPS
     with open(path, "rb") as f:
         for outage in sorted(cut, key=lambda o: o.offset):
             while done < outage.offset:
@@ -334,7 +339,15 @@ def _with_outages(tables: VnTables, path: str, cut, fs: float | None) -> VnTable
                 done += len(piece)
                 cols = stream.feed(piece).tables.get(name, {})
                 rows += len(next(iter(cols.values()))) if cols else 0
-            before.extend([rows] * max(0, round(outage.seconds * fs) - 1))
+            missing = max(0, round(outage.seconds * fs) - 1)
+            room -= missing
+            if room < 0:
+                raise ParseError(
+                    f"the outages up to this one leave more than {MAX_GRID_RATIO - 1}x the "
+                    f"{records} records missing (this one: {outage.seconds:.6g} s at {fs:g} "
+                    f"Hz, {missing} samples); not a gap of this recording",
+                    kind="malformed_field", line=outage.line, source=side)
+            before.extend([rows] * missing)
     missing = dict(tables.missing)
     missing[name] = np.sort(np.concatenate([np.asarray(missing.get(name, ()), np.int64),
                                             np.asarray(before, np.int64)]))

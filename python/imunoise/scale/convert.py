@@ -21,7 +21,8 @@ Output layouts (chosen by ``out``):
     plus ``meta.json`` (sample rate, source, parse issues, message counts).
 ``OUT.npy``
     one structured array, a field per channel (``a["gyro"]`` is (n, 3)), plus
-    ``OUT.meta.json``.
+    ``OUT.npy.meta.json`` (with the array file's fingerprint: the two are published
+    together, see :func:`imunoise._atomic.publish_pair`).
 ``OUT.parquet``
     a column per axis (``gyro_x`` ...) written row group by row group (needs
     pyarrow); the metadata are the file's key-value metadata (``fs``, ``source``,
@@ -50,8 +51,8 @@ import numpy as np
 from imunoise import _atomic, _summary
 from imunoise._core import vn as _core_vn
 from imunoise._schema import CHANNELS, column_names
-from imunoise.readers import registry
-from imunoise.readers.columnar import META_KEY, log_meta, meta_path, read_columnar
+from imunoise.readers import metafile, registry
+from imunoise.readers.columnar import META_KEY, log_meta, read_columnar
 from imunoise.readers.grid import (
     FIRST_KEPT,
     OUTLIER_WINDOW,
@@ -247,7 +248,12 @@ class _DirSink(_Sink):
             f.close()
 
     def publish(self, out, meta):
-        _atomic.write_text(self.staging / "meta.json", json.dumps(meta, indent=1))
+        # each channel file's fingerprint: a directory whose files were replaced one
+        # by one (below) and interrupted is refused by the reader, not mixed
+        ties = {f"{ch}.npy": _atomic.fingerprint(self.staging / f"{ch}.npy")
+                for ch in self.channels}
+        _atomic.write_text(self.staging / "meta.json",
+                           json.dumps({**meta, "data": ties}, indent=1))
         _atomic.sync(self.staging)
         names = [f"{ch}.npy" for ch in self.channels] + ["meta.json"]
         if not out.exists():
@@ -300,9 +306,9 @@ class _NpySink(_Sink):
         self.file.close()
 
     def publish(self, out, meta):
-        meta_file = meta_path(out)
-        _atomic.publish(self.staging, out)
-        _atomic.write_text(meta_file, json.dumps(meta, indent=1))
+        meta_file = metafile.meta_path(out)
+        _atomic.publish_pair(self.staging, out,
+                             lambda tie: json.dumps({**meta, "data": tie}, indent=1), meta_file)
         return [out, meta_file]
 
 
@@ -981,4 +987,7 @@ def load(out) -> ImuLog:
         raise FileNotFoundError(2, "no such file or directory", str(out))
     if not out.is_dir():
         _layout(out)  # a suffix convert does not write is an error naming the layouts
-    return read_columnar(out)
+    from imunoise.readers.read import naming
+
+    with naming(out):
+        return read_columnar(out)

@@ -3,10 +3,12 @@
 Both carry the metadata of :func:`imunoise.readers.columnar.log_meta` (rate,
 source, format, issues, messages, gaps), so that :func:`imunoise.read` gives
 back the log that was written: the ``.npz`` as an entry ``imunoise`` (a JSON
-string), the CSV in ``OUT.meta.json`` beside it (the CSV itself stays a plain
-header and rows for any other tool). Every value is written with the shortest
-text that parses back to the same float64 (numpy's round-trip repr): epoch
-times keep their nanoseconds, samples are bit-identical.
+string), the CSV in ``OUT.csv.meta.json`` beside it (the CSV itself stays a plain
+header and rows for any other tool), with the CSV's fingerprint so that a reader
+never pairs it with another CSV (:func:`imunoise._atomic.publish_pair`). Every
+value is written with the shortest text that parses back to the same float64
+(numpy's round-trip repr): epoch times keep their nanoseconds, samples are
+bit-identical.
 """
 
 from __future__ import annotations
@@ -20,7 +22,8 @@ import numpy as np
 
 from imunoise import _atomic
 from imunoise._schema import column_names
-from imunoise.readers.columnar import META_KEY, log_meta, meta_path
+from imunoise.readers import metafile
+from imunoise.readers.columnar import META_KEY, log_meta
 from imunoise.readers.log import ImuLog
 
 __all__ = ["log_columns", "write_csv", "write_npz"]
@@ -55,17 +58,20 @@ def _meta(log: ImuLog) -> dict:
 
 def write_csv(log: ImuLog, out, *, inputs: Iterable = ()) -> list[Path]:
     """Write ``log`` as CSV (a header, one row per grid row, NaN in missing rows) and
-    its metadata as ``OUT.meta.json``, each atomically (``inputs`` are refused as
-    outputs); returns both paths."""
+    its metadata as ``OUT.csv.meta.json``, published together (``inputs`` are
+    refused as outputs); returns both paths."""
     out = Path(os.fspath(out))
     names, cols = log_columns(log)
-    with _atomic.replacing(out, inputs=inputs) as fh:
+    meta_file = metafile.meta_path(out)
+    _atomic.refuse_input(meta_file, inputs)
+    meta = _meta(log)
+    with _atomic.staged(out, inputs=inputs) as (fh, tmp):
         fh.write((",".join(names) + "\n").encode())
         for start in range(0, len(log), _CSV_ROWS):
             text = [c[start:start + _CSV_ROWS].astype(str) for c in cols]  # round-trip repr
             fh.write("".join(",".join(row) + "\n" for row in zip(*text, strict=True)).encode())
-    meta_file = meta_path(out)
-    _atomic.write_text(meta_file, json.dumps(_meta(log), indent=1), inputs=inputs)
+    _atomic.publish_pair(tmp, out, lambda tie: json.dumps({**meta, "data": tie}, indent=1),
+                         meta_file)
     return [out, meta_file]
 
 
