@@ -724,7 +724,8 @@ def spectrum(
     """One-sided PSD (or ASD with ``amplitude``), log-binned, one panel per axis: the
     ``confidence`` band, the white band the N read-off used (shaded) with its level
     2N² and the value of N, and ``model``'s PSD (:func:`imunoise.spectrum.model_psd`,
-    total and terms) when given."""
+    total and terms, its resonance included) with its reported tones marked at their
+    frequencies, when given."""
     from imunoise.spectrum import Spectrum, model_psd_terms
 
     new_figure = _plt()
@@ -770,6 +771,12 @@ def spectrum(
                     text, dash = TERM_STYLES.get(name, (name, (0, (2, 2))))
                     ax.loglog(s.f, np.reshape(values, shape)[:, j] ** power, color="0.4",
                               linestyle=dash, linewidth=0.8, label=text)
+            if model is not None:
+                # the model's tones are lines, no density: marked where reported
+                shown_lines = [line for line in model.lines[j] if line.reported]
+                for k, line in enumerate(shown_lines):
+                    ax.axvline(line.frequency, color="tab:olive", linewidth=1.0,
+                               label="model's line (tone)" if k == 0 else None)
             ax.set_title(names[j])
             ax.set_xlabel("frequency [Hz]")
         # the panels share y: one range holding every panel's spectrum and band (a

@@ -92,6 +92,7 @@ __all__ = [
     "model_psd",
     "model_psd_terms",
     "psd",
+    "resonance_psd",
     "term_psd",
 ]
 
@@ -449,7 +450,9 @@ def model_psd(model: NoiseModel, f: npt.ArrayLike) -> np.ndarray:
 def model_psd_terms(model: NoiseModel, f: npt.ArrayLike) -> dict[str, np.ndarray]:
     """Each fitted component of ``model`` that is present (non-zero) as its one-sided
     PSD at ``f``:
-    keys "Q", "N", "B", "K", "R", "GM1", … (GM: the sampled AR1, see the module)."""
+    keys "Q", "N", "B", "K", "R", "GM1", … (GM: the sampled AR1, see the module) and
+    "resonance" (:func:`resonance_psd`). A tone is a line, no density: plots mark
+    its frequency (:attr:`NoiseModel.lines`)."""
     f = _check_frequencies(f)
     fs = float(model.fs)
     channels = 1 if model.one_channel else model.channels
@@ -464,7 +467,33 @@ def model_psd_terms(model: NoiseModel, f: npt.ArrayLike) -> dict[str, np.ndarray
             gm = (2 * sigma**2 * (1 - phi**2) / fs
                   / np.abs(1 - phi * np.exp(-2j * np.pi * f / fs)) ** 2)
             out.setdefault(f"GM{k + 1}", np.zeros((f.size, channels)))[:, j] = gm
+        for sigma, f_r, tau_r, skew in model.components.resonance(j):
+            out.setdefault("resonance", np.zeros((f.size, channels)))[:, j] = resonance_psd(
+                sigma, f_r, tau_r, skew, f, fs)
     return {k: (v[:, 0] if model.one_channel else v) for k, v in out.items()}
+
+
+def resonance_psd(sigma: float, f_r: float, tau_r: float, skew: float, f, fs: float):
+    r"""One-sided PSD at ``f`` of the model's resonance: the sampled process of
+    autocovariance :math:`\sigma^2\,\mathrm{Re}[(1-i\beta)z^{|h|}]`,
+    :math:`z = e^{-1/(f_s\tau_r) + 2\pi i f_r/f_s}`, β its skew times the bound that
+    keeps the spectrum non-negative:
+
+    .. math:: S(f) = \frac{2\sigma^2}{f_s}\,\mathrm{Re}\left[(1-i\beta)
+              \frac{1-z^2}{(1-z e^{-i\omega})(1-z e^{i\omega})}\right],
+              \quad \omega = 2\pi f/f_s
+
+    (the sum of the autocovariance's geometric series); at f = 0 it is 2N² of the
+    white tail its Allan variance has beyond τr."""
+    from imunoise.noise._terms import quadrature_bound
+
+    z = math.exp(-1.0 / (fs * tau_r)) * complex(math.cos(2 * math.pi * f_r / fs),
+                                                math.sin(2 * math.pi * f_r / fs))
+    bound = quadrature_bound(f_r, tau_r, fs)
+    beta = skew * bound if math.isfinite(bound) else 0.0
+    e = np.exp(-2j * np.pi * np.asarray(f, float) / fs)
+    series = (1 - z * z) / ((1 - z * e) * (1 - z * np.conj(e)))
+    return np.maximum(2 * sigma**2 / fs * ((1 - 1j * beta) * series).real, 0.0)
 
 
 # -- the estimate ---------------------------------------------------------------------

@@ -140,7 +140,8 @@ def _parse_terms(terms) -> tuple[np.ndarray, int, tuple[int, bool, bool], bool]:
 @old_call_forms(keyword_only=("method", "terms", "tau_range"))
 def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
         tau_range: tuple[float, float] | None = None, uncertainty: str = "independent",
-        replicates: int = 30, seed=None, warn_coverage: bool = True) -> NoiseModel:
+        replicates: int = 30, seed=None, warn_coverage: bool = True,
+        spectrum=None) -> NoiseModel:
     """Fit the noise model to an Allan deviation.
 
     Parameters
@@ -180,6 +181,13 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
     warn_coverage : bool
         Warn when the model follows the curve poorly (below); False for callers
         that say it in their own words (the report, ``imunoise fit``).
+    spectrum : Spectrum, optional
+        The Welch PSD of the same sensor (:func:`imunoise.psd`, not smoothed; the
+        same channels and rate): each fitted tone is checked against it
+        (:mod:`imunoise.spectral_lines`) and reported as a line
+        (:attr:`NoiseModel.lines`) only where the spectrum shows one, at the
+        spectrum's frequency. Without it the tones are reported unchecked: the
+        Allan curve alone cannot tell a line from a filter's roll-off.
 
     Returns
     -------
@@ -223,6 +231,7 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
                 f"{MAX_BOOTSTRAP_SAMPLES:,}); got replicates={replicates:,}"
             )
     mask, gm_count, oscillators, select = _parse_terms(terms)
+    _check_spectrum(spectrum, result)
     taus, var, edf, one = _extract(result, tau_range)
     dev_all, edf_raw = measured(result, taus)
     channels = var.shape[1]
@@ -341,6 +350,7 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
         supported={k: shaped(v) for k, v in resolved.items()},
         upper={k: shaped(np.where(resolved[k], np.nan, bounds[k])) for k in TERMS},
         notes=tuple(datasheet_notes(components, taus, c, method) for c in range(channels)),
+        lines=tuple(_lines(components, spectrum, c) for c in range(channels)),
         components=components,
         method=method,
         kind=result.kind,
@@ -368,6 +378,38 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
             RuntimeWarning,
         )
     return model
+
+
+def _check_spectrum(spectrum, result) -> None:
+    """``spectrum`` must be a Welch PSD of the result's channels at its rate."""
+    if spectrum is None:
+        return
+    from imunoise.spectrum import Spectrum
+
+    if not isinstance(spectrum, Spectrum):
+        raise TypeError(f"spectrum must be a Spectrum (imunoise.psd) or None; got "
+                        f"{type(spectrum).__name__}")
+    channels = 1 if np.ndim(result.dev) == 1 else np.shape(result.dev)[1]
+    if spectrum.channels != channels:
+        raise ValueError(f"spectrum has {spectrum.channels} channels; the Allan result has "
+                         f"{channels}")
+    if not math.isclose(float(spectrum.fs), float(result.fs), rel_tol=1e-9):
+        raise ValueError(f"spectrum.fs must equal result.fs ({result.fs} Hz); got "
+                         f"{spectrum.fs} Hz")
+    if spectrum.bins_per_decade:
+        raise ValueError("spectrum must be on Welch's linear grid (imunoise.psd), not "
+                         f"smoothed; got bins_per_decade={spectrum.bins_per_decade}")
+
+
+def _lines(components, spectrum, channel: int) -> tuple:
+    """Each fitted tone of ``channel`` checked against ``spectrum`` (unchecked
+    without one)."""
+    from imunoise import spectral_lines
+
+    tones = components.sine(channel)
+    if spectrum is None:
+        return tuple(spectral_lines.unchecked(a, f0) for a, f0 in tones)
+    return tuple(spectral_lines.check_line(spectrum, channel, f0, a) for a, f0 in tones)
 
 
 #: Taus per decade below which a fitted line or correlated term is placed poorly.

@@ -26,6 +26,7 @@ if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
     from imunoise.allan import AllanResult
+    from imunoise.spectral_lines import SpectralLine
 
 
 def _moved(old: str, new: str) -> None:
@@ -83,6 +84,11 @@ class NoiseModel(PerTerm):
         Per channel, what a reader of the datasheet values needs to know: a slow
         Gauss–Markov term standing in for K (its hump lies beyond the record), or a
         bump within the record kept out of K.
+    lines : tuple of tuple of SpectralLine
+        Per channel, each fitted tone checked against the spectrum given to
+        :func:`imunoise.fit` (``in_spectrum`` None where none was given): a tone is
+        reported as a line only where the spectrum shows one, at its frequency
+        (:mod:`imunoise.spectral_lines`).
     components : Components
         The fitted components: IEEE coefficients of the fit, Gauss–Markov terms
         (σ, τc), the tone (A, f0) and the resonance (σ, f_r, τr), with their
@@ -133,6 +139,7 @@ class NoiseModel(PerTerm):
     readoff: dict[str, dict[str, np.ndarray]] = field(repr=False)
     upper: dict[str, np.ndarray] = field(repr=False)
     notes: tuple[tuple[str, ...], ...] = field(repr=False)
+    lines: tuple[tuple[SpectralLine, ...], ...] = field(repr=False)
 
     # -- per term (channels, one_channel, value, std: PerTerm) ---------------
     def resolved(self, term: str) -> np.ndarray:
@@ -211,7 +218,11 @@ class NoiseModel(PerTerm):
                  for t in TERMS if self.resolved(t)[channel]]
         parts = self.components
         gm = len(parts.gauss_markov(channel))
-        extra = "".join(f", tone {_summary.number(f0)} Hz" for _, f0 in parts.sine(channel))
+        extra = "".join(f", tone {_summary.number(line.frequency)} Hz"
+                        for line in self.lines[channel] if line.reported)
+        extra += "".join(f", no line at {_summary.number(line.allan_frequency)} Hz (the "
+                         "spectrum shows none: a filter's shape)"
+                         for line in self.lines[channel] if not line.reported)
         extra += "".join(f", resonance {_summary.number(f)} Hz"
                          for _, f, _, _ in parts.resonance(channel))
         extra += "".join(f", bounded motion τc {_summary.number(tc)} s"

@@ -32,6 +32,7 @@ from imunoise.report import folder, sections
 from imunoise.report.document import Doc
 from imunoise.report.formatting import format_duration
 from imunoise.report.inputs import read_log, streams
+from imunoise.spectrum import Spectrum
 
 __all__ = ["SECTIONS", "TAUS_PER_DECADE", "TITLE", "Context", "Report", "Section", "build"]
 
@@ -159,10 +160,31 @@ class Context:
         return out
 
     @cached_property
+    def spectra(self) -> dict[str, Spectrum]:
+        """Welch PSD per sensor of the long log (the log the models are fitted to), on
+        the linear grid; a sensor without 256 present samples or an unbroken stretch
+        of 16 has none."""
+        from imunoise import spectrum
+
+        out = {}
+        for sensor in ALLAN_SENSORS:
+            y = getattr(self.long, sensor)
+            if y is None or np.count_nonzero(~np.isnan(y).any(axis=1)) < 256:
+                continue
+            try:  # segments with a missing sample are left out
+                out[sensor] = spectrum.psd(y, self.long.fs)
+            except ValueError:  # no unbroken stretch of 16 samples
+                pass
+            _stream.release(y)
+        return out
+
+    @cached_property
     def models(self) -> dict[str, noise.NoiseModel]:
-        """The noise model per sensor; a poor fit is said in the report's words
+        """The noise model per sensor, its tones checked against the same log's
+        spectrum; a poor fit is said in the report's words
         (:func:`~imunoise.report.model_sentences`), not warned about."""
-        return {sensor: noise.fit(r, warn_coverage=False) for sensor, r in self.allan.items()}
+        return {sensor: noise.fit(r, warn_coverage=False, spectrum=self.spectra.get(sensor))
+                for sensor, r in self.allan.items()}
 
     @cached_property
     def events(self) -> Events | None:

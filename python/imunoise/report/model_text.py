@@ -100,12 +100,21 @@ def model_sentences(model: NoiseModel, sensor: str,
         tone_stds = zip(np.reshape(parts_of.sine_amplitude_std, (parts_of.channels, -1))[c],
                         np.reshape(parts_of.sine_freq_std, (parts_of.channels, -1))[c],
                         strict=True)
-        for (amplitude, f0), (amp_std, f0_std) in zip(parts_of.sine(c), tone_stds,
-                                                      strict=False):
-            value, value_std = _units.convert(np.array([amplitude, amp_std]), "B", b_unit.name,
-                                             sensor=sensor)
-            parts.append(f"a tone of amplitude {format_number(value, value_std)} "
-                         f"{b_unit.label} at {format_number(f0, f0_std)} Hz")
+        for line, (amp_std, f0_std) in zip(model.lines[c], tone_stds, strict=False):
+            value, value_std = _units.convert(np.array([line.amplitude, amp_std]), "B",
+                                             b_unit.name, sensor=sensor)
+            if line.in_spectrum is None:
+                parts.append(f"a tone of amplitude {format_number(value, value_std)} "
+                             f"{b_unit.label} at {format_number(line.frequency, f0_std)} Hz "
+                             "(not checked against a spectrum)")
+            elif line.in_spectrum:
+                parts.append(f"a line of amplitude {format_number(value, value_std)} "
+                             f"{b_unit.label} at {line.frequency:.4g} Hz (the spectrum's "
+                             f"peak, {line.ratio:.3g}× its background)")
+            else:
+                parts.append(f"the Allan curve bends like a tone near "
+                             f"{line.allan_frequency:.3g} Hz, but the spectrum shows no line "
+                             "there: a shape of the sensor's filter or noise, not a vibration")
         for sigma, f_r, tau_r, skew in parts_of.resonance(c):
             stds = [float(np.atleast_1d(a)[c]) for a in (
                 parts_of.resonance_sigma_std, parts_of.resonance_freq_std,

@@ -328,13 +328,18 @@ def power_spectral_density(ctx: Context, doc: Doc) -> None:
         if np.count_nonzero(~np.isnan(y).any(axis=1)) < 256:
             continue
         _stream.release(y)
-        try:  # segments with a missing sample are left out
-            s = spectrum.psd(y, ctx.short.fs)
-        except ValueError:  # no unbroken stretch of 16 samples
-            continue
+        if ctx.one_log:  # the models' own spectrum
+            s = ctx.spectra.get(sensor)
+            if s is None:
+                continue
+        else:
+            try:  # segments with a missing sample are left out
+                s = spectrum.psd(y, ctx.short.fs)
+            except ValueError:  # no unbroken stretch of 16 samples
+                continue
         model = ctx.models.get(sensor) if ctx.one_log else noise.fit(
             _stream.adev(y, ctx.short.fs, ctx.taus_per_decade, ctx.streamed, ctx.block),
-            warn_coverage=False)
+            warn_coverage=False, spectrum=s)
         _stream.release(y)
         unit = CHANNELS[sensor][1]
         doc.h(3, sensor)
