@@ -22,7 +22,7 @@ resolve each value), on x = ln(value):
   and the value that max |z| of n units drawn from one log-normal population
   exceeds with probability ``false_alarm`` (1 %, Monte Carlo with a fixed seed).
   The MAD of a few units is itself uncertain, so small fleets need a larger
-  distance: cut(4) ≈ 16, cut(10) ≈ 6.9, cut(100) ≈ 4.3. A fleet without outliers
+  distance: cut(4) ≈ 16, cut(10) ≈ 6.8, cut(100) ≈ 4.3. A fleet without outliers
   thus shows a false one on a given coefficient at most ``false_alarm`` of the
   time, whatever its size;
 * with fewer than :data:`MIN_UNITS` resolving units no outlier is judged (two

@@ -188,7 +188,7 @@ def _outliers_section(doc: Doc, f: Fleet) -> None:
           f"{outlier_rule(f.false_alarm)}. A fleet without outliers shows a false one on a "
           f"given coefficient at most {100 * f.false_alarm:g} % of the time, whatever its size; "
           f"with few units the median absolute deviation is itself uncertain, so the cut "
-          f"is large (about 16 robust σ for 4 units, 6.9 for 10, 4.3 for 100).")
+          f"is large (about 16 robust σ for 4 units, 6.8 for 10, 4.3 for 100).")
     if not f.outliers:
         doc.p("No unit is an outlier on any coefficient.")
         return
