@@ -71,10 +71,10 @@ _DRAWS = 20_000
 
 @functools.lru_cache(maxsize=256)
 def cut(units: int, false_alarm: float = FALSE_ALARM) -> float:
-    """The outlier cut on |z| for a coefficient ``units`` units resolve.
+    """The outlier cut on ``|z|`` for a coefficient ``units`` units resolve.
 
     The larger of :data:`Z_CUT` and the (1 − ``false_alarm``) quantile of
-    max |z| over ``units`` draws of one normal population (z with the MAD of those
+    max ``|z|`` over ``units`` draws of one normal population (z with the MAD of those
     draws; Monte Carlo, fixed seed, so the same fleet gets the same cut); ``inf``
     below :data:`MIN_UNITS`.
     """
@@ -146,7 +146,7 @@ class Fleet:
         ``units`` (units with that sensor), ``resolved`` (how many of them resolve
         the value), ``median`` (over those), ``sigma`` (robust σ of ln value: a
         relative spread), ``low``/``high`` (smallest and largest resolved value),
-        ``cut`` (the |z| beyond which a unit is an outlier; inf when not judged),
+        ``cut`` (the ``|z|`` beyond which a unit is an outlier; inf when not judged),
         ``judged`` (at least :data:`MIN_UNITS` resolve it) and ``outliers`` (unit
         names), plus ``spec`` and ``limit`` where the datasheet specifies it.
     outliers : tuple of dict
