@@ -257,11 +257,15 @@ def test_dask_gives_the_serial_numbers(units, result):
                                   host="127.0.0.1", dashboard_address=None) as cluster, \
             distributed.Client(cluster) as client:
         parallel = imunoise.fleet(paths, client=client)
-    assert parallel.rows == result.rows or all(
-        a.keys() == b.keys() and all(
+    def same(a: dict, b: dict) -> bool:  # NaN (not resolved) equals NaN here
+        return a.keys() == b.keys() and all(
             a[k] == b[k] or (isinstance(a[k], float) and math.isnan(a[k]) and math.isnan(b[k]))
-            for k in a) for a, b in zip(parallel.rows, result.rows, strict=True))
-    assert parallel.outliers == result.outliers
+            for k in a)
+
+    assert len(parallel.rows) == len(result.rows)
+    assert all(same(a, b) for a, b in zip(parallel.rows, result.rows, strict=True))
+    assert all(same(a, b) for a, b in zip(parallel.stats, result.stats, strict=True))
+    assert parallel.outliers == result.outliers and parallel.units == result.units
 
 
 def test_computing_a_fleet_loads_no_plotting():
