@@ -456,8 +456,11 @@ def _compare(files: list[str], results: list[list[dict]], spec: Spec | None,
         if item is not None:
             stat |= {"spec": item.value, "limit": item.limit}
         stats.append(stat)
+    per_unit: dict[str, list[dict]] = {}
+    for r in rows:
+        per_unit.setdefault(r["unit"], []).append(r)
     for u in units:
-        mine = [r for r in rows if r["unit"] == u["unit"]]
+        mine = per_unit.get(u["unit"], [])
         words = [r["verdict"] for r in mine if r["verdict"] is not None]
         checked = spec is not None and u["error"] is None and bool(words)
         u["verdict"] = min(words, key=_VERDICT_RANK.__getitem__) if checked else None
