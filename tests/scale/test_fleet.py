@@ -147,16 +147,14 @@ def test_cli_fleet_writes_one_report_naming_every_unit(units, tmp_path, capsys):
 def test_cli_fleet_bad_input_is_one_line_exit_2(units, tmp_path, capsys):
     d, paths = units
     cases = [
-        [str(d / "missing.bin")],
-        [str(d / "nothing*.bin")],
-        [str(paths[0]), "--spec", "no-such-sheet"],
+        [str(d / "missing.bin"), "--serial"],
+        [str(d / "nothing*.bin"), "--serial"],
+        [str(paths[0]), "--serial", "--spec", "no-such-sheet"],
         [str(paths[0]), "--serial", "--scheduler", "tcp://127.0.0.1:1"],
     ]
     for extra in cases:
         capsys.readouterr()
-        assert main(["fleet", *extra, "-o", str(tmp_path / "r"), "--serial"]
-                    if "--serial" not in extra else ["fleet", *extra, "-o",
-                                                     str(tmp_path / "r")]) == 2, extra
+        assert main(["fleet", *extra, "-o", str(tmp_path / "r")]) == 2, extra
         err = capsys.readouterr().err
         assert err.startswith("imunoise: error: ") and err.count("\n") == 1, err
     junk = tmp_path / "junk.bin"
