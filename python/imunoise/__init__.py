@@ -29,7 +29,18 @@ from imunoise.allan import (
 )
 from imunoise.datasheet import compare
 from imunoise.dynamic import DynamicAllan, dynamic_adev
-from imunoise.errors import ParseError
+from imunoise.errors import (
+    AssumptionWarning,
+    CoverageWarning,
+    DataWarning,
+    GapWarning,
+    ImunoiseDeprecationWarning,
+    ImunoiseError,
+    ImunoiseTypeError,
+    ImunoiseValueError,
+    ImunoiseWarning,
+    ParseError,
+)
 from imunoise.noise import NoiseModel, fit
 from imunoise.planner import plan
 from imunoise.readers import Gaps, ImuLog, ParseIssues
@@ -44,6 +55,15 @@ _cpu.apply_environment()
 
 __all__ = [
     "__version__",
+    "AssumptionWarning",
+    "CoverageWarning",
+    "DataWarning",
+    "GapWarning",
+    "ImunoiseDeprecationWarning",
+    "ImunoiseError",
+    "ImunoiseTypeError",
+    "ImunoiseValueError",
+    "ImunoiseWarning",
     "AllanResult",
     "DynamicAllan",
     "Events",

@@ -36,6 +36,8 @@ from collections.abc import Iterable, Iterator
 from pathlib import Path
 from typing import BinaryIO
 
+from imunoise.errors import DataWarning
+
 __all__ = [
     "TEMP_TAG",
     "exchange_dir",
@@ -101,6 +103,7 @@ def remove_stale(directory) -> list[Path]:
         warnings.warn(
             f"removed {len(removed)} temporary file(s) left in {str(directory)!r} by an "
             f"interrupted imunoise run: {names}",
+            DataWarning,
             stacklevel=3,
         )
     return removed

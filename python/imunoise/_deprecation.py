@@ -13,6 +13,7 @@ from collections.abc import Callable, Mapping, Sequence
 from typing import TypeVar
 
 from imunoise import _warn
+from imunoise.errors import ImunoiseDeprecationWarning
 
 F = TypeVar("F", bound=Callable)
 
@@ -70,4 +71,4 @@ def old_call_forms(
 
 def _deprecated(message: str) -> None:
     # at the caller's line, past this helper and the wrapper
-    _warn.warn(message, DeprecationWarning)
+    _warn.warn(message, ImunoiseDeprecationWarning)

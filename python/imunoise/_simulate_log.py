@@ -25,6 +25,7 @@ from imunoise._deprecation import old_call_forms
 from imunoise._simulate import simulate
 from imunoise._validate import positive_finite, sample_rate
 from imunoise.datasheet import load_spec
+from imunoise.errors import AssumptionWarning
 from imunoise.noise import FLICKER, model_variance
 from imunoise.readers.log import ImuLog
 from imunoise.units import convert_back
@@ -99,7 +100,8 @@ def flicker_for_floor(floor: float, *, sensor: str = "", **terms: float) -> floa
     if others >= floor**2:
         _warn.warn(
             f"{sensor or 'sensor'}: the datasheet's other terms alone put the Allan floor at "
-            f"{np.sqrt(others):.3g}, above its bias instability {floor:.3g}; simulating B = 0"
+            f"{np.sqrt(others):.3g}, above its bias instability {floor:.3g}; simulating B = 0",
+            AssumptionWarning,
         )
         return 0.0
     return float(np.sqrt(floor**2 - others))

@@ -25,6 +25,7 @@ from typing import TypeVar
 import numpy as np
 
 from imunoise import _schema
+from imunoise.errors import DataWarning
 from imunoise.readers.log import ImuLog
 
 __all__ = ["BLOCK_ROWS", "CHANNEL_WORKERS", "PARSE_BYTES", "STREAM_BYTES", "adev", "blocks",
@@ -303,7 +304,7 @@ def fresh_workdir(parent: Path, prefix: str) -> Path:
         if old.is_dir() and pid.isdigit() and not _alive(int(pid)):
             shutil.rmtree(old, ignore_errors=True)
             _warn.warn(f"removed {old}, the parsed log of an earlier run that was killed",
-                       RuntimeWarning)
+                       DataWarning)
     return Path(tempfile.mkdtemp(prefix=f"{prefix}{os.getpid()}-", dir=parent))
 
 

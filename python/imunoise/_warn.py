@@ -14,6 +14,8 @@ import sys
 import warnings
 from pathlib import Path
 
+from imunoise.errors import CoverageWarning, ImunoiseDeprecationWarning, ImunoiseWarning
+
 __all__ = ["warn"]
 
 #: Files under this folder are imunoise's own.
@@ -27,8 +29,17 @@ def _inside(filename: str) -> bool:
         return False
 
 
-def warn(message, category: type[Warning] = UserWarning) -> None:
-    """:func:`warnings.warn` at the first frame outside the imunoise package."""
+#: The built-in categories a call site may still name, as imunoise's own.
+_OWN = {UserWarning: ImunoiseWarning, RuntimeWarning: CoverageWarning,
+        DeprecationWarning: ImunoiseDeprecationWarning}
+
+
+def warn(message, category: type[Warning] = ImunoiseWarning) -> None:
+    """:func:`warnings.warn` at the first frame outside the imunoise package, always as
+    an :class:`~imunoise.errors.ImunoiseWarning` (a built-in ``category`` becomes its
+    imunoise kind), so that one filter silences every imunoise warning."""
+    if not issubclass(category, ImunoiseWarning):
+        category = _OWN.get(category, ImunoiseWarning)
     frame = sys._getframe(1)
     level = 2  # stacklevel 2 is this function's caller
     while frame is not None and _inside(frame.f_code.co_filename):

@@ -88,6 +88,7 @@ from imunoise import _schema, _summary, _warn
 from imunoise._core import allan as _core_allan
 from imunoise._runs import true_runs
 from imunoise._validate import confidence_level, integer, sample_rate, samples
+from imunoise.errors import CoverageWarning, GapWarning, ImunoiseWarning
 from imunoise.taus import averaging_factors, keep_estimable
 
 if TYPE_CHECKING:
@@ -616,7 +617,8 @@ def theoh(x: npt.ArrayLike, fs: float, *, taus: TauSpec = "octave",
         m_avar = m_avar[short & (m_avar >= 1)]
         if dropped:
             _warn.warn(
-                f"{dropped} of {arr.size} taus dropped: theoh needs tau >= 1/fs = {1 / fs:g} s"
+                f"{dropped} of {arr.size} taus dropped: theoh needs tau >= 1/fs = {1 / fs:g} s",
+                CoverageWarning,
             )
         m_avar = np.unique(m_avar)
         k = int(m_avar.max()) if m_avar.size else 0
@@ -748,7 +750,8 @@ def _keep_gapped(kind, m, var, terms, alpha, identified, edf, fs, user_given):
     if user_given and not keep.all():
         _warn.warn(
             f"{int(np.count_nonzero(~keep))} of {len(m)} taus dropped: the gaps in x leave "
-            f"{kind} fewer than 2 terms there (largest usable tau {m[keep].max() / fs:g} s)"
+            f"{kind} fewer than 2 terms there (largest usable tau {m[keep].max() / fs:g} s)",
+            GapWarning,
         )
     enough = enough[keep]
     return (
@@ -860,7 +863,8 @@ def _keep_theobr(m, n: int, fs: float, user_given: bool, kind: str, lower: float
         above = f", above the last AVAR tau {lower / fs:g} s" if lower > 0 else ""
         _warn.warn(
             f"{dropped} of {m.size} taus dropped: {kind}'s ThêoBR taus are 0.75·m/fs for "
-            f"even 10 <= m <= {n} (here {7.5 / fs:g} s to {0.75 * n / fs:g} s{above})"
+            f"even 10 <= m <= {n} (here {7.5 / fs:g} s to {0.75 * n / fs:g} s{above})",
+            CoverageWarning,
         )
     return np.unique(m[keep])
 
@@ -895,7 +899,7 @@ def _warn_theobr_cost(kind: str, n: int, m: np.ndarray, channels: int, ratio: di
             f"{kind}'s bias ratio needs Theo1 at N/{per} averaging factors (cost ~N²): "
             f"{n} samples will take roughly {seconds / 60:.0f} minutes; ratio_block=b "
             "(the fast ThêoBR) computes the ratio on averages of b samples in ~1/b² the time"
-        )
+ , ImunoiseWarning       )
 
 
 def _minimum_samples(statistic: str) -> int:
@@ -941,13 +945,14 @@ def _gapped_samples(x, gaps, kind: str, skips: bool):
         a, b = int(starts[i]), int(ends[i])
         _warn.warn(
             f"x has {dropped} missing samples (NaN): {kind} analyses the longest gap-free "
-            f"segment, samples {a} to {b - 1}, {b - a} of {n} samples ({100 * (b - a) / n:.3g} %)"
+            f"segment, samples {a} to {b - 1}, {b - a} of {n} samples ({100 * (b - a) / n:.3g} %)",
+            GapWarning,
         )
         return data[a:b], one_d, missing
     _warn.warn(
         f"x has {dropped} missing samples (NaN): {kind} splices over them, joining the "
         f"{n - dropped} valid samples as if they were contiguous ({100 * dropped / n:.3g} % "
-        "of the record spliced out); this biases long taus"
+        "of the record spliced out); this biases long taus", GapWarning
     )
     return data[~bad], one_d, missing
 

@@ -24,6 +24,7 @@ from imunoise._schema import (
     sensor_label,
 )
 from imunoise.allan import KINDS
+from imunoise.errors import DataWarning
 from imunoise.numbers import duration
 from imunoise.readers.csv_reader import (
     LAYOUT_CHANNELS,  # the --kind choices: every public Allan-family statistic
@@ -761,7 +762,7 @@ def _cmd_fleet(args) -> int:
         _fail(str(exc))
     for u in result.units:
         if u["error"] is not None:
-            warnings.warn(f"{u['path']}: not analysed: {u['error']}", stacklevel=1)
+            warnings.warn(f"{u['path']}: not analysed: {u['error']}", DataWarning, stacklevel=1)
     written = result.report(args.output, force=args.force)
     outliers = "; ".join(f"{o['unit']} {o['sensor']} {o['term']} {o['axis']} "
                          f"{o['ratio']:.3g}x the median" for o in result.outliers[:5])

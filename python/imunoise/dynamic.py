@@ -70,6 +70,7 @@ from imunoise._core import allan as _core_allan
 from imunoise._runs import true_runs
 from imunoise._validate import no_infinity, positive_finite, sample_rate, samples
 from imunoise.allan import ONE_SIGMA, AllanResult, adev, adev_by_column, chi2_interval
+from imunoise.errors import CoverageWarning
 from imunoise.taus import averaging_factors
 
 if TYPE_CHECKING:
@@ -569,7 +570,8 @@ def _window_factors(taus, fs: float, width: int) -> np.ndarray:
     if user_given and not fits.all():
         _warn.warn(
             f"{int(np.count_nonzero(~fits))} of {m.size} taus dropped: a window of {width} "
-            f"samples holds taus from {1 / fs:g} s to {math.floor((width - 1) / 2) / fs:g} s"
+            f"samples holds taus from {1 / fs:g} s to {math.floor((width - 1) / 2) / fs:g} s",
+            CoverageWarning,
         )
     m = np.unique(m[fits])
     if m.size == 0:

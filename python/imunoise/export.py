@@ -46,6 +46,7 @@ import numpy as np
 
 from imunoise import _atomic, _warn
 from imunoise import units as _units
+from imunoise.errors import CoverageWarning, ImunoiseDeprecationWarning
 from imunoise.noise import gm_white_density, resonance_white_density
 
 __all__ = [
@@ -68,7 +69,7 @@ def write_atomic(path, text: str) -> Path:
     your own atomically use :func:`write_json` / :func:`write_kalibr` or your own code.
     Writes ``text`` to ``path`` through the one atomic-write helper."""
     _warn.warn("imunoise.export.write_atomic is deprecated and will be removed in 0.3; "
-               "the export.write_* functions write atomically", DeprecationWarning)
+               "the export.write_* functions write atomically", ImunoiseDeprecationWarning)
     return _atomic.write_text(path, text)
 
 
@@ -85,7 +86,7 @@ def _value_or_bound(model, term: str, sensor: str) -> np.ndarray:
         _warn.warn(
             f"the {sensor} model does not resolve {term} on axis {axes}; writing its 95 % "
             "upper bound (model.upper), the largest value the measured curve allows",
-            RuntimeWarning,
+            CoverageWarning,
         )
     return values
 
@@ -100,7 +101,7 @@ def _combine(model, term: str, combine: str, sensor: str, input_unit) -> float:
         _warn.warn(
             f"the {sensor} model has no {term} and no bound on it on any axis; writing 0 "
             f"(an estimator may need a small positive value)",
-            RuntimeWarning,
+            CoverageWarning,
         )
         return 0.0
     v = values[sup] * scale

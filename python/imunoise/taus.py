@@ -7,6 +7,7 @@ import numbers
 import numpy as np
 
 from imunoise import _warn
+from imunoise.errors import CoverageWarning
 
 #: Named grids. Their largest m follows allantools: every m below the number of
 #: phase points, then any tau whose estimator has fewer than two terms is dropped.
@@ -118,6 +119,6 @@ def keep_estimable(
             f"{dropped} of {len(m)} taus dropped: {kind} needs tau >= 1/fs = {1 / fs:g} s "
             f"and at least 2 terms in its sum (largest usable tau {m[keep].max() / fs:g} s)"
             if keep.any()
-            else f"{dropped} of {len(m)} taus dropped: none is in range for {kind}"
+            else f"{dropped} of {len(m)} taus dropped: none is in range for {kind}", CoverageWarning
         )
     return np.unique(m[keep])

@@ -196,7 +196,7 @@ def test_a_killed_runs_parsed_log_is_removed_by_the_next(tmp_path):
     (left / "gyro").mkdir(parents=True)
     mine = tmp_path / f".imunoise-stream-{os.getpid()}-keep"  # a run still going
     mine.mkdir()
-    with pytest.warns(RuntimeWarning, match="parsed log of an earlier run that was killed"):
+    with pytest.warns(imunoise.DataWarning, match="parsed log of an earlier run that was killed"):
         fresh = _stream.workdir_for(tmp_path / "report")
     assert not left.exists() and mine.exists() and fresh.exists()
     assert fresh.name.startswith(f".imunoise-stream-{os.getpid()}-")

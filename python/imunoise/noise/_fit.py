@@ -16,6 +16,7 @@ import numpy as np
 from imunoise import _warn
 from imunoise._core import fit as _core_fit
 from imunoise._deprecation import old_call_forms
+from imunoise.errors import CoverageWarning
 from imunoise.noise._components import Components
 from imunoise.noise._datasheet import datasheet_notes, datasheet_values, upper_bounds
 from imunoise.noise._model import NoiseModel
@@ -375,7 +376,7 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
             f"{cover[c]:.0%} of the taus (inside the 95 % interval or within 5 %); its "
             "coefficients summarise a curve they do not describe: plot it with "
             "result.plot(model) or imunoise.plot.allan(result, model=model)",
-            RuntimeWarning,
+            CoverageWarning,
         )
     return model
 
@@ -432,7 +433,7 @@ def _warn_sparse_grid(taus) -> None:
             "lines or correlated terms, which a grid this sparse places poorly: its N, B "
             "and K can move by several standard uncertainties against a denser grid's; "
             "fit adev(..., taus=10) or denser",
-            UserWarning,
+            CoverageWarning,
         )
 
 

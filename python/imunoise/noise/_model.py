@@ -13,6 +13,7 @@ from imunoise import _schema, _summary, _warn
 from imunoise import numbers as _numbers
 from imunoise import units as _units
 from imunoise._deprecation import old_call_forms
+from imunoise.errors import ImunoiseDeprecationWarning
 from imunoise.noise._components import (
     Components,
     PerTerm,
@@ -30,7 +31,7 @@ if TYPE_CHECKING:
 
 
 def _moved(old: str, new: str) -> None:
-    _warn.warn(f"NoiseModel.{old} is deprecated; use {new}", DeprecationWarning)
+    _warn.warn(f"NoiseModel.{old} is deprecated; use {new}", ImunoiseDeprecationWarning)
 
 
 @dataclass(frozen=True, repr=False)

@@ -9,6 +9,7 @@ import math
 import numpy as np
 
 from imunoise import _warn
+from imunoise.errors import CoverageWarning
 from imunoise.noise._terms import CLOSE, FLAT_SLOPE, FLICKER, READ_TAU, SLOPE, TERMS
 
 
@@ -97,7 +98,7 @@ def fit_slopes(t, v, e, mask, tolerance=0.25):
     sup = np.zeros(5, dtype=bool)
     rng = np.full((5, 2), np.nan)
     if t.size < 2:
-        _warn.warn("slope read-off needs at least two taus; no term resolved", RuntimeWarning)
+        _warn.warn("slope read-off needs at least two taus; no term resolved", CoverageWarning)
         return coef, std, sup, rng
     dev = np.sqrt(v)
     logt, logd = np.log10(t), np.log10(dev)

@@ -23,7 +23,7 @@ import numpy as np
 
 from imunoise import _warn
 from imunoise._schema import CHANNELS, COLUMN_SUFFIXES, G
-from imunoise.errors import ParseError
+from imunoise.errors import AssumptionWarning, DataWarning, ParseError
 from imunoise.readers import metafile
 from imunoise.readers._sentences import IssueTally, sentence_rows
 from imunoise.readers.columnar import check_meta, log_from_meta
@@ -709,7 +709,7 @@ def _convert_meta(name: str) -> dict | None:
     meta = check_meta(meta, meta_file, tied=True)
     why = metafile.tie_errors(meta["data"], path, meta_file)
     if why is not None:
-        _warn.warn(f"{why}; its metadata is not used: read as a plain CSV")
+        _warn.warn(f"{why}; its metadata is not used: read as a plain CSV", DataWarning)
         return None
     return meta
 
@@ -725,7 +725,7 @@ def _legacy_note(path: Path) -> None:
         _warn.warn(f"{path}: {legacy.name} beside it is the metadata name earlier versions "
                    f"gave {path.stem}.csv and {path.stem}.npy alike, so it is not used (read as "
                    f"a plain CSV); rename it to {path.name}{metafile.SUFFIX} if it is this "
-                   "file's, or convert the log again")
+                   "file's, or convert the log again", DataWarning)
 
 
 def _restore_meta(reader: _Reader, channels, time) -> ImuLog | None:
@@ -743,7 +743,7 @@ def _restore_meta(reader: _Reader, channels, time) -> ImuLog | None:
         _warn.warn(
             f"{reader.name}: the rows no longer match the imunoise metadata beside it "
             f"({n} rows of {sorted(arrays)}, metadata {meta['samples']} of "
-            f"{sorted(meta['channels'])}); read as a plain CSV"
+            f"{sorted(meta['channels'])}); read as a plain CSV", DataWarning
         )
         return None
     return log_from_meta(meta, arrays, reader.name)
@@ -791,7 +791,7 @@ def _time_unit(t: np.ndarray, header: str | None, source: str) -> tuple[float, f
         _warn.warn(
             f"{source}: {column} has no unit; taken as {chosen}: a median step of {step:.6g} "
             f"gives {rate[chosen]:.6g} Hz in {chosen} ({rate['s']:.6g} Hz in seconds); pass "
-            "units={'time': ...} (CLI: --units time=...) to say it"
+            "units={'time': ...} (CLI: --units time=...) to say it", AssumptionWarning
         )
     return None if chosen == "s" else UNITS[chosen][1:]
 

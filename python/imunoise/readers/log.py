@@ -12,6 +12,7 @@ import numpy as np
 from imunoise import _schema, _summary, _warn
 from imunoise._core import vn as _core_vn
 from imunoise._validate import sample_rate
+from imunoise.errors import AssumptionWarning, DataWarning, GapWarning
 from imunoise.readers.grid import Gaps, TimeGrid
 
 if TYPE_CHECKING:
@@ -394,7 +395,7 @@ def log_on_grid(
         try:
             grid = TimeGrid.from_timestamps(time)
         except ValueError as exc:
-            _warn.warn(f"{source}: {exc}; samples kept one per row, gaps not detected")
+            _warn.warn(f"{source}: {exc}; samples kept one per row, gaps not detected", GapWarning)
     if grid is None:
         grid = TimeGrid.identity(n)
     rate = grid.fs if grid.fs is not None else fs_from_median_step(None, fs, source)
@@ -432,7 +433,7 @@ def _warn_time(source: str, n: int, found: Mapping[str, int], grid: TimeGrid) ->
                      f"{list(grid.first.get('time_reset', ()))}...): the log is "
                      f"{found['time_reset'] + 1} segments in file order (time_reset)")
     if notes:
-        _warn.warn(f"{source}: " + "; ".join(notes))
+        _warn.warn(f"{source}: " + "; ".join(notes), DataWarning)
 
 
 def fs_from_median_step(
@@ -446,6 +447,6 @@ def fs_from_median_step(
         return sample_rate(fs)
     _warn.warn(
         f"{source}: no timestamps and no fs given; assuming {DEFAULT_FS:g} Hz "
-        "(pass fs= to set the sample rate)"
+        "(pass fs= to set the sample rate)", AssumptionWarning
     )
     return DEFAULT_FS

@@ -28,7 +28,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from imunoise import _warn
-from imunoise.errors import ParseError
+from imunoise.errors import DataWarning, ParseError
 from imunoise.readers import metafile
 
 __all__ = ["GAPS", "MAX_OUTAGE", "META", "SPAN_SLACK", "TIMES", "Outage", "host_times",
@@ -206,7 +206,7 @@ def recording_meta(path) -> dict | None:
         stem = os.path.basename(os.fspath(path))
         _warn.warn(f"{where} is the metadata an earlier imunoise convert wrote for {stem}.csv "
                    f"or {stem}.npy, not {stem}'s own; not used (rename it to "
-                   f"{stem}.csv.meta.json or {stem}.npy.meta.json, whichever it is)")
+                   f"{stem}.csv.meta.json or {stem}.npy.meta.json, whichever it is)", DataWarning)
         return None
     if meta.get("fs") is not None:
         metafile.rate(meta["fs"], where)

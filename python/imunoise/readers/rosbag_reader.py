@@ -40,7 +40,7 @@ from pathlib import Path
 import numpy as np
 
 from imunoise import _warn
-from imunoise.errors import ParseError
+from imunoise.errors import AssumptionWarning, ParseError
 from imunoise.readers._sentences import IssueTally, sentence_rows
 from imunoise.readers.log import ImuLog, log_on_grid
 from imunoise.readers.probe import Confidence, Probe
@@ -470,7 +470,7 @@ def _read_vn_topic(reader, conns, kind, field, tally, strict, name, tick) -> _To
         _warn.warn(
             f"{name}: topic {conns[0].topic!r} has type {msgtype!r} with no definition in the "
             "bag; VN sentences were cut out of the message bytes and the bag receive time is "
-            "used (pass msg_defs= to use the message header stamps)"
+            "used (pass msg_defs= to use the message header stamps)", AssumptionWarning
         )
     channels = {ch: np.concatenate([p[ch] for p in parts]) for ch in (parts[0] if parts else ())}
     time_ns = np.concatenate(kept_ns) if kept_ns else np.zeros(0, dtype=np.int64)

@@ -5,6 +5,7 @@ Kept for one release so that old imports keep working.
 
 import warnings
 
+from imunoise.errors import ImunoiseDeprecationWarning
 from imunoise.writers.vn import binary_columns, write_vn_ascii, write_vn_binary
 
 __all__ = ["binary_columns", "write_vn_ascii", "write_vn_binary"]
@@ -12,6 +13,6 @@ __all__ = ["binary_columns", "write_vn_ascii", "write_vn_binary"]
 warnings.warn(
     "imunoise.readers.vn_write is deprecated; import from imunoise.writers.vn "
     "(or use imunoise.write_vn_ascii / imunoise.write_vn_binary)",
-    DeprecationWarning,
+    ImunoiseDeprecationWarning,
     stacklevel=2,
 )

@@ -34,6 +34,7 @@ import warnings
 from dataclasses import dataclass, field
 
 from imunoise import _atomic
+from imunoise.errors import DataWarning
 from imunoise.readers.recording import GAPS, META, TIMES, Outage
 from imunoise.recording import config
 from imunoise.recording.live import LiveView, Snapshot
@@ -212,14 +213,14 @@ class _Recorder:
                                      "(ASCII output off, no binary output): nothing to "
                                      "record")
                 for note in self.notes:  # once the record will be made: one line if not
-                    warnings.warn(note, stacklevel=3)
+                    warnings.warn(note, DataWarning, stacklevel=3)
             config.apply(session, self.wanted, self.touched)
             session.command("VNASY,1")
         except BaseException:
             try:
                 if first:  # leave the sensor as it was, streaming
                     for problem in self._restore(session, answered):
-                        warnings.warn(problem, stacklevel=3)
+                        warnings.warn(problem, DataWarning, stacklevel=3)
             finally:
                 serial.close()
             raise
@@ -347,7 +348,7 @@ class _Recorder:
             self.session.serial.close()
         self.notes += problems
         for problem in problems:
-            warnings.warn(problem, stacklevel=3)
+            warnings.warn(problem, DataWarning, stacklevel=3)
         return bool(self.touched) and not self.keep_config and not self.restore_failed
 
 
