@@ -10,14 +10,13 @@ allantools has no multi-channel call, so its 6-channel time is 6 × one channel
 from __future__ import annotations
 
 import argparse
-import os
-import platform
 import statistics
 import time
 
 import allantools
 import imunoise
 import numpy as np
+from imunoise import _cpu
 
 
 def median_time(fn, repeats: int, *args, **kwargs) -> float:
@@ -36,7 +35,7 @@ def main() -> None:
     sizes = [10**6] if args.quick else [10**6, 10**7]
     rng = np.random.default_rng(0)
     fs = 100.0
-    print(f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
+    print(f"machine: {_cpu.describe()}, "
           f"numpy {np.__version__}, allantools {allantools.__version__}, "
           f"imunoise {imunoise.__version__}")
     print("| n | taus | channels | imunoise (s) | allantools (s) | ratio |")

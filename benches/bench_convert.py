@@ -16,12 +16,13 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import platform
 import shutil
 import subprocess
 import sys
 import textwrap
 from pathlib import Path
+
+from imunoise import _cpu
 
 PARSE = """
 import json, resource, sys, time
@@ -74,7 +75,7 @@ def main() -> None:
         if not src.exists():
             generate(src, int(args.gb * 1e9))
     size = src.stat().st_size
-    print(f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores; "
+    print(f"machine: {_cpu.describe()}; "
           f"log {src} ({size / 1e6:.0f} MB)\n")
     print("| round | load | parser wall / CPU (s) | parser MB/s | parser RSS (MB) "
           "| convert wall / CPU (s) | convert MB/s | convert RSS (MB) | ratio |")

@@ -13,6 +13,7 @@ import time
 
 import imunoise
 import numpy as np
+from imunoise import _cpu
 
 
 def best_of(repeat: int, call):
@@ -31,6 +32,7 @@ def naive(y, fs, window: float, step: float, taus):
 
 
 def main() -> None:
+    print(f"machine: {_cpu.describe()}", flush=True)
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--hours", type=float, default=5.0)
     parser.add_argument("--repeat", type=int, default=3)

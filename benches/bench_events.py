@@ -33,6 +33,7 @@ from pathlib import Path
 
 import imunoise
 import numpy as np
+from imunoise import _cpu
 from scipy import ndimage
 
 DATA = Path(__file__).resolve().parents[2] / "shared" / "data"
@@ -206,6 +207,7 @@ def timing(rng) -> None:
 
 
 def main() -> None:
+    print(f"machine: {_cpu.describe()}", flush=True)
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--white", type=int, default=20_000_000)
     parser.add_argument("--bursts", type=int, default=200)

@@ -27,7 +27,6 @@ from __future__ import annotations
 
 import argparse
 import math
-import os
 import platform
 import time
 import warnings
@@ -35,6 +34,7 @@ import warnings
 import allan_variance
 import imunoise
 import numpy as np
+from imunoise import _cpu
 from imunoise.noise import FLICKER, model_variance
 
 DEG = math.pi / 180
@@ -87,16 +87,7 @@ def true_datasheet(taus) -> dict[str, float]:
 
 
 def machine() -> str:
-    cpu = platform.processor() or platform.machine()
-    try:
-        with open("/proc/cpuinfo", encoding="utf-8") as fh:
-            for line in fh:
-                if line.startswith("model name"):
-                    cpu = line.split(":", 1)[1].strip()
-                    break
-    except OSError:
-        pass
-    return (f"{cpu}, {os.cpu_count()} logical cores, Python {platform.python_version()}, "
+    return (f"{_cpu.describe()}, Python {platform.python_version()}, "
             f"numpy {np.__version__}, {platform.system()} {platform.release()}")
 
 

@@ -40,6 +40,7 @@ import warnings
 
 import imunoise
 import numpy as np
+from imunoise import _cpu
 from scipy.signal import butter, lfilter
 
 ARCSEC = np.pi / 180 / 3600
@@ -140,6 +141,7 @@ def classes():
 
 
 def main() -> int:
+    print(f"machine: {_cpu.describe()}", flush=True)
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--only", help="one class")
     ap.add_argument("--seeds", type=int, default=2, help="records per class")

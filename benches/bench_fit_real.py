@@ -35,6 +35,7 @@ import allan_variance
 import imunoise
 import imunoise.plot
 import numpy as np
+from imunoise import _cpu
 
 HERE = Path(__file__).resolve().parent
 DATA = HERE.parent.parent / "shared" / "data"
@@ -150,6 +151,7 @@ def grid_spread(x, fs):
 
 
 def main() -> int:
+    print(f"machine: {_cpu.describe()}", flush=True)
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seeds", type=int, default=4, help="simulated records (0: skip)")
     ap.add_argument("--plots", type=Path, help="write one Allan plot per channel here")

@@ -12,11 +12,11 @@ from __future__ import annotations
 
 import argparse
 import os
-import platform
 
 import imunoise
 import numpy as np
 from bench_allan import median_time
+from imunoise import _cpu
 
 
 def with_gaps(y: np.ndarray, gaps: int, share: float, rng) -> np.ndarray:
@@ -41,7 +41,7 @@ def main() -> None:
     y = rng.normal(size=args.n) * 1e-3 + 9.81
     gapped = with_gaps(y, 100, 0.10, rng)
     print(
-        f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
+        f"machine: {_cpu.describe()}, "
         f"numpy {np.__version__}, imunoise {imunoise.__version__}; n = {args.n:.0e}, "
         f"{int(np.isnan(gapped).sum())} missing in 100 gaps"
     )

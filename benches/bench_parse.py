@@ -28,6 +28,7 @@ from pathlib import Path
 import imunoise
 import numpy as np
 import pandas as pd
+from imunoise import _cpu
 
 
 def median_time(fn, repeats: int) -> tuple[float, float]:
@@ -89,7 +90,7 @@ def main() -> None:
     hours_ascii = 0.5 if args.quick else 5.0
     minutes_bin = 10 if args.quick else 60
     repeats = 3 if args.quick else 5
-    print(f"machine: {platform.machine()}, {os.cpu_count()} cores, python "
+    print(f"machine: {_cpu.describe()}, python "
           f"{platform.python_version()}, pandas {pd.__version__}, numpy {np.__version__}")
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)

@@ -16,6 +16,7 @@ from pathlib import Path
 
 import imunoise
 import numpy as np
+from imunoise import _cpu
 
 HERE = Path(__file__).resolve().parent
 DATA = HERE.parent.parent / "shared" / "data"
@@ -81,6 +82,7 @@ def why(s, j):
 
 
 def main() -> None:
+    print(f"machine: {_cpu.describe()}", flush=True)
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seeds", type=int, default=40)
     args = parser.parse_args()

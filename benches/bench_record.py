@@ -22,6 +22,7 @@ import sys
 import tempfile
 from pathlib import Path
 
+from imunoise import _cpu
 from imunoise.emulate import Emulator
 
 FIELDS = "common=TimeStartup+YawPitchRoll+Quaternion+AngularRate+Accel+MagPres+Imu"
@@ -63,6 +64,7 @@ def run(seconds: float, live: bool, tmp: Path, index: int) -> dict:
 
 
 def main() -> None:
+    print(f"machine: {_cpu.describe()}", flush=True)
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seconds", type=float, default=30.0)
     args = parser.parse_args()

@@ -20,6 +20,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+from imunoise import _cpu
 
 
 def write_vnymr(path: Path, hours: float, fs: float, seed: int = 0) -> int:
@@ -45,6 +46,7 @@ def write_vnymr(path: Path, hours: float, fs: float, seed: int = 0) -> int:
 
 
 def main() -> None:
+    print(f"machine: {_cpu.describe()}", flush=True)
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--hours", type=float, default=5.0)
     ap.add_argument("--fs", type=float, default=40.0)

@@ -39,6 +39,7 @@ import warnings
 import allantools
 import imunoise
 import numpy as np
+from imunoise import _cpu
 from imunoise._core import allan as _core_allan
 
 
@@ -171,7 +172,7 @@ def main() -> None:
             ladder_cost(args.ladder_size)
         return
     print(
-        f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
+        f"machine: {_cpu.describe()}, "
         f"Python {platform.python_version()}, numpy {np.__version__}, "
         f"allantools {allantools.__version__}, imunoise {imunoise.__version__}\n"
     )

@@ -16,7 +16,6 @@ from __future__ import annotations
 import argparse
 import contextlib
 import io
-import os
 import platform
 import statistics
 import time
@@ -25,6 +24,7 @@ import warnings
 import allantools
 import imunoise
 import numpy as np
+from imunoise import _cpu
 
 #: (name, imunoise function, allantools function): both libraries use the same names.
 CASES = [
@@ -54,7 +54,7 @@ def main() -> None:
     parser.add_argument("--million-only", action="store_true", help="part 2 only")
     args = parser.parse_args()
     print(
-        f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
+        f"machine: {_cpu.describe()}, "
         f"Python {platform.python_version()}, numpy {np.__version__}, "
         f"allantools {allantools.__version__}, imunoise {imunoise.__version__}"
     )

@@ -45,6 +45,8 @@ from collections import Counter
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from imunoise import _cpu
+
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
 DATA = ROOT / "tests" / "data"
@@ -395,6 +397,7 @@ def bag_faults(per_bag: int, seed: int, work: Path, shared: bool = False) -> dic
 
 
 def main(argv=None) -> int:
+    print(f"machine: {_cpu.describe()}", flush=True)
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("what", choices=("convert", "report", "bags"))
     p.add_argument("--runs", type=int, default=100, help="runs (half kill -9, half SIGINT)")

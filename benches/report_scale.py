@@ -25,6 +25,8 @@ import tempfile
 import time
 from pathlib import Path
 
+from imunoise import _cpu
+
 CLI = [sys.executable, "-m", "imunoise.cli"]
 #: Hours per piece when the log is longer than ``imunoise simulate`` makes at once
 #: (10⁷ samples: 3.47 h at 800 Hz).
@@ -100,8 +102,8 @@ def main() -> None:
                 write_long_log(log, opts.hours, opts.fs)
             print(f"simulated {opts.hours:g} h at {opts.fs:g} Hz: "
                   f"{log.stat().st_size / 1e6:.0f} MB in {time.perf_counter() - t:.0f} s")
-        print(f"machine: {platform.processor() or platform.machine()}, "
-              f"{os.cpu_count()} CPUs, Python {platform.python_version()}")
+        print(f"machine: {_cpu.describe()}, "
+              f"Python {platform.python_version()}")
         rows = {}
         for path in ("memory", "stream"):
             if opts.only and path != opts.only:

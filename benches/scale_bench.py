@@ -13,13 +13,14 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import platform
 import shutil
 import subprocess
 import sys
 import textwrap
 import time
 from pathlib import Path
+
+from imunoise import _cpu
 
 FS = 800.0
 
@@ -36,6 +37,7 @@ print(json.dumps({{"wall_s": wall, "peak_rss": resource.getrusage(resource.RUSAG
 ANALYSE = """
 import json, resource, sys, time
 import imunoise
+from imunoise import _cpu
 from imunoise import scale
 t = time.perf_counter()
 log = scale.load(sys.argv[1])
@@ -85,7 +87,7 @@ def main() -> None:
         npy = sum(p.stat().st_size for p in out.iterdir())
         ana = run(ANALYSE, str(out))
         print(json.dumps({
-            "machine": f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
+            "machine": f"{_cpu.describe()}, "
                        f"{os.sysconf('SC_PAGE_SIZE') * os.sysconf('SC_PHYS_PAGES') / 2**30:.0f}"
                        " GiB RAM",
             "text_bytes": size, "generate_s": gen_s, "npy_bytes": npy,

@@ -8,6 +8,7 @@ plots and reports. Start with ``imunoise.adev(x, fs)``.
 from imunoise import _cpu, export, units
 from imunoise._core import __version__
 from imunoise._events import Events, events
+from imunoise._fleet import Fleet, fleet
 from imunoise._simulate import simulate
 from imunoise._simulate_log import simulate_log
 from imunoise._thermal import Thermal, thermal
@@ -46,6 +47,7 @@ __all__ = [
     "AllanResult",
     "DynamicAllan",
     "Events",
+    "Fleet",
     "Thermal",
     "Warmup",
     "Gaps",
@@ -63,6 +65,7 @@ __all__ = [
     "events",
     "export",
     "fit",
+    "fleet",
     "hdev",
     "htotdev",
     "mdev",

@@ -110,8 +110,8 @@ def simulate(n_samples: int, fs: float, Q: float = 0.0, N: float = 0.0, B: float
              gm: Sequence[tuple[float, float]] = (),
              sinusoid: tuple[float, float] | Sequence[tuple[float, float]] | None = None,
              resonance: tuple[float, ...] | None = None,
-             motion: tuple[float, float] | None = None) -> np.ndarray:
-    """Rate noise with the given IEEE 952 coefficients.
+             motion: tuple[float, float] | None = None, like=None) -> np.ndarray:
+    """Rate noise with the given IEEE 952 coefficients, or like a measured sensor's.
 
     Parameters
     ----------
@@ -152,6 +152,15 @@ def simulate(n_samples: int, fs: float, Q: float = 0.0, N: float = 0.0, B: float
         deviation ``sigma`` (rate·s) and correlation time ``tau_c`` (s) — a
         parked vehicle rocking; the process of the ``"motion"`` term of
         :func:`imunoise.fit`.
+    like : NoiseModel, AllanResult, Spectrum or (f, psd), optional
+        Noise like a measured sensor's instead of given coefficients: from a fitted
+        model's components (each channel its own), from an Allan deviation (fitted
+        first), or synthesised from a one-sided PSD (frequencies in Hz, densities in
+        units²/Hz; a spectrum holds no phase, so lines come out as narrow bands). The
+        coefficients and components above must then be left out; ``fs`` must be the
+        source's own rate (or None for a model, result or Spectrum); the channels are
+        the source's (``channels`` repeats a one-channel source). See
+        ``imunoise._simulate_like``.
 
     Returns
     -------
@@ -166,6 +175,17 @@ def simulate(n_samples: int, fs: float, Q: float = 0.0, N: float = 0.0, B: float
     >>> y.shape
     (100000,)
     """
+    if like is not None:
+        given = [name for name, v in (("Q", Q), ("N", N), ("B", B), ("K", K), ("R", R))
+                 if v] + [name for name, v in (("gm", gm), ("sinusoid", sinusoid),
+                                               ("resonance", resonance), ("motion", motion))
+                          if v is not None and len(v)]
+        if given:
+            raise ValueError(f"like= replaces the coefficients; leave out {', '.join(given)}")
+        from imunoise._simulate_like import simulate_like
+
+        return simulate_like(like, n_samples, fs, channels=None if channels == 1 else channels,
+                             seed=seed)
     n = integer(n_samples, "n_samples", 1)
     channels = integer(channels, "channels", 1)
     fs = sample_rate(fs)

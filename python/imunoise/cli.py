@@ -162,6 +162,26 @@ def _build_parser() -> argparse.ArgumentParser:
                    help="no Dask: analyse the logs one after another in this process")
     _shared_options(b, spec=True, fs=True, progress=True)
 
+    fl = sub.add_parser("fleet", help="compare units: spread, outliers, verdicts, one report",
+                        description="One log per unit: N, B, K, Q, R of every unit and axis "
+                        "with uncertainties, the fleet's median and robust spread, the units "
+                        "that stand out (robust z-score on ln value; the rule is in the "
+                        "report) and each unit's datasheet verdict, written as fleet.md and "
+                        "fleet.html with one figure per coefficient across units. The logs "
+                        "are analysed as by 'imunoise batch' (a local Dask cluster of 2 "
+                        "worker processes unless --scheduler or --serial is given).")
+    fl.add_argument("logs", metavar="LOG", nargs="+",
+                    help="one log per unit, or glob patterns ('lab/*.bin')")
+    fl.add_argument("-o", "--output", required=True, metavar="DIR",
+                    help="report folder (created)")
+    fl.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                    help="address of a running Dask scheduler (default: a local cluster)")
+    fl.add_argument("--serial", action="store_true",
+                    help="no Dask: analyse the logs one after another in this process")
+    fl.add_argument("--force", action="store_true",
+                    help="write into an existing folder that is not an imunoise report")
+    _shared_options(fl, spec=True, fs=True, progress=True)
+
     m = sub.add_parser("simulate", help="write the log of a simulated still VN-100",
                        description="Write the log of a still VN-100 (gravity on -Z, a constant "
                        "magnetic field and attitude) with the datasheet's noise densities and "
@@ -728,6 +748,32 @@ def _cmd_batch(args) -> int:
     return 0
 
 
+def _cmd_fleet(args) -> int:
+    from imunoise._fleet import fleet
+
+    if args.serial and args.scheduler:
+        _fail("--serial and --scheduler exclude each other")
+    client = False if args.serial else args.scheduler
+    try:
+        result = fleet(args.logs, spec=args.spec, client=client, fs=args.fs,
+                       progress=args.progress)
+    except ImportError as exc:
+        _fail(str(exc))
+    for u in result.units:
+        if u["error"] is not None:
+            warnings.warn(f"{u['path']}: not analysed: {u['error']}", stacklevel=1)
+    written = result.report(args.output, force=args.force)
+    outliers = "; ".join(f"{o['unit']} {o['sensor']} {o['term']} {o['axis']} "
+                         f"{o['ratio']:.3g}x the median" for o in result.outliers[:5])
+    more = len(result.outliers) - 5
+    print(f"fleet report of {len(result.units)} units written to {written[1]}; "
+          + (f"outliers: {outliers}" + (f" and {more} more" if more > 0 else "")
+             if outliers else "no outlier")
+          + (f"; {len(result.failed)} failing the spec: {', '.join(result.failed[:10])}"
+             + (" ..." if len(result.failed) > 10 else "") if result.failed else ""))
+    return 0
+
+
 def _cmd_simulate(args) -> int:
     from imunoise._simulate_log import simulate_log
 
@@ -900,6 +946,7 @@ _COMMANDS = {
     "thermal": _cmd_thermal,
     "convert": _cmd_convert,
     "batch": _cmd_batch,
+    "fleet": _cmd_fleet,
     "simulate": _cmd_simulate,
     "demo": _cmd_demo,
     "psd": _cmd_psd,

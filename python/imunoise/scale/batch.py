@@ -17,11 +17,11 @@ from imunoise import _schema
 from imunoise._progress import Progress
 from imunoise.allan import adev
 from imunoise.datasheet import VERDICTS, compare, load_spec
-from imunoise.noise import fit
+from imunoise.noise import GM_MAX, fit
 from imunoise.readers.log import ISSUE_KINDS
 from imunoise.readers.read import read
 
-__all__ = ["BATCH_SENSORS", "BATCH_TAUS", "analyse_log", "batch"]
+__all__ = ["BATCH_SENSORS", "BATCH_TAUS", "analyse_log", "analyse_logs", "batch", "expand"]
 
 
 #: Sensors analysed by :func:`batch`.
@@ -33,7 +33,9 @@ _VERDICT_RANK = {w: len(VERDICTS) - i for i, w in enumerate(VERDICTS)}
 BATCH_TAUS = _schema.TAUS_PER_DECADE
 
 
-def _expand(paths) -> list[str]:
+def expand(paths) -> list[str]:
+    """The logs ``paths`` names: paths as given, glob patterns expanded in sorted order;
+    ``ValueError`` for a pattern that matches nothing or no path at all."""
     if isinstance(paths, (str, os.PathLike)):
         paths = [paths]
     out: list[str] = []
@@ -65,7 +67,8 @@ def _base_row(path: str) -> dict:
     return row
 
 
-def analyse_log(path: str, spec=None, fs: float | None = None) -> list[dict]:
+def analyse_log(path: str, spec=None, fs: float | None = None, *,
+                components: bool = False) -> list[dict]:
     """The batch rows of one log: one per sensor and axis, or one error row.
 
     Reads the log (:func:`imunoise.read`), computes the overlapping Allan
@@ -73,6 +76,9 @@ def analyse_log(path: str, spec=None, fs: float | None = None) -> list[dict]:
     (:func:`imunoise.fit`) and compares it with ``spec`` (a name, a TOML file or
     a :class:`~imunoise.datasheet.Spec`; ``None`` skips the comparison). Never
     raises for a bad log: the exception becomes the ``error`` of one row.
+    ``components``: each row also holds ``gauss_markov``, the fitted Gauss–Markov
+    terms of its axis as ``(sigma, sigma_std, tau_c, tau_c_std)`` tuples by
+    increasing τc (rate units and seconds; :func:`imunoise.fleet` lists them).
     """
     try:
         with warnings.catch_warnings():
@@ -108,6 +114,8 @@ def analyse_log(path: str, spec=None, fs: float | None = None) -> list[dict]:
                     row["verdict"] = max(v.values(), key=_VERDICT_RANK.__getitem__)
                 for t in _TERM_ORDER:
                     row[f"verdict_{t}"] = v.get(t)
+                if components:
+                    row["gauss_markov"] = _gauss_markov(m.components, j)
                 rows.append(row)
         return rows
     except Exception as exc:  # noqa: BLE001 - a bad log is a row, not a failed batch
@@ -116,6 +124,14 @@ def analyse_log(path: str, spec=None, fs: float | None = None) -> list[dict]:
             row[f"verdict_{t}"] = None
         row["error"] = f"{type(exc).__name__}: {exc}"
         return [row]
+
+
+def _gauss_markov(c, channel: int) -> tuple[tuple[float, float, float, float], ...]:
+    """``(sigma, sigma_std, tau_c, tau_c_std)`` of each Gauss–Markov term of a channel."""
+    cols = [np.reshape(a, (-1, GM_MAX))[channel]
+            for a in (c.gm_sigma, c.gm_sigma_std, c.gm_tau, c.gm_tau_std)]
+    return tuple(tuple(float(v) for v in term) for term in zip(*cols, strict=True)
+                 if np.isfinite(term[0]))
 
 
 def _frame(rows: list[dict]):
@@ -182,23 +198,33 @@ def batch(
     The workers must be able to import imunoise and to read the paths (on a
     remote cluster: the same files at the same paths).
     """
-    files = _expand(paths)
+    results = analyse_logs(paths, client, spec, fs=fs, progress=progress)
+    return _frame([row for rows in results for row in rows])
+
+
+def analyse_logs(paths, client=None, spec="vn100", *, fs: float | None = None,
+                 progress: bool | None = None, components: bool = False,
+                 desc: str = "imunoise batch") -> list[list[dict]]:
+    """:func:`analyse_log` of every log ``paths`` names, in their order: the one loop
+    of :func:`batch` and :func:`imunoise.fleet` (``client``, ``spec``, ``fs`` and
+    ``progress`` as :func:`batch`; ``components`` as :func:`analyse_log`; ``desc``
+    labels the progress bar)."""
+    files = expand(paths)
     if isinstance(spec, str) and spec.lower() == "none":
         spec = None
     if spec is not None:
         spec = load_spec(spec)  # fail early, and ship the parsed spec to the workers
-    with Progress(progress, len(files), unit="log", desc="imunoise batch", leave=True) as bar:
+    with Progress(progress, len(files), unit="log", desc=desc, leave=True) as bar:
         if client is False:
             results = []
             for p in files:
-                results.append(analyse_log(p, spec, fs))
+                results.append(analyse_log(p, spec, fs, components=components))
                 bar.step()
-        else:
-            results = _run_dask(files, client, spec, fs, bar)
-    return _frame([row for rows in results for row in rows])
+            return results
+        return _run_dask(files, client, spec, fs, bar, components)
 
 
-def _run_dask(files, client, spec, fs, bar: Progress) -> list[list[dict]]:
+def _run_dask(files, client, spec, fs, bar: Progress, components: bool) -> list[list[dict]]:
     try:
         from distributed import Client, LocalCluster, as_completed
     except ImportError:
@@ -219,7 +245,8 @@ def _run_dask(files, client, spec, fs, bar: Progress) -> list[list[dict]]:
             f"got {type(client).__name__}"
         )
     try:
-        futures = [client.submit(analyse_log, p, spec, fs, pure=False) for p in files]
+        futures = [client.submit(analyse_log, p, spec, fs, components=components, pure=False)
+                   for p in files]
         index = {f.key: i for i, f in enumerate(futures)}
         results: list[list[dict] | None] = [None] * len(files)
         for fut in as_completed(futures):
