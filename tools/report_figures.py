@@ -1,4 +1,4 @@
-"""Keep the README's pictures of the report current: build the report of the bundled
+"""Keep the pictures of the report in docs/report.md current: build the report of the bundled
 VN-100 capture (and of a simulated 20-minute still log, for the warm-up and the
 dynamic Allan deviation, which need a longer record) and copy some of its figures
 into docs/img/.
