@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from imunoise import _atomic
+from imunoise import _atomic, _interrupt
 from imunoise._schema import (
     ALLAN_SENSORS,
     CHANNELS,
@@ -903,29 +903,34 @@ def main(argv: list[str] | None = None) -> int:
         # ``file``: the progress bars pass a stream that prints above them
         print(f"imunoise: warning: {_one_line(message)}", file=file or sys.stderr)
 
-    parser = _build_parser()
     old = warnings.showwarning
     warnings.showwarning = _warn
-    old_term = _exit_on_sigterm()
+    old_term = None
     try:
         try:
+            old_term = _exit_on_sigterm()
+            parser = _build_parser()
             args = parser.parse_args(argv)
             if args.command is None:
                 parser.print_help(sys.stderr)
                 return 2
+            # the recorder's own clean-up (the sensor's settings written back) must
+            # finish however long it takes: no deadline after Ctrl-C there
+            _interrupt.work(backstop=args.command != "record")
             return _COMMANDS[args.command](args)
         except _Failure as exc:
             message = str(exc)
-        except (ValueError, OSError, TypeError) as exc:
+        except (ValueError, OSError, TypeError, OverflowError) as exc:
             message = str(exc) or type(exc).__name__
             if isinstance(exc, OSError) and exc.filename and exc.strerror:
                 message = f"{exc.filename}: {exc.strerror}"
         except KeyboardInterrupt:
-            print("imunoise: interrupted", file=sys.stderr)
+            _interrupt.interrupted()
             return 130
         print(f"imunoise: error: {_one_line(message)}", file=sys.stderr)
         return 2
     finally:
+        _interrupt.done()
         warnings.showwarning = old
         if old_term is not None:
             signal.signal(signal.SIGTERM, old_term)
@@ -939,7 +944,7 @@ def _exit_on_sigterm():
         return None
 
     def _terminated(signum, frame):
-        print("imunoise: terminated", file=sys.stderr)
+        _interrupt.interrupted(signum)
         raise SystemExit(128 + signum)
 
     return signal.signal(signal.SIGTERM, _terminated)
