@@ -70,4 +70,4 @@ def test_thermal_without_temperature_fails_in_one_line(capsys):
 
 def test_events_bad_false_alarm(capsys):
     assert main(["events", VN_LOG, "--fs", "40", "--false-alarm", "0.5"]) == 2
-    assert "false_alarm must be in (0, 0.01)" in capsys.readouterr().err
+    assert "argument --false-alarm: must be in (0, 0.01); got '0.5'" in capsys.readouterr().err
