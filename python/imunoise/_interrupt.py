@@ -29,10 +29,11 @@ import threading
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 
-__all__ = ["DEADLINE", "guard_startup", "interrupted", "undo_on_exit", "work", "done"]
+__all__ = ["DEADLINE", "at_hard_exit", "done", "guard_startup", "interrupted", "undo_on_exit",
+           "work"]
 
 #: Seconds from a Ctrl-C (or SIGTERM) to the process's end at the latest.
-DEADLINE = 0.8
+DEADLINE = 0.6
 
 #: Console script names and ``-m`` modules that are the command line.
 _SCRIPTS = ("imunoise", "imunoise.exe", "imunoise-script.py")
@@ -156,6 +157,11 @@ def interrupted(signum: int = signal.SIGINT) -> None:
     else:
         word = "interrupted" if signum == signal.SIGINT else "terminated"
         print(f"imunoise: {word}", file=sys.stderr)
+
+
+def at_hard_exit(fn: Callable[[], None]) -> None:
+    """Run ``fn`` should the watchdog end the process (atexit does not run then)."""
+    _cleanups.append(fn)
 
 
 @contextmanager

@@ -432,6 +432,7 @@ def _stream_workdir():
 
     path = fresh_workdir(tempfile.gettempdir(), "imunoise-stream-")
     atexit.register(shutil.rmtree, path, ignore_errors=True)
+    _interrupt.at_hard_exit(lambda: shutil.rmtree(path, ignore_errors=True))
     return path
 
 

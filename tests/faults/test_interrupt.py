@@ -22,7 +22,7 @@ import pytest
 ROOT = Path(__file__).resolve().parents[2]
 MARKER = "starting"
 #: Generous bound on the seconds from SIGINT to the exit: the watchdog ends the
-#: process 0.8 s after the signal at the latest; before, a non-polling Rust kernel
+#: process 0.6 s after the signal at the latest; before, a non-polling Rust kernel
 #: held it up for 8-15 s on the log below.
 BOUND = 5.0
 
