@@ -958,9 +958,16 @@ def main(argv: list[str] | None = None) -> int:
             # the recorder's own clean-up (the sensor's settings written back) must
             # finish however long it takes: no deadline after Ctrl-C there
             _interrupt.work(backstop=args.command != "record")
-            return _COMMANDS[args.command](args)
+            code = _COMMANDS[args.command](args)
+            sys.stdout.flush()  # a closed pipe shows here, not in the interpreter's exit
+            return code
         except _Failure as exc:
             message = str(exc)
+        except BrokenPipeError:
+            # the reader went away (``imunoise stats LOG | head``): end quietly with
+            # 141 = 128 + SIGPIPE, the status a shell shows for a tool SIGPIPE ended
+            _silence_stdout()
+            return 141
         except (ValueError, OSError, TypeError, OverflowError) as exc:
             message = str(exc) or type(exc).__name__
             if isinstance(exc, OSError) and exc.filename and exc.strerror:
@@ -975,6 +982,20 @@ def main(argv: list[str] | None = None) -> int:
         warnings.showwarning = old
         if old_term is not None:
             signal.signal(signal.SIGTERM, old_term)
+
+
+def _silence_stdout() -> None:
+    """Point stdout at /dev/null, so the output still buffered for a closed pipe is
+    dropped instead of failing again ("Exception ignored ... Broken pipe") at exit."""
+    import os
+
+    try:
+        fd = sys.stdout.fileno()
+    except (AttributeError, OSError, ValueError):  # not a real file (tests' capture)
+        return
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    os.dup2(devnull, fd)
+    os.close(devnull)
 
 
 def _exit_on_sigterm():

@@ -1,5 +1,6 @@
 """Ctrl-C on the command line at any moment: exit 130, one line, no traceback, and
-soon after the signal (start-up included).
+soon after the signal (start-up included); a reader that closes the pipe early
+ends the command quietly.
 
 Each run is a real ``imunoise`` process: a script named ``imunoise`` that imports
 the command line as the installed console script does, after writing a marker on
@@ -122,3 +123,21 @@ def test_the_library_keeps_pythons_handler():
                          env=dict(os.environ, PYTHONPATH=str(ROOT / "python")),
                          preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     assert out.stdout.strip() == "True", out.stderr
+
+
+def test_a_closed_pipe_ends_the_command_quietly_with_141(script):
+    # ``imunoise adev LOG --taus all | head -1``: ~1 MB of table for a reader that
+    # leaves after a line; the rest of the output meets a closed pipe
+    from imunoise.cli import bundled_log
+
+    env = dict(os.environ, PYTHONPATH=str(ROOT / "python"))
+    proc = subprocess.Popen(
+        [sys.executable, str(script), "adev", str(bundled_log()), "--fs", "40", "--taus",
+         "all"], env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    assert proc.stderr.readline().strip() == MARKER
+    assert proc.stdout.readline().startswith("# adev of gyro")
+    proc.stdout.close()
+    err = proc.stderr.read()
+    # 141 = 128 + SIGPIPE: what a shell shows for a tool that SIGPIPE ended
+    assert proc.wait() == 141, err
+    assert err == "", err  # was "imunoise: error: [Errno 32] Broken pipe", exit 2
