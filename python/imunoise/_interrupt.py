@@ -83,10 +83,10 @@ def guard_startup() -> None:
             or not _is_command_line()):
         return
     read, write = os.pipe()
-    os.set_blocking(write, False)  # the C handler must never block on a full pipe
     try:
+        os.set_blocking(write, False)  # the C handler must never block on a full pipe
         signal.set_wakeup_fd(write, warn_on_full_buffer=False)
-    except ValueError:  # pragma: no cover - not the main thread after all
+    except (AttributeError, OSError, ValueError):  # pragma: no cover - Windows pipes
         os.close(read)
         os.close(write)
         return
