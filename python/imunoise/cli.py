@@ -526,6 +526,18 @@ def _cmd_fit(args) -> int:
         _fail(f"{args.log}: no {' or '.join(sensors or ['gyro/accel'])} channel in the log")
     if args.bootstrap and args.bootstrap < 5:
         _fail(f"--bootstrap must be >= 5 replicates; got {args.bootstrap}")
+    if args.bootstrap:
+        # the replicates are simulated at once: their bound depends on the log, and
+        # is checked here, not after the Allan deviation, in the option's own name
+        from imunoise.noise._fit import MAX_BOOTSTRAP_SAMPLES
+
+        most = MAX_BOOTSTRAP_SAMPLES // max(len(log), 1)
+        if args.bootstrap > most:
+            _fail(f"--bootstrap must be at most {most:,} replicates for this log's "
+                  f"{len(log):,} samples (at most {MAX_BOOTSTRAP_SAMPLES:,} simulated samples "
+                  f"are held at once); got {args.bootstrap:,}" if most >= 5 else
+                  f"--bootstrap: this log's {len(log):,} samples are too many for a "
+                  f"bootstrap (at most {MAX_BOOTSTRAP_SAMPLES // 5:,}); leave it out")
     for s in sensors:
         result = allan.adev(getattr(log, s), log.fs, taus=report.TAUS_PER_DECADE)
         if args.bootstrap:

@@ -103,3 +103,14 @@ def test_named_bounds(argv, message, capsys):
 def test_values_inside_the_bounds_still_run(capsys):
     assert main(["plan", "--fs", "1e6", "--sensor", "gyro"]) == 0
     assert "plan VectorNav VN-100 gyro" in capsys.readouterr().out
+
+
+def test_bootstrap_bound_of_the_log_names_the_option(capsys):
+    from imunoise.cli import bundled_log
+
+    # 13,223 samples: at most 15,125 replicates, said before any analysis
+    assert main(["fit", str(bundled_log()), "--fs", "40", "--bootstrap", "20000"]) == 2
+    err = capsys.readouterr().err
+    assert err.strip() == ("imunoise: error: --bootstrap must be at most 15,125 replicates "
+                           "for this log's 13,223 samples (at most 200,000,000 simulated "
+                           "samples are held at once); got 20,000")
