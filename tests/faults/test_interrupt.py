@@ -98,6 +98,15 @@ def test_ctrl_c_during_a_bootstrap_fit(script, long_log):
     assert took < BOUND, f"fit stopped {took:.2f} s after SIGINT"
 
 
+def test_ctrl_c_during_a_report_leaves_no_folder(script, long_log, tmp_path):
+    out = tmp_path / "new" / "report"
+    argv = ["report", str(long_log), "-o", str(out), "--spec", "none", "--no-progress"]
+    code, err, took = _interrupt(script, argv, 2.5)
+    _assert_interrupted(code, err, took, "SIGINT in report")
+    # before: the folder, its manifest and figures/ stayed behind
+    assert list(tmp_path.iterdir()) == [], list(tmp_path.rglob("*"))
+
+
 def test_a_second_ctrl_c_ends_the_process_at_once(script, long_log):
     env = dict(os.environ, PYTHONPATH=str(ROOT / "python"))
     proc = subprocess.Popen(
