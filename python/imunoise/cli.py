@@ -386,7 +386,8 @@ def _number_in(low: float, high: float, unit: str = "", *, low_open: bool = True
         except ValueError:
             raise argparse.ArgumentTypeError(f"expected {kind} in {interval}; got {text!r}"
                                              ) from None
-        inside = (np.isfinite(v) and (v > low if low_open else v >= low)
+        # an int of any size compares with the ends; only a float can be nan or inf
+        inside = ((integer or bool(np.isfinite(v))) and (v > low if low_open else v >= low)
                   and (v < high if high_open else v <= high))
         if not inside:
             raise argparse.ArgumentTypeError(f"must be in {interval}; got {text!r}")

@@ -65,7 +65,8 @@ def test_every_numeric_option_has_a_bounded_type():
     assert ("plan", "--fs", None) in NUMERIC and ("psd", "--bins", None) in NUMERIC
 
 
-@pytest.mark.parametrize("value", ["nan", "inf", "-inf", "1e300", "-1e300", "-1"])
+@pytest.mark.parametrize("value", ["nan", "inf", "-inf", "1e300", "-1e300", "-1",
+                                   "9" * 40])
 @pytest.mark.parametrize(("command", "option", "nargs"), NUMERIC,
                          ids=[f"{c} {o}" for c, o, _ in NUMERIC])
 def test_out_of_bound_values_are_one_line_errors(command, option, nargs, value, capsys,
