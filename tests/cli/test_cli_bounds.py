@@ -81,6 +81,7 @@ def test_out_of_bound_values_are_one_line_errors(command, option, nargs, value, 
     assert len(lines) == 1 and "Traceback" not in err, err
     assert lines[0].startswith(f"imunoise: error: argument {option}"), err
     assert repr(value) in lines[0] or f"invalid choice: {value}" in lines[0], err
+    assert "invalid parse value" not in err, err  # the type failed inside itself
 
 
 @pytest.mark.parametrize(("argv", "message"), [
