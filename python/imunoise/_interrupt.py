@@ -52,11 +52,18 @@ def _is_command_line() -> bool:
         any(a in (f"-m{m}" for m in _MODULES) for a in orig)
 
 
+_said = threading.RLock()
+
+
 def _say(signum: int) -> None:
-    if not _state["said"]:
-        _state["said"] = True
+    # once, though the main thread and the watchdog may both get here: written under
+    # the lock, so the other cannot end the process between the flag and the line
+    with _said:
+        if _state["said"]:
+            return
         word = "interrupted" if signum == signal.SIGINT else "terminated"
         os.write(2, f"imunoise: {word}\n".encode())
+        _state["said"] = True
 
 
 def _end(signum: int) -> None:
@@ -71,7 +78,9 @@ def _end(signum: int) -> None:
 
 
 def _at_once(signum, frame) -> None:
-    # start-up and the tail after the command: nothing is being written
+    # start-up and the tail after the command: nothing is being written; a second
+    # Ctrl-C must not run this again halfway through the first
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
     _end(signum)
 
 
@@ -144,10 +153,16 @@ def work(*, backstop: bool = True) -> None:
         signal.signal(signal.SIGINT, signal.default_int_handler)
 
 
-def done() -> None:
-    """The command has returned: Ctrl-C ends the process at once again."""
-    if _state["guarded"]:
-        signal.signal(signal.SIGINT, _at_once)
+def done(*, interrupted: bool = False) -> None:
+    """The command has returned: Ctrl-C ends the process at once again. After an
+    interrupt (``interrupted``) further ones are ignored instead: the watchdog ends
+    the process within DEADLINE anyway, and an ignored SIGINT stays ignored through
+    the interpreter's exit, where Python puts back the default action and a second
+    Ctrl-C would be a death by SIGINT (-2) instead of exit 130."""
+    if not _state["guarded"]:
+        return
+    _state["stopping"] = _state.get("stopping", False) or interrupted
+    signal.signal(signal.SIGINT, signal.SIG_IGN if _state["stopping"] else _at_once)
 
 
 def interrupted(signum: int = signal.SIGINT) -> None:

@@ -986,6 +986,7 @@ def main(argv: list[str] | None = None) -> int:
             if isinstance(exc, OSError) and exc.filename and exc.strerror:
                 message = f"{exc.filename}: {exc.strerror}"
         except KeyboardInterrupt:
+            _interrupt.done(interrupted=True)  # a second Ctrl-C: no new traceback
             _interrupt.interrupted()
             return 130
         print(f"imunoise: error: {_one_line(message)}", file=sys.stderr)
