@@ -39,7 +39,7 @@ DEADLINE = 0.6
 _SCRIPTS = ("imunoise", "imunoise.exe", "imunoise-script.py")
 _MODULES = ("imunoise.cli",)
 
-_state = {"guarded": False, "said": False, "backstop": True, "again": 0}
+_state = {"guarded": False, "said": False, "backstop": True, "again": 0, "stopping": False}
 _cleanups: list[Callable[[], None]] = []
 
 
@@ -161,7 +161,7 @@ def done(*, interrupted: bool = False) -> None:
     Ctrl-C would be a death by SIGINT (-2) instead of exit 130."""
     if not _state["guarded"]:
         return
-    _state["stopping"] = _state.get("stopping", False) or interrupted
+    _state["stopping"] = _state["stopping"] or interrupted
     signal.signal(signal.SIGINT, signal.SIG_IGN if _state["stopping"] else _at_once)
 
 
