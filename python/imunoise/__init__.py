@@ -5,7 +5,10 @@ fitting, log readers for VectorNav VN-100 (ASCII and binary), CSV and ROS bags,
 plots and reports. Start with ``imunoise.adev(x, fs)``.
 """
 
-from imunoise import _cpu, export, units
+# _interrupt is imported first, before the heavy imports: importing it arms Ctrl-C
+# for the command line's start-up (exit 130 and one line, not a traceback from
+# inside numpy); in any other process it does nothing.
+from imunoise import _cpu, _interrupt, export, units  # noqa: F401
 from imunoise._core import __version__
 from imunoise._events import Events, events
 from imunoise._fleet import Fleet, fleet

@@ -685,7 +685,7 @@ def _deviation(
         missing = core.missing.astype(np.int64)
         if missing.any():
             m, var, terms, alpha, identified, edf = _keep_gapped(
-                kind, m, var, terms, alpha, identified, edf, fs, user_given
+                kind, m, var, terms, alpha, identified, edf, fs, user_given, data
             )
     tau = m / fs
     if bias_correction and spec.bias is not None:
@@ -737,7 +737,7 @@ def adev_by_column(column: Callable[[int], np.ndarray], k: int, fs: float, *,
         missing=np.array([r.missing for r in results], dtype=np.int64), gaps=first.gaps)
 
 
-def _keep_gapped(kind, m, var, terms, alpha, identified, edf, fs, user_given):
+def _keep_gapped(kind, m, var, terms, alpha, identified, edf, fs, user_given, data):
     """Drops the taus at which the gaps leave no channel two terms (warning when
     they were asked for explicitly); NaN where one channel has fewer than two."""
     enough = terms >= 2
@@ -748,9 +748,17 @@ def _keep_gapped(kind, m, var, terms, alpha, identified, edf, fs, user_given):
             f"long enough (pass gaps='splice' to join the runs)"
         )
     if user_given and not keep.all():
+        # The rule: say what limited the taus (the record is long enough for them,
+        # or keep_estimable would have dropped them: its gap-free runs are not) and
+        # which argument changes it; a bare "gaps in x" left users guessing.
+        run = longest_valid_run(data)
         _warn.warn(
-            f"{int(np.count_nonzero(~keep))} of {len(m)} taus dropped: the gaps in x leave "
-            f"{kind} fewer than 2 terms there (largest usable tau {m[keep].max() / fs:g} s)",
+            f"{int(np.count_nonzero(~keep))} of {len(m)} taus dropped: the missing "
+            f"samples (NaN) of x split it into gap-free runs of at most {run / fs:g} s "
+            f"({run} samples), too short for 2 {kind} terms beyond tau = "
+            f"{m[keep].max() / fs:g} s (the record's length would allow "
+            f"{m.max() / fs:g} s); ask taus up to that, or pass gaps='splice' to join "
+            "the runs",
             GapWarning,
         )
     enough = enough[keep]
@@ -907,6 +915,17 @@ def _minimum_samples(statistic: str) -> int:
         if _core_allan.estimator_terms(statistic, n + 1, np.array([1], dtype=np.uint64))[0] > 1:
             return n
     return 16
+
+
+def longest_valid_run(data: np.ndarray) -> int:
+    """Length of the longest stretch of rows of ``data`` (n, channels) with no NaN in
+    some channel (the best channel's longest gap-free run)."""
+    best = 0
+    for c in range(data.shape[1]):
+        bad = np.flatnonzero(np.isnan(data[:, c]))
+        edges = np.concatenate(([-1], bad, [data.shape[0]]))
+        best = max(best, int(np.diff(edges).max()) - 1)
+    return best
 
 
 def _gapped_samples(x, gaps, kind: str, skips: bool):

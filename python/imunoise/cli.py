@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from imunoise import _atomic
+from imunoise import _atomic, _interrupt
 from imunoise._schema import (
     ALLAN_SENSORS,
     CHANNELS,
@@ -101,7 +101,8 @@ def _build_parser() -> argparse.ArgumentParser:
     _shared_options(f, fs=True, layout=True)
     f.add_argument("--sensor", choices=ALLAN_SENSORS, default=None,
                    help="one sensor (default: gyro and accel)")
-    f.add_argument("--bootstrap", type=int, default=0, metavar="REPLICATES",
+    f.add_argument("--bootstrap", type=_number_in(0, 100_000, low_open=False, integer=True),
+                   default=0, metavar="REPLICATES",
                    help="uncertainties by parametric bootstrap with this many simulated "
                    "records (>= 5; default: from the fit, taus treated as independent)")
     f.add_argument("--plot", default=None, metavar="PNG",
@@ -125,7 +126,8 @@ def _build_parser() -> argparse.ArgumentParser:
                        "(imunoise.events; docs/events.md).")
     e.add_argument("log", metavar="LOG")
     _shared_options(e, fs=True, layout=True)
-    e.add_argument("--false-alarm", type=_positive_float, default=1e-7, metavar="P",
+    e.add_argument("--false-alarm", type=_number_in(0, 0.01, high_open=True), default=1e-7,
+                   metavar="P",
                    help="design false events per sample and channel (default: %(default)g)")
 
     t = sub.add_parser("thermal", help="bias vs temperature and warm-up per axis",
@@ -145,7 +147,8 @@ def _build_parser() -> argparse.ArgumentParser:
                        "streamed with bounded memory, whatever their size.")
     c.add_argument("log", metavar="LOG")
     c.add_argument("-o", "--output", required=True, metavar="OUTPUT")
-    c.add_argument("--chunk-mb", type=_positive_float, default=64.0, metavar="MB",
+    c.add_argument("--chunk-mb", type=_number_in(0.01, 65536, "MB", low_open=False),
+                   default=64.0, metavar="MB",
                    help="bytes read per piece when streaming (default: %(default)s MB)")
     _shared_options(c, fs=True, progress=True)
 
@@ -188,10 +191,10 @@ def _build_parser() -> argparse.ArgumentParser:
                        "magnetic field and attitude) with the datasheet's noise densities and "
                        "bias instabilities plus a typical rate random walk.")
     m.add_argument("-o", "--output", required=True, metavar="OUTPUT")
-    m.add_argument("--hours", type=_positive_float, default=1.0)
-    m.add_argument("--fs", type=_positive_float, default=40.0, help="sample rate in Hz")
+    m.add_argument("--hours", type=_HOURS, default=1.0)
+    m.add_argument("--fs", type=_FS, default=40.0, help="sample rate in Hz")
     m.add_argument("--format", choices=("vn-ascii", "vn-binary"), default="vn-ascii")
-    m.add_argument("--seed", type=int, default=None)
+    m.add_argument("--seed", type=_SEED, default=None)
 
     ps = sub.add_parser("psd", help="print the power spectral density and the noise density N",
                         description="Welch one-sided PSD per axis, log-binned, and N read off "
@@ -200,11 +203,14 @@ def _build_parser() -> argparse.ArgumentParser:
     ps.add_argument("log", metavar="LOG")
     _shared_options(ps, fs=True, layout=True)
     ps.add_argument("--sensor", choices=ALLAN_SENSORS, default="gyro")
-    ps.add_argument("--band", type=_positive_float, nargs=2, default=None, metavar=("LOW", "HIGH"),
+    ps.add_argument("--band", type=_number_in(0, 1e6, "Hz"), nargs=2, default=None,
+                    metavar=("LOW", "HIGH"),
                     help="white band in Hz for N (default: chosen automatically)")
-    ps.add_argument("--nperseg", type=int, default=None, metavar="SAMPLES",
+    ps.add_argument("--nperseg", type=_number_in(16, 10**9, low_open=False, integer=True),
+                    default=None, metavar="SAMPLES",
                     help="samples per Welch segment (default: a power of two ~ n/8)")
-    ps.add_argument("--bins", type=int, default=10, metavar="PER_DECADE",
+    ps.add_argument("--bins", type=_number_in(1, 1000, low_open=False, integer=True),
+                    default=10, metavar="PER_DECADE",
                     help="log bins per decade of the printed table (default: %(default)s)")
     ps.add_argument("--plot", default=None, metavar="PNG", help="also save the PSD figure")
 
@@ -215,9 +221,9 @@ def _build_parser() -> argparse.ArgumentParser:
     dd.add_argument("log", metavar="LOG")
     _shared_options(dd, fs=True, layout=True)
     dd.add_argument("--sensor", choices=ALLAN_SENSORS, default="gyro")
-    dd.add_argument("--window", type=_positive_float, default=None, metavar="SECONDS",
+    dd.add_argument("--window", type=_number_in(0, 1e9, "s"), default=None, metavar="SECONDS",
                     help="window length (default: a tenth of the log)")
-    dd.add_argument("--step", type=_positive_float, default=None, metavar="SECONDS",
+    dd.add_argument("--step", type=_number_in(0, 1e9, "s"), default=None, metavar="SECONDS",
                     help="step between windows (default: a sixth of the window)")
     dd.add_argument("--taus", default="octave",
                     help="octave, decade, all, or points per decade (default: %(default)s)")
@@ -229,9 +235,9 @@ def _build_parser() -> argparse.ArgumentParser:
     d.add_argument("-o", "--output", default="imunoise-demo", metavar="DIR")
     d.add_argument("--force", action="store_true",
                    help="write into an existing folder that is not an imunoise report")
-    d.add_argument("--hours", type=_positive_float, default=5.0,
+    d.add_argument("--hours", type=_HOURS, default=5.0,
                    help="length of the simulated long log (default: %(default)s)")
-    d.add_argument("--seed", type=int, default=1)
+    d.add_argument("--seed", type=_SEED, default=1)
     _shared_options(d, progress=True)
     _add_recording_commands(sub)
     return p
@@ -303,11 +309,11 @@ def _add_recording_commands(sub) -> None:
                     "%(default)s)")
     pl.add_argument("--sensor", choices=ALLAN_SENSORS, default=None,
                     help="one sensor (default: gyro and accel)")
-    pl.add_argument("--fs", type=_positive_float, default=None, metavar="HZ",
+    pl.add_argument("--fs", type=_FS, default=None, metavar="HZ",
                     help="sample rate to plan for (default: the log's, else 40 Hz)")
-    pl.add_argument("--target", type=_positive_float, default=0.2,
+    pl.add_argument("--target", type=_number_in(0, 1, high_open=True), default=0.2,
                     help="relative uncertainty wanted (default: %(default)s = ±20 %%)")
-    pl.add_argument("--confidence", type=_positive_float, default=0.95,
+    pl.add_argument("--confidence", type=_number_in(0, 1, high_open=True), default=0.95,
                     help="probability of being within it (default: %(default)s)")
 
 
@@ -334,7 +340,7 @@ def _shared_options(p, *, spec: bool = False, fs: bool = False, progress: bool =
                        help="datasheet to compare with: a name or a TOML file (default: "
                        "%(default)s); 'none' to skip")
     if fs:
-        p.add_argument("--fs", type=_positive_float, default=None, metavar="HZ",
+        p.add_argument("--fs", type=_FS, default=None, metavar="HZ",
                        help="sample rate of logs without timestamps (VN ASCII: the rate the "
                        "sensor was set to; default 40 Hz with a warning)")
     if not progress:
@@ -387,6 +393,43 @@ def _positive_float(text: str) -> float:
     return v
 
 
+def _number_in(low: float, high: float, unit: str = "", *, low_open: bool = True,
+               high_open: bool = False, integer: bool = False):
+    """An argparse type: a finite number (an integer when ``integer``) within
+    ``low``..``high``. Every numeric option has one: past its bound a value reaches
+    arithmetic that overflows (``plan --fs 1e300``) or allocates without end, so it
+    is refused with one line naming the bound and the value (argparse adds the
+    option's name)."""
+    ends = (f"{low}, {high}" if integer else f"{low:g}, {high:g}")
+    interval = (f"{'(' if low_open else '['}{ends}{')' if high_open else ']'}"
+                + (f" {unit}" if unit else ""))
+    kind = "an integer" if integer else "a number"
+
+    def parse(text: str):
+        try:
+            v = int(text) if integer else float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected {kind} in {interval}; got {text!r}"
+                                             ) from None
+        # an int of any size compares with the ends; only a float can be nan or inf
+        inside = ((integer or bool(np.isfinite(v))) and (v > low if low_open else v >= low)
+                  and (v < high if high_open else v <= high))
+        if not inside:
+            raise argparse.ArgumentTypeError(f"must be in {interval}; got {text!r}")
+        return v
+
+    return parse
+
+
+#: Sample rates (Hz) the command line takes: slower than a sample per 1000 s or
+#: faster than 1 MHz is no IMU, and 1e300 Hz overflowed the planner's arithmetic.
+_FS = _number_in(1e-3, 1e6, "Hz", low_open=False)
+#: Hours of a simulated log (the simulator bounds the samples further).
+_HOURS = _number_in(0, 1e5, "h")
+#: Seeds: numpy's generators take non-negative integers.
+_SEED = _number_in(0, 2**64 - 1, low_open=False, integer=True)
+
+
 # --- dependencies, one function each -------------------------------------------------
 
 
@@ -415,6 +458,7 @@ def _stream_workdir():
 
     path = fresh_workdir(tempfile.gettempdir(), "imunoise-stream-")
     atexit.register(shutil.rmtree, path, ignore_errors=True)
+    _interrupt.at_hard_exit(lambda: shutil.rmtree(path, ignore_errors=True))
     return path
 
 
@@ -508,6 +552,18 @@ def _cmd_fit(args) -> int:
         _fail(f"{args.log}: no {' or '.join(sensors or ['gyro/accel'])} channel in the log")
     if args.bootstrap and args.bootstrap < 5:
         _fail(f"--bootstrap must be >= 5 replicates; got {args.bootstrap}")
+    if args.bootstrap:
+        # the replicates are simulated at once: their bound depends on the log, and
+        # is checked here, not after the Allan deviation, in the option's own name
+        from imunoise.noise._fit import MAX_BOOTSTRAP_SAMPLES
+
+        most = MAX_BOOTSTRAP_SAMPLES // max(len(log), 1)
+        if args.bootstrap > most:
+            _fail(f"--bootstrap must be at most {most:,} replicates for this log's "
+                  f"{len(log):,} samples (at most {MAX_BOOTSTRAP_SAMPLES:,} simulated samples "
+                  f"are held at once); got {args.bootstrap:,}" if most >= 5 else
+                  f"--bootstrap: this log's {len(log):,} samples are too many for a "
+                  f"bootstrap (at most {MAX_BOOTSTRAP_SAMPLES // 5:,}); leave it out")
     for s in sensors:
         result = allan.adev(getattr(log, s), log.fs, taus=report.TAUS_PER_DECADE)
         if args.bootstrap:
@@ -627,8 +683,6 @@ def _cmd_psd(args) -> int:
     from imunoise.numbers import format_value
 
     log, y = _sensor_samples(args)
-    if args.bins < 1:
-        _fail(f"--bins must be >= 1; got {args.bins}")
     band = tuple(args.band) if args.band else None
     s = spectrum.psd(y, log.fs, nperseg=args.nperseg, band=band)
     if s.segments_skipped:
@@ -969,32 +1023,59 @@ def main(argv: list[str] | None = None) -> int:
         # ``file``: the progress bars pass a stream that prints above them
         print(f"imunoise: warning: {_one_line(message)}", file=file or sys.stderr)
 
-    parser = _build_parser()
     old = warnings.showwarning
     warnings.showwarning = _warn
-    old_term = _exit_on_sigterm()
+    old_term = None
     try:
         try:
+            old_term = _exit_on_sigterm()
+            parser = _build_parser()
             args = parser.parse_args(argv)
             if args.command is None:
                 parser.print_help(sys.stderr)
                 return 2
-            return _COMMANDS[args.command](args)
+            # the recorder's own clean-up (the sensor's settings written back) must
+            # finish however long it takes: no deadline after Ctrl-C there
+            _interrupt.work(backstop=args.command != "record")
+            code = _COMMANDS[args.command](args)
+            sys.stdout.flush()  # a closed pipe shows here, not in the interpreter's exit
+            return code
         except _Failure as exc:
             message = str(exc)
-        except (ValueError, OSError, TypeError) as exc:
+        except BrokenPipeError:
+            # the reader went away (``imunoise stats LOG | head``): end quietly with
+            # 141 = 128 + SIGPIPE, the status a shell shows for a tool SIGPIPE ended
+            _silence_stdout()
+            return 141
+        except (ValueError, OSError, TypeError, OverflowError) as exc:
             message = str(exc) or type(exc).__name__
             if isinstance(exc, OSError) and exc.filename and exc.strerror:
                 message = f"{exc.filename}: {exc.strerror}"
         except KeyboardInterrupt:
-            print("imunoise: interrupted", file=sys.stderr)
+            _interrupt.done(interrupted=True)  # a second Ctrl-C: no new traceback
+            _interrupt.interrupted()
             return 130
         print(f"imunoise: error: {_one_line(message)}", file=sys.stderr)
         return 2
     finally:
+        _interrupt.done()
         warnings.showwarning = old
         if old_term is not None:
             signal.signal(signal.SIGTERM, old_term)
+
+
+def _silence_stdout() -> None:
+    """Point stdout at /dev/null, so the output still buffered for a closed pipe is
+    dropped instead of failing again ("Exception ignored ... Broken pipe") at exit."""
+    import os
+
+    try:
+        fd = sys.stdout.fileno()
+    except (AttributeError, OSError, ValueError):  # not a real file (tests' capture)
+        return
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    os.dup2(devnull, fd)
+    os.close(devnull)
 
 
 def _exit_on_sigterm():
@@ -1005,7 +1086,7 @@ def _exit_on_sigterm():
         return None
 
     def _terminated(signum, frame):
-        print("imunoise: terminated", file=sys.stderr)
+        _interrupt.interrupted(signum)
         raise SystemExit(128 + signum)
 
     return signal.signal(signal.SIGTERM, _terminated)

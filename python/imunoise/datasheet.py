@@ -74,20 +74,23 @@ def load_spec(spec) -> Spec:
     if not isinstance(spec, (str, Path)):
         raise TypeError(f"spec must be a name, a path or a Spec; got {type(spec).__name__}")
     path = Path(spec)
-    if path.suffix == ".toml" or path.exists():
-        if not path.is_file():
-            raise ValueError(f"spec file {str(path)!r} does not exist")
+    name = str(spec).lower()
+    # A file of that name wins; a name is the built-in datasheet only when no such
+    # file exists (a folder called vn100 in the working directory is no spec)
+    if path.is_file():
         text = path.read_text(encoding="utf-8")
         origin = str(path)
-    else:
-        name = str(spec).lower()
-        res = resources.files("imunoise") / "specs" / f"{name}.toml"
-        if not res.is_file():
-            raise ValueError(
-                f"spec must be one of {available_specs()} or a .toml path; got {spec!r}"
-            )
-        text = res.read_text(encoding="utf-8")
+    elif name in available_specs():
+        text = (resources.files("imunoise") / "specs" / f"{name}.toml").read_text(
+            encoding="utf-8")
         origin = f"imunoise/specs/{name}.toml"
+    elif path.suffix == ".toml" or path.exists():
+        what = "is not a file" if path.exists() else "does not exist"
+        raise ValueError(f"spec file {str(path)!r} {what}")
+    else:
+        raise ValueError(
+            f"spec must be one of {available_specs()} or a .toml path; got {spec!r}"
+        )
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:

@@ -298,7 +298,7 @@ def test_dadev_command(tmp_path, capsys):
 
 
 @pytest.mark.parametrize("argv, message", [
-    (["psd", "--bins", "0"], "--bins must be >= 1"),
+    (["psd", "--bins", "0"], "argument --bins: must be in [1, 1000]; got '0'"),
     (["psd", "--band", "5", "1"], "band must satisfy"),
     (["dadev", "--window", "1000"], "window must hold between 3"),
 ])

@@ -70,4 +70,24 @@ def test_thermal_without_temperature_fails_in_one_line(capsys):
 
 def test_events_bad_false_alarm(capsys):
     assert main(["events", VN_LOG, "--fs", "40", "--false-alarm", "0.5"]) == 2
-    assert "false_alarm must be in (0, 0.01)" in capsys.readouterr().err
+    assert "argument --false-alarm: must be in (0, 0.01); got '0.5'" in capsys.readouterr().err
+
+
+def test_report_says_the_events_not_gaps_cut_the_comparisons_taus(tmp_path, capsys):
+    # a live capture with no gaps, 30 % of it bursts: left out, they leave no
+    # stretch long enough for tau 100 s; the warning named "the gaps in x" before
+    from helpers.data import shared_file
+
+    log = shared_file("data/vn100-ascii/live_capture.txt")
+    assert main(["report", str(log), "--fs", "40", "-o", str(tmp_path / "r"),
+                 "--spec", "none", "--no-progress"]) == 0
+    err = capsys.readouterr().err
+    line = next(w for w in err.splitlines() if "without its events" in w)
+    assert line.startswith("imunoise: warning: the Allan deviation of the log without its "
+                           "events stops at τ = 9.95 s (gyro, accel; 1 of the 4 compared "
+                           "taus dropped): the 32 events left out")
+    assert "leave no event-free stretch longer than 2.1 min, too short for τ = 99.5 s; " \
+           "the log's length is not the limit" in line
+    assert "`imunoise events LOG` lists them" in line
+    assert "gaps in x" not in err and "taus dropped: the missing samples" not in err
+    assert "stops at τ = 9.95 s" in (tmp_path / "r" / "report.md").read_text()

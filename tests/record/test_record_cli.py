@@ -14,7 +14,7 @@ from imunoise.cli import main
     (["record", "p", "-o", "x.vn", "--binary", "800:common=Bogus"], "'Bogus' is not in group"),
     (["record", "p", "-o", "x.vn", "--baud", "fast"], "--baud must be a number or 'auto'"),
     (["record", "p", "-o", "x.vn", "--rate", "33"], "rate must be one of"),
-    (["plan", "--target", "2"], "target must be a relative uncertainty in (0, 1)"),
+    (["plan", "--target", "2"], "argument --target: must be in (0, 1); got '2'"),
     (["emulate", "p", "--fault", "melt@1"], "fault kind must be one of"),
     # bounds said before anything is written to a sensor or a port made
     (["record", "p", "-o", "x.vn", "--binary", "1e-300:common=TimeStartup"],

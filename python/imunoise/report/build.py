@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-from imunoise import _atomic, _schema, _stream, _summary, export, noise, plot, stats
+from imunoise import _atomic, _interrupt, _schema, _stream, _summary, export, noise, plot, stats
 from imunoise import allan as _allan
 from imunoise._core import __version__
 from imunoise._events import Events, events
@@ -27,6 +27,7 @@ from imunoise._progress import Progress, wanted
 from imunoise._schema import ALLAN_SENSORS, SAMPLE_SENSORS, sensor_label
 from imunoise._thermal import Thermal, thermal
 from imunoise._warmup import Warmup, warmup
+from imunoise.datasheet import load_spec
 from imunoise.readers.log import ImuLog
 from imunoise.report import folder, sections
 from imunoise.report.document import Doc
@@ -403,6 +404,10 @@ def build(
         raise ValueError(f"units must be None or 'datasheet'; got {units!r}")
     if stream not in (None, True, False):
         raise ValueError(f"stream must be None, True or False; got {stream!r}")
+    if spec is not None:
+        # a wrong --spec is found before the analysis, not after it (17 s on an
+        # hour's log), and before a folder is made
+        load_spec(spec)
     out = Path(out_dir)
     inputs = [p for p in (short, long) if isinstance(p, str | os.PathLike)]
     previous = folder.claim(out, force=force, inputs=inputs)
@@ -410,12 +415,24 @@ def build(
     streamed = stream if stream is not None else any(
         streams(p, options) for p in (short, long) if p is not None)
     workdirs: list[Path] = []
-    try:
-        return _build(short, long, out, previous, inputs, options, workdirs, spec=spec,
-                      fs=fs, progress=progress, trim=trim, streamed=streamed, units=units)
-    finally:
+    undo = folder.Undo(out)
+
+    def clean(failed: bool) -> None:
         for w in workdirs:
             shutil.rmtree(w, ignore_errors=True)
+        if failed:  # no skeleton of a report left behind
+            undo()
+
+    try:
+        # should the command line's watchdog end a stuck process, it cleans up too
+        with _interrupt.undo_on_exit(lambda: clean(True)):
+            rep = _build(short, long, out, previous, inputs, options, workdirs, spec=spec,
+                         fs=fs, progress=progress, trim=trim, streamed=streamed, units=units)
+    except BaseException:
+        clean(True)
+        raise
+    clean(False)
+    return rep
 
 
 def _build(short, long, out: Path, previous, inputs, options, workdirs: list[Path], *,

@@ -8,19 +8,22 @@ this one did not (figures of sections that no longer apply) and records the new
 list. Every file is written atomically (:mod:`imunoise._atomic`), so an
 interrupted report leaves each file either old or new, never partial, and the
 manifest still names the folder a report: :func:`mark` writes it before the first
-file.
+file. A report that fails or is interrupted takes back what it added
+(:class:`Undo`): a new folder goes entirely, an existing one loses only the files
+this report created.
 """
 
 from __future__ import annotations
 
 import json
 import os
+import shutil
 from collections.abc import Iterable
 from pathlib import Path
 
 from imunoise import _atomic
 
-__all__ = ["MANIFEST", "claim", "mark", "settle"]
+__all__ = ["MANIFEST", "Undo", "claim", "mark", "settle"]
 
 #: The file that marks a folder as an imunoise report and lists its files.
 MANIFEST = "imunoise-report.json"
@@ -100,3 +103,44 @@ def settle(out, written: Iterable, previous: Iterable[str], *, inputs: Iterable 
         if path.is_file() or path.is_symlink():
             path.unlink(missing_ok=True)
     _write(out, new)
+
+
+class Undo:
+    """Removes what a report into ``out`` added, should it fail or be interrupted:
+    the folders it created (``out`` and any missing parent), or in a folder that
+    existed the entries of ``out`` and ``out/figures`` that were not there before
+    (files replaced by this report stay new, as each file is old or new). Made
+    before the report writes anything; calling it twice is harmless."""
+
+    def __init__(self, out) -> None:
+        self.out = Path(os.path.abspath(os.fspath(out)))
+        top, p = None, self.out
+        while not p.exists() and p != p.parent:
+            top, p = p, p.parent
+        self.top = top
+        self.before = set() if top is not None else _entries(self.out)
+
+    def __call__(self) -> None:
+        if self.top is not None:
+            shutil.rmtree(self.top, ignore_errors=True)
+            return
+        # the deepest first: a new figures/ goes after the files in it
+        for path in sorted(_entries(self.out) - self.before, key=lambda p: -len(p.parts)):
+            try:
+                if path.is_dir() and not path.is_symlink():
+                    shutil.rmtree(path, ignore_errors=True)
+                else:
+                    path.unlink(missing_ok=True)
+            except OSError:
+                pass  # the folder is the user's: leave what cannot be removed
+
+
+def _entries(out: Path) -> set[Path]:
+    """The entries of ``out`` and of ``out/figures`` (where a report writes)."""
+    found: set[Path] = set()
+    for d in (out, out / "figures"):
+        try:
+            found.update(d.iterdir())
+        except OSError:
+            continue
+    return found

@@ -7,13 +7,14 @@ computes each analysis once, on first use) and adds its figures through it.
 
 from __future__ import annotations
 
+import warnings
 from functools import partial
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
 
-from imunoise import _stream, noise, numbers, plot, stats, units
+from imunoise import _stream, _warn, noise, numbers, plot, stats, units
 from imunoise import allan as _allan
 from imunoise._schema import CHANNELS, SAMPLE_SENSORS, axis_names
 from imunoise.numbers import format_value
@@ -528,7 +529,7 @@ def long_log_events(ctx: Context, doc: Doc) -> None:
           f"Left out as missing samples (±{format_duration(EVENT_PAD)}), the gap-aware Allan "
           "statistics skip every term that touches one. The Allan deviation with and "
           "without them:")
-    rows, changed = [], []
+    rows, changed, short = [], [], []
     for sensor, with_ in ctx.allan.items():
         taus = _decade_taus(with_)
         if not taus.size:
@@ -536,17 +537,26 @@ def long_log_events(ctx: Context, doc: Doc) -> None:
         y = getattr(log, sensor)
         both = _stream.adev(y, log.fs, taus, ctx.streamed, ctx.block)
         _stream.release(y)
-        if ctx.streamed:  # a column at a time, the events made missing in it
-            inside = found.padded_mask(EVENT_PAD)
+        with warnings.catch_warnings(record=True) as said:
+            warnings.simplefilter("always")
+            if ctx.streamed:  # a column at a time, the events made missing in it
+                inside = found.padded_mask(EVENT_PAD)
 
-            def excluded(j: int, y=y, inside=inside) -> np.ndarray:
-                col = _stream.column(y, j, ctx.block)
-                col[inside] = np.nan
-                return col
+                def excluded(j: int, y=y, inside=inside) -> np.ndarray:
+                    col = _stream.column(y, j, ctx.block)
+                    col[inside] = np.nan
+                    return col
 
-            without = _allan.adev_by_column(excluded, y.shape[1], log.fs, taus=both.taus)
-        else:
-            without = _allan.adev(found.exclude(y, pad=EVENT_PAD), log.fs, taus=both.taus)
+                without = _allan.adev_by_column(excluded, y.shape[1], log.fs, taus=both.taus)
+            else:
+                without = _allan.adev(found.exclude(y, pad=EVENT_PAD), log.fs, taus=both.taus)
+        # "taus dropped" here is about the taus this section picked, in adev's words
+        # (x, NaN): said below in the report's (the events left out); the rest as is
+        for w in said:
+            if "taus dropped" not in str(w.message):
+                warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+        if without.taus.size < both.taus.size:
+            short.append((sensor, both.taus, without.taus))
         # the taus both have (the grid's own, whole samples; gaps may cost the longest)
         taus, a, b = np.intersect1d(both.taus, without.taus, return_indices=True)
         dev, lo, hi = (np.reshape(v, (len(both.taus), -1))[a] for v in (
@@ -563,6 +573,10 @@ def long_log_events(ctx: Context, doc: Doc) -> None:
                              f"{dev_out[i, j] / dev[i, j]:.3g}" if dev[i, j] > 0 else "—",
                              "yes" if outside else "no"])
     level = f"{100 * next(iter(ctx.allan.values())).confidence:.3g} %"
+    if short:
+        note = _events_cut_note(ctx, found, short)
+        doc.p(note[0].upper() + note[1:] + ".")
+        _warn.warn(note)
     doc.table(["channel", "unit", "τ", "ADEV", "without events", "ratio",
                f"outside the {level} interval"], rows,
               caption=f"Allan deviation of the {'only' if ctx.one_log else 'long'} log with "
@@ -577,6 +591,31 @@ def long_log_events(ctx: Context, doc: Doc) -> None:
     else:
         doc.p(f"Leaving them out moves no point outside the {level} confidence interval: "
               "the Allan analysis above holds with or without them.")
+
+
+def _events_cut_note(ctx: Context, found, short) -> str:
+    """Why the comparison without the events stops short of the longest taus: the
+    events cut the log into stretches too short for them (not the log's length,
+    which the taus were picked to fit)."""
+    mask = found.padded_mask(EVENT_PAD)
+    gaps = ctx.long.issues.samples_missing
+    edges = np.concatenate(([-1], np.flatnonzero(mask), [mask.size]))
+    stretch = (int(np.diff(edges).max()) - 1) / ctx.long.fs
+    sensors = ", ".join(sensor for sensor, _all, _kept in short)
+    _sensor, wanted, kept = short[0]
+    which, arg = ("the log", "LOG") if ctx.one_log else ("the long log", "LONG_LOG")
+    return (
+        f"the Allan deviation of {which} without its events stops at τ = "
+        f"{format_duration(kept.max())} ({sensors}; "
+        f"{wanted.size - kept.size} of the {wanted.size} compared taus dropped): the "
+        f"{len(found)} events left out (±{format_duration(EVENT_PAD)} each, "
+        f"{100 * found.share:.3g} % of the samples"
+        + (f", besides the log's {gaps} missing samples" if gaps else "")
+        + f") leave no event-free stretch longer than {format_duration(stretch)}, too "
+        f"short for τ = {format_duration(wanted[kept.size:].min())}; the log's length "
+        f"is not the limit. A log ({arg}) with fewer disturbances reaches further; "
+        f"`imunoise events {arg}` lists them"
+    )
 
 
 def warmup_section(ctx: Context, doc: Doc) -> None:
