@@ -95,7 +95,7 @@ pub fn analyse_plan_with(
     }
     let mut job = Job::new(phases, plan, n_phase)?;
     job.ratio = ratio;
-    let swept = job.sweep_blocked();
+    let swept = job.sweep_blocked(stop);
     stop.check()?;
     let estimates = job.estimate_pairs(&swept, stop);
     stop.check()?;
@@ -234,7 +234,8 @@ impl<'a> Job<'a> {
     /// The overlapping Allan and Hadamard variances sweep all their taus of a
     /// channel at once (see `fast::blocked`, run over each gap-free run); every
     /// other pair is `None` here and goes tau by tau.
-    fn sweep_blocked(&self) -> Vec<Option<f64>> {
+    /// Meaningless once `stop` is raised.
+    fn sweep_blocked(&self, stop: &Interrupt) -> Vec<Option<f64>> {
         let mut swept: Vec<Option<f64>> = vec![None; self.pairs.len()];
         for (statistic, taus, ms) in self.by_statistic() {
             let (Some(difference), Some(estimator)) =
@@ -246,8 +247,8 @@ impl<'a> Job<'a> {
                 .phases
                 .par_iter()
                 .map(|p| match &p.gaps {
-                    None => fast::blocked::sums_of_squares(&p.c, &ms, difference),
-                    Some(g) => runs::sums_over_runs(&p.c, &g.segments, &ms, difference),
+                    None => fast::blocked::sums_of_squares(&p.c, &ms, difference, stop),
+                    Some(g) => runs::sums_over_runs(&p.c, &g.segments, &ms, difference, stop),
                 })
                 .collect();
             for (k, &t) in taus.iter().enumerate() {

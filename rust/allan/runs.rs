@@ -19,6 +19,7 @@ use super::fast::blocked::{self, Difference};
 use super::phase::{Gaps, Phase};
 use super::sum::column_totals;
 use super::Statistic;
+use crate::interrupt::Interrupt;
 
 /// Phase points → how many runs have that many, over the runs where the
 /// estimator has terms. Statistics that cannot skip gaps have no runs.
@@ -56,10 +57,11 @@ pub fn sums_over_runs(
     segments: &[Range<usize>],
     ms: &[usize],
     difference: Difference,
+    stop: &Interrupt,
 ) -> Vec<f64> {
     let partials: Vec<Vec<f64>> = segments
         .par_iter()
-        .map(|s| blocked::sums_of_squares(&c[s.start..=s.end], ms, difference))
+        .map(|s| blocked::sums_of_squares(&c[s.start..=s.end], ms, difference, stop))
         .collect();
     column_totals(&partials, ms.len())
 }

@@ -13,6 +13,7 @@
 use rayon::prelude::*;
 
 use crate::allan::sum::{column_totals, sum_of_squared_combinations, Neumaier};
+use crate::interrupt::Interrupt;
 
 /// Samples per block: three windows of every short tau stay in L1/L2.
 const BLOCK: usize = 2048;
@@ -37,7 +38,13 @@ impl Difference {
 
 /// Σ_k (d-th difference of c at lag m, starting at k)² for every m in `ms`, over
 /// k = 0..N − d·m (all overlapping terms). Averaging factors that do not fit give 0.
-pub fn sums_of_squares(c: &[f64], ms: &[usize], difference: Difference) -> Vec<f64> {
+/// Meaningless once `stop` is raised (each task of a few milliseconds checks it).
+pub fn sums_of_squares(
+    c: &[f64],
+    ms: &[usize],
+    difference: Difference,
+    stop: &Interrupt,
+) -> Vec<f64> {
     let span = difference.span();
     let terms: Vec<usize> = ms
         .iter()
@@ -55,6 +62,9 @@ pub fn sums_of_squares(c: &[f64], ms: &[usize], difference: Difference) -> Vec<f
     let partials: Vec<Vec<f64>> = (0..tasks)
         .into_par_iter()
         .map(|task| {
+            if stop.raised() {
+                return vec![0.0; ms.len()];
+            }
             let start = task * task_len;
             sweep.task_sums(start, (start + task_len).min(longest))
         })
@@ -149,7 +159,7 @@ mod tests {
                 6.0,
             ),
         ] {
-            let sums = sums_of_squares(&c, &ms, difference);
+            let sums = sums_of_squares(&c, &ms, difference, &crate::interrupt::NEVER);
             for (j, &m) in ms.iter().enumerate() {
                 let one = statistic.estimate(&c, m, &crate::interrupt::NEVER);
                 let blocked = sums[j] / (divisor * (m * m) as f64 * one.terms as f64);
