@@ -318,6 +318,28 @@ mod tests {
         }
     }
 
+    /// Every level's kernels give the same sums, to the bit (the limbs are
+    /// exact integers, whatever redundant form each path leaves them in).
+    #[test]
+    fn every_level_gives_the_same_bits() {
+        let never = Interrupt::new();
+        let c = integrated_noise(1200, 7, 2);
+        let p = ExactPhase::new(&c, 1199).unwrap();
+        let ms: Vec<usize> = (2..40).step_by(2).chain((44..1200).step_by(4)).collect();
+        let mut first: Option<Vec<u64>> = None;
+        crate::simd::at_every_level(|level| {
+            let bits: Vec<u64> = theo1_sums(&p, &ms, &never)
+                .unwrap()
+                .iter()
+                .map(|s| s.to_bits())
+                .collect();
+            match &first {
+                None => first = Some(bits),
+                Some(want) => assert!(&bits == want, "{} differs", level.name()),
+            }
+        });
+    }
+
     #[test]
     fn stops_when_interrupted() {
         let stop = Interrupt::new();
