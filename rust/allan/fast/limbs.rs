@@ -233,6 +233,11 @@ pub fn weighted_terms(f: [i64; 3], a: LimbSlice, b: LimbSlice, c: LimbSlice, w: 
         // SAFETY: the CPU has the features; lengths are asserted inside.
         return unsafe { x86::weighted_terms(f, a, b, c, w) };
     }
+    #[cfg(target_arch = "x86_64")]
+    if avx2() {
+        // SAFETY: as above.
+        return unsafe { x86::weighted_terms_avx2(f, a, b, c, w) };
+    }
     weighted_terms_scalar(f, a, b, c, w)
 }
 
@@ -566,6 +571,100 @@ mod x86 {
         total + dot_scalar(a, b, i)
     }
 
+    /// The scalar kernel's operations, four terms at a time, its eight
+    /// accumulators in two vectors. AVX2 has no 64-bit arithmetic shift nor
+    /// conversion to double: the shift is a logical one between two flips of
+    /// the sign, the carried l₀, l₁ (in [0, 2⁵²)) convert as mantissas, and l₂
+    /// as the mantissa of 1.5·2⁵² + l₂, exact for l₂ in [0, 2⁵¹); outside that
+    /// (a negative term, or one beyond 2¹⁵⁵, which the sweep never makes) the
+    /// scalar kernel gives the result.
+    #[target_feature(enable = "avx2,fma")]
+    pub unsafe fn weighted_terms_avx2(
+        f: [i64; 3],
+        a: LimbSlice,
+        b: LimbSlice,
+        c: LimbSlice,
+        w: &[f64],
+    ) -> f64 {
+        let h = a.l0.len();
+        for s in [a, b, c] {
+            assert!(s.l0.len() == h && s.l1.len() == h && s.l2.len() == h);
+        }
+        assert!(w.len() == h);
+        const REVERSE: i32 = 0b00_01_10_11;
+        let mask = _mm256_set1_epi64x(MASK);
+        let fv = f.map(|v| _mm256_set1_epi64x(v));
+        let (one, two) = (_mm256_set1_pd(LIMB_1), _mm256_set1_pd(LIMB_2));
+        let round = _mm256_set1_pd(ROUND);
+        let top_limit = _mm256_set1_epi64x((1 << 51) - 1);
+        let zero = _mm256_setzero_si256();
+        let mut acc = [_mm256_setzero_pd(); 2];
+        let mut outside = _mm256_setzero_si256();
+        // x >> 52, arithmetic (macros, not closures: the intrinsics inline into
+        // this function's features).
+        macro_rules! shift {
+            ($x:expr) => {{
+                let x = $x;
+                let sign = _mm256_cmpgt_epi64(zero, x);
+                _mm256_xor_si256(_mm256_srli_epi64::<52>(_mm256_xor_si256(x, sign)), sign)
+            }};
+        }
+        // An integer t in [0, 2⁵²) under base's exponent, as a double.
+        macro_rules! to_f64 {
+            ($t:expr, $base:expr) => {{
+                let biased = _mm256_add_epi64($t, _mm256_castpd_si256($base));
+                _mm256_sub_pd(_mm256_castsi256_pd(biased), $base)
+            }};
+        }
+        // One limb of four terms u..u + 4: f + a[u..] + b[v + 3 − j] − 2·c[u..].
+        macro_rules! limb {
+            ($k:expr, $sa:expr, $sb:expr, $sc:expr, $u:expr, $v:expr) => {{
+                let bv = _mm256_permute4x64_epi64::<REVERSE>(_mm256_loadu_si256(
+                    $sb.as_ptr().add($v).cast(),
+                ));
+                let av = _mm256_loadu_si256($sa.as_ptr().add($u).cast());
+                let cv = _mm256_loadu_si256($sc.as_ptr().add($u).cast());
+                _mm256_sub_epi64(
+                    _mm256_add_epi64(_mm256_add_epi64(fv[$k], av), bv),
+                    _mm256_add_epi64(cv, cv),
+                )
+            }};
+        }
+        let mut u = 0;
+        while u + 8 <= h {
+            for (half, acc) in acc.iter_mut().enumerate() {
+                let u = u + 4 * half;
+                let v = h - 4 - u; // b and w run backwards: lanes v + 3 … v
+                let t0 = limb!(0, a.l0, b.l0, c.l0, u, v);
+                let t1 = limb!(1, a.l1, b.l1, c.l1, u, v);
+                let t2 = limb!(2, a.l2, b.l2, c.l2, u, v);
+                let t1 = _mm256_add_epi64(t1, shift!(t0));
+                let t0 = _mm256_and_si256(t0, mask);
+                let t2 = _mm256_add_epi64(t2, shift!(t1));
+                let t1 = _mm256_and_si256(t1, mask);
+                // Negative (sign bit) or above the exact conversion's range.
+                outside = _mm256_or_si256(
+                    outside,
+                    _mm256_or_si256(t2, _mm256_cmpgt_epi64(t2, top_limit)),
+                );
+                let value = _mm256_add_pd(
+                    _mm256_mul_pd(to_f64!(t2, round), two),
+                    _mm256_add_pd(_mm256_mul_pd(to_f64!(t1, one), one), to_f64!(t0, one)),
+                );
+                let wv = _mm256_permute4x64_pd::<REVERSE>(_mm256_loadu_pd(w.as_ptr().add(v)));
+                *acc = _mm256_add_pd(*acc, _mm256_mul_pd(value, wv));
+            }
+            u += 8;
+        }
+        if _mm256_movemask_pd(_mm256_castsi256_pd(outside)) != 0 {
+            return weighted_terms_scalar(f, a, b, c, w);
+        }
+        let mut lanes = [0.0f64; LANES];
+        _mm256_storeu_pd(lanes.as_mut_ptr(), acc[0]);
+        _mm256_storeu_pd(lanes.as_mut_ptr().add(4), acc[1]);
+        weighted_tail(f, a, b, c, w, u, lanes)
+    }
+
     #[target_feature(enable = "avx512f,avx512dq")]
     pub unsafe fn weighted_terms(
         f: [i64; 3],
@@ -883,6 +982,70 @@ mod tests {
             let want: i128 = a.iter().zip(&b).map(|(&x, &y)| x as i128 * y as i128).sum();
             assert_eq!(dot(&a, &b), want, "n {n}");
             assert_eq!(dot_scalar(&a, &b[..n], 0), want, "n {n}");
+        }
+    }
+
+    /// The same integers in redundant limbs: l₀ − k·2⁵², l₁ + k.
+    fn redundant(mut l: Limbs, seed: u64) -> Limbs {
+        let k = pseudo(l.len(), seed, 8);
+        for i in 0..l.len() {
+            let k = k[i] - 128;
+            l.l0[i] -= k << LIMB_BITS;
+            l.l1[i] += k;
+        }
+        l
+    }
+
+    /// Every level rounds as the scalar kernel does, to the bit, on redundant
+    /// limbs, at lengths with and without whole groups of eight; a negative term
+    /// gives NaN, and terms beyond the vector conversion's range (l₂ ≥ 2⁵¹)
+    /// still the scalar kernel's bits.
+    #[test]
+    fn weighted_terms_agree_at_every_level() {
+        for h in [0, 1, 3, 4, 7, 8, 9, 15, 16, 17, 29, 64, 67] {
+            let big = |s| -> Vec<i128> {
+                pseudo(h, s, 62)
+                    .iter()
+                    .map(|&v| ((v as i128) << 55) - (1 << 115))
+                    .collect()
+            };
+            let (a, b) = (big(1), big(2));
+            // Terms up to 2¹¹², so that all three carried limbs vary.
+            let small = pseudo(h, 3, 62);
+            let f: i128 = 1 << 116;
+            let c: Vec<i128> = (0..h)
+                .map(|u| (f + a[u] + b[h - 1 - u] - ((small[u] as i128) << 50)) >> 1)
+                .collect();
+            let w: Vec<f64> = (1..=h).map(|k| 1.0 / k as f64).collect();
+            let limbs = |v: &[i128], s| redundant(Limbs::from_values(v.iter().copied()), s);
+            let (la, lb, lc) = (limbs(&a, 4), limbs(&b, 5), limbs(&c, 6));
+            let (sa, sb, sc) = (la.slice(0..h), lb.slice(0..h), lc.slice(0..h));
+            let mut c_neg = c.clone();
+            if h > 5 {
+                c_neg[5] += 1 << 113;
+            }
+            let lc_neg = limbs(&c_neg, 7);
+            let huge = {
+                let [f0, f1, f2] = split(f);
+                [f0, f1, f2 + (1 << 52)]
+            };
+            let cases = [(split(f), sc), (huge, sc), (split(f), lc_neg.slice(0..h))];
+            let want: Vec<f64> = cases
+                .iter()
+                .map(|&(f, c)| weighted_terms_scalar(f, sa, sb, c, &w))
+                .collect();
+            assert_eq!(want[2].is_nan(), h > 5);
+            simd::at_every_level(|level| {
+                for (k, &(f, c)) in cases.iter().enumerate() {
+                    let got = weighted_terms(f, sa, sb, c, &w);
+                    assert!(
+                        got.to_bits() == want[k].to_bits() || got.is_nan() && want[k].is_nan(),
+                        "{} h {h} case {k}: {got} vs {}",
+                        level.name(),
+                        want[k]
+                    );
+                }
+            });
         }
     }
 
