@@ -21,7 +21,8 @@
 //! or l₁ alone.
 //!
 //! Every kernel gives the same result on every [`Level`]: the integer kernels are
-//! exact, and [`weighted_terms`] rounds in the same order on both paths.
+//! exact, and [`weighted_terms`] rounds in the same order on every path (scalar,
+//! AVX2, AVX-512).
 
 use crate::simd::{self, Level};
 
