@@ -1,15 +1,28 @@
 //! Exact integer sums held as three signed 52-bit limbs, v = l₀ + l₁·2⁵² + l₂·2¹⁰⁴,
 //! each limb in its own `i64` array, so that the products of non-negative
-//! integers below 2⁵² (each split into its low and high 52 bits, as AVX-512 IFMA
-//! splits it) are added eight lanes at a time where the CPU has IFMA, and with
-//! the same integers, one lane at a time, elsewhere.
+//! integers below 2⁵² are added to l₀ and l₁ as two parts of at most 52 bits:
+//!
+//! - with AVX-512 IFMA ([`Level::Ifma`]), eight lanes at a time, as the low and
+//!   high 52 bits of the product (p mod 2⁵², ⌊p/2⁵²⌋), and one lane at a time,
+//!   the same two integers by a 128-bit product, in the portable kernels;
+//! - with AVX2 and FMA ([`Level::Avx2`], [`Level::Avx512`]), four lanes at a
+//!   time in double precision, exactly: the factors (below 2⁵³) are exact
+//!   doubles; `fma(a, b, 2¹⁰⁴)` rounds 2¹⁰⁴ + p once to a multiple of 2⁵², so
+//!   its mantissa field is H = p/2⁵² rounded to nearest; and p − H·2⁵², an
+//!   integer in [−2⁵¹, 2⁵¹], is exact in a second FMA. H goes to l₁ and the
+//!   signed remainder to l₀ (see `x86::two_product`).
 //!
 //! Limbs are redundant between normalisations: a lane may hold more than 52 bits
-//! in l₀ and l₁ (each product adds below 2⁵² to both), which is exact as long as
-//! no limb leaves ±2⁶³; [`Limbs::normalise`] carries them back below 2⁵².
+//! in l₀ and l₁, and l₀ may be negative (each product adds less than 2⁵² in
+//! magnitude to both), which is exact as long as no limb leaves ±2⁶³;
+//! [`Limbs::normalise`] carries them back to [0, 2⁵²). The two schemes give the
+//! same integer in different redundant limbs, so readers join the limbs exactly
+//! ([`Limbs::get`], [`Limbs::normalise`], [`weighted_terms`]) and never read l₀
+//! or l₁ alone.
 //!
-//! Every kernel gives the same bits on every [`Level`]: the integer kernels are
-//! exact, and [`weighted_terms`] rounds in the same order on both paths.
+//! Every kernel gives the same result on every [`Level`]: the integer kernels are
+//! exact, and [`weighted_terms`] rounds in the same order on every path (scalar,
+//! AVX2, AVX-512).
 
 use crate::simd::{self, Level};
 
@@ -125,6 +138,12 @@ pub fn add_scaled_rows<const R: usize>(lo: &mut [i64], hi: &mut [i64], rows: [(i
         unsafe { x86::scaled_rows(lo, hi, rows) };
         return;
     }
+    #[cfg(target_arch = "x86_64")]
+    if avx2() {
+        // SAFETY: as above.
+        unsafe { x86::scaled_rows_avx2(lo, hi, rows) };
+        return;
+    }
     scaled_rows_scalar(lo, hi, rows, 0);
 }
 
@@ -140,6 +159,12 @@ pub fn add_pair_products<const R: usize>(
         unsafe { x86::pair_products(lo, hi, pairs) };
         return;
     }
+    #[cfg(target_arch = "x86_64")]
+    if avx2() {
+        // SAFETY: as above.
+        unsafe { x86::pair_products_avx2(lo, hi, pairs) };
+        return;
+    }
     pair_products_scalar(lo, hi, pairs, 0);
 }
 
@@ -151,6 +176,11 @@ pub fn dot(a: &[i64], b: &[i64]) -> i128 {
     if ifma() {
         // SAFETY: the CPU has the features; the slices have equal lengths.
         return unsafe { x86::dot(a, b) };
+    }
+    #[cfg(target_arch = "x86_64")]
+    if avx2() {
+        // SAFETY: as above.
+        return unsafe { x86::dot_avx2(a, b) };
     }
     dot_scalar(a, b, 0)
 }
@@ -203,6 +233,11 @@ pub fn weighted_terms(f: [i64; 3], a: LimbSlice, b: LimbSlice, c: LimbSlice, w: 
     if avx512() {
         // SAFETY: the CPU has the features; lengths are asserted inside.
         return unsafe { x86::weighted_terms(f, a, b, c, w) };
+    }
+    #[cfg(target_arch = "x86_64")]
+    if avx2() {
+        // SAFETY: as above.
+        return unsafe { x86::weighted_terms_avx2(f, a, b, c, w) };
     }
     weighted_terms_scalar(f, a, b, c, w)
 }
@@ -288,6 +323,11 @@ fn weighted_tail(
 #[cfg(target_arch = "x86_64")]
 fn ifma() -> bool {
     simd::level() >= Level::Ifma
+}
+
+#[cfg(target_arch = "x86_64")]
+fn avx2() -> bool {
+    simd::level() >= Level::Avx2
 }
 
 #[cfg(target_arch = "x86_64")]
@@ -385,6 +425,245 @@ mod x86 {
             }
         }
         total + dot_scalar(a, b, i)
+    }
+
+    /// 2¹⁰⁴: in its binade [2¹⁰⁴, 2¹⁰⁵) the ulp is 2⁵², and a double's bits are
+    /// bits(2¹⁰⁴) + v/2⁵².
+    const TOP: f64 = LIMB_2;
+    /// 1.5·2⁵²: for an integer v in [−2⁵¹, 2⁵¹], v + ROUND lies in [2⁵², 2⁵³]
+    /// (ulp 1, so exact) and its bits are bits(ROUND) + v (2⁵³ included).
+    const ROUND: f64 = 1.5 * LIMB_1;
+
+    /// An integer in [0, 2⁵²) as a double, exactly: it is the mantissa of 2⁵² + x.
+    #[inline]
+    #[target_feature(enable = "avx2,fma")]
+    unsafe fn to_double(x: __m256i) -> __m256d {
+        let one = _mm256_set1_pd(LIMB_1);
+        let biased = _mm256_or_si256(x, _mm256_castpd_si256(one));
+        _mm256_sub_pd(_mm256_castsi256_pd(biased), one)
+    }
+
+    /// The exact product p = a·b of integers a, b in [0, 2⁵²) as two integers
+    /// of at most 52 bits, p = H·2⁵² + L, given doubles x, y and an addend k
+    /// with x·y + k = 2¹⁰⁴ + p exactly and k − 2¹⁰⁴ a multiple of 2⁵² below 2¹⁰⁵
+    /// in magnitude (x = a, y = b, k = 2¹⁰⁴; or x = 2⁵² + a, y = b,
+    /// k = 2¹⁰⁴ − b·2⁵²). Returned as bit patterns: bits(2¹⁰⁴) + H and
+    /// bits(1.5·2⁵²) + L, to be added as integers and the biases taken out once.
+    ///
+    /// Exactness (round to nearest, the default mode): 2¹⁰⁴ + p lies in
+    /// [2¹⁰⁴, 2¹⁰⁵) (p ≤ (2⁵² − 1)² rounds below 2¹⁰⁴ − 2⁵²), so the first FMA
+    /// rounds it once to 2¹⁰⁴ + H·2⁵² with H = p/2⁵² to nearest, in [0, 2⁵²),
+    /// the mantissa field. k − big = (k − 2¹⁰⁴) − H·2⁵² is a multiple of 2⁵² below
+    /// 2¹⁰⁵ (53 significant bits at most), so exact; the second FMA's exact value
+    /// x·y + k − big = p − H·2⁵² = L is an integer in [−2⁵¹, 2⁵¹], so exact; and
+    /// L + 1.5·2⁵² is exact in [2⁵², 2⁵³].
+    #[inline]
+    #[target_feature(enable = "avx2,fma")]
+    unsafe fn two_product(x: __m256d, y: __m256d, k: __m256d) -> (__m256i, __m256i) {
+        let big = _mm256_fmadd_pd(x, y, k);
+        let low = _mm256_fmadd_pd(x, y, _mm256_sub_pd(k, big));
+        let low = _mm256_add_pd(low, _mm256_set1_pd(ROUND));
+        (_mm256_castpd_si256(big), _mm256_castpd_si256(low))
+    }
+
+    /// The biases of `count` results of [`two_product`] added together (as
+    /// wrapping integers: the unbiased sums fit in an i64).
+    #[inline]
+    #[target_feature(enable = "avx2,fma")]
+    unsafe fn biases(count: i64) -> (__m256i, __m256i) {
+        let bias = |v: f64| _mm256_set1_epi64x(count.wrapping_mul(v.to_bits() as i64));
+        (bias(ROUND), bias(TOP))
+    }
+
+    #[target_feature(enable = "avx2,fma")]
+    pub unsafe fn scaled_rows_avx2<const R: usize>(
+        lo: &mut [i64],
+        hi: &mut [i64],
+        rows: [(i64, &[i64]); R],
+    ) {
+        let n = lo.len();
+        assert!(hi.len() == n && rows.iter().all(|(_, x)| x.len() >= n));
+        // x enters as 2⁵² + x (its bits under 2⁵²'s exponent, one OR), and the
+        // addend 2¹⁰⁴ − s·2⁵² = (2⁵² − s)·2⁵² (exact) takes the extra s·2⁵² out.
+        let scale: [__m256d; R] = std::array::from_fn(|r| _mm256_set1_pd(rows[r].0 as f64));
+        let addend: [__m256d; R] = std::array::from_fn(|r| {
+            _mm256_set1_pd(((1i64 << LIMB_BITS) - rows[r].0) as f64 * LIMB_1)
+        });
+        let exponent = _mm256_castpd_si256(_mm256_set1_pd(LIMB_1));
+        let (bias_lo, bias_hi) = biases(R as i64);
+        let mut i = 0;
+        while i + 4 <= n {
+            let mut l = _mm256_loadu_si256(lo.as_ptr().add(i).cast());
+            let mut h = _mm256_loadu_si256(hi.as_ptr().add(i).cast());
+            for r in 0..R {
+                let x = _mm256_loadu_si256(rows[r].1.as_ptr().add(i).cast());
+                let x = _mm256_castsi256_pd(_mm256_or_si256(x, exponent));
+                let (high, low) = two_product(x, scale[r], addend[r]);
+                l = _mm256_add_epi64(l, low);
+                h = _mm256_add_epi64(h, high);
+            }
+            let l = _mm256_sub_epi64(l, bias_lo);
+            let h = _mm256_sub_epi64(h, bias_hi);
+            _mm256_storeu_si256(lo.as_mut_ptr().add(i).cast(), l);
+            _mm256_storeu_si256(hi.as_mut_ptr().add(i).cast(), h);
+            i += 4;
+        }
+        scaled_rows_scalar(lo, hi, rows, i);
+    }
+
+    #[target_feature(enable = "avx2,fma")]
+    pub unsafe fn pair_products_avx2<const R: usize>(
+        lo: &mut [i64],
+        hi: &mut [i64],
+        pairs: [(&[i64], &[i64]); R],
+    ) {
+        let n = lo.len();
+        assert!(hi.len() == n && pairs.iter().all(|(a, b)| a.len() >= n && b.len() >= n));
+        let top = _mm256_set1_pd(TOP);
+        let (bias_lo, bias_hi) = biases(R as i64);
+        let mut i = 0;
+        while i + 4 <= n {
+            let mut l = _mm256_loadu_si256(lo.as_ptr().add(i).cast());
+            let mut h = _mm256_loadu_si256(hi.as_ptr().add(i).cast());
+            for (a, b) in pairs {
+                let x = to_double(_mm256_loadu_si256(a.as_ptr().add(i).cast()));
+                let y = to_double(_mm256_loadu_si256(b.as_ptr().add(i).cast()));
+                let (high, low) = two_product(x, y, top);
+                l = _mm256_add_epi64(l, low);
+                h = _mm256_add_epi64(h, high);
+            }
+            let l = _mm256_sub_epi64(l, bias_lo);
+            let h = _mm256_sub_epi64(h, bias_hi);
+            _mm256_storeu_si256(lo.as_mut_ptr().add(i).cast(), l);
+            _mm256_storeu_si256(hi.as_mut_ptr().add(i).cast(), h);
+            i += 4;
+        }
+        pair_products_scalar(lo, hi, pairs, i);
+    }
+
+    /// Four lanes of the two parts, folded into an i128 every 1024 steps (each
+    /// adds less than 2⁵² in magnitude to a lane).
+    #[target_feature(enable = "avx2,fma")]
+    pub unsafe fn dot_avx2(a: &[i64], b: &[i64]) -> i128 {
+        let n = a.len();
+        assert!(b.len() == n);
+        let top = _mm256_set1_pd(TOP);
+        let mut total: i128 = 0;
+        let mut i = 0;
+        while i + 4 <= n {
+            let stop = (i + 4 * 1024).min(n - n % 4);
+            let (bias_lo, bias_hi) = biases(((stop - i) / 4) as i64);
+            let (mut l, mut h) = (_mm256_setzero_si256(), _mm256_setzero_si256());
+            while i < stop {
+                let x = to_double(_mm256_loadu_si256(a.as_ptr().add(i).cast()));
+                let y = to_double(_mm256_loadu_si256(b.as_ptr().add(i).cast()));
+                let (high, low) = two_product(x, y, top);
+                l = _mm256_add_epi64(l, low);
+                h = _mm256_add_epi64(h, high);
+                i += 4;
+            }
+            let (mut lo, mut hi) = ([0i64; 4], [0i64; 4]);
+            _mm256_storeu_si256(lo.as_mut_ptr().cast(), _mm256_sub_epi64(l, bias_lo));
+            _mm256_storeu_si256(hi.as_mut_ptr().cast(), _mm256_sub_epi64(h, bias_hi));
+            for k in 0..4 {
+                total += lo[k] as i128 + ((hi[k] as i128) << LIMB_BITS);
+            }
+        }
+        total + dot_scalar(a, b, i)
+    }
+
+    /// The scalar kernel's operations, four terms at a time, its eight
+    /// accumulators in two vectors. AVX2 has no 64-bit arithmetic shift nor
+    /// conversion to double: the shift is a logical one between two flips of
+    /// the sign, the carried l₀, l₁ (in [0, 2⁵²)) convert as mantissas, and l₂
+    /// as the mantissa of 1.5·2⁵² + l₂, exact for l₂ in [0, 2⁵¹); outside that
+    /// (a negative term, or one beyond 2¹⁵⁵, which the sweep never makes) the
+    /// scalar kernel gives the result.
+    #[target_feature(enable = "avx2,fma")]
+    pub unsafe fn weighted_terms_avx2(
+        f: [i64; 3],
+        a: LimbSlice,
+        b: LimbSlice,
+        c: LimbSlice,
+        w: &[f64],
+    ) -> f64 {
+        let h = a.l0.len();
+        for s in [a, b, c] {
+            assert!(s.l0.len() == h && s.l1.len() == h && s.l2.len() == h);
+        }
+        assert!(w.len() == h);
+        const REVERSE: i32 = 0b00_01_10_11;
+        let mask = _mm256_set1_epi64x(MASK);
+        let fv = f.map(|v| _mm256_set1_epi64x(v));
+        let (one, two) = (_mm256_set1_pd(LIMB_1), _mm256_set1_pd(LIMB_2));
+        let round = _mm256_set1_pd(ROUND);
+        let top_limit = _mm256_set1_epi64x((1 << 51) - 1);
+        let zero = _mm256_setzero_si256();
+        let mut acc = [_mm256_setzero_pd(); 2];
+        let mut outside = _mm256_setzero_si256();
+        // x >> 52, arithmetic (macros, not closures: the intrinsics inline into
+        // this function's features).
+        macro_rules! shift {
+            ($x:expr) => {{
+                let x = $x;
+                let sign = _mm256_cmpgt_epi64(zero, x);
+                _mm256_xor_si256(_mm256_srli_epi64::<52>(_mm256_xor_si256(x, sign)), sign)
+            }};
+        }
+        // An integer t in [0, 2⁵²) under base's exponent, as a double.
+        macro_rules! to_f64 {
+            ($t:expr, $base:expr) => {{
+                let biased = _mm256_add_epi64($t, _mm256_castpd_si256($base));
+                _mm256_sub_pd(_mm256_castsi256_pd(biased), $base)
+            }};
+        }
+        // One limb of four terms u..u + 4: f + a[u..] + b[v + 3 − j] − 2·c[u..].
+        macro_rules! limb {
+            ($k:expr, $sa:expr, $sb:expr, $sc:expr, $u:expr, $v:expr) => {{
+                let bv = _mm256_permute4x64_epi64::<REVERSE>(_mm256_loadu_si256(
+                    $sb.as_ptr().add($v).cast(),
+                ));
+                let av = _mm256_loadu_si256($sa.as_ptr().add($u).cast());
+                let cv = _mm256_loadu_si256($sc.as_ptr().add($u).cast());
+                _mm256_sub_epi64(
+                    _mm256_add_epi64(_mm256_add_epi64(fv[$k], av), bv),
+                    _mm256_add_epi64(cv, cv),
+                )
+            }};
+        }
+        let mut u = 0;
+        while u + 8 <= h {
+            for (half, acc) in acc.iter_mut().enumerate() {
+                let u = u + 4 * half;
+                let v = h - 4 - u; // b and w run backwards: lanes v + 3 … v
+                let t0 = limb!(0, a.l0, b.l0, c.l0, u, v);
+                let t1 = limb!(1, a.l1, b.l1, c.l1, u, v);
+                let t2 = limb!(2, a.l2, b.l2, c.l2, u, v);
+                let t1 = _mm256_add_epi64(t1, shift!(t0));
+                let t0 = _mm256_and_si256(t0, mask);
+                let t2 = _mm256_add_epi64(t2, shift!(t1));
+                let t1 = _mm256_and_si256(t1, mask);
+                // Negative (sign bit) or above the exact conversion's range.
+                outside = _mm256_or_si256(
+                    outside,
+                    _mm256_or_si256(t2, _mm256_cmpgt_epi64(t2, top_limit)),
+                );
+                let value = _mm256_add_pd(
+                    _mm256_mul_pd(to_f64!(t2, round), two),
+                    _mm256_add_pd(_mm256_mul_pd(to_f64!(t1, one), one), to_f64!(t0, one)),
+                );
+                let wv = _mm256_permute4x64_pd::<REVERSE>(_mm256_loadu_pd(w.as_ptr().add(v)));
+                *acc = _mm256_add_pd(*acc, _mm256_mul_pd(value, wv));
+            }
+            u += 8;
+        }
+        if _mm256_movemask_pd(_mm256_castsi256_pd(outside)) != 0 {
+            return weighted_terms_scalar(f, a, b, c, w);
+        }
+        let mut lanes = [0.0f64; LANES];
+        _mm256_storeu_pd(lanes.as_mut_ptr(), acc[0]);
+        _mm256_storeu_pd(lanes.as_mut_ptr().add(4), acc[1]);
+        weighted_tail(f, a, b, c, w, u, lanes)
     }
 
     #[target_feature(enable = "avx512f,avx512dq")]
@@ -521,14 +800,180 @@ mod tests {
             [(&x[0][..], &x[1][..])],
             0,
         );
-        assert_eq!((&portable.l0, &portable.l1), (&limbs.l0, &limbs.l1));
+        // Paths may leave different redundant limbs: compare them normalised.
         limbs.normalise();
+        portable.normalise();
+        assert_eq!((&portable.l0, &portable.l1), (&limbs.l0, &limbs.l1));
+        assert_eq!(&portable.l2, &limbs.l2);
         for i in 0..n {
             let want = start[i]
                 + (0..4).map(|r| s[r] as i128 * x[r][i] as i128).sum::<i128>()
                 + x[0][i] as i128 * x[1][i] as i128;
             assert_eq!(limbs.get(i), want, "lane {i}");
         }
+    }
+
+    /// Factors below 2⁵² with the extremes 0 and [`MAX_FACTOR`] at some lanes.
+    fn factors(n: usize, seed: u64) -> Vec<i64> {
+        let mut x = pseudo(n, seed, LIMB_BITS);
+        for (i, v) in x.iter_mut().enumerate() {
+            match (i as u64 + seed) % 7 {
+                0 => *v = MAX_FACTOR,
+                3 => *v = 0,
+                _ => {}
+            }
+        }
+        x
+    }
+
+    /// Lengths covering empty, tail-only, whole vectors (4 and 8 lanes) and tails.
+    const LENGTHS: [usize; 14] = [0, 1, 3, 4, 5, 7, 8, 9, 11, 12, 15, 16, 17, 37];
+
+    /// Start values of both signs, normalised.
+    fn start(n: usize, seed: u64) -> Vec<i128> {
+        pseudo(n, seed, 62)
+            .iter()
+            .map(|&v| ((v as i128) << 48) - (1 << 109))
+            .collect()
+    }
+
+    /// Checks the limbs against the exact sums, joined as they are and then
+    /// normalised.
+    fn check(mut limbs: Limbs, want: &[i128], what: &str) {
+        for (i, &w) in want.iter().enumerate() {
+            assert_eq!(limbs.get(i), w, "{what}: lane {i} (redundant)");
+            for l in [limbs.l0[i], limbs.l1[i]] {
+                assert!(l.abs() < 1 << 60, "{what}: lane {i} limb {l}");
+            }
+        }
+        limbs.normalise();
+        let normal = Limbs::from_values(want.iter().copied());
+        assert_eq!(limbs.l0, normal.l0, "{what}");
+        assert_eq!(limbs.l1, normal.l1, "{what}");
+        assert_eq!(limbs.l2, normal.l2, "{what}");
+    }
+
+    /// 16 calls of eight products (the sweep's cadence between normalisations),
+    /// at every level, give the exact sums, all-extreme factors included.
+    #[test]
+    fn scaled_rows_are_exact_at_every_level() {
+        simd::at_every_level(|level| {
+            for n in LENGTHS {
+                for all_max in [false, true] {
+                    let x: Vec<Vec<i64>> = (0..8)
+                        .map(|r| match all_max {
+                            true => vec![MAX_FACTOR; n + r],
+                            false => factors(n + r, 10 + r as u64),
+                        })
+                        .collect();
+                    let s0 = [
+                        MAX_FACTOR,
+                        0,
+                        1,
+                        12345,
+                        (1 << 51) - 3,
+                        MAX_FACTOR - 1,
+                        7,
+                        1 << 51,
+                    ];
+                    let mut want = start(n, 1);
+                    let mut limbs = Limbs::from_values(want.iter().copied());
+                    for call in 0..16u64 {
+                        let s: [i64; 8] = std::array::from_fn(|r| match (all_max, call) {
+                            (true, _) => MAX_FACTOR,
+                            (false, 0) => s0[r],
+                            _ => pseudo(1, 100 * call + r as u64, LIMB_BITS)[0],
+                        });
+                        let rows: [(i64, &[i64]); 8] = std::array::from_fn(|r| (s[r], &x[r][r..]));
+                        add_scaled_rows(&mut limbs.l0, &mut limbs.l1, rows);
+                        for (i, w) in want.iter_mut().enumerate() {
+                            *w += (0..8)
+                                .map(|r| s[r] as i128 * x[r][r + i] as i128)
+                                .sum::<i128>();
+                        }
+                    }
+                    // Two rows (the sweep's single row) on top.
+                    add_scaled_rows(
+                        &mut limbs.l0,
+                        &mut limbs.l1,
+                        [(s0[0], &x[0][..]), (s0[4], &x[1][..])],
+                    );
+                    for (i, w) in want.iter_mut().enumerate() {
+                        *w += s0[0] as i128 * x[0][i] as i128 + s0[4] as i128 * x[1][i] as i128;
+                    }
+                    check(
+                        limbs,
+                        &want,
+                        &format!("{} n {n} all_max {all_max}", level.name()),
+                    );
+                }
+            }
+        });
+    }
+
+    #[test]
+    fn pair_products_are_exact_at_every_level() {
+        simd::at_every_level(|level| {
+            for n in LENGTHS {
+                for all_max in [false, true] {
+                    let x: Vec<Vec<i64>> = (0..8)
+                        .map(|r| match all_max {
+                            true => vec![MAX_FACTOR; n + 1],
+                            false => factors(n + 1, 20 + r as u64),
+                        })
+                        .collect();
+                    let mut want = start(n, 2);
+                    let mut limbs = Limbs::from_values(want.iter().copied());
+                    for call in 0..16 {
+                        let shift = call % 2;
+                        let pairs: [(&[i64], &[i64]); 4] =
+                            std::array::from_fn(|r| (&x[2 * r][shift..], &x[2 * r + 1][..]));
+                        add_pair_products(&mut limbs.l0, &mut limbs.l1, pairs);
+                        for (i, w) in want.iter_mut().enumerate() {
+                            *w += pairs
+                                .iter()
+                                .map(|(a, b)| a[i] as i128 * b[i] as i128)
+                                .sum::<i128>();
+                        }
+                    }
+                    add_pair_products(
+                        &mut limbs.l0,
+                        &mut limbs.l1,
+                        [(&x[0][..], &x[1][..]), (&x[2][..], &x[3][..])],
+                    );
+                    for (i, w) in want.iter_mut().enumerate() {
+                        *w += x[0][i] as i128 * x[1][i] as i128 + x[2][i] as i128 * x[3][i] as i128;
+                    }
+                    check(
+                        limbs,
+                        &want,
+                        &format!("{} n {n} all_max {all_max}", level.name()),
+                    );
+                }
+            }
+        });
+    }
+
+    #[test]
+    fn dot_is_exact_at_every_level() {
+        simd::at_every_level(|level| {
+            // Tails, and more than one fold of 1024 vectors (4 or 8 lanes).
+            for n in LENGTHS.into_iter().chain([4096, 4099, 8192, 8197, 20_001]) {
+                for all_max in [false, true] {
+                    let (a, b) = match all_max {
+                        true => (vec![MAX_FACTOR; n], vec![MAX_FACTOR; n + 3]),
+                        false => (factors(n, 5), factors(n + 3, 6)),
+                    };
+                    let want: i128 = a.iter().zip(&b).map(|(&x, &y)| x as i128 * y as i128).sum();
+                    assert_eq!(
+                        dot(&a, &b),
+                        want,
+                        "{} n {n} all_max {all_max}",
+                        level.name()
+                    );
+                }
+            }
+        });
     }
 
     #[test]
@@ -538,6 +983,70 @@ mod tests {
             let want: i128 = a.iter().zip(&b).map(|(&x, &y)| x as i128 * y as i128).sum();
             assert_eq!(dot(&a, &b), want, "n {n}");
             assert_eq!(dot_scalar(&a, &b[..n], 0), want, "n {n}");
+        }
+    }
+
+    /// The same integers in redundant limbs: l₀ − k·2⁵², l₁ + k.
+    fn redundant(mut l: Limbs, seed: u64) -> Limbs {
+        let k = pseudo(l.len(), seed, 8);
+        for i in 0..l.len() {
+            let k = k[i] - 128;
+            l.l0[i] -= k << LIMB_BITS;
+            l.l1[i] += k;
+        }
+        l
+    }
+
+    /// Every level rounds as the scalar kernel does, to the bit, on redundant
+    /// limbs, at lengths with and without whole groups of eight; a negative term
+    /// gives NaN, and terms beyond the vector conversion's range (l₂ ≥ 2⁵¹)
+    /// still the scalar kernel's bits.
+    #[test]
+    fn weighted_terms_agree_at_every_level() {
+        for h in [0, 1, 3, 4, 7, 8, 9, 15, 16, 17, 29, 64, 67] {
+            let big = |s| -> Vec<i128> {
+                pseudo(h, s, 62)
+                    .iter()
+                    .map(|&v| ((v as i128) << 55) - (1 << 115))
+                    .collect()
+            };
+            let (a, b) = (big(1), big(2));
+            // Terms up to 2¹¹², so that all three carried limbs vary.
+            let small = pseudo(h, 3, 62);
+            let f: i128 = 1 << 116;
+            let c: Vec<i128> = (0..h)
+                .map(|u| (f + a[u] + b[h - 1 - u] - ((small[u] as i128) << 50)) >> 1)
+                .collect();
+            let w: Vec<f64> = (1..=h).map(|k| 1.0 / k as f64).collect();
+            let limbs = |v: &[i128], s| redundant(Limbs::from_values(v.iter().copied()), s);
+            let (la, lb, lc) = (limbs(&a, 4), limbs(&b, 5), limbs(&c, 6));
+            let (sa, sb, sc) = (la.slice(0..h), lb.slice(0..h), lc.slice(0..h));
+            let mut c_neg = c.clone();
+            if h > 5 {
+                c_neg[5] += 1 << 113;
+            }
+            let lc_neg = limbs(&c_neg, 7);
+            let huge = {
+                let [f0, f1, f2] = split(f);
+                [f0, f1, f2 + (1 << 52)]
+            };
+            let cases = [(split(f), sc), (huge, sc), (split(f), lc_neg.slice(0..h))];
+            let want: Vec<f64> = cases
+                .iter()
+                .map(|&(f, c)| weighted_terms_scalar(f, sa, sb, c, &w))
+                .collect();
+            assert_eq!(want[2].is_nan(), h > 5);
+            simd::at_every_level(|level| {
+                for (k, &(f, c)) in cases.iter().enumerate() {
+                    let got = weighted_terms(f, sa, sb, c, &w);
+                    assert!(
+                        got.to_bits() == want[k].to_bits() || got.is_nan() && want[k].is_nan(),
+                        "{} h {h} case {k}: {got} vs {}",
+                        level.name(),
+                        want[k]
+                    );
+                }
+            });
         }
     }
 

@@ -20,7 +20,8 @@
 //! each requested m O(m) more: O(N log N + M²) instead of O(N·M) per factor.
 //! Every quantity is an exact integer, so the sum of T_k over i is exact
 //! before it is weighted by 1/k in double precision. The sums live in 52-bit
-//! limbs (`limbs`), whose products AVX-512 IFMA adds eight at a time.
+//! limbs (`limbs`), whose products AVX-512 IFMA adds eight at a time, and AVX2
+//! with FMA four at a time (exactly, in double precision).
 
 use super::exact_phase::ExactPhase;
 use super::limbs::{self, LimbSlice, Limbs};
@@ -93,8 +94,10 @@ fn weighted_terms(f: [i64; 3], a: LimbSlice, b: LimbSlice, c: LimbSlice, w: &[f6
 }
 
 /// Four-row steps between normalisations of the limbs: each step adds at most
-/// eight products (< 2⁵² per limb) to a lane, so limbs stay below 2⁶⁰ and a
-/// term (four of them) below 2⁶³.
+/// eight products to a lane, each less than 2⁵² in magnitude to l₀ and to l₁ on
+/// every path (IFMA's and the portable high and low halves, non-negative; the
+/// AVX2 path's rounded high part, and its remainder in [−2⁵¹, 2⁵¹]), so limbs
+/// stay below 2⁶⁰ in magnitude and a term (four of them) below 2⁶³.
 const STEPS_PER_NORMALISATION: usize = 16;
 
 /// The pair sums of both directions of the phase, folded with the terms that
@@ -316,6 +319,28 @@ mod tests {
                 );
             }
         }
+    }
+
+    /// Every level's kernels give the same sums, to the bit (the limbs are
+    /// exact integers, whatever redundant form each path leaves them in).
+    #[test]
+    fn every_level_gives_the_same_bits() {
+        let never = Interrupt::new();
+        let c = integrated_noise(1200, 7, 2);
+        let p = ExactPhase::new(&c, 1199).unwrap();
+        let ms: Vec<usize> = (2..40).step_by(2).chain((44..1200).step_by(4)).collect();
+        let mut first: Option<Vec<u64>> = None;
+        crate::simd::at_every_level(|level| {
+            let bits: Vec<u64> = theo1_sums(&p, &ms, &never)
+                .unwrap()
+                .iter()
+                .map(|s| s.to_bits())
+                .collect();
+            match &first {
+                None => first = Some(bits),
+                Some(want) => assert!(&bits == want, "{} differs", level.name()),
+            }
+        });
     }
 
     #[test]
