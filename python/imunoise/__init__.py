@@ -11,6 +11,7 @@ from imunoise._events import Events, events
 from imunoise._simulate import simulate
 from imunoise._simulate_log import simulate_log
 from imunoise._thermal import Thermal, thermal
+from imunoise._timefreq import mtie, pdev, tierms
 from imunoise._warmup import Warmup, warmup
 from imunoise.allan import (
     AllanResult,
@@ -19,6 +20,7 @@ from imunoise.allan import (
     htotdev,
     mdev,
     mtotdev,
+    ohdev,
     tdev,
     theo1,
     theobr,
@@ -66,7 +68,10 @@ __all__ = [
     "hdev",
     "htotdev",
     "mdev",
+    "mtie",
     "mtotdev",
+    "ohdev",
+    "pdev",
     "plot",
     "plan",
     "psd",
@@ -81,6 +86,7 @@ __all__ = [
     "theobr",
     "thermal",
     "theoh",
+    "tierms",
     "totdev",
     "ttotdev",
     "units",
