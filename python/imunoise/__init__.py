@@ -8,6 +8,7 @@ plots and reports. Start with ``imunoise.adev(x, fs)``.
 from imunoise import _cpu, export, units
 from imunoise._core import __version__
 from imunoise._events import Events, events
+from imunoise._hat import ThreeCorneredHat, gcodev, three_cornered_hat
 from imunoise._simulate import simulate
 from imunoise._simulate_log import simulate_log
 from imunoise._thermal import Thermal, thermal
@@ -56,6 +57,7 @@ __all__ = [
     "ParseError",
     "ParseIssues",
     "Spectrum",
+    "ThreeCorneredHat",
     "adev",
     "batch",
     "compare",
@@ -65,6 +67,7 @@ __all__ = [
     "events",
     "export",
     "fit",
+    "gcodev",
     "hdev",
     "htotdev",
     "mdev",
@@ -85,6 +88,7 @@ __all__ = [
     "theo1",
     "theobr",
     "thermal",
+    "three_cornered_hat",
     "theoh",
     "tierms",
     "totdev",
