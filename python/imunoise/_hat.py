@@ -200,13 +200,28 @@ class ThreeCorneredHat:
     def __len__(self) -> int:
         return 3
 
-    def __repr__(self) -> str:
+    def _facts(self) -> list[str]:
         counts = [int(np.count_nonzero(v)) for v in self.negative]
-        facts = [f"{self.a.kind}", _summary.tau_span(self.a.taus),
-                 f"fs {_summary.number(self.a.fs)} Hz",
-                 "negative at " + ", ".join(f"{s} {k}" for s, k in zip(_SENSORS, counts,
-                                                                         strict=True))]
-        return _summary.lines("ThreeCorneredHat(", facts, sep=", ")
+        return [f"{self.a.kind}", _summary.tau_span(self.a.taus),
+                f"fs {_summary.number(self.a.fs)} Hz",
+                "negative at " + ", ".join(f"{s} {k}" for s, k in zip(_SENSORS, counts,
+                                                                        strict=True))]
+
+    def __repr__(self) -> str:
+        return _summary.lines("ThreeCorneredHat(", self._facts(), sep=", ")
+
+    def _repr_html_(self) -> str:
+        """Per sensor (and channel) its own deviation at the first and last tau and
+        its minimum, and the taus where its variance is negative."""
+        names = [f"{s} {c}" if self.a.channels > 1 else s
+                 for s in _SENSORS for c in range(self.a.channels)]
+        dev = np.concatenate([np.reshape(r.dev, (len(r.taus), -1)) for r in self], axis=1)
+        header, rows = _summary.curve_rows(self.a.taus, dev, names)
+        negative = self.negative.reshape(3, len(self.a.taus), -1).sum(axis=1).ravel()
+        return _summary.html_table(
+            [*header, "negative taus"],
+            [[*row, int(k)] for row, k in zip(rows, negative, strict=True)],
+            caption="ThreeCorneredHat: " + ", ".join(self._facts()))
 
 
 def three_cornered_hat(a: npt.ArrayLike, b: npt.ArrayLike, c: npt.ArrayLike, fs: float, *,
