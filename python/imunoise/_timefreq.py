@@ -141,7 +141,13 @@ def _grid(taus, fs: float, n_points: int, kind: str, terms) -> np.ndarray:
     """The averaging factors of ``taus`` at which ``terms(m)`` (the number of
     terms of the statistic) is at least 2."""
     m, user_given = averaging_factors(taus, fs, n_points - 1)
-    return keep_estimable(m, terms(np.maximum(m, 1)), fs, user_given, kind)
+    m = keep_estimable(m, terms(np.maximum(m, 1)), fs, user_given, kind)
+    if m.size == 0:
+        # m = 1 has n_points − c terms: two of them need c + 2 points
+        least = n_points - int(terms(np.array([1]))[0]) + 2
+        raise ValueError(f"x has {n_points} phase points (rate samples + 1), too few for "
+                         f"any tau of {kind} (at least {least}: two terms at tau = 1/fs)")
+    return m
 
 
 def _result(kind, m, var, dev, terms, edf, alpha, identified, *, fs, confidence, one_d,

@@ -717,7 +717,7 @@ def _deviation(
     """A statistic of :data:`KINDS` whose taus are m/fs, as its registry entry says.
     Called from the public function itself (the warnings' stack levels count on it)."""
     _check_bool("overlapping", overlapping)
-    x, phase_missing = rate_samples(x, fs, data_type)
+    x, phase_missing = _rate_samples(x, fs, data_type)
     spec = _REGISTRY[kind]
     statistic = spec.non_overlapping if not overlapping and spec.non_overlapping else spec.statistic
     data, one_d, missing = _gapped_samples(x, gaps, kind, statistic in _SKIPS_GAPS)
@@ -886,7 +886,7 @@ def chi2_interval(
 def _theo_input(x, fs, confidence, gaps, kind: str, data_type: str):
     """The checked rate samples, fs and confidence of a Thêo statistic (no gap
     skipping; a record long enough for ThêoBR)."""
-    x, phase_missing = rate_samples(x, fs, data_type)
+    x, phase_missing = _rate_samples(x, fs, data_type)
     data, one_d, missing = _gapped_samples(x, gaps, kind, False)
     if phase_missing is not None:
         missing = phase_missing
@@ -1021,7 +1021,7 @@ def _gapped_samples(x, gaps, kind: str, skips: bool):
     return data[~bad], one_d, missing
 
 
-def rate_samples(x, fs, data_type: str):
+def _rate_samples(x, fs, data_type: str):
     """``x`` as rate samples, and the missing phase points per channel (None for
     rate input, whose missing samples are counted where they are analysed).
 

@@ -79,6 +79,10 @@ def test_data_type_errors_name_the_argument():
     for f in (imunoise.pdev, imunoise.mtie, imunoise.tierms):
         with pytest.raises(ValueError, match="data_type must be one of"):
             f(np.ones(10), 1.0, data_type="Phase")
+    with pytest.raises(ValueError, match=r"x has 2 phase points .* \(at least 3: "):
+        imunoise.mtie(np.ones(2), 1.0, data_type="phase")
+    with pytest.raises(ValueError, match=r"x has 3 phase points, too few for pdev \(at least 4"):
+        imunoise.pdev(np.ones(2), 1.0)
 
 
 @pytest.mark.parametrize("name", sorted(PHASE_STATS))
