@@ -146,3 +146,15 @@ def test_mtie_grows_with_tau_and_bounds_tie():
     r, t = imunoise.mtie(y, 1.0, taus="all"), imunoise.tierms(y, 1.0, taus="all")
     assert np.all(np.diff(r.dev) >= 0)
     assert np.all(r.dev >= t.dev)
+
+
+def test_a_curve_without_interval_plots_on_its_own_scale():
+    pytest.importorskip("matplotlib")
+    import matplotlib
+
+    matplotlib.use("Agg")
+    r = imunoise.mtie(noise("white", 2000, seed=1), 10.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        low, high = r.plot().axes[0].get_ylim()
+    assert low < np.nanmin(r.dev) and np.nanmax(r.dev) < high
