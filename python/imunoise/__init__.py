@@ -8,13 +8,16 @@ plots and reports. Start with ``imunoise.adev(x, fs)``.
 # _interrupt is imported first, before the heavy imports: importing it arms Ctrl-C
 # for the command line's start-up (exit 130 and one line, not a traceback from
 # inside numpy); in any other process it does nothing.
-from imunoise import _cpu, _interrupt, export, units  # noqa: F401
+from imunoise import _interrupt, export, units  # noqa: F401
 from imunoise._core import __version__
+from imunoise._cpu import apply_environment as _apply_simd_environment
 from imunoise._events import Events, events
 from imunoise._fleet import Fleet, fleet
+from imunoise._hat import ThreeCorneredHat, gcodev, three_cornered_hat
 from imunoise._simulate import simulate
 from imunoise._simulate_log import simulate_log
 from imunoise._thermal import Thermal, thermal
+from imunoise._timefreq import mtie, pdev, tierms
 from imunoise._warmup import Warmup, warmup
 from imunoise.allan import (
     AllanResult,
@@ -23,6 +26,7 @@ from imunoise.allan import (
     htotdev,
     mdev,
     mtotdev,
+    ohdev,
     tdev,
     theo1,
     theobr,
@@ -54,7 +58,7 @@ from imunoise.spectrum import Spectrum, psd
 from imunoise.stats import describe, distribution
 from imunoise.writers.vn import write_vn_ascii, write_vn_binary
 
-_cpu.apply_environment()
+_apply_simd_environment()
 
 __all__ = [
     "__version__",
@@ -79,6 +83,7 @@ __all__ = [
     "ParseError",
     "ParseIssues",
     "Spectrum",
+    "ThreeCorneredHat",
     "adev",
     "batch",
     "compare",
@@ -89,10 +94,14 @@ __all__ = [
     "export",
     "fit",
     "fleet",
+    "gcodev",
     "hdev",
     "htotdev",
     "mdev",
+    "mtie",
     "mtotdev",
+    "ohdev",
+    "pdev",
     "plot",
     "plan",
     "psd",
@@ -106,7 +115,9 @@ __all__ = [
     "theo1",
     "theobr",
     "thermal",
+    "three_cornered_hat",
     "theoh",
+    "tierms",
     "totdev",
     "ttotdev",
     "units",

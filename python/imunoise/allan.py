@@ -13,7 +13,8 @@ O(n log² m) at long taus). With :math:`\tau = m/f_s` and N = n + 1:
   (non-overlapping: k in steps of m);
 - modified Allan variance, SP 1065 eq. 14; time variance
   :math:`\sigma_x^2 = \tau^2\,\mathrm{Mod}\,\sigma_y^2/3`;
-- Hadamard variance (third differences, divisor 6), overlapping by default;
+- Hadamard variance (third differences, divisor 6), overlapping by default
+  (``ohdev``: the overlapping one under allantools' name);
 - total variance, SP 1065 eq. 25 (phase reflected about both ends);
 - the total family beyond it (MTOT, TTOT, HTOT, Theo1, ThêoBR, ThêoH), see each
   function.
@@ -37,6 +38,20 @@ allantools' and Stable32's uncorrected values; the correction depends on the
 noise identification, which is uncertain where the curve changes slope, and a
 misidentified tau would jump. Turn it on to compare with Allan-variance values of
 the same noise (a datasheet, a fitted model).
+
+Phase input
+-----------
+Every function takes ``data_type="phase"`` (allantools' convention): ``x`` is then the
+phase, the integral of the rate — time error in seconds for a clock, angle for a
+gyro — sampled at ``fs``, n + 1 points spanning n intervals. It is differentiated,
+:math:`y_i = (x_{i+1} - x_i)\,f_s`, and analysed as rate samples: the cumulative sum
+above gives back :math:`c_k = (x_k - x_0)f_s` less a linear trend, and every
+statistic here is a function of second or higher differences of the phase (the
+total family of the detrended or reflected phase), which no linear trend changes.
+So the conversion is exact — the values equal allantools' with phase input to
+rounding. A missing phase point (NaN) makes both rate samples beside it missing:
+a term whose span holds it is left out (``gaps="skip"``), and ``r.missing`` counts
+missing phase points. ``r.n_samples`` is n, the number of intervals.
 
 Gaps
 ----
@@ -87,7 +102,13 @@ from scipy import stats as _stats
 from imunoise import _schema, _summary, _warn
 from imunoise._core import allan as _core_allan
 from imunoise._runs import true_runs
-from imunoise._validate import confidence_level, integer, sample_rate, samples
+from imunoise._validate import (
+    confidence_level,
+    integer,
+    no_infinity,
+    sample_rate,
+    samples,
+)
 from imunoise.errors import CoverageWarning, GapWarning, ImunoiseWarning
 from imunoise.taus import averaging_factors, keep_estimable
 
@@ -179,6 +200,8 @@ _REGISTRY: Mapping[str, _Kind] = MappingProxyType(
         "adev": _Kind("oadev", non_overlapping="adev"),
         "mdev": _Kind("mdev"),
         "hdev": _Kind("ohdev", non_overlapping="hdev"),
+        # allantools' name for the overlapping Hadamard deviation, hdev's default
+        "ohdev": _Kind("ohdev"),
         "tdev": _Kind("mdev", time_scaled=True),
         "totdev": _Kind("totdev"),
         "mtotdev": _Kind("mtotdev", bias=_mtot_bias),
@@ -194,7 +217,11 @@ _REGISTRY: Mapping[str, _Kind] = MappingProxyType(
 #: ``imunoise``) and a value of :attr:`AllanResult.kind`.
 KINDS: tuple[str, ...] = tuple(_REGISTRY)
 
-__all__ = ["AllanResult", *KINDS, "KINDS", "GAPS", "ONE_SIGMA", "chi2_interval"]
+#: Values of the ``data_type=`` keyword: rate samples (allantools' "freq") or phase.
+DATA_TYPES = ("freq", "phase")
+
+__all__ = ["AllanResult", *KINDS, "KINDS", "GAPS", "DATA_TYPES", "ONE_SIGMA",
+           "chi2_interval"]
 
 #: Statistics (core names) that can leave out the terms touching a missing sample.
 _SKIPS_GAPS = frozenset(_core_allan.GAP_SKIPPING)
@@ -210,7 +237,8 @@ class AllanResult:
     Attributes
     ----------
     kind : str
-        The statistic, one of :data:`KINDS` (the function that made the result).
+        The statistic, one of :data:`KINDS`, or ``"pdev"``, ``"mtie"``, ``"tierms"``
+        (:func:`imunoise.pdev` …) or ``"gcodev"`` (the function that made the result).
     overlapping : bool
         Whether the estimator uses every start sample (stride 1) or stride m.
     taus : ndarray, (T,)
@@ -253,6 +281,11 @@ class AllanResult:
         Missing samples (NaN) in ``x`` per channel (int for 1-D input).
     gaps : str
         How missing samples were treated: ``"skip"``, ``"longest"`` or ``"splice"``.
+    data_type : str
+        ``"freq"`` (rate samples, the default) or ``"phase"`` (their integral,
+        see the module notes); for phase input ``n_samples`` counts the intervals
+        between phase points, len(x) − 1, so that n_samples/fs is the record's
+        length, and ``missing`` the missing phase points.
     """
 
     kind: str
@@ -272,6 +305,7 @@ class AllanResult:
     n_samples: int
     missing: int | np.ndarray = 0
     gaps: str = "skip"
+    data_type: str = "freq"
 
     def __post_init__(self) -> None:
         for name in (
@@ -344,6 +378,7 @@ def adev(
     overlapping: bool = True,
     confidence: float = ONE_SIGMA,
     gaps: str = "skip",
+    data_type: str = "freq",
 ) -> AllanResult:
     """Allan deviation, overlapping by default.
 
@@ -365,6 +400,10 @@ def adev(
         How NaN (missing samples) in ``x`` are treated, see the module notes:
         leave out the terms touching one (default), analyse the longest gap-free
         segment, or drop them and join the rest (both with a warning).
+    data_type : {"freq", "phase"}, optional
+        ``"freq"`` (default): ``x`` holds rate samples. ``"phase"``: ``x`` holds
+        their integral at the same rate (time error in seconds for a clock, angle
+        for a gyro), n + 1 points for n intervals; see the module notes.
 
     Returns
     -------
@@ -378,42 +417,54 @@ def adev(
     >>> bool(abs(r.dev[0] - 1.0) < 0.01)
     True
     """
-    return _deviation("adev", x, fs, taus, confidence, gaps, overlapping=overlapping)
+    return _deviation("adev", x, fs, taus, confidence, gaps, overlapping=overlapping,
+                      data_type=data_type)
 
 
 def mdev(x: npt.ArrayLike, fs: float, *, taus: TauSpec = "octave",
-         confidence: float = ONE_SIGMA, gaps: str = "skip") -> AllanResult:
+         confidence: float = ONE_SIGMA, gaps: str = "skip", data_type: str = "freq") -> AllanResult:
     """Modified Allan deviation (SP 1065 eq. 14); see :func:`adev` for the parameters."""
-    return _deviation("mdev", x, fs, taus, confidence, gaps)
+    return _deviation("mdev", x, fs, taus, confidence, gaps, data_type=data_type)
 
 
 def tdev(x: npt.ArrayLike, fs: float, *, taus: TauSpec = "octave",
-         confidence: float = ONE_SIGMA, gaps: str = "skip") -> AllanResult:
+         confidence: float = ONE_SIGMA, gaps: str = "skip", data_type: str = "freq") -> AllanResult:
     """Time deviation, τ·MDEV/√3 (SP 1065 eq. 16), in input units × seconds;
     see :func:`adev` for the parameters."""
-    return _deviation("tdev", x, fs, taus, confidence, gaps)
+    return _deviation("tdev", x, fs, taus, confidence, gaps, data_type=data_type)
 
 
 def hdev(x: npt.ArrayLike, fs: float, *, taus: TauSpec = "octave", overlapping: bool = True,
-         confidence: float = ONE_SIGMA, gaps: str = "skip") -> AllanResult:
+         confidence: float = ONE_SIGMA, gaps: str = "skip", data_type: str = "freq") -> AllanResult:
     """Hadamard deviation (SP 1065 eqs. 17–20), overlapping by default; insensitive
     to a linear drift of the rate. See :func:`adev` for the parameters."""
-    return _deviation("hdev", x, fs, taus, confidence, gaps, overlapping=overlapping)
+    return _deviation("hdev", x, fs, taus, confidence, gaps, overlapping=overlapping,
+                      data_type=data_type)
+
+
+def ohdev(x: npt.ArrayLike, fs: float, *, taus: TauSpec = "octave",
+          confidence: float = ONE_SIGMA, gaps: str = "skip",
+          data_type: str = "freq") -> AllanResult:
+    """Overlapping Hadamard deviation (SP 1065 eq. 20), allantools' ``ohdev``: the same
+    values as :func:`hdev` (overlapping by default), under the name allantools users
+    know; ``kind == "ohdev"``. See :func:`adev` for the parameters."""
+    return _deviation("ohdev", x, fs, taus, confidence, gaps, data_type=data_type)
 
 
 def totdev(x: npt.ArrayLike, fs: float, *, taus: TauSpec = "octave",
-           confidence: float = ONE_SIGMA, gaps: str = "skip") -> AllanResult:
+           confidence: float = ONE_SIGMA, gaps: str = "skip",
+           data_type: str = "freq") -> AllanResult:
     """Total deviation (SP 1065 eq. 25): the overlapping Allan deviation of the
     phase extended by reflection at both ends, better confidence at long taus.
     No bias correction is applied (it is small for white and flicker FM).
     Cannot skip gaps: NaN in ``x`` needs ``gaps="longest"`` or ``"splice"``.
     See :func:`adev` for the parameters."""
-    return _deviation("totdev", x, fs, taus, confidence, gaps)
+    return _deviation("totdev", x, fs, taus, confidence, gaps, data_type=data_type)
 
 
 def mtotdev(x: npt.ArrayLike, fs: float, *, taus: TauSpec = "octave",
             confidence: float = ONE_SIGMA, bias_correction: bool = False,
-            gaps: str = "skip") -> AllanResult:
+            gaps: str = "skip", data_type: str = "freq") -> AllanResult:
     r"""Modified total deviation (SP 1065 eq. 27; Howe & Vernotte 1999).
 
     Each of the N − 3m + 1 phase subsequences of 3m points (N = n + 1) has its
@@ -429,21 +480,23 @@ def mtotdev(x: npt.ArrayLike, fs: float, *, taus: TauSpec = "octave",
     ``bias_correction`` as in the module notes, with the SP 1065 factors white PM
     0.94, flicker PM 0.83, white FM 0.73, flicker FM 0.70, random-walk FM 0.69.
     """
-    return _deviation("mtotdev", x, fs, taus, confidence, gaps, bias_correction=bias_correction)
+    return _deviation("mtotdev", x, fs, taus, confidence, gaps, bias_correction=bias_correction,
+                      data_type=data_type)
 
 
 def ttotdev(x: npt.ArrayLike, fs: float, *, taus: TauSpec = "octave",
             confidence: float = ONE_SIGMA, bias_correction: bool = False,
-            gaps: str = "skip") -> AllanResult:
+            gaps: str = "skip", data_type: str = "freq") -> AllanResult:
     r"""Time total deviation, τ·MTOTDEV/√3 (SP 1065 eq. 28, with τ² in the variance;
     the τ³ printed there is a typo), in input units × seconds. Parameters, EDF and
     bias correction as for :func:`mtotdev`."""
-    return _deviation("ttotdev", x, fs, taus, confidence, gaps, bias_correction=bias_correction)
+    return _deviation("ttotdev", x, fs, taus, confidence, gaps, bias_correction=bias_correction,
+                      data_type=data_type)
 
 
 def htotdev(x: npt.ArrayLike, fs: float, *, taus: TauSpec = "octave",
             confidence: float = ONE_SIGMA, bias_correction: bool = False,
-            gaps: str = "skip") -> AllanResult:
+            gaps: str = "skip", data_type: str = "freq") -> AllanResult:
     r"""Hadamard total deviation (SP 1065 eq. 29; Howe, Beard, Greenhall, Riley 2005).
 
     The MTOT construction applied to the *rate* samples: each of the n − 3m + 1
@@ -461,12 +514,13 @@ def htotdev(x: npt.ArrayLike, fs: float, *, taus: TauSpec = "octave",
     random-run FM 0.679; none is published for phase noise (α > 0), where no
     correction is applied, nor at m = 1.
     """
-    return _deviation("htotdev", x, fs, taus, confidence, gaps, bias_correction=bias_correction)
+    return _deviation("htotdev", x, fs, taus, confidence, gaps, bias_correction=bias_correction,
+                      data_type=data_type)
 
 
 def theo1(x: npt.ArrayLike, fs: float, *, taus: TauSpec = "octave",
           confidence: float = ONE_SIGMA, bias_correction: bool = False,
-          gaps: str = "skip") -> AllanResult:
+          gaps: str = "skip", data_type: str = "freq") -> AllanResult:
     r"""Theo1 deviation (SP 1065 eq. 30; Howe & Peppler 2003), even m only.
 
     :math:`\mathrm{Theo1}(m) = \frac{1}{0.75\,(N-m)(m\tau_0)^2}\sum_{i=0}^{N-m-1}
@@ -488,12 +542,14 @@ def theo1(x: npt.ArrayLike, fs: float, *, taus: TauSpec = "octave",
     flicker PM 0.14 + 0.82/m^0.30, white FM 1, flicker FM 1.87 − 1.05/m^0.79,
     random-walk FM 2.70 − 1.53/m^0.85.
     """
-    return _deviation("theo1", x, fs, taus, confidence, gaps, bias_correction=bias_correction)
+    return _deviation("theo1", x, fs, taus, confidence, gaps, bias_correction=bias_correction,
+                      data_type=data_type)
 
 
 def theobr(x: npt.ArrayLike, fs: float, *, taus: TauSpec = "octave",
            confidence: float = ONE_SIGMA, gaps: str = "skip",
-           ratio_ladder: str = "taylor-howe", ratio_block: int = 1) -> AllanResult:
+           ratio_ladder: str = "taylor-howe", ratio_block: int = 1,
+          data_type: str = "freq") -> AllanResult:
     r"""ThêoBR deviation: Theo1 with its bias relative to the Allan variance removed
     by the data's own AVAR/Theo1 ratio (Howe & Tasset 2004; Howe 2006; SP 1065
     §5.2.15). An estimate of the Allan deviation out to τ ≈ 0.75·T (T the record
@@ -553,7 +609,8 @@ def theobr(x: npt.ArrayLike, fs: float, *, taus: TauSpec = "octave",
     AllanResult
         ``kind == "theobr"``.
     """
-    data, one_d, missing, fs, confidence = _theo_input(x, fs, confidence, gaps, "theobr")
+    data, one_d, missing, fs, confidence = _theo_input(x, fs, confidence, gaps, "theobr",
+                                                       data_type)
     n = data.shape[0]
     m, user_given = _theo1_factors(taus, fs, n)
     m = _keep_theobr(m, n, fs, user_given, "theobr", lower=0.0)
@@ -565,13 +622,14 @@ def theobr(x: npt.ArrayLike, fs: float, *, taus: TauSpec = "octave",
     return _assemble(
         "theobr", True, 0.75 * m / fs, m, core.var, core.terms, core.alpha,
         core.alpha_identified, core.edf, fs=fs, confidence=confidence, one_d=one_d,
-        missing=missing, gaps=gaps, n_samples=n,
+        missing=missing, gaps=gaps, n_samples=n, data_type=data_type,
     )
 
 
 def theoh(x: npt.ArrayLike, fs: float, *, taus: TauSpec = "octave",
           confidence: float = ONE_SIGMA, gaps: str = "skip",
-          ratio_ladder: str = "taylor-howe", ratio_block: int = 1) -> AllanResult:
+          ratio_ladder: str = "taylor-howe", ratio_block: int = 1,
+          data_type: str = "freq") -> AllanResult:
     r"""ThêoH deviation: the overlapping Allan deviation at short taus and ThêoBR
     (:func:`theobr`) at long ones (Howe, "ThêoH: a hybrid, high-confidence
     statistic that improves on the Allan deviation", Metrologia 43, 2006; SP 1065
@@ -605,7 +663,8 @@ def theoh(x: npt.ArrayLike, fs: float, *, taus: TauSpec = "octave",
     Parameters (``ratio_ladder``, ``ratio_block`` included) and result as for
     :func:`theobr`, with ``kind == "theoh"``.
     """
-    data, one_d, missing, fs, confidence = _theo_input(x, fs, confidence, gaps, "theoh")
+    data, one_d, missing, fs, confidence = _theo_input(x, fs, confidence, gaps, "theoh",
+                                                       data_type)
     n = data.shape[0]
     # Validates taus and gives the AVAR candidates (rounded to whole samples).
     m_avar, user_given = averaging_factors(taus, fs, n)
@@ -641,7 +700,7 @@ def theoh(x: npt.ArrayLike, fs: float, *, taus: TauSpec = "octave",
     return _assemble(
         "theoh", True, tau, m, core.var, core.terms, core.alpha, core.alpha_identified,
         core.edf, fs=fs, confidence=confidence, one_d=one_d, missing=missing, gaps=gaps,
-        n_samples=n,
+        n_samples=n, data_type=data_type,
     )
 
 
@@ -655,10 +714,12 @@ def _deviation(
     *,
     overlapping: bool = True,
     bias_correction: bool = False,
+    data_type: str = "freq",
 ) -> AllanResult:
     """A statistic of :data:`KINDS` whose taus are m/fs, as its registry entry says.
     Called from the public function itself (the warnings' stack levels count on it)."""
     _check_bool("overlapping", overlapping)
+    x, phase_missing = _rate_samples(x, fs, data_type)
     spec = _REGISTRY[kind]
     statistic = spec.non_overlapping if not overlapping and spec.non_overlapping else spec.statistic
     data, one_d, missing = _gapped_samples(x, gaps, kind, statistic in _SKIPS_GAPS)
@@ -687,6 +748,8 @@ def _deviation(
             m, var, terms, alpha, identified, edf = _keep_gapped(
                 kind, m, var, terms, alpha, identified, edf, fs, user_given, data
             )
+    if phase_missing is not None:
+        missing = phase_missing
     tau = m / fs
     if bias_correction and spec.bias is not None:
         var = var * spec.bias(alpha, m)
@@ -702,6 +765,7 @@ def _deviation(
     return _assemble(
         kind, overlapping, tau, m, var, terms, alpha, identified, edf, fs=fs,
         confidence=confidence, one_d=one_d, missing=missing, gaps=gaps, n_samples=n,
+        data_type=data_type,
     )
 
 
@@ -789,6 +853,7 @@ def _assemble(
     missing: np.ndarray,
     gaps: str,
     n_samples: int,
+    data_type: str = "freq",
 ) -> AllanResult:
     """The result object from the core's (T, channels) arrays."""
     dev = np.sqrt(var)
@@ -813,6 +878,7 @@ def _assemble(
         n_samples=int(n_samples),
         missing=int(missing[0]) if one_d else np.asarray(missing, dtype=np.int64),
         gaps=gaps,
+        data_type=data_type,
     )
 
 
@@ -828,10 +894,13 @@ def chi2_interval(
     return low, high
 
 
-def _theo_input(x, fs, confidence, gaps, kind: str):
-    """The checked samples, fs and confidence of a Thêo statistic (no gap skipping;
-    a record long enough for ThêoBR)."""
+def _theo_input(x, fs, confidence, gaps, kind: str, data_type: str):
+    """The checked rate samples, fs and confidence of a Thêo statistic (no gap
+    skipping; a record long enough for ThêoBR)."""
+    x, phase_missing = _rate_samples(x, fs, data_type)
     data, one_d, missing = _gapped_samples(x, gaps, kind, False)
+    if phase_missing is not None:
+        missing = phase_missing
     fs = sample_rate(fs)
     confidence = confidence_level(confidence)
     _check_theo_length(kind, data.shape[0])
@@ -974,6 +1043,30 @@ def _gapped_samples(x, gaps, kind: str, skips: bool):
         "of the record spliced out); this biases long taus", GapWarning
     )
     return data[~bad], one_d, missing
+
+
+def _rate_samples(x, fs, data_type: str):
+    """``x`` as rate samples, and the missing phase points per channel (None for
+    rate input, whose missing samples are counted where they are analysed).
+
+    Phase x (n + 1 points) becomes y_i = (x_{i+1} − x_i)·fs (n samples). Every
+    statistic of the family is a function of the phase's differences (second or
+    higher, or the detrended phase), so this is exact, not an approximation; a
+    missing phase point makes the two rate samples beside it missing, so a term
+    whose span holds it is left out, as for rate input."""
+    if not isinstance(data_type, str) or data_type not in DATA_TYPES:
+        error = ValueError if isinstance(data_type, str) else TypeError
+        raise error(f"data_type must be one of 'freq', 'phase'; got {data_type!r}")
+    if data_type == "freq":
+        return x, None
+    data, one_d = samples(x)
+    if data.shape[0] < 2:
+        raise ValueError(f"x as phase must have at least 2 points (one interval); got "
+                         f"{data.shape[0]}")
+    # checked before differencing: inf − inf would be NaN, a silent missing sample
+    no_infinity(data)
+    y = np.diff(data, axis=0) * sample_rate(fs)
+    return (y[:, 0] if one_d else y), np.isnan(data).sum(axis=0)
 
 
 def _check_bool(name, value) -> None:

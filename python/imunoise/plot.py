@@ -17,6 +17,7 @@ its maximum, so 10⁷ points draw in milliseconds and no spike disappears.
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from pathlib import Path
@@ -642,8 +643,13 @@ def allan(
                 ax.set_xlabel("τ [s]")
             ax.set_title(names[j])
             ax.grid(True, which="both", alpha=0.25)
-            ymin = np.nanmin(np.where(lo[:, j] > 0, lo[:, j], np.nan))
-            ymax = np.nanmax(hi[:, j])
+            # a statistic without an interval (MTIE, TIE rms) is scaled by its curve
+            low = np.where(np.isfinite(lo[:, j]), lo[:, j], dev[:, j])
+            high = np.where(np.isfinite(hi[:, j]), hi[:, j], dev[:, j])
+            with np.errstate(invalid="ignore"), warnings.catch_warnings():
+                warnings.simplefilter("ignore", RuntimeWarning)  # an all-NaN channel
+                ymin = np.nanmin(np.where(low > 0, low, np.nan))
+                ymax = np.nanmax(high)
             shown = [marks.get(t, 0.0) for t in ("N", "K")]
             shown = [v for v in shown if v > 0]
             if shown:  # keep the read-off points (N at 1 s, K at 3 s) inside the axes

@@ -105,13 +105,15 @@ def objects(tmp_path_factory):
         "Plan": imunoise.plan(model, fs=40.0),
         "Recording": Recording(path="still.vn", bytes=1_234_567, seconds=4.5, outages=(),
                                identity={}, settings={}, previous={}, restored=True),
+        "ThreeCorneredHat": imunoise.three_cornered_hat(
+            *(x[:20_000, 0] + x[:20_000, k] for k in range(3)), 40.0),
     }
 
 
 NAMES = ("ImuLog", "damaged ImuLog", "ParseIssues", "Gaps", "AllanResult", "NoiseModel",
          "Components", "Prediction", "Description", "Distribution", "Comparison", "Spectrum",
          "DynamicAllan", "Stationarity", "Events", "Warmup", "Thermal", "Conversion", "Report",
-         "Plan", "Recording")
+         "Plan", "Recording", "ThreeCorneredHat")
 
 
 @pytest.mark.parametrize("name", NAMES)
