@@ -32,6 +32,7 @@ from imunoise.report import folder, sections
 from imunoise.report.document import Doc
 from imunoise.report.formatting import format_duration
 from imunoise.report.inputs import read_log, streams
+from imunoise.report.model_text import report_units
 from imunoise.spectrum import Spectrum
 
 __all__ = ["SECTIONS", "TAUS_PER_DECADE", "TITLE", "Context", "Report", "Section", "build"]
@@ -387,9 +388,12 @@ def build(
         Write into an existing folder that is not a report (default False: refused
         with a ``ValueError``).
     units : {None, "datasheet"}
-        Units of N, B, K, Q, R in every table of the report (one unit per quantity):
-        None the defaults (°/√h, °/h, mg/√Hz, µg, …), ``"datasheet"`` the units MEMS
-        datasheets write (°/s/√Hz, °/h, µg/√Hz, µg; :data:`imunoise.units.DATASHEET_UNITS`).
+        Units of N, B, K, Q, R in every table of the report (one unit per quantity,
+        one family per sensor): None the report's (°/√h, °/h, °/h/√h; µg/√Hz, µg, µg/√s;
+        :data:`imunoise.report.model_text.REPORT_UNITS`), ``"datasheet"`` the units
+        ``spec`` writes (the VN-100's °/s/√Hz, °/h, mg/√Hz, mg; the accelerometer's
+        other terms in the family of its B), without ``spec``
+        :data:`imunoise.units.DATASHEET_UNITS`.
     stream : bool or None
         Bounded memory for logs larger than memory (:mod:`imunoise._stream`): each
         log file is parsed once into memory maps (a temporary folder beside
@@ -450,7 +454,8 @@ def _build(short, long, out: Path, previous, inputs, options, workdirs: list[Pat
     folder.mark(out, previous)
     (out / "figures").mkdir(parents=True, exist_ok=True)
     ctx = Context(short=short_log, long=long_log, one_log=long is None, spec=spec, out_dir=out,
-                  streamed=streamed, block=_stream.BLOCK_ROWS, timings=timings, units=units)
+                  streamed=streamed, block=_stream.BLOCK_ROWS, timings=timings,
+                  units=report_units(units, spec))
     if trim == "auto":
         start = time.perf_counter()
         _trim_warmup(ctx)

@@ -31,6 +31,7 @@ from imunoise.report.model_text import (
     datasheet_rows,
     lab_rows,
     model_sentences,
+    units_of,
 )
 
 if TYPE_CHECKING:
@@ -297,7 +298,12 @@ def noise_coefficients(ctx: Context, doc: Doc) -> None:
             doc.p(sentence)
         r = ctx.allan.get(sensor)
         if r is not None:  # how long to record for the coefficients (imunoise plan)
-            doc.p(fit_line(m, r.fs, r.n_samples / r.fs).replace("plan:", f"Plan ({sensor}):"))
+            line = fit_line(m, r.fs, r.n_samples / r.fs).replace("plan:", f"Plan ({sensor}):")
+            if "resolves" in line:  # what its ± are: not the table's
+                line += (" (95 % intervals of a read-off of the Allan curve in a record "
+                         "this long; the ± in the tables above are the fit's 1σ, and the "
+                         "datasheet comparison uses the larger of the two)")
+            doc.p(line + ".")
 
 
 def datasheet_comparison(ctx: Context, doc: Doc) -> None:
@@ -305,8 +311,15 @@ def datasheet_comparison(ctx: Context, doc: Doc) -> None:
     if ctx.spec is None:
         doc.p("No datasheet given (`--spec`).")
         return
-    header, rows = comparison_rows(ctx.models, ctx.spec, ctx.units)
+    seconds = {sensor: r.n_samples / r.fs for sensor, r in ctx.allan.items()}
+    header, rows = comparison_rows(ctx.models, ctx.spec, ctx.units, seconds=seconds)
     doc.table(header, rows, caption=f"Measured vs datasheet ({ctx.spec})")
+    doc.p("The ± of a measured value here is its standard uncertainty (1σ): the larger of "
+          "the fit's (the tables above) and what the Allan deviation at the τ the term is "
+          "read at allows from a record this long (the plan lines' uncertainty, at "
+          "68.3 %). A limit passes when the value plus 1.645 of it (one-sided 95 %) is "
+          "below the limit, fails when the value minus 1.645 of it is above, and is "
+          "\"not significant\" in between; a typical value is no limit.")
 
 
 
@@ -386,7 +399,8 @@ def power_spectral_density(ctx: Context, doc: Doc) -> None:
         n, n_std = np.atleast_1d(s.N), np.atleast_1d(s.N_std)
         band = np.reshape(s.band, (-1, 2))
         # N in the unit of every other table of the report
-        n_unit = units.unit_info("N", units.unit_choice(ctx.units, sensor).get("N"), sensor)
+        chosen = units.unit_choice(units_of(ctx.units, sensor), sensor)
+        n_unit = units.unit_info("N", chosen.get("N"), sensor)
         in_n_unit = partial(units.convert, term="N", unit=n_unit.name, sensor=sensor)
         rows = []
         for j, a in enumerate(axis_names(s.channels)):
