@@ -105,9 +105,15 @@ def _per(unit: str) -> str:
 
 
 def _channel_unit(name: str) -> str:
-    """Unit of a channel named ``"gyro X"`` (or ``"gyro"``); "" when not a log's."""
+    """Unit of a channel named ``"gyro X"`` (or ``"gyro"``), as figures write it
+    (``"m/s²"``); "" when not a log's."""
     sensor = name.split(" ")[0]
-    return CHANNELS[sensor][1] if sensor in CHANNELS else ""
+    return _symbols(CHANNELS[sensor][1]) if sensor in CHANNELS else ""
+
+
+def _symbols(unit: str) -> str:
+    """``"m/s^2"`` -> ``"m/s²"``: one spelling of a unit in every figure and table."""
+    return unit.replace("^2", "²").replace("^3", "³")
 
 
 def _plt():
@@ -221,7 +227,7 @@ def time_series(
                              f"its own); got {', '.join(given)}")
         log = y
         chosen = _log_channels(log, channels)
-        blocks = [(name, CHANNELS[name][1], _channel_axes(name), getattr(log, name))
+        blocks = [(name, _symbols(CHANNELS[name][1]), _channel_axes(name), getattr(log, name))
                   for name in chosen]
         source = "" if log.source.startswith("<") else _summary.source_name(log.source)
         if len(blocks) == 1:  # one sensor: the array layout, the channel in the title

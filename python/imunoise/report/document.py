@@ -184,7 +184,7 @@ tbody tr:nth-child(even){background:#fafbfd}
 nav.toc{background:var(--hd);border:1px solid var(--bd);border-radius:4px;
 padding:.5rem 1rem;margin:1rem 0 1.4rem;display:inline-block}
 nav.toc ol{list-style:none;margin:.3rem 0 0;padding:0;columns:2;column-gap:2.5rem}
-nav.toc li{margin:.1rem 0}
+nav.toc li{padding:.1rem 0;break-inside:avoid}
 nav.toc a{color:var(--ac);text-decoration:none}
 nav.toc a:hover{text-decoration:underline}
 figure{margin:1rem 0 1.6rem}

@@ -98,7 +98,7 @@ def _off_scale(dists) -> str:
     ("" when none of ``dists`` has any)."""
     if not any(d.off_scale_below or d.off_scale_above for d in dists):
         return ""
-    return (" The numbers in a panel's upper corners (\"← 5\", \"7 →\") count the samples "
+    return (". The numbers in a panel's upper corners (\"← 5\", \"7 →\") count the samples "
             "beyond the plotted range, below it on the left and above it on the right; "
             "the fit and the tables use them.")
 
