@@ -286,7 +286,8 @@ def noise_coefficients(ctx: Context, doc: Doc) -> None:
     if ctx.models:
         header, rows = lab_rows(ctx.models, ctx.spec, ctx.units)
         doc.table(header, rows, caption="Lab table: N, B and K per axis"
-                  + (f" beside the datasheet ({ctx.spec}), in one unit" if ctx.spec else ""))
+                  + (f" beside the datasheet ({ctx.spec}), in one unit" if ctx.spec else "")
+                  + "; ± the fit's standard uncertainty (1σ)")
     for sensor, m in ctx.models.items():
         header, rows = datasheet_rows(m, sensor, ctx.units, symbols=True)
         doc.table(header, rows, caption=f"{sensor} noise coefficients per axis")
