@@ -490,8 +490,8 @@ def _report_units_option(parser) -> None:
     action.type = units_value
     action.metavar = "CHANNEL=UNIT|datasheet"
     action.help += ("; 'datasheet': every table of the report gives N, B, K in the units "
-                    "datasheets write (deg/s/sqrt(Hz), deg/h, ug/sqrt(Hz), ug) instead of "
-                    "deg/sqrt(h), mg/sqrt(Hz)")
+                    "the --spec datasheet writes (the VN-100's deg/s/sqrt(Hz), deg/h, "
+                    "mg/sqrt(Hz), mg) instead of deg/sqrt(h), deg/h, ug/sqrt(Hz), ug")
 
 
 def _cmd_report(args) -> int:

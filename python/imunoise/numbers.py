@@ -84,8 +84,23 @@ def rounded(value, std=None, *, digits: int = 4, missing: str = EMPTY) -> str:
         return text
     head, tail = text.split(" ± ")
     if head.startswith("("):  # "(3.50 ± 0.12)e-3"
-        return head[1:] + tail[tail.index(")") + 1:]
+        return _normalised(head[1:], int(tail[tail.index(")") + 2:]))
     return head
+
+
+def _normalised(mantissa: str, power: int) -> str:
+    """``"0.6", -5`` -> ``"6e-6"``: a value smaller than its uncertainty shares the
+    uncertainty's power of ten in ``(0.6 ± 1.2)e-5``; alone it is written with a
+    mantissa from 1 to 10, keeping its decimal place."""
+    sign = "-" if mantissa.startswith("-") else ""
+    digits = mantissa.lstrip("-")
+    whole, _, frac = digits.partition(".")
+    if whole != "0" or not frac.strip("0"):
+        return f"{mantissa}e{power}" if frac.strip("0") or whole != "0" else "0"
+    shift = len(frac) - len(frac.lstrip("0")) + 1  # 0.06 -> 6: two places
+    rest = frac[shift - 1:]
+    text = rest[0] + ("." + rest[1:] if len(rest) > 1 else "")
+    return f"{sign}{text}e{power - shift}"
 
 
 def _significant(value: float, digits: int) -> str:

@@ -88,6 +88,9 @@ class Plan:
     terms: Mapping[str, TermPlan]
     coefficients: Mapping[str, float]
     label: str = ""
+    #: Terms whose value the source does not give and the planner assumed (a
+    #: datasheet without K: the simulator's typical K); :meth:`line` says so.
+    assumed: tuple[str, ...] = ()
 
     @property
     def seconds(self) -> float:
@@ -111,6 +114,9 @@ class Plan:
         need = ", ".join(f"{k} {_length(t.seconds)}" for k, t in self.terms.items())
         text = (f"plan{' ' + self.label if self.label else ''}: ±{100 * self.target:g} % "
                 f"({100 * self.confidence:g} % confidence) needs {need}")
+        if self.assumed:
+            text += (f" ({', '.join(self.assumed)}: not on the datasheet, a typical value is "
+                     "assumed; its record length is a guide only)")
         if seconds is not None:
             have = ", ".join(f"{k} ±{100 * u:.2g} %" if math.isfinite(u) and u < 10
                              else f"{k} not yet (its τ is beyond the record)"
@@ -185,9 +191,10 @@ def _seconds(fs: float, tau: float, alpha: int, target: float, confidence: float
     return hi / fs
 
 
-def _coefficients(source, sensor: str) -> tuple[dict[str, float], str]:
+def _coefficients(source, sensor: str) -> tuple[dict[str, float], str, tuple[str, ...]]:
+    """The coefficients to plan with, the plan's label and the terms assumed."""
     if isinstance(source, Mapping):
-        return {k: float(source.get(k, 0.0)) for k in PLAN_TERMS}, ""
+        return {k: float(source.get(k, 0.0)) for k in PLAN_TERMS}, "", ()
     if hasattr(source, "components") and hasattr(source, "N"):  # a NoiseModel
         # The median over the axes that resolve the term; a term no axis resolves
         # (NaN) is planned as absent, as a datasheet that omits it.
@@ -196,15 +203,18 @@ def _coefficients(source, sensor: str) -> tuple[dict[str, float], str]:
             values = np.atleast_1d(getattr(source, k)).astype(float)
             values = values[np.isfinite(values)]
             out[k] = float(np.median(values)) if values.size else 0.0
-        return out, ""
+        return out, "", ()
     from imunoise._simulate_log import noise_of_spec
     from imunoise.datasheet import load_spec
 
     noise = noise_of_spec(source)
     if sensor not in noise:
         raise ValueError(f"sensor must be one of {sorted(noise)} for this spec; got {sensor!r}")
+    spec = load_spec(source)
+    given = {item.term for item in spec.items if item.sensor == sensor}
+    assumed = tuple(k for k in PLAN_TERMS if k not in given and noise[sensor].get(k, 0.0) > 0)
     return ({k: float(noise[sensor].get(k, 0.0)) for k in PLAN_TERMS},
-            f"{load_spec(source).name} {sensor}")
+            f"{spec.name} {sensor}", assumed)
 
 
 def plan(source="vn100", *, fs: float = 40.0, target: float = 0.2, confidence: float = 0.95,
@@ -237,7 +247,7 @@ def plan(source="vn100", *, fs: float = 40.0, target: float = 0.2, confidence: f
         raise ValueError(f"target must be a relative uncertainty in (0, 1); got {target!r}")
     if not (isinstance(confidence, int | float) and 0 < confidence < 1):
         raise ValueError(f"confidence must be in (0, 1); got {confidence!r}")
-    coefficients, label = _coefficients(source, sensor)
+    coefficients, label, assumed = _coefficients(source, sensor)
     bad = {k: v for k, v in coefficients.items() if not (math.isfinite(v) and v >= 0)}
     if bad:
         raise ValueError(f"coefficients must be finite and >= 0; got {bad}")
@@ -246,7 +256,7 @@ def plan(source="vn100", *, fs: float = 40.0, target: float = 0.2, confidence: f
                          _seconds(fs, tau, PLAN_TERMS[k], float(target), float(confidence)))
              for k, tau in taus.items()}
     return Plan(fs=fs, target=float(target), confidence=float(confidence), terms=terms,
-                coefficients=coefficients, label=label)
+                coefficients=coefficients, label=label, assumed=assumed)
 
 
 def fit_line(model, fs: float, seconds: float, *, target: float = 0.2,

@@ -20,6 +20,7 @@ from __future__ import annotations
 import warnings
 from collections.abc import Iterator, Mapping, Sequence
 from contextlib import contextmanager
+from functools import cache
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -30,7 +31,7 @@ from imunoise._schema import ATTITUDE_NAMES, CHANNELS, axis_names
 from imunoise.allan import AllanResult
 from imunoise.noise import FLICKER, TERMS, NoiseModel, model_variance
 from imunoise.noise._terms import term_variances
-from imunoise.numbers import format_value, rounded
+from imunoise.numbers import cell, format_value, rounded
 from imunoise.readers.log import ImuLog
 from imunoise.stats import Distribution
 
@@ -48,6 +49,7 @@ __all__ = [
     "dynamic",
     "events",
     "histograms",
+    "plain_ticks",
     "save",
     "spectrum",
     "style",
@@ -104,9 +106,15 @@ def _per(unit: str) -> str:
 
 
 def _channel_unit(name: str) -> str:
-    """Unit of a channel named ``"gyro X"`` (or ``"gyro"``); "" when not a log's."""
+    """Unit of a channel named ``"gyro X"`` (or ``"gyro"``), as figures write it
+    (``"m/s²"``); "" when not a log's."""
     sensor = name.split(" ")[0]
-    return CHANNELS[sensor][1] if sensor in CHANNELS else ""
+    return _symbols(CHANNELS[sensor][1]) if sensor in CHANNELS else ""
+
+
+def _symbols(unit: str) -> str:
+    """``"m/s^2"`` -> ``"m/s²"``: one spelling of a unit in every figure and table."""
+    return unit.replace("^2", "²").replace("^3", "³")
 
 
 def _plt():
@@ -220,7 +228,7 @@ def time_series(
                              f"its own); got {', '.join(given)}")
         log = y
         chosen = _log_channels(log, channels)
-        blocks = [(name, CHANNELS[name][1], _channel_axes(name), getattr(log, name))
+        blocks = [(name, _symbols(CHANNELS[name][1]), _channel_axes(name), getattr(log, name))
                   for name in chosen]
         source = "" if log.source.startswith("<") else _summary.source_name(log.source)
         if len(blocks) == 1:  # one sensor: the array layout, the channel in the title
@@ -308,7 +316,7 @@ def _series_figure(blocks, fs: float, title: str, columns: int, gaps) -> Figure:
             _margins(fig, left=0.95, bottom=0.45, title=bool(title))
         if title:
             fig.suptitle(title)
-    return fig
+    return plain_ticks(fig)
 
 
 def _columns(v) -> list[np.ndarray]:
@@ -330,9 +338,10 @@ def histograms(
 
     The x axis is the distribution's range (its bulk, see
     :func:`imunoise.distribution`); samples beyond it are counted in the panel's
-    upper corners ("← 3", "12 →"). Tick labels use an offset ("−134" under
-    "−0.05 0 0.05") when the values share leading digits, and fewer ticks when
-    labels would touch.
+    upper corners ("← 3", "12 →"). Tick labels are plain numbers: where the values
+    share leading digits the shared part goes into the axis label ("yaw + 134 [deg]"
+    over "−0.05 0 0.05"; :func:`plain_ticks`), and fewer ticks are drawn when labels
+    would touch.
 
     Parameters
     ----------
@@ -359,7 +368,8 @@ def histograms(
             ax.set_xlim(d.edges[0], d.edges[-1])
             ax.set_title(
                 f"{names[j]}: μ = {rounded(d.mu, d.mu_std)}, σ = {rounded(d.sigma, d.sigma_std)}"
-                f"\nskew {d.skewness:.2f}, ex. kurt {d.excess_kurtosis:.2f}",
+                f"\nskew {cell(d.skewness, digits=3)}, "
+                f"ex. kurt {cell(d.excess_kurtosis, digits=3)}",
                 fontsize=8,
             )
             for count, xpos, align, text in (
@@ -383,18 +393,15 @@ HIST_TICKS = 5
 
 
 def _readable_ticks(fig, axes) -> None:
-    """x tick labels that never touch: an offset when the values share leading
-    digits ("−134.20, −134.15" → "−0.05, 0" and the offset "−134"), then fewer ticks
-    (down to two) until no two labels of a panel, or of neighbouring panels, overlap
-    on the renderer."""
-    import matplotlib
+    """x tick labels that never touch: plain numbers (an offset the values share,
+    "−134" of a yaw near −134°, goes into the axis label, :func:`plain_ticks`), then
+    fewer ticks (down to two) until no two labels of a panel, or of neighbouring
+    panels, overlap on the renderer."""
     from matplotlib.ticker import MaxNLocator
 
-    with matplotlib.rc_context({"axes.formatter.offset_threshold": 2}):
-        for ax in axes:
-            fmt = _plain_offset_formatter()
-            fmt.set_powerlimits((-3, 4))
-            ax.xaxis.set_major_formatter(fmt)
+    for ax in axes:
+        _plain_axis(ax.xaxis, offset_threshold=2)
+        _plain_axis(ax.yaxis)
     renderer = _renderer(fig)
     for i, ax in enumerate(axes):
         for nbins in range(HIST_TICKS, 1, -1):
@@ -403,18 +410,67 @@ def _readable_ticks(fig, axes) -> None:
                 break
 
 
-def _plain_offset_formatter():
-    """Matplotlib's scalar formatter (offset on, math text) with the offset written as
-    a plain number ("−134", not "−1.34×10²")."""
+def plain_ticks(fig) -> Figure:
+    """Tick labels without matplotlib's corner text, on every linear axis of ``fig``.
+
+    Where matplotlib would write an offset in the axis's corner (an accelerometer's
+    Z axis near −9.97 m/s² as "0.0 0.1" with "−10" apart) the offset moves into the
+    axis label in the axis's own unit ("accel Z + 10 [m/s²]") and the ticks count
+    from it; a scientific multiplier ("1e−5") is never used (plain decimals).
+    Called by every figure function; idempotent. Returns ``fig``."""
+    for ax in fig.axes:
+        for axis in (ax.xaxis, ax.yaxis):
+            _plain_axis(axis)
+    return fig
+
+
+def _plain_axis(axis, *, offset_threshold: int | None = None) -> None:
+    """:func:`plain_ticks` for one axis (``offset_threshold``: matplotlib's
+    ``axes.formatter.offset_threshold`` for deciding whether the values share
+    leading digits; default its rc value, 4)."""
+    import matplotlib
     from matplotlib.ticker import ScalarFormatter
 
-    class PlainOffset(ScalarFormatter):
-        def format_data(self, value):
-            if self.offset and value == self.offset:
-                return f"{value:.12g}"
-            return super().format_data(value)
+    fmt = axis.get_major_formatter()
+    if axis.get_scale() != "linear" or type(fmt) is not ScalarFormatter:
+        return  # a log axis, a formatter of the figure's own, or one already plain
+    rc = {} if offset_threshold is None else {
+        "axes.formatter.offset_threshold": offset_threshold}
+    with matplotlib.rc_context(rc):
+        probe = ScalarFormatter(useOffset=True)
+    probe.set_axis(axis)
+    locs = [x for x in axis.get_majorticklocs() if np.isfinite(x)]
+    probe.set_locs(locs)
+    shift = float(probe.offset) if locs else 0.0
+    axis.set_major_formatter(_Shifted(shift))
+    label = axis.get_label_text()
+    if shift and label:
+        name, bracket, rest = label.partition(" [")
+        sign = "−" if shift > 0 else "+"
+        axis.set_label_text(f"{name} {sign} {abs(shift):.12g}{bracket}{rest}")
 
-    return PlainOffset(useOffset=True, useMathText=True)
+
+@cache
+def _shifted_class():
+    from matplotlib.ticker import ScalarFormatter
+
+    class Shifted(ScalarFormatter):
+        """Ticks counted from ``shift`` (written in the axis label), never an offset
+        or a power of ten in the corner."""
+
+        def __init__(self, shift: float = 0.0):
+            super().__init__(useOffset=False)
+            self.set_scientific(False)
+            self.offset = shift
+
+        def get_offset(self) -> str:
+            return ""
+
+    return Shifted
+
+
+def _Shifted(shift: float = 0.0):  # noqa: N802 - a class made on first use (lazy matplotlib)
+    return _shifted_class()(shift)
 
 
 #: Pixels two neighbouring tick labels of an axis keep apart at the least.
@@ -988,7 +1044,7 @@ def warmup(result, *, title: str = "", unit: str = "") -> Figure:
                  else "no warm-up transient")
         fig.suptitle(title or f"Bias over time: {where}")
         _margins(fig, left=1.0, bottom=0.45, title=True)
-    return fig
+    return plain_ticks(fig)
 
 
 def thermal(result, *, title: str = "") -> Figure:
@@ -1019,7 +1075,7 @@ def thermal(result, *, title: str = "") -> Figure:
             axes[j // cols, j % cols].set_visible(False)
         fig.suptitle(title or "Bias against temperature")
         _margins(fig, left=0.8, bottom=0.5, top=0.3, wspace=0.45, hspace=0.6, title=True)
-    return fig
+    return plain_ticks(fig)
 
 
 def compensation(before: AllanResult, after: AllanResult, *, title: str = "",

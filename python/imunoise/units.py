@@ -111,7 +111,11 @@ def _units() -> dict[tuple[str, str], Unit]:
         ("accel", "B", "ug", "µg", 1e6 / G),
         ("accel", "K", "m/s^2/sqrt(s)", "m/s²/√s", 1.0),
         ("accel", "K", "m/s/h/sqrt(h)", "m/s/h/√h", _H * _SQRT_H),
+        ("accel", "K", "mg/sqrt(s)", "mg/√s", 1e3 / G),
+        ("accel", "K", "ug/sqrt(s)", "µg/√s", 1e6 / G),
         ("accel", "R", "m/s^3", "m/s³", 1.0),
+        ("accel", "R", "mg/s", "mg/s", 1e3 / G),
+        ("accel", "R", "ug/s", "µg/s", 1e6 / G),
     ]
     return {(s, n): Unit(n, lab, t, s, f) for s, t, n, lab, f in rows}
 

@@ -64,3 +64,11 @@ def test_b_without_a_walk_is_read_where_its_floor_dominates():
     assert 1.0 < tau < 1e4
     assert 0.6643**2 * 3.8e-5**2 >= 2.9 * 1e-8 / tau
     assert plan.terms["B"].seconds < 3.6e6
+
+
+def test_a_datasheet_without_k_says_k_is_assumed():
+    from imunoise.planner import plan
+
+    line = plan("vn100").line()
+    assert "K " in line and "K: not on the datasheet, a typical value is assumed" in line
+    assert plan({"N": 1e-4, "B": 1e-5, "K": 1e-6}).assumed == ()

@@ -265,12 +265,16 @@ def test_lab_table_is_the_first_table_of_the_noise_section(reports):
     rows = _md_tables(section)[first.strip("*")]
     assert rows[0] == ["sensor", "quantity", "unit", "X", "Y", "Z", "datasheet", "as printed"]
     by = {(r[0], r[1]): r for r in rows[1:]}
-    # datasheet units (--units datasheet): the VN-100's 0.0035 °/s/√Hz and 0.14 mg/√Hz
+    # datasheet units (--units datasheet): the VN-100's own, 0.0035 °/s/√Hz, 0.14 mg/√Hz
+    # and < 0.04 mg; the accelerometer's K in the same family (mg/√s), never m/s²/√s
     gyro_n = by[("gyro", "angle random walk (N)")]
     assert gyro_n[2] == "°/s/√Hz" and float(gyro_n[6]) == pytest.approx(0.0035)
     accel_n = by[("accel", "velocity random walk (N)")]
-    assert accel_n[2] == "µg/√Hz" and float(accel_n[6]) == pytest.approx(140)
+    assert accel_n[2] == "mg/√Hz" and float(accel_n[6]) == pytest.approx(0.14)
     assert accel_n[7] == "0.14 mg/√Hz typ."
+    accel_b = by[("accel", "bias instability (B)")]
+    assert accel_b[2] == "mg" and float(accel_b[6]) == pytest.approx(0.04)
+    assert by[("accel", "rate random walk (K)")][2] == "mg/√s"
     assert [r[1] for r in rows[1:4]] == ["angle random walk (N)", "bias instability (B)",
                                         "rate random walk (K)"]
 
@@ -308,8 +312,15 @@ def test_one_unit_per_quantity_across_the_tables(reports):
             assert len(units) == 1, (name, key, units)
     bundled = _units_by_quantity(reports["bundled"][0].markdown.read_text(encoding="utf-8"))
     simulated = _units_by_quantity(reports["simulated"][0].markdown.read_text(encoding="utf-8"))
-    assert bundled[("gyro", "N")] == {"°/s/√Hz"} and bundled[("accel", "B")] == {"µg"}
-    assert simulated[("gyro", "N")] == {"°/√h"} and simulated[("accel", "N")] == {"mg/√Hz"}
+    assert bundled[("gyro", "N")] == {"°/s/√Hz"} and bundled[("accel", "B")] == {"mg"}
+    assert simulated[("gyro", "N")] == {"°/√h"} and simulated[("accel", "N")] == {"µg/√Hz"}
+    # one family per accelerometer: never mg beside µg, nor an SI K beside them
+    for seen in (bundled, simulated):
+        accel = {u for (sensor, term), units in seen.items() if sensor == "accel"
+                 and term in "NBK" for u in units}
+        assert not ({u for u in accel if u.startswith("mg")}
+                    and {u for u in accel if u.startswith("µg")}), accel
+        assert not any(u.startswith("m/s") for u in accel), accel
 
 
 def test_lab_table_text_and_its_units():
@@ -352,3 +363,115 @@ def test_columns_of_words_are_left_aligned_and_long_tables_collapse():
     assert '<td class="l">pass</td>' in html and '<td>(1.2 ± 0.1)e-3</td>' in html
     assert '<td>not resolved</td>' in html  # a column without a word or a number: as is
     assert "<details><summary>long (40 rows)</summary>" in html
+
+
+# --- a report a student reads without help -------------------------------------------
+
+
+def test_figures_have_plain_tick_labels(reports):
+    """No matplotlib offset or power of ten in an axis corner ("−10" beside the ticks of
+    accel Z): a shared offset is in the axis label, in the axis's unit."""
+    for name, fig in _all_figures(reports):
+        fig.canvas.draw()
+        for ax in fig.axes:
+            for axis in (ax.xaxis, ax.yaxis):
+                assert axis.get_offset_text().get_text() == "", (name, axis.get_label_text())
+    _rep, figs = reports["bundled"]
+    # the VN-100 capture's accel Z sits near −9.9 m/s²: its histogram counts from there
+    z = figs["hist_accel"].axes[2].get_xlabel()
+    assert re.fullmatch(r"Z \+ [\d.]+ \[m/s²\]", z), z
+
+
+def test_histogram_titles_are_rounded_like_the_tables(reports):
+    for name, fig in _all_figures(reports):
+        if "hist_" not in name:
+            continue
+        for ax in fig.axes:
+            title = ax.get_title()
+            # a mantissa from 1 to 10 ("6e-6", never "0.6e-5"); no "67.20"-style padding
+            assert not re.search(r"(?<![\d.])-?0\.\d+e-?\d", title), (name, title)
+            assert "μ = " in title and "σ = " in title
+
+
+def test_off_scale_counts_are_explained(reports):
+    rep, figs = reports["bundled"]
+    md = rep.markdown.read_text(encoding="utf-8")
+    counted = [n for n, fig in figs.items() if n.startswith("hist_") and any(
+        t.get_text().startswith("←") or t.get_text().endswith("→")
+        for ax in fig.axes for t in ax.texts)]
+    assert counted, "the bundled capture has samples beyond a histogram's range"
+    for n in counted:
+        caption = re.search(rf"!\[([^\]]*)\]\(figures/{n}\.png\)", md).group(1)
+        assert "upper corners" in caption and "beyond the plotted range" in caption, caption
+
+
+def test_contents_at_the_top(reports):
+    rep, _figs = reports["simulated"]
+    md = rep.markdown.read_text(encoding="utf-8")
+    html = rep.html.read_text(encoding="utf-8")
+    headings = re.findall(r"^## (.+)$", md, flags=re.M)
+    assert md.index("**Contents**") < md.index("## 1.")
+    for h in headings:
+        assert f"- [{h}](#" in md
+    toc = html[html.index('<nav class="toc">'):html.index("</nav>")]
+    assert html.index('<nav class="toc">') < html.index("<h2")
+    anchors = re.findall(r'<h2 id="([^"]+)">', html)
+    assert re.findall(r'href="#([^"]+)"', toc) == anchors and len(anchors) == len(headings)
+
+
+def test_one_log_is_not_called_short_or_long(reports):
+    for name, (rep, figs) in reports.items():
+        md = rep.markdown.read_text(encoding="utf-8")
+        assert "short log" not in md.lower() and "long log" not in md.lower(), name
+        for fig_name, fig in figs.items():
+            titles = [fig._suptitle.get_text() if fig._suptitle else ""]
+            assert not any("short log" in t or "long log" in t for t in titles), fig_name
+
+
+def test_one_unit_spelling_and_links_to_the_documentation_site(reports):
+    from imunoise.report.formatting import DOCS_URL
+
+    for name, (rep, figs) in reports.items():
+        for text in (rep.markdown.read_text(encoding="utf-8"),
+                     rep.html.read_text(encoding="utf-8")):
+            assert "m/s^2" not in text and "docs/" not in text, name
+            assert DOCS_URL in text
+        for fig_name, fig in figs.items():
+            labels = [a.get_label_text() for ax in fig.axes for a in (ax.xaxis, ax.yaxis)]
+            assert not any("^2" in x for x in labels), (fig_name, labels)
+
+
+def test_comparison_says_which_uncertainty_its_verdicts_use(reports):
+    rep, _figs = reports["simulated"]
+    md = rep.markdown.read_text(encoding="utf-8")
+    tables = _md_tables(md)
+    lab = next(rows for c, rows in tables.items() if c and c.startswith("Lab table"))
+    cmp = next(rows for c, rows in tables.items() if c and c.startswith("Measured vs"))
+    lab_b = {r[0]: r for r in lab[1:] if r[1].endswith("(B)")}
+    for r in cmp[1:]:
+        if not r[1].endswith("(B)") or " ± " not in r[4]:
+            continue
+        fit_std = float(lab_b[r[0]][3 + "XYZ".index(r[2])].split(" ± ")[1])
+        # the record's own uncertainty of B is never below the fit's
+        assert float(r[4].split(" ± ")[1]) >= fit_std * 0.99, (r, fit_std)
+    assert "the larger of the fit's" in md
+    plans = [line for line in md.splitlines() if line.startswith("Plan (")]
+    assert plans and all("95 % intervals of a read-off" in p for p in plans)
+
+
+def test_an_assumed_sample_rate_is_said_in_the_report(tmp_path):
+    """A log without timestamps read without ``--fs``: the report says, at its top and
+    in the command line's words, that 40 Hz was assumed."""
+    lines = BUNDLED.read_text(encoding="utf-8").splitlines(keepends=True)
+    path = tmp_path / "vn.txt"
+    path.write_text("".join(lines[:4000]), encoding="utf-8")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        rep = report.build(path, None, tmp_path / "r", progress=False, spec=None)
+        given = report.build(path, None, tmp_path / "given", progress=False, spec=None,
+                             fs=40.0)
+    md = rep.markdown.read_text(encoding="utf-8")
+    note = md[:md.index("## 1.")]
+    assert "**Sample rate assumed**" in note and "40 Hz" in note and "`--fs" in note
+    assert "Sample rate assumed" in rep.html.read_text(encoding="utf-8")
+    assert "Sample rate assumed" not in given.markdown.read_text(encoding="utf-8")

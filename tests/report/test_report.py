@@ -152,7 +152,11 @@ def test_html_embeds_every_image(built):
     md_figs = re.findall(r"^!\[.*\]\((figures/[^)]*)\)$", rep.markdown.read_text(), re.M)
     assert len(srcs) == len(md_figs) == 15
     assert all(s.startswith("data:image/png;base64,") for s in srcs)
-    assert "<script" not in html and "<link" not in html and "href=" not in html
+    assert "<script" not in html and "<link" not in html
+    # links only within the page (the contents) and to the documentation site
+    from imunoise.report.formatting import DOCS_URL
+
+    assert all(h.startswith(("#", DOCS_URL)) for h in re.findall(r'href="([^"]*)"', html))
     for s in md_figs:
         assert (rep.out_dir / s).is_file()
 
@@ -184,7 +188,9 @@ def test_model_files_and_tables_match_fit(built):
             written = [np.nan if v is None else v for v in data[sensor][term]["value"]]
             np.testing.assert_allclose(written, model.value(term), rtol=1e-12)
         rows = _md_table(md, f"{sensor} noise coefficients per axis")
-        for want, got in zip(model.table(sensor), rows[1:], strict=True):
+        # in the report's units: one family per sensor (µg for the accelerometer)
+        units = report.model_text.REPORT_UNITS[sensor]
+        for want, got in zip(model.table(sensor, units=units), rows[1:], strict=True):
             assert got[1] == want["term"]
             for j, axis in enumerate("XYZ"):
                 if not want[f"{axis}_supported"]:  # a value's 95 % bound, never 0
@@ -213,7 +219,7 @@ def test_report_on_bundled_real_log(tmp_path):
     rep = report.build(bundled_log(), None, tmp_path, progress=False)
     md = rep.markdown.read_text()
     assert "vn100_stationary_5min.txt" in md
-    rows = _md_table(md, "Histogram bins (short log): the sensor's quantization step and the "
+    rows = _md_table(md, "Histogram bins: the sensor's quantization step and the "
                          "spacing of the levels it uses")
     steps = {r[0]: r[2] for r in rows[1:]}
     assert float(steps["gyro X"]) == pytest.approx(1e-6, rel=1e-3)
@@ -259,7 +265,7 @@ def test_sections_are_numbered_from_the_list(built):
 def test_psd_and_dynamic_sections(built):
     rep, _, _ = built
     md = rep.markdown.read_text()
-    psd = md.split("Power spectral density")[1].split("\n## ")[0]
+    psd = md.split("## 7. Power spectral density")[1].split("\n## ")[0]
     assert psd.count("| X |") == 2 and "N PSD" in psd  # gyro and accel tables
-    dadev = md.split("Dynamic Allan deviation")[1].split("\n## ")[0]
+    dadev = md.split("## 8. Dynamic Allan deviation")[1].split("\n## ")[0]
     assert dadev.count("noise is stationary") + dadev.count("noise is not stationary") == 2

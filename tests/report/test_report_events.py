@@ -65,7 +65,7 @@ def test_trim_auto_states_what_it_cut_and_the_analysis_uses_the_rest(trimmed):
 def test_event_found_and_listed(trimmed):
     _rep, _log, md = trimmed
     # times are from the first sample of the recording, trimmed part included
-    table = md.split("Events of the short log")[1].split("\n\n")[1]
+    table = md.split("Events of the log")[1].split("\n\n")[1]  # one log: not "short"
     row = re.search(r"\| 4000(\.\d+)? \| 400[12](\.\d+)? \| [\d.]+ \| burst \| gyro X \| "
                     r"[\d.]+ \| ([\d.]+) \(gyro X\) \|", table)
     assert row, table

@@ -37,6 +37,14 @@ class Doc:
     def figure(self, png: Path, caption: str) -> None:
         self.blocks.append(("figure", png, caption))
 
+    def contents(self) -> None:
+        """The table of contents: a list of every level-2 heading, wherever they
+        are added (before or after this block), each a link to its section."""
+        self.blocks.append(("toc",))
+
+    def _sections(self) -> list[str]:
+        return [b[2] for b in self.blocks if b[0] == "h" and b[1] == 2]
+
     def markdown(self, out_dir: Path) -> str:
         """Markdown text; figures linked relative to ``out_dir``."""
         lines = []
@@ -45,6 +53,10 @@ class Doc:
                 lines += ["#" * b[1] + " " + b[2], ""]
             elif b[0] == "p":
                 lines += [b[1], ""]
+            elif b[0] == "toc":
+                lines += ["**Contents**", ""]
+                lines += [f"- [{t}](#{_md_slug(t)})" for t in self._sections()]
+                lines.append("")
             elif b[0] == "table":
                 _, header, rows, caption, collapsed = b
                 if collapsed:
@@ -73,6 +85,10 @@ class Doc:
                 body.append(f"<h{b[1]}{anchor}>{e(b[2])}</h{b[1]}>")
             elif b[0] == "p":
                 body.append(f"<p>{_inline(b[1])}</p>")
+            elif b[0] == "toc":
+                items = "".join(f'<li><a href="#{_slug(t)}">{e(t)}</a></li>'
+                                for t in self._sections())
+                body.append(f'<nav class="toc"><strong>Contents</strong><ol>{items}</ol></nav>')
             elif b[0] == "table":
                 _, header, rows, caption, collapsed = b
                 cap = f"<caption>{e(caption)}</caption>" if caption and not collapsed else ""
@@ -123,10 +139,25 @@ def _slug(heading: str) -> str:
     return "-".join(words) or "section"
 
 
+def _md_slug(heading: str) -> str:
+    """The anchor GitHub (and most Markdown renderers) give a heading:
+    ``"4. Attitude (yaw, pitch, roll)"`` -> ``"4-attitude-yaw-pitch-roll"``."""
+    kept = re.sub(r"[^\w\- ]", "", heading.lower())
+    return kept.replace(" ", "-")
+
+
 def _inline(text: str) -> str:
-    """Escape and turn `code` spans into <code>."""
-    parts = _html.escape(text).split("`")
-    return "".join(f"<code>{p}</code>" if i % 2 else p for i, p in enumerate(parts))
+    """Escape, turn `code` spans into <code>, **bold** into <strong> and
+    ``[text](https://…)`` links into <a>."""
+    parts = _html.escape(text, quote=False).split("`")
+    out = "".join(f"<code>{p}</code>" if i % 2 else _LINK.sub(
+        r'<a href="\2">\1</a>', _BOLD.sub(r"<strong>\1</strong>", p))
+        for i, p in enumerate(parts))
+    return out
+
+
+_LINK = re.compile(r"\[([^\]]+)\]\((https?://[^)\s]+)\)")
+_BOLD = re.compile(r"\*\*(.+?)\*\*")
 
 
 _CSS = """
@@ -150,6 +181,12 @@ summary{cursor:pointer;color:var(--mut);font-style:italic}
 th{background:var(--hd);font-weight:600}
 td:first-child,th:first-child,td.l,th.l{text-align:left}
 tbody tr:nth-child(even){background:#fafbfd}
+nav.toc{background:var(--hd);border:1px solid var(--bd);border-radius:4px;
+padding:.5rem 1rem;margin:1rem 0 1.4rem;display:inline-block}
+nav.toc ol{list-style:none;margin:.3rem 0 0;padding:0;columns:2;column-gap:2.5rem}
+nav.toc li{padding:.1rem 0;break-inside:avoid}
+nav.toc a{color:var(--ac);text-decoration:none}
+nav.toc a:hover{text-decoration:underline}
 figure{margin:1rem 0 1.6rem}
 img{max-width:100%;height:auto;border:1px solid var(--bd);border-radius:4px}
 figcaption{color:var(--mut);font-size:13px;margin-top:.3rem}

@@ -7,7 +7,32 @@ import numpy as np
 
 from imunoise import numbers as _numbers
 
-__all__ = ["format_duration", "format_number", "gap_note", "missing_text", "terms_used"]
+__all__ = ["DOCS_URL", "docs_link", "format_duration", "format_number", "gap_note",
+           "missing_text", "terms_used", "unit_text"]
+
+
+#: The documentation site; the report links its pages (a wheel user has no ``docs/``
+#: folder). The one place the address is written.
+DOCS_URL = "https://imunoise.readthedocs.io/en/latest/"
+
+
+def docs_link(page: str, text: str | None = None) -> str:
+    """A Markdown link to a page of the documentation site: ``docs_link("gaps")``
+    -> ``"[gaps](https://…/gaps.html)"`` (the report's HTML renders it too)."""
+    return f"[{text or page} documentation]({DOCS_URL}{page}.html)"
+
+
+#: The report's spelling of units the logs name in ASCII (one spelling per unit
+#: across every table, caption and figure: the symbols the noise tables use).
+_SYMBOLS = (("m/s^2", "m/s²"), ("m/s^3", "m/s³"), ("sqrt(Hz)", "√Hz"), ("sqrt(h)", "√h"),
+            ("sqrt(s)", "√s"), ("deg/s", "°/s"), ("deg/h", "°/h"))
+
+
+def unit_text(unit: str) -> str:
+    """A unit as the report writes it: ``"m/s^2"`` -> ``"m/s²"``."""
+    for ascii_, symbol in _SYMBOLS:
+        unit = unit.replace(ascii_, symbol)
+    return unit
 
 
 def format_number(v: float, std: float | None = None) -> str:

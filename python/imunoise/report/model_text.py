@@ -15,7 +15,53 @@ from imunoise.noise import NoiseModel, gm_white_density, resolution_noise
 from imunoise.noise._model import table_cell
 from imunoise.report.formatting import format_number
 
-__all__ = ["comparison_rows", "datasheet_rows", "lab_rows", "model_sentences"]
+__all__ = ["REPORT_UNITS", "comparison_rows", "datasheet_rows", "lab_rows",
+           "model_sentences", "record_uncertainty", "report_units", "units_of"]
+
+#: The report's units when none are asked for: one family per sensor (the gyro's in
+#: degrees and hours, the accelerometer's in µg), so a table never mixes mg and µg
+#: for one accelerometer.
+REPORT_UNITS: dict[str, dict[str, str]] = {
+    "gyro": dict(_units.DEFAULT_UNITS["gyro"]),
+    "accel": {"Q": "m/s", "N": "ug/sqrt(Hz)", "B": "ug", "K": "ug/sqrt(s)", "R": "ug/s"},
+}
+
+
+def report_units(units, spec=None) -> dict[str, dict[str, str]]:
+    """``{sensor: {term: unit}}`` of every table of a report: ``None`` the report's
+    own (:data:`REPORT_UNITS`); ``"datasheet"`` the datasheet's own units where
+    ``spec`` gives the term (the VN-100's °/s/√Hz, °/h, mg/√Hz, mg), the rest in
+    the same family (an accelerometer's K in mg/√s beside B in mg), else
+    :data:`imunoise.units.DATASHEET_UNITS`; a dict of term -> unit is used as
+    given for every sensor."""
+    if isinstance(units, dict):
+        return {s: dict(units) for s in _units.SENSORS}
+    if units is None:
+        return {s: dict(u) for s, u in REPORT_UNITS.items()}
+    out = {s: _units.unit_choice("datasheet", s) for s in _units.SENSORS}
+    given = set()
+    for item in datasheet.load_spec(spec).items if spec is not None else ():
+        if item.sensor in out:
+            out[item.sensor][item.term] = _units.unit_info(item.term, item.unit,
+                                                          item.sensor).name
+            given.add((item.sensor, item.term))
+    accel = out["accel"]
+    for prefix in ("mg", "ug"):  # the accelerometer's family, from its B
+        if accel.get("B", "").startswith(prefix):
+            for term, unit in (("N", f"{prefix}/sqrt(Hz)"), ("K", f"{prefix}/sqrt(s)"),
+                               ("R", f"{prefix}/s")):
+                if ("accel", term) not in given:
+                    accel[term] = unit
+    return out
+
+
+def units_of(units, sensor: str):
+    """One sensor's units out of :func:`report_units`' mapping (or ``units`` as
+    given: ``None``, ``"datasheet"``, a dict of term -> unit)."""
+    if isinstance(units, dict) and units and set(units) <= set(_units.SENSORS):
+        return units.get(sensor)
+    return units
+
 
 #: Coverage (share of taus the model follows) below which the report says that
 #: the coefficients only summarise the curve.
@@ -36,7 +82,7 @@ def datasheet_rows(model: NoiseModel, sensor: str, units: str | dict | None = No
     """
     axes = axis_names(model.channels)
     out = []
-    for r in model.table(sensor, axes=axes, units=units):
+    for r in model.table(sensor, axes=axes, units=units_of(units, sensor)):
         cells = [r["quantity"], r["term"], r["label"] if symbols else r["unit"]]
         cells += [table_cell(r, a, format_number) for a in axes]
         out.append(cells)
@@ -55,7 +101,7 @@ def lab_rows(models: dict[str, NoiseModel], spec,
     for sensor, model in models.items():
         names = axis_names(model.channels)
         axes = axes or names
-        for r in model.lab_table(sensor, spec=spec, units=units, axes=names):
+        for r in model.lab_table(sensor, spec=spec, units=units_of(units, sensor), axes=names):
             cells = [sensor, f"{r['quantity']} ({r['term']})", r["label"]]
             cells += [table_cell(r, a, format_number) for a in names]
             cells += [""] * (len(axes) - len(names))
@@ -77,7 +123,7 @@ def model_sentences(model: NoiseModel, sensor: str,
     if steps is not None and len(steps) != model.channels:
         raise ValueError(f"steps must have one value per channel ({model.channels}); "
                          f"got {len(steps)}")
-    chosen = _units.unit_choice(units, sensor)
+    chosen = _units.unit_choice(units_of(units, sensor), sensor)
     b_unit = _units.unit_info("B", chosen.get("B"), sensor)
     n_unit = _units.unit_info("N", chosen.get("N"), sensor)
     q_unit = _units.unit_info("Q", chosen.get("Q"), sensor)
@@ -273,25 +319,67 @@ def _readoff_agreement(model: NoiseModel, c: int, term: str, unit, sensor: str) 
 
 
 def comparison_rows(models: dict[str, NoiseModel], spec,
-                    units: str | dict | None = None) -> tuple[list[str], list[list[str]]]:
+                    units: str | dict | None = None, *,
+                    seconds: dict[str, float] | None = None,
+                    ) -> tuple[list[str], list[list[str]]]:
     """Measured vs datasheet (:func:`imunoise.datasheet.compare`) as text rows, the
     measured and specified values in ``units`` (as for :meth:`NoiseModel.table`: the
-    report's one unit per quantity, whatever unit the datasheet file uses)."""
+    report's one unit per quantity, whatever unit the datasheet file uses).
+
+    ``seconds`` (per sensor, the length of the record the model was fitted to):
+    the ``±`` of a measured value and its verdict use the larger of the fit's
+    standard uncertainty and :func:`record_uncertainty` — what the Allan deviation
+    at the τ the term is read at can claim from a record this long (the plan
+    line's uncertainty, at 68.3 %). A fit's standard uncertainty alone can be far
+    smaller (it pools every τ) and fail a sensor that meets its datasheet."""
     cmp = datasheet.compare(models, spec)
     header = ["sensor", "quantity", "axis", "unit", "measured", "spec", "ratio", "verdict"]
+    relative = {sensor: record_uncertainty(m, seconds[sensor])
+                for sensor, m in models.items() if seconds and sensor in seconds}
     out = []
     for r in cmp.rows:
         bound = {"max": "<", "min": ">"}.get(r["limit"], "typ.")
         term, sensor = r["term"], r["sensor"]
-        unit = _units.unit_info(term, _units.unit_choice(units, sensor).get(term), sensor)
-        measured, std, spec_value = (
+        word, remark, std = r["verdict"], r.get("remark", ""), r["std"]
+        rel = relative.get(sensor, {}).get(term, math.nan)
+        if math.isfinite(r["measured"]) and math.isfinite(rel) and rel * r["measured"] > std:
+            std = rel * r["measured"]
+            if r["limit"] in ("max", "min"):
+                word, remark = datasheet.verdict(r["measured"], std, r["spec"], r["limit"])
+        unit = _units.unit_info(term, _units.unit_choice(units_of(units, sensor), sensor)
+                                .get(term), sensor)
+        if math.isfinite(r.get("upper", math.nan)):  # the bound in the table's unit
+            upper = _units.convert(_units.convert_back(r["upper"], term, r["unit"],
+                                                       sensor=sensor), term, unit.name,
+                                   sensor=sensor)
+            remark = f"{'' if word == 'not resolved' else 'not resolved, '}at most " \
+                     f"{float(upper):.3g} {unit.label} (95 % bound)"
+        measured, std_shown, spec_value = (
             _units.convert(_units.convert_back(v, term, r["unit"], sensor=sensor), term,
                            unit.name, sensor=sensor)
-            for v in (r["measured"], r["std"], r["spec"]))
+            for v in (r["measured"], std, r["spec"]))
         out.append([
             sensor, f"{r['quantity']} ({term})", r["axis"], unit.label,
-            format_number(measured, std), f"{bound} {format_number(spec_value)}",
-            format_number(r["ratio"], r["ratio_std"]),
-            r["verdict"] + (f" ({r['remark']})" if r.get("remark") else ""),
+            format_number(measured, std_shown), f"{bound} {format_number(spec_value)}",
+            format_number(r["ratio"], std / r["spec"] if math.isfinite(std) else math.nan),
+            word + (f" ({remark})" if remark else ""),
         ])
     return header, out
+
+
+#: Confidence of :func:`record_uncertainty`: one standard uncertainty.
+ONE_SIGMA = 0.6826894921370859
+
+
+def record_uncertainty(model: NoiseModel, seconds: float) -> dict[str, float]:
+    """Relative standard uncertainty (68.3 %) of N, B and K that a record of
+    ``seconds`` allows, from the Allan deviation's degrees of freedom at the τ each
+    is read at (:func:`imunoise.plan`, as the report's plan lines); ``{}`` where
+    the planner has nothing to say."""
+    from imunoise.planner import plan
+
+    try:
+        p = plan(model, fs=model.fs, confidence=ONE_SIGMA)
+    except ValueError:
+        return {}
+    return {k: v for k, v in p.uncertainty(seconds).items() if math.isfinite(v)}

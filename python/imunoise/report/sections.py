@@ -20,16 +20,19 @@ from imunoise._schema import CHANNELS, SAMPLE_SENSORS, axis_names
 from imunoise.numbers import format_value
 from imunoise.planner import fit_line
 from imunoise.report.formatting import (
+    docs_link,
     format_duration,
     format_number,
     missing_text,
     terms_used,
+    unit_text,
 )
 from imunoise.report.model_text import (
     comparison_rows,
     datasheet_rows,
     lab_rows,
     model_sentences,
+    units_of,
 )
 
 if TYPE_CHECKING:
@@ -62,15 +65,43 @@ GAP_ROWS = 10
 GAP_SHADE = plot.SHADED_GAPS
 
 
+def _unit(sensor: str) -> str:
+    """Unit of a sensor's samples as the report writes it (``"m/s²"``)."""
+    return unit_text(CHANNELS[sensor][1])
+
+
 def _unit_of(channel: str) -> str:
     """Unit of a channel named like ``"gyro X"``; "" for a name that is no log channel's."""
     sensor = channel.split(" ")[0]
-    return CHANNELS[sensor][1] if sensor in CHANNELS else ""
+    return _unit(sensor) if sensor in CHANNELS else ""
 
 
 def _which(label: str) -> str:
     """How the text names a log: "the log" (one log for both) or "the short log"."""
     return "the log" if label == "both" else f"the {label} log"
+
+
+def _short(ctx: Context) -> str:
+    """How the text names the log of the statistics: "the log" when one log is given
+    (there is no long log to tell it from), else "the short log"."""
+    return "the log" if ctx.one_log else "the short log"
+
+
+def _tag(ctx: Context, extra: str = "") -> str:
+    """A caption's or title's note of which log: " (short log)", nothing for one
+    log; ``extra`` joins it ("; std …")."""
+    parts = ([] if ctx.one_log else ["short log"]) + ([extra] if extra else [])
+    return f" ({'; '.join(parts)})" if parts else ""
+
+
+def _off_scale(dists) -> str:
+    """The caption sentence for histograms that count samples beyond their range
+    ("" when none of ``dists`` has any)."""
+    if not any(d.off_scale_below or d.off_scale_above for d in dists):
+        return ""
+    return (". The numbers in a panel's upper corners (\"← 5\", \"7 →\") count the samples "
+            "beyond the plotted range, below it on the left and above it on the right; "
+            "the fit and the tables use them.")
 
 
 def recording_summary(ctx: Context, doc: Doc) -> None:
@@ -113,7 +144,7 @@ def recording_summary(ctx: Context, doc: Doc) -> None:
             y = getattr(log, sensor)
             if y is None:
                 continue
-            unit = CHANNELS[sensor][1]
+            unit = _unit(sensor)
             which = _which(label)
             fig = plot.time_series(y, log.fs, title=f"{sensor} ({which})", unit=unit,
                                    gaps=shade)
@@ -125,13 +156,13 @@ def recording_summary(ctx: Context, doc: Doc) -> None:
 def sample_statistics(ctx: Context, doc: Doc) -> None:
     """Mean, std, variance, min, max and drift per channel of the short log."""
     desc = ctx.description
-    doc.p(f"Short log, {desc.n} samples at {format_number(desc.fs)} Hz; std and variance "
-          "with ddof = 1; drift is the least-squares slope against time.")
+    doc.p(f"{_short(ctx)[4:].capitalize()}, {desc.n} samples at {format_number(desc.fs)} Hz; "
+          "std and variance with ddof = 1; drift is the least-squares slope against time.")
     doc.table(
         ["channel", "unit", "mean", "std", "variance", "min", "max", "drift [unit/h]"],
-        [[r["name"], r["unit"], *(format_number(r[k]) for k in
+        [[r["name"], unit_text(r["unit"]), *(format_number(r[k]) for k in
           ("mean", "std", "var", "min", "max", "drift_per_hour"))] for r in desc.rows()],
-        caption="Sample statistics (short log)",
+        caption=f"Sample statistics{_tag(ctx)}",
     )
 
 
@@ -144,7 +175,7 @@ def distribution_fits(ctx: Context, doc: Doc) -> None:
           "as sizes of the departure from normal.")
     rows, bins = [], []
     for sensor, per_axis in ctx.sensor_distributions.items():
-        unit = CHANNELS[sensor][1]
+        unit = _unit(sensor)
         for name, d in per_axis.items():
             rows.append([
                 name, unit, format_number(d.mu, d.mu_std), format_number(d.sigma, d.sigma_std),
@@ -155,16 +186,17 @@ def distribution_fits(ctx: Context, doc: Doc) -> None:
                          format_number(d.level_spacing) if d.level_spacing else "—",
                          str(len(d.counts))])
         fig = plot.histograms(list(per_axis.values()),
-                              title=f"{sensor} distribution (short log)", unit=unit)
+                              title=f"{sensor} distribution{_tag(ctx)}", unit=unit)
         ctx.add_figure(doc, fig, f"hist_{sensor}",
-                       f"Histogram of {sensor} with the fitted normal density")
+                       f"Histogram of {sensor} with the fitted normal density"
+                       + _off_scale(per_axis.values()))
     doc.table(
         ["channel", "unit", "μ", "σ", "KS D", "KS p", "AD A²", "skewness", "excess kurtosis"],
         rows,
-        caption="Distribution fits (short log)",
+        caption=f"Distribution fits{_tag(ctx)}",
     )
     doc.table(["channel", "unit", "quantization step", "level spacing", "bins"], bins,
-              caption="Histogram bins (short log): the sensor's quantization step and the "
+              caption=f"Histogram bins{_tag(ctx)}: the sensor's quantization step and the "
                       "spacing of the levels it uses")
 
 
@@ -198,17 +230,19 @@ def attitude(ctx: Context, doc: Doc) -> None:
         ["angle", "unit", "mean", "std", "variance", "min", "max", "KS D", "KS p", "AD A²",
          "skewness", "excess kurtosis"],
         rows,
-        caption="Attitude statistics and normality (short log; std and variance with ddof = 1)",
+        caption="Attitude statistics and normality"
+                + _tag(ctx, "std and variance with ddof = 1"),
     )
     names = list(angles)
     fig = plot.time_series([angles[n] for n in names], ctx.short.fs,  # not stacked: a copy
-                           title="attitude (short log)", unit="deg", names=names)
+                           title=f"attitude{_tag(ctx)}", unit="deg", names=names)
     ctx.add_figure(doc, fig, "timeseries_attitude",
-                   "Yaw (about its circular mean), pitch and roll of the short log [deg]")
-    fig = plot.histograms([dists[n] for n in names], title="attitude distribution (short log)",
+                   f"Yaw (about its circular mean), pitch and roll of {_short(ctx)} [deg]")
+    fig = plot.histograms([dists[n] for n in names], title=f"attitude distribution{_tag(ctx)}",
                           unit="deg", names=names)
     ctx.add_figure(doc, fig, "hist_attitude",
-                   "Histograms of yaw, pitch and roll with the fitted normal density")
+                   "Histograms of yaw, pitch and roll with the fitted normal density"
+                   + _off_scale(dists.values()))
 
 
 def allan_deviation(ctx: Context, doc: Doc) -> None:
@@ -220,7 +254,7 @@ def allan_deviation(ctx: Context, doc: Doc) -> None:
           f"{next(iter(allan.values())).confidence:.1%} confidence level (χ² with Greenhall "
           "EDF)." if allan else "The log has no gyro or accelerometer channel.")
     for sensor, r in allan.items():
-        unit = CHANNELS[sensor][1]
+        unit = _unit(sensor)
         model = models.get(sensor)
         fig = plot.allan(r, model, title=f"{sensor} Allan deviation", unit=unit)
         doc.h(3, sensor)
@@ -248,11 +282,13 @@ def noise_coefficients(ctx: Context, doc: Doc) -> None:
           "IEEE 952 Annex C), a resonance (a damped oscillator) and a bounded motion of the "
           "mount, on ln σ², each octave of τ weighted alike, the terms chosen by BIC; "
           "standard uncertainties from the fit "
-          "(docs/noise.md). Read-offs: N on the −½ line at τ = 1 s, B = σ_min/0.664.")
+          f"({docs_link('noise', 'noise model')}). Read-offs: N on the −½ line at τ = 1 s, "
+          "B = σ_min/0.664.")
     if ctx.models:
         header, rows = lab_rows(ctx.models, ctx.spec, ctx.units)
         doc.table(header, rows, caption="Lab table: N, B and K per axis"
-                  + (f" beside the datasheet ({ctx.spec}), in one unit" if ctx.spec else ""))
+                  + (f" beside the datasheet ({ctx.spec}), in one unit" if ctx.spec else "")
+                  + "; ± the fit's standard uncertainty (1σ)")
     for sensor, m in ctx.models.items():
         header, rows = datasheet_rows(m, sensor, ctx.units, symbols=True)
         doc.table(header, rows, caption=f"{sensor} noise coefficients per axis")
@@ -264,7 +300,12 @@ def noise_coefficients(ctx: Context, doc: Doc) -> None:
             doc.p(sentence)
         r = ctx.allan.get(sensor)
         if r is not None:  # how long to record for the coefficients (imunoise plan)
-            doc.p(fit_line(m, r.fs, r.n_samples / r.fs).replace("plan:", f"Plan ({sensor}):"))
+            line = fit_line(m, r.fs, r.n_samples / r.fs).replace("plan:", f"Plan ({sensor}):")
+            if "resolves" in line:  # what its ± are: not the table's
+                line += (" (95 % intervals of a read-off of the Allan curve in a record "
+                         "this long; the ± in the tables above are the fit's 1σ, and the "
+                         "datasheet comparison uses the larger of the two)")
+            doc.p(line + ".")
 
 
 def datasheet_comparison(ctx: Context, doc: Doc) -> None:
@@ -272,8 +313,15 @@ def datasheet_comparison(ctx: Context, doc: Doc) -> None:
     if ctx.spec is None:
         doc.p("No datasheet given (`--spec`).")
         return
-    header, rows = comparison_rows(ctx.models, ctx.spec, ctx.units)
+    seconds = {sensor: r.n_samples / r.fs for sensor, r in ctx.allan.items()}
+    header, rows = comparison_rows(ctx.models, ctx.spec, ctx.units, seconds=seconds)
     doc.table(header, rows, caption=f"Measured vs datasheet ({ctx.spec})")
+    doc.p("The ± of a measured value here is its standard uncertainty (1σ): the larger of "
+          "the fit's (the tables above) and what the Allan deviation at the τ the term is "
+          "read at allows from a record this long (the plan lines' uncertainty, at "
+          "68.3 %). A limit passes when the value plus 1.645 of it (one-sided 95 %) is "
+          "below the limit, fails when the value minus 1.645 of it is above, and is "
+          "\"not significant\" in between; a typical value is no limit.")
 
 
 
@@ -321,7 +369,8 @@ def power_spectral_density(ctx: Context, doc: Doc) -> None:
           "read off the white region chosen automatically (below a sensor filter's bend or a "
           "spectral line) as √(level/2), the IEEE convention of the noise model (the "
           "one-sided ASD level is √2·N); the noise model fitted to the same log's Allan "
-          "deviation is drawn over it and its N compared (docs/spectrum.md).")
+          "deviation is drawn over it and its N compared "
+          f"({docs_link('spectrum')}).")
     for sensor in ("gyro", "accel"):
         y = getattr(ctx.short, sensor)
         if y is None:
@@ -342,7 +391,7 @@ def power_spectral_density(ctx: Context, doc: Doc) -> None:
             _stream.adev(y, ctx.short.fs, ctx.taus_per_decade, ctx.streamed, ctx.block),
             warn_coverage=False, spectrum=s)
         _stream.release(y)
-        unit = CHANNELS[sensor][1]
+        unit = _unit(sensor)
         doc.h(3, sensor)
         ctx.add_figure(doc, plot.spectrum(s, model, unit=unit, title=f"{sensor} PSD"),
                        f"psd_{sensor}", f"PSD of {sensor} [({unit})²/Hz], white band shaded, "
@@ -352,7 +401,8 @@ def power_spectral_density(ctx: Context, doc: Doc) -> None:
         n, n_std = np.atleast_1d(s.N), np.atleast_1d(s.N_std)
         band = np.reshape(s.band, (-1, 2))
         # N in the unit of every other table of the report
-        n_unit = units.unit_info("N", units.unit_choice(ctx.units, sensor).get("N"), sensor)
+        chosen = units.unit_choice(units_of(ctx.units, sensor), sensor)
+        n_unit = units.unit_info("N", chosen.get("N"), sensor)
         in_n_unit = partial(units.convert, term="N", unit=n_unit.name, sensor=sensor)
         rows = []
         for j, a in enumerate(axis_names(s.channels)):
@@ -419,9 +469,9 @@ def events_section(ctx: Context, doc: Doc) -> None:
     and normal fits with and without them."""
     found, log = ctx.events, ctx.short
     doc.p(f"Spikes (Hampel test) and bursts (sliding energy, window "
-          f"{format_duration(found.window / found.fs)}) per channel of the short log, "
+          f"{format_duration(found.window / found.fs)}) per channel of {_short(ctx)}, "
           f"thresholds set for {found.false_alarm:.0e} false events per sample and channel "
-          "(measured on white noise: docs/events.md). "
+          f"(measured on white noise: {docs_link('events')}). "
           f"{len(found)} events cover {100 * found.share:.3g} % of the samples.")
     # with --trim auto on one log the short log starts at the settle point: times
     # are given from the first sample of the recording
@@ -455,7 +505,7 @@ def events_section(ctx: Context, doc: Doc) -> None:
           numbers.cell(found.duration[i], digits=3), kind(i), ", ".join(found.channels[i]),
           f"{found.peak[i]:.3g}", loudest(i)]
          for i in sorted(order)],
-        caption=f"Events of the short log ({min(len(found), EVENT_ROWS)} largest of "
+        caption=f"Events of {_short(ctx)} ({min(len(found), EVENT_ROWS)} largest of "
                 f"{len(found)})",
     )
     rows = []
@@ -463,10 +513,10 @@ def events_section(ctx: Context, doc: Doc) -> None:
         y = getattr(log, sensor)
         if y is None:
             continue
-        fig = plot.events(y, found, log.fs, title=f"{sensor} with events (short log)",
-                          unit=CHANNELS[sensor][1])
+        fig = plot.events(y, found, log.fs, title=f"{sensor} with events{_tag(ctx)}",
+                          unit=_unit(sensor))
         ctx.add_figure(doc, fig, f"events_{sensor}",
-                       f"{sensor} of the short log, events shaded, peak in sigmas above")
+                       f"{sensor} of {_short(ctx)}, events shaded, peak in sigmas above")
         inside = found.mask
 
         def quiet(j, y=y, inside=inside):
@@ -490,15 +540,18 @@ def events_section(ctx: Context, doc: Doc) -> None:
                 std, std_without, with_.excess_kurtosis,
                 without.excess_kurtosis, with_.ks_statistic, without.ks_statistic))])
         _stream.release(y)
-        fig = plot.histograms(kept, title=f"{sensor} without events (short log)",
-                              unit=CHANNELS[sensor][1])
+        fig = plot.histograms(kept, title=f"{sensor} without events{_tag(ctx)}",
+                              unit=_unit(sensor))
         ctx.add_figure(doc, fig, f"hist_{sensor}_no_events",
-                       f"Histogram of {sensor} with the events left out, fitted normal")
+                       f"Histogram of {sensor} with the events left out, fitted normal"
+                       + _off_scale(kept))
     doc.table(["channel", "std", "std without events", "excess kurtosis",
                "without events", "KS D", "without events"], rows,
-              caption="Statistics and normal fits with and without the events (short log)")
+              caption="Statistics and normal fits with and without the events"
+                      + _tag(ctx))
     doc.p("`imunoise.events(log).exclude(log)` makes the events missing samples; the "
-          "Allan statistics then skip every term that touches one (docs/gaps.md).")
+          "Allan statistics then skip every term that touches one "
+          f"({docs_link('gaps')}).")
 
 
 #: Padding (s) around each event of the long log when it is left out of the Allan analysis.
@@ -568,7 +621,7 @@ def long_log_events(ctx: Context, doc: Doc) -> None:
                 outside = not lo[i, j] <= dev_out[i, j] <= hi[i, j]
                 if outside:
                     changed.append(f"{sensor} {axis} at {format_duration(tau)}")
-                rows.append([f"{sensor} {axis}", CHANNELS[sensor][1], format_duration(tau),
+                rows.append([f"{sensor} {axis}", _unit(sensor), format_duration(tau),
                              numbers.cell(dev[i, j]), numbers.cell(dev_out[i, j]),
                              f"{dev_out[i, j] / dev[i, j]:.3g}" if dev[i, j] > 0 else "—",
                              "yes" if outside else "no"])
@@ -627,7 +680,8 @@ def warmup_section(ctx: Context, doc: Doc) -> None:
           f"a transient counts when it explains the means better than the sensor's own "
           f"stationary noise does (parametric bootstrap of its noise model, p < {w.alpha:g}) "
           "and has settled when what is left of it is below "
-          "the channel's Allan-deviation floor (docs/events.md).")
+          "the channel's Allan-deviation floor "
+          f"({docs_link('events')}).")
     doc.table(
         ["channel", "unit of A and tolerance", "A", "τ", "p", "tolerance", "settled after"],
         [[r["name"], _unit_of(r["name"]),
@@ -676,7 +730,7 @@ def thermal_section(ctx: Context, doc: Doc) -> None:
           "warm-up or drift cannot be told apart; a log with temperature cycles separates "
           "them).")
     doc.table(["channel", "slope", "unit", "R²"],
-              [[r["name"], format_number(r["slope"], r["slope_std"]), r["unit"],
+              [[r["name"], format_number(r["slope"], r["slope_std"]), unit_text(r["unit"]),
                 format_number(r["r_squared"])] for r in th.rows()],
               caption="Bias temperature sensitivity (datasheet units)")
     ctx.add_figure(doc, plot.thermal(th), "thermal", "Bias against temperature with the fit")
@@ -693,6 +747,6 @@ def thermal_section(ctx: Context, doc: Doc) -> None:
         after = _allan.adev(th.compensated[:, k:k + 3], log.fs, taus=before.taus)
         k += 3
         fig = plot.compensation(before, after, title=f"{sensor}: temperature compensation",
-                                unit=CHANNELS[sensor][1])
+                                unit=_unit(sensor))
         ctx.add_figure(doc, fig, f"thermal_adev_{sensor}",
                        f"Allan deviation of {sensor} before and after compensation")
