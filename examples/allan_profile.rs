@@ -52,7 +52,12 @@ fn main() {
         check += p.c[n / 2];
     });
     stage("octave sweep", reps, || {
-        check += sums_of_squares(std::hint::black_box(&phases[0].c), &ms, Difference::Second)[0];
+        check += sums_of_squares(
+            std::hint::black_box(&phases[0].c),
+            &ms,
+            Difference::Second,
+            &_core::interrupt::NEVER,
+        )[0];
     });
     let oadev = Statistic::Allan { overlapping: true };
     stage("analyse (sweep, noise id, edf)", reps, || {

@@ -80,3 +80,29 @@ def test_direct_warnings_name_an_imunoise_kind():
             (k.value for k in node.keywords if k.arg == "category"), None)
         assert isinstance(category, ast.Name) and category.id in kinds, (
             f"{path.relative_to(PACKAGE)}:{node.lineno}")
+
+
+@pytest.mark.parametrize("call", [
+    lambda: imunoise.adev(np.ones(100), -1.0),                      # Python's check
+    lambda: imunoise.adev(np.ones(100), 1.0, taus="fortnightly"),  # Python's check
+    lambda: imunoise._core.simd.force("avx1024"),                  # the Rust binding's
+    lambda: imunoise.fit(np.ones(3)),                              # a wrong type
+    lambda: imunoise.read(b"no imu here\n1,2\n"),                  # a reader's
+])
+def test_one_except_catches_every_imunoise_error(call):
+    with pytest.raises(imunoise.ImunoiseError) as caught:
+        call()
+    assert isinstance(caught.value, ValueError | TypeError)
+
+
+def test_no_module_raises_a_bare_builtin_error():
+    """Every raise site names an imunoise class (a test, not a convention on trust)."""
+    bad = []
+    for path in sorted(PACKAGE.rglob("*.py")):
+        tree = ast.parse(path.read_text(encoding="utf-8"))
+        for node in ast.walk(tree):
+            if isinstance(node, ast.Raise) and node.exc is not None:
+                exc = node.exc.func if isinstance(node.exc, ast.Call) else node.exc
+                if isinstance(exc, ast.Name) and exc.id in ("ValueError", "TypeError"):
+                    bad.append(f"{path.relative_to(PACKAGE)}:{node.lineno}")
+    assert not bad, bad

@@ -36,7 +36,7 @@ from collections.abc import Iterable, Iterator
 from pathlib import Path
 from typing import BinaryIO
 
-from imunoise.errors import DataWarning
+from imunoise.errors import DataWarning, ImunoiseValueError
 
 __all__ = [
     "TEMP_TAG",
@@ -141,7 +141,7 @@ def refuse_input(target, inputs: Iterable) -> None:
         except OSError:
             continue
         if same:
-            raise ValueError(
+            raise ImunoiseValueError(
                 f"output {target!r} is the input {source!r}: writing it would destroy the "
                 f"input; choose another output"
             )

@@ -7,6 +7,7 @@ import numpy as np
 
 from imunoise import _schema
 from imunoise._validate import sample_rate
+from imunoise.errors import ImunoiseTypeError, ImunoiseValueError
 from imunoise.readers.log import ImuLog
 
 
@@ -91,11 +92,11 @@ def _wanted(data: ImuLog, channels) -> list[str]:
         wanted = [channels] if isinstance(channels, str) else list(channels)
         missing = [c for c in wanted if c not in data.channels]
         if missing:
-            raise ValueError(
+            raise ImunoiseValueError(
                 f"channels {missing} are not in the log; it has {list(data.channels)}"
             )
     if not wanted:
-        raise ValueError(f"data has no gyro or accel channel; got {list(data.channels)}")
+        raise ImunoiseValueError(f"data has no gyro or accel channel; got {list(data.channels)}")
     return wanted
 
 
@@ -113,17 +114,17 @@ def rate_channels(data, fs, channels) -> tuple[np.ndarray, float, tuple[str, ...
         x = np.hstack(blocks)
     else:
         if channels is not None:
-            raise ValueError("channels= selects log channels; data is an array")
+            raise ImunoiseValueError("channels= selects log channels; data is an array")
         if fs is None:
-            raise ValueError("fs is required when data is an array")
+            raise ImunoiseValueError("fs is required when data is an array")
         try:
             x = np.asarray(data, dtype=np.float64)
         except (TypeError, ValueError) as exc:
-            raise TypeError(f"data must be an ImuLog or numeric array; got {exc}") from None
+            raise ImunoiseTypeError(f"data must be an ImuLog or numeric array; got {exc}") from None
         if x.ndim not in (1, 2):
-            raise ValueError(f"data must have shape (n,) or (n, k); got {x.shape}")
+            raise ImunoiseValueError(f"data must have shape (n,) or (n, k); got {x.shape}")
         if np.isinf(x).any():
-            raise ValueError("data has infinite values (NaN marks a missing sample)")
+            raise ImunoiseValueError("data has infinite values (NaN marks a missing sample)")
         x = x.reshape(len(x), -1)
         names = ["x"] if x.shape[1] == 1 else [f"ch{j}" for j in range(x.shape[1])]
     return x, sample_rate(fs), tuple(names)

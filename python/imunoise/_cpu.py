@@ -18,6 +18,7 @@ from contextlib import contextmanager
 from pathlib import Path
 
 from imunoise._core import simd as _simd
+from imunoise.errors import ImunoiseValueError
 
 #: The environment variable that pins the level.
 ENVIRONMENT = "IMUNOISE_SIMD"
@@ -29,7 +30,7 @@ def apply_environment() -> None:
     if not name:
         return
     if name not in _simd.levels():
-        raise ValueError(f"{ENVIRONMENT} must be one of {', '.join(_simd.levels())}; "
+        raise ImunoiseValueError(f"{ENVIRONMENT} must be one of {', '.join(_simd.levels())}; "
                          f"got {os.environ[ENVIRONMENT]!r}")
     _simd.force(name)
 

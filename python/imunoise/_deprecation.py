@@ -13,7 +13,7 @@ from collections.abc import Callable, Mapping, Sequence
 from typing import TypeVar
 
 from imunoise import _warn
-from imunoise.errors import ImunoiseDeprecationWarning
+from imunoise.errors import ImunoiseDeprecationWarning, ImunoiseTypeError
 
 F = TypeVar("F", bound=Callable)
 
@@ -43,20 +43,21 @@ def old_call_forms(
             for old, new in renamed.items():
                 if old in kwargs:
                     if new in kwargs:
-                        raise TypeError(f"{name}() got both {new!r} and its old name {old!r}")
+                        raise ImunoiseTypeError(
+                            f"{name}() got both {new!r} and its old name {old!r}")
                     _deprecated(f"{name}({old}=...) is deprecated; use {new}=")
                     kwargs[new] = kwargs.pop(old)
             extra = args[n_positional:]
             if extra:
                 if len(extra) > len(keyword_only):
-                    raise TypeError(
+                    raise ImunoiseTypeError(
                         f"{name}() takes at most {n_positional + len(keyword_only)} "
                         f"positional arguments; got {len(args)}"
                     )
                 moved = keyword_only[: len(extra)]
                 for option, value in zip(moved, extra, strict=True):
                     if option in kwargs:
-                        raise TypeError(f"{name}() got multiple values for {option!r}")
+                        raise ImunoiseTypeError(f"{name}() got multiple values for {option!r}")
                     kwargs[option] = value
                 _deprecated(
                     f"passing {', '.join(moved)} to {name}() by position is deprecated; "

@@ -63,6 +63,7 @@ from imunoise import _blocks, _summary
 from imunoise._channels import rate_columns
 from imunoise._runs import true_runs
 from imunoise._validate import positive_finite
+from imunoise.errors import ImunoiseValueError
 from imunoise.readers.log import ImuLog
 
 __all__ = ["Events", "events", "FALSE_ALARM", "OVERLAP_FACTOR", "CHANGE_POINT_DOF",
@@ -194,7 +195,7 @@ class Events:
     def padded_mask(self, pad: float = 0.0) -> np.ndarray:
         """:attr:`mask` with every event widened by ``pad`` seconds on each side."""
         if pad < 0 or not np.isfinite(pad):
-            raise ValueError(f"pad must be >= 0 and finite (s); got {pad!r}")
+            raise ImunoiseValueError(f"pad must be >= 0 and finite (s); got {pad!r}")
         extra = int(np.ceil(pad * self.fs))
         out = np.zeros(self.n_samples, dtype=bool)  # a byte per sample, nothing wider
         lo = np.clip(self.start_index - extra, 0, self.n_samples)
@@ -224,7 +225,7 @@ class Events:
         mask = self.padded_mask(pad)
         if isinstance(data, ImuLog):
             if len(data) != self.n_samples:
-                raise ValueError(
+                raise ImunoiseValueError(
                     f"data has {len(data)} samples; the events are for {self.n_samples}"
                 )
             changed = {}
@@ -235,7 +236,7 @@ class Events:
             return replace(data, gaps=None, **changed)
         arr = np.array(data, dtype=np.float64)
         if arr.ndim not in (1, 2) or arr.shape[0] != self.n_samples:
-            raise ValueError(
+            raise ImunoiseValueError(
                 f"data must have shape ({self.n_samples},) or ({self.n_samples}, k); "
                 f"got {arr.shape}"
             )
@@ -262,7 +263,7 @@ class Events:
         cols, _fs, names = rate_columns(data, None if isinstance(data, ImuLog) else self.fs,
                                         None)
         if cols.n != self.n_samples or names != self.names:
-            raise ValueError(f"data must be the record of the events ({self.n_samples} "
+            raise ImunoiseValueError(f"data must be the record of the events ({self.n_samples} "
                              f"samples of {', '.join(self.names)}); got {cols.n} samples "
                              f"of {', '.join(names)}")
         baseline = positive_finite(baseline, "baseline", unit="s")
@@ -372,16 +373,17 @@ def events(
     """
     cols, fs, names = rate_columns(data, fs, channels)
     if isinstance(false_alarm, bool) or not (0 < float(false_alarm) < 0.01):
-        raise ValueError(f"false_alarm must be in (0, 0.01) per sample; got {false_alarm!r}")
+        raise ImunoiseValueError(
+            f"false_alarm must be in (0, 0.01) per sample; got {false_alarm!r}")
     false_alarm = float(false_alarm)
     window = positive_finite(window, "window", unit="s")
     baseline = positive_finite(baseline, "baseline", unit="s")
     if isinstance(merge, bool) or not (np.isfinite(merge) and merge >= 0):
-        raise ValueError(f"merge must be >= 0 and finite (s); got {merge!r}")
+        raise ImunoiseValueError(f"merge must be >= 0 and finite (s); got {merge!r}")
     n = cols.n
     w = max(MIN_WINDOW, int(round(window * fs)))
     if n < 2 * w:
-        raise ValueError(f"data needs at least 2·window = {2 * w} samples; got {n}")
+        raise ImunoiseValueError(f"data needs at least 2·window = {2 * w} samples; got {n}")
     block = max(2 * w, int(round(baseline * fs)))
     k_spike = float(_sstats.norm.isf(false_alarm / 4))
     # a short burst is diluted in a long window: the energy test runs at w, w/2, w/4

@@ -50,6 +50,7 @@ from imunoise import _summary
 from imunoise import numbers as _numbers
 from imunoise import units as _units
 from imunoise.datasheet import VERDICTS, Spec, load_spec
+from imunoise.errors import ImunoiseValueError
 from imunoise.scale.batch import BATCH_SENSORS, analyse_logs, expand
 
 __all__ = ["FALSE_ALARM", "Fleet", "MAD_SCALE", "MIN_UNITS", "TERMS", "Z_CUT", "cut",
@@ -80,7 +81,7 @@ def cut(units: int, false_alarm: float = FALSE_ALARM) -> float:
     """
     units = int(units)
     if not 0.0 < false_alarm < 0.5:
-        raise ValueError(f"false_alarm must be in (0, 0.5); got {false_alarm!r}")
+        raise ImunoiseValueError(f"false_alarm must be in (0, 0.5); got {false_alarm!r}")
     if units < MIN_UNITS:
         return math.inf
     draws = max(2_000, min(_DRAWS, 20_000_000 // units))
@@ -380,7 +381,7 @@ def fleet(
     >>> # print(f.text()); f.report("fleet-report")
     """
     if not 0.0 < false_alarm < 0.5:
-        raise ValueError(f"false_alarm must be in (0, 0.5); got {false_alarm!r}")
+        raise ImunoiseValueError(f"false_alarm must be in (0, 0.5); got {false_alarm!r}")
     files = expand(logs)
     for p in files:
         if not os.path.isfile(p):
@@ -426,7 +427,7 @@ def _compare(files: list[str], results: list[list[dict]], spec: Spec | None,
                            "tau_c": tau_c, "tau_c_std": tau_c_std})
     if not rows:
         reasons = "; ".join(f"{u['unit']}: {u['error']}" for u in units)
-        raise ValueError(f"no log could be analysed ({reasons})")
+        raise ImunoiseValueError(f"no log could be analysed ({reasons})")
     stats, outliers = [], []
     groups: dict[tuple[str, str, str], list[dict]] = {}
     for r in rows:

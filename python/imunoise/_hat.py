@@ -41,6 +41,7 @@ from imunoise._core import allan as _core_allan
 from imunoise._timefreq import _grid, _result, _valid_windows, pdev, phase_points
 from imunoise._validate import confidence_level, samples
 from imunoise.allan import ONE_SIGMA, AllanResult, TauSpec, chi2_interval
+from imunoise.errors import ImunoiseValueError
 
 __all__ = ["gcodev", "three_cornered_hat", "ThreeCorneredHat", "HAT_KINDS"]
 
@@ -62,10 +63,10 @@ def _same_shape(a, b, c=None):
     first = arrays["a"]
     for name, arr in list(arrays.items())[1:]:
         if arr.shape[0] != first.shape[0]:
-            raise ValueError(f"{name} must have as many samples as a ({first.shape[0]}); "
+            raise ImunoiseValueError(f"{name} must have as many samples as a ({first.shape[0]}); "
                              f"got {arr.shape[0]}")
         if arr.shape[1] != first.shape[1]:
-            raise ValueError(f"{name} must have the {first.shape[1]} channel(s) of a; got "
+            raise ImunoiseValueError(f"{name} must have the {first.shape[1]} channel(s) of a; got "
                              f"{arr.shape[1]}")
     return arrays
 
@@ -114,7 +115,7 @@ def gcodev(a: npt.ArrayLike, b: npt.ArrayLike, fs: float, *, taus: TauSpec = "oc
     xa, broken_a, one_d, missing_a, fs = phase_points(a, fs, data_type, gaps, "gcodev")
     xb, broken_b, _, missing_b, _ = phase_points(b, fs, data_type, gaps, "gcodev")
     if xa.shape != xb.shape:  # "longest" runs of different lengths
-        raise ValueError(f"a's and b's gaps must leave runs of one length for "
+        raise ImunoiseValueError(f"a's and b's gaps must leave runs of one length for "
                          f"gaps={gaps!r}; got {xa.shape[0]} and {xb.shape[0]} phase points "
                          "(pass gaps='skip')")
     del arrays
@@ -280,7 +281,7 @@ def three_cornered_hat(a: npt.ArrayLike, b: npt.ArrayLike, c: npt.ArrayLike, fs:
     True
     """
     if not isinstance(kind, str) or kind not in HAT_KINDS:
-        raise ValueError(f"kind must be one of {', '.join(HAT_KINDS)}; got {kind!r}")
+        raise ImunoiseValueError(f"kind must be one of {', '.join(HAT_KINDS)}; got {kind!r}")
     arrays = _same_shape(a, b, c)
     confidence = confidence_level(confidence)
     one_d = np.ndim(a) == 1

@@ -12,6 +12,8 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from types import MappingProxyType
 
+from imunoise.errors import ImunoiseValueError
+
 #: Standard gravity (CGPM), m/s².
 G = 9.80665
 
@@ -71,7 +73,7 @@ def axis_names(channels: int, axes: Sequence[str] | None = None) -> list[str]:
         return [f"ch{i}" for i in range(channels)]
     axes = list(axes)
     if len(axes) != channels:
-        raise ValueError(f"axes must name {channels} channels; got {axes!r}")
+        raise ImunoiseValueError(f"axes must name {channels} channels; got {axes!r}")
     return axes
 
 

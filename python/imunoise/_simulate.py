@@ -47,6 +47,7 @@ from scipy import fft as _fft
 
 from imunoise._deprecation import old_call_forms
 from imunoise._validate import integer, sample_rate
+from imunoise.errors import ImunoiseTypeError, ImunoiseValueError
 
 __all__ = ["simulate", "flicker"]
 
@@ -58,9 +59,9 @@ def _check_coef(name: str, value) -> float:
     try:
         v = float(value)
     except (TypeError, ValueError):
-        raise TypeError(f"{name} must be a real number; got {value!r}") from None
+        raise ImunoiseTypeError(f"{name} must be a real number; got {value!r}") from None
     if not (math.isfinite(v) and v >= 0.0):
-        raise ValueError(f"{name} must be finite and >= 0; got {value!r}")
+        raise ImunoiseValueError(f"{name} must be finite and >= 0; got {value!r}")
     return v
 
 
@@ -181,7 +182,8 @@ def simulate(n_samples: int, fs: float, Q: float = 0.0, N: float = 0.0, B: float
                                                ("resonance", resonance), ("motion", motion))
                           if v is not None and len(v)]
         if given:
-            raise ValueError(f"like= replaces the coefficients; leave out {', '.join(given)}")
+            raise ImunoiseValueError(
+                f"like= replaces the coefficients; leave out {', '.join(given)}")
         from imunoise._simulate_like import simulate_like
 
         return simulate_like(like, n_samples, fs, channels=None if channels == 1 else channels,
@@ -262,12 +264,13 @@ def _size_and_rate(value, name: str, article: str, members: tuple[str, str],
     try:
         size, rate = (float(v) for v in value)
     except (TypeError, ValueError):
-        raise TypeError(f"{name} must be {article} ({size_name}, {rate_name}) pair or None; "
+        raise ImunoiseTypeError(
+            f"{name} must be {article} ({size_name}, {rate_name}) pair or None; "
                         f"got {value!r}") from None
     if not (math.isfinite(size) and size >= 0):
-        raise ValueError(f"{name} {size_name} must be finite and >= 0; got {size!r}")
+        raise ImunoiseValueError(f"{name} {size_name} must be finite and >= 0; got {size!r}")
     if not (math.isfinite(rate) and rate > 0):
-        raise ValueError(f"{name} {rate_name} must be finite and > 0 {unit}; got {rate!r}")
+        raise ImunoiseValueError(f"{name} {rate_name} must be finite and > 0 {unit}; got {rate!r}")
     return size, rate
 
 
@@ -277,20 +280,20 @@ def _check_resonance(resonance, fs: float) -> tuple[float, float, float, float] 
     try:
         values = [float(v) for v in resonance]
         if len(values) not in (3, 4):
-            raise ValueError
+            raise ImunoiseValueError
     except (TypeError, ValueError):
-        raise TypeError(f"resonance must be a (sigma, f_r, tau_r) triple, a (sigma, f_r, "
+        raise ImunoiseTypeError(f"resonance must be a (sigma, f_r, tau_r) triple, a (sigma, f_r, "
                         f"tau_r, skew) quadruple or None; got {resonance!r}") from None
     sigma, f_r, tau_r = values[:3]
     skew = values[3] if len(values) == 4 else 0.0
     if not (math.isfinite(sigma) and sigma >= 0):
-        raise ValueError(f"resonance sigma must be finite and >= 0; got {sigma!r}")
+        raise ImunoiseValueError(f"resonance sigma must be finite and >= 0; got {sigma!r}")
     if not (math.isfinite(f_r) and 0 < f_r <= fs / 2):
-        raise ValueError(f"resonance f_r must be in (0, fs/2 = {fs / 2:g}] Hz; got {f_r!r}")
+        raise ImunoiseValueError(f"resonance f_r must be in (0, fs/2 = {fs / 2:g}] Hz; got {f_r!r}")
     if not (math.isfinite(tau_r) and tau_r > 0):
-        raise ValueError(f"resonance tau_r must be finite and > 0 s; got {tau_r!r}")
+        raise ImunoiseValueError(f"resonance tau_r must be finite and > 0 s; got {tau_r!r}")
     if not abs(skew) <= 1:
-        raise ValueError(f"resonance skew must be in [-1, 1] (a non-negative spectrum); "
+        raise ImunoiseValueError(f"resonance skew must be in [-1, 1] (a non-negative spectrum); "
                          f"got {skew!r}")
     return sigma, f_r, tau_r, skew
 
@@ -320,12 +323,13 @@ def _check_gm(gm) -> list[tuple[float, float]]:
     try:
         pairs = [(float(a), float(b)) for a, b in gm]
     except (TypeError, ValueError):
-        raise TypeError(f"gm must be a sequence of (sigma, tau_c) pairs; got {gm!r}") from None
+        raise ImunoiseTypeError(
+            f"gm must be a sequence of (sigma, tau_c) pairs; got {gm!r}") from None
     for sigma, tau_c in pairs:
         if not (math.isfinite(sigma) and sigma >= 0):
-            raise ValueError(f"gm sigma must be finite and >= 0; got {sigma!r}")
+            raise ImunoiseValueError(f"gm sigma must be finite and >= 0; got {sigma!r}")
         if not (math.isfinite(tau_c) and tau_c > 0):
-            raise ValueError(f"gm tau_c must be finite and > 0; got {tau_c!r}")
+            raise ImunoiseValueError(f"gm tau_c must be finite and > 0; got {tau_c!r}")
     return pairs
 
 

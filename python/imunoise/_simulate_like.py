@@ -22,6 +22,7 @@ from __future__ import annotations
 import numpy as np
 
 from imunoise._validate import integer, sample_rate
+from imunoise.errors import ImunoiseTypeError, ImunoiseValueError
 
 __all__ = ["simulate_like"]
 
@@ -39,7 +40,7 @@ def simulate_like(source, n_samples: int, fs: float | None, *, channels: int | N
         from imunoise.noise import fit
 
         if source.kind != "adev":
-            raise ValueError(f"like= takes an Allan deviation (kind 'adev'); got kind "
+            raise ImunoiseValueError(f"like= takes an Allan deviation (kind 'adev'); got kind "
                              f"{source.kind!r}")
         source = fit(source, warn_coverage=False)
     if isinstance(source, NoiseModel):
@@ -49,10 +50,10 @@ def simulate_like(source, n_samples: int, fs: float | None, *, channels: int | N
         return _from_spectrum(f, p, n, _rate(fs, source.fs), channels, rng)
     if isinstance(source, tuple) and len(source) == 2:
         if fs is None:
-            raise ValueError("fs must be given with like=(f, psd)")
+            raise ImunoiseValueError("fs must be given with like=(f, psd)")
         f, p = (np.asarray(a, float) for a in source)
         return _from_spectrum(f, p, n, sample_rate(fs), channels, rng)
-    raise TypeError("like must be a NoiseModel (imunoise.fit), an AllanResult "
+    raise ImunoiseTypeError("like must be a NoiseModel (imunoise.fit), an AllanResult "
                     "(imunoise.adev), a Spectrum (imunoise.psd) or a pair (f, psd); got "
                     f"{type(source).__name__}")
 
@@ -60,7 +61,7 @@ def simulate_like(source, n_samples: int, fs: float | None, *, channels: int | N
 def _rate(fs, own: float) -> float:
     """The source's own rate: a different ``fs`` would change what its terms mean."""
     if fs is not None and not np.isclose(sample_rate(fs), own, rtol=1e-9):
-        raise ValueError(f"fs must be the source's own rate ({own} Hz) or None; got {fs}")
+        raise ImunoiseValueError(f"fs must be the source's own rate ({own} Hz) or None; got {fs}")
     return float(own)
 
 
@@ -73,7 +74,7 @@ def _channels(channels, available: int) -> list[int]:
     if available == 1:
         return [0] * c
     if c != available:
-        raise ValueError(f"channels must be None or {available} (the source's channels); "
+        raise ImunoiseValueError(f"channels must be None or {available} (the source's channels); "
                          f"got {c}")
     return list(range(c))
 
@@ -99,13 +100,13 @@ def _from_model(model, n: int, fs: float, channels, rng) -> np.ndarray:
 
 def _from_spectrum(f, p, n: int, fs: float, channels, rng) -> np.ndarray:
     if f.ndim != 1 or f.size < 2 or p.shape[0] != f.size:
-        raise ValueError(f"a spectrum needs ≥ 2 frequencies and a psd of as many rows; got "
+        raise ImunoiseValueError(f"a spectrum needs ≥ 2 frequencies and a psd of as many rows; got "
                          f"f {f.shape}, psd {p.shape}")
     if not (np.all(np.isfinite(f)) and np.all(f > 0) and np.all(np.diff(f) > 0)):
-        raise ValueError("spectrum frequencies must be finite, > 0 and increasing")
+        raise ImunoiseValueError("spectrum frequencies must be finite, > 0 and increasing")
     p = p.reshape(f.size, -1)
     if not (np.all(np.isfinite(p)) and np.all(p >= 0)):
-        raise ValueError("spectrum densities must be finite and >= 0")
+        raise ImunoiseValueError("spectrum densities must be finite and >= 0")
     grid = np.fft.rfftfreq(n, 1.0 / fs)
     log_f = np.log(f)
     out = np.empty((n, 0))

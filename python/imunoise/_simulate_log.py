@@ -25,7 +25,7 @@ from imunoise._deprecation import old_call_forms
 from imunoise._simulate import simulate
 from imunoise._validate import positive_finite, sample_rate
 from imunoise.datasheet import load_spec
-from imunoise.errors import AssumptionWarning
+from imunoise.errors import AssumptionWarning, ImunoiseValueError
 from imunoise.noise import FLICKER, model_variance
 from imunoise.readers.log import ImuLog
 from imunoise.units import convert_back
@@ -114,14 +114,15 @@ def still_log(hours: float, fs: float = 40.0, *, spec="vn100", seed=None) -> Imu
     fs = sample_rate(fs)
     samples = hours * 3600.0 * fs
     if samples > MAX_SAMPLES:
-        raise ValueError(
+        raise ImunoiseValueError(
             f"hours={hours:g} at fs={fs:g} Hz gives {samples:.4g} samples; at most "
             f"{MAX_SAMPLES:,} are simulated (about 400 bytes of memory each; "
             f"{MAX_SAMPLES / fs / 3600:.4g} h at this rate)"
         )
     n = int(round(samples))
     if n < 2:
-        raise ValueError(f"hours={hours:g} at fs={fs:g} Hz gives {n} samples; at least 2 needed")
+        raise ImunoiseValueError(
+            f"hours={hours:g} at fs={fs:g} Hz gives {n} samples; at least 2 needed")
     noise = noise_of_spec(spec)
     rng = np.random.default_rng(seed)
     channels = {}
@@ -163,7 +164,7 @@ def simulate_log(path: str | os.PathLike, hours: float, fs: float = 40.0, *,
         The file written; ``imunoise.read`` reads it back.
     """
     if format not in _FORMATS:
-        raise ValueError(f"format must be one of {', '.join(_FORMATS)}; got {format!r}")
+        raise ImunoiseValueError(f"format must be one of {', '.join(_FORMATS)}; got {format!r}")
     log = still_log(hours, fs, spec=spec, seed=seed)
     path = Path(os.fspath(path))
     path.parent.mkdir(parents=True, exist_ok=True)

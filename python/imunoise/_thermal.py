@@ -34,6 +34,7 @@ import numpy as np
 
 from imunoise import _schema, _summary
 from imunoise._channels import rate_channels
+from imunoise.errors import ImunoiseValueError
 from imunoise.numbers import format_value
 from imunoise.readers.log import ImuLog
 
@@ -111,7 +112,7 @@ class Thermal:
         in datasheet units (°/h/°C, mg/°C; ``/°C²`` for the quadratic), with the unit
         names; NaN for channels of unknown sensor."""
         if term not in range(1, self.degree + 1):
-            raise ValueError(f"term must be 1..{self.degree}; got {term!r}")
+            raise ImunoiseValueError(f"term must be 1..{self.degree}; got {term!r}")
         scale = np.array([DATASHEET_UNITS[s][1] if s in DATASHEET_UNITS else np.nan
                           for s in self.sensors])
         units = tuple(
@@ -195,7 +196,7 @@ def thermal(
     x, fs, names = rate_channels(data, fs, channels)
     n, k = x.shape
     if degree not in (1, 2) or isinstance(degree, bool):
-        raise ValueError(f"degree must be 1 or 2; got {degree!r}")
+        raise ImunoiseValueError(f"degree must be 1 or 2; got {degree!r}")
     temp = _temperature(data, temperature, n)
     if isinstance(data, ImuLog):
         sensors = tuple(name.split()[0] for name in names)
@@ -204,12 +205,12 @@ def thermal(
     elif sensor in DATASHEET_UNITS:
         sensors = (sensor,) * k
     else:
-        raise ValueError(f"sensor must be one of {sorted(DATASHEET_UNITS)} or None; "
+        raise ImunoiseValueError(f"sensor must be one of {sorted(DATASHEET_UNITS)} or None; "
                          f"got {sensor!r}")
     if block is None:
         block = max(1.0, n / fs / 500)
     elif isinstance(block, bool) or not (np.isfinite(block) and block > 0):
-        raise ValueError(f"block must be positive and finite (s); got {block!r}")
+        raise ImunoiseValueError(f"block must be positive and finite (s); got {block!r}")
     size = max(1, int(round(block * fs)))
     m = n // size
     with warnings.catch_warnings():
@@ -218,11 +219,11 @@ def thermal(
         xb = np.nanmean(x[: m * size].reshape(m, size, k), axis=1)
     ok = np.isfinite(tb) & np.all(np.isfinite(xb), axis=1)
     if ok.sum() < MIN_BLOCKS + degree:
-        raise ValueError(f"data must hold at least {MIN_BLOCKS + degree} blocks of "
+        raise ImunoiseValueError(f"data must hold at least {MIN_BLOCKS + degree} blocks of "
                          f"{size / fs:g} s with temperature and rate; got {int(ok.sum())}")
     tb_ok, xb_ok = tb[ok], xb[ok]
     if np.ptp(tb_ok) == 0:
-        raise ValueError("temperature is constant: no bias-vs-temperature fit possible")
+        raise ImunoiseValueError("temperature is constant: no bias-vs-temperature fit possible")
     t0 = float(np.mean(tb_ok)) if reference is None else float(reference)
     design = np.vander(tb_ok - t0, degree + 1, increasing=True)
     coef, *_ = np.linalg.lstsq(design, xb_ok, rcond=None)
@@ -252,12 +253,14 @@ def _temperature(data, temperature, n) -> np.ndarray:
     if temperature is None:
         if isinstance(data, ImuLog):
             if data.temperature is None:
-                raise ValueError(f"data has no temperature channel; it has {list(data.channels)}")
+                raise ImunoiseValueError(
+                    f"data has no temperature channel; it has {list(data.channels)}")
             return np.asarray(data.temperature, dtype=float)
-        raise ValueError("temperature is required when data is an array")
+        raise ImunoiseValueError("temperature is required when data is an array")
     temp = np.asarray(temperature, dtype=float).reshape(-1)
     if temp.shape[0] != n:
-        raise ValueError(f"temperature must have {n} samples (one per row); got {temp.shape[0]}")
+        raise ImunoiseValueError(
+            f"temperature must have {n} samples (one per row); got {temp.shape[0]}")
     return temp
 
 

@@ -55,6 +55,7 @@ from imunoise.allan import (
     _gapped_samples,
     chi2_interval,
 )
+from imunoise.errors import ImunoiseValueError
 from imunoise.taus import averaging_factors, keep_estimable
 
 __all__ = ["pdev", "mtie", "tierms"]
@@ -78,7 +79,7 @@ def phase_points(x, fs: float, data_type: str, gaps: str, kind: str):
         if missing is None:
             missing = nan.sum(axis=0)
         if nan.all(axis=0).any():
-            raise ValueError(f"x has no valid samples in channel "
+            raise ImunoiseValueError(f"x has no valid samples in channel "
                              f"{int(np.flatnonzero(nan.all(axis=0))[0])}: all are NaN")
         no_infinity(data)
         # allantools' frequency2phase: the mean rate removed, phase from 0
@@ -91,14 +92,14 @@ def phase_points(x, fs: float, data_type: str, gaps: str, kind: str):
         raise error(f"gaps must be one of 'skip', 'longest', 'splice'; got {gaps!r}")
     data, one_d = samples(x)
     if data.shape[0] < 2:
-        raise ValueError(f"x as phase must have at least 2 points (one interval); got "
+        raise ImunoiseValueError(f"x as phase must have at least 2 points (one interval); got "
                          f"{data.shape[0]}")
     no_infinity(data)
     nan = np.isnan(data)
     missing = nan.sum(axis=0)
     bad = nan.any(axis=1)
     if bad.all():
-        raise ValueError(f"x has no valid phase points: all {len(bad)} are NaN")
+        raise ImunoiseValueError(f"x has no valid phase points: all {len(bad)} are NaN")
     if gaps == "longest" and bad.any():
         starts, ends = true_runs(~bad)
         i = int(np.argmax(ends - starts))
@@ -123,7 +124,7 @@ def phase_points(x, fs: float, data_type: str, gaps: str, kind: str):
                                        np.cumsum(rate[keep], axis=0)])
         nan = np.zeros(data.shape, dtype=bool)
     if data.shape[0] < 2:
-        raise ValueError(f"x's longest gap-free run has {data.shape[0]} phase point; "
+        raise ImunoiseValueError(f"x's longest gap-free run has {data.shape[0]} phase point; "
                          f"{kind} needs at least 2")
     broken = nan[:-1] | nan[1:]
     return np.where(nan, 0.0, data), broken, one_d, missing, fs
@@ -145,7 +146,7 @@ def _grid(taus, fs: float, n_points: int, kind: str, terms) -> np.ndarray:
     if m.size == 0:
         # m = 1 has n_points − c terms: two of them need c + 2 points
         least = n_points - int(terms(np.array([1]))[0]) + 2
-        raise ValueError(f"x has {n_points} phase points (rate samples + 1), too few for "
+        raise ImunoiseValueError(f"x has {n_points} phase points (rate samples + 1), too few for "
                          f"any tau of {kind} (at least {least}: two terms at tau = 1/fs)")
     return m
 
@@ -213,7 +214,7 @@ def pdev(x: npt.ArrayLike, fs: float, *, taus: TauSpec = "octave",
     confidence = confidence_level(confidence)
     n_points, channels = phase.shape
     if n_points < 4:
-        raise ValueError(f"x has {n_points} phase points, too few for pdev (at least 4: "
+        raise ImunoiseValueError(f"x has {n_points} phase points, too few for pdev (at least 4: "
                          f"two terms at m = 1)")
     m = _grid(taus, fs, n_points, "pdev", _pdev_terms(n_points))
     var = np.empty((m.size, channels))

@@ -7,6 +7,8 @@ import numbers
 
 import numpy as np
 
+from imunoise.errors import ImunoiseTypeError, ImunoiseValueError
+
 
 def positive_finite(value, name: str, *, unit: str | None = None) -> float:
     """``value`` as a float, or ``TypeError``/``ValueError`` naming ``name``.
@@ -16,13 +18,13 @@ def positive_finite(value, name: str, *, unit: str | None = None) -> float:
     """
     of_unit = f" of {unit}" if unit else ""
     if isinstance(value, bool) or not isinstance(value, numbers.Real):
-        raise TypeError(
+        raise ImunoiseTypeError(
             f"{name} must be a real number{of_unit}; got {type(value).__name__} {value!r}"
         )
     number = float(value)
     if not (math.isfinite(number) and number > 0):
         in_unit = f" ({unit})" if unit else ""
-        raise ValueError(f"{name} must be positive and finite{in_unit}; got {value!r}")
+        raise ImunoiseValueError(f"{name} must be positive and finite{in_unit}; got {value!r}")
     return number
 
 
@@ -34,9 +36,9 @@ def sample_rate(fs, name: str = "fs") -> float:
 def integer(value, name: str, minimum: int) -> int:
     """``value`` as an int of at least ``minimum`` (bools are not integers here)."""
     if isinstance(value, bool) or not isinstance(value, numbers.Integral):
-        raise TypeError(f"{name} must be an integer; got {value!r}")
+        raise ImunoiseTypeError(f"{name} must be an integer; got {value!r}")
     if value < minimum:
-        raise ValueError(f"{name} must be >= {minimum}; got {value!r}")
+        raise ImunoiseValueError(f"{name} must be >= {minimum}; got {value!r}")
     return int(value)
 
 
@@ -45,15 +47,15 @@ def samples(x, name: str = "x") -> tuple[np.ndarray, bool]:
     whether ``x`` was 1-D."""
     arr = x if isinstance(x, np.ndarray) else np.asarray(x)
     if arr.dtype.kind not in "iuf":
-        raise TypeError(f"{name} must be an array of real numbers; got dtype {arr.dtype}")
+        raise ImunoiseTypeError(f"{name} must be an array of real numbers; got dtype {arr.dtype}")
     if arr.ndim not in (1, 2):
-        raise ValueError(
+        raise ImunoiseValueError(
             f"{name} must be 1-D (n,) or 2-D (n, channels); got {arr.ndim}-D shape {arr.shape}"
         )
     if arr.shape[0] == 0:
-        raise ValueError(f"{name} must not be empty; got 0 samples")
+        raise ImunoiseValueError(f"{name} must not be empty; got 0 samples")
     if arr.ndim == 2 and arr.shape[1] == 0:
-        raise ValueError(f"{name} must have at least one channel; got shape {arr.shape}")
+        raise ImunoiseValueError(f"{name} must have at least one channel; got shape {arr.shape}")
     data = arr.astype(np.float64, copy=False)
     return (data[:, None], True) if data.ndim == 1 else (data, False)
 
@@ -64,15 +66,15 @@ def no_infinity(data: np.ndarray, name: str = "x") -> None:
     bad = np.isinf(data)
     if bad.any():
         first = np.argwhere(bad)[0]
-        raise ValueError(f"{name} must be finite or NaN (a missing sample); sample "
+        raise ImunoiseValueError(f"{name} must be finite or NaN (a missing sample); sample "
                          f"{int(first[0])} is {data[tuple(first)]}")
 
 
 def confidence_level(value) -> float:
     """A two-sided confidence level in (0, 1) as a float."""
     if isinstance(value, bool) or not isinstance(value, numbers.Real):
-        raise TypeError(f"confidence must be a number in (0, 1); got {value!r}")
+        raise ImunoiseTypeError(f"confidence must be a number in (0, 1); got {value!r}")
     level = float(value)
     if not 0.0 < level < 1.0:
-        raise ValueError(f"confidence must be in (0, 1); got {value!r}")
+        raise ImunoiseValueError(f"confidence must be in (0, 1); got {value!r}")
     return level

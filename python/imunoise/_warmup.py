@@ -59,6 +59,7 @@ from imunoise import _stream, _summary
 from imunoise._channels import rate_columns
 from imunoise._simulate import simulate
 from imunoise.allan import adev, adev_by_column
+from imunoise.errors import ImunoiseValueError
 from imunoise.noise import fit, model_variance
 from imunoise.readers.log import ImuLog
 
@@ -169,12 +170,12 @@ class Warmup:
         i = self.settle_index
         if isinstance(data, ImuLog):
             if len(data) != self.n_samples:
-                raise ValueError(f"data has {len(data)} samples; warm-up was found on "
+                raise ImunoiseValueError(f"data has {len(data)} samples; warm-up was found on "
                                  f"{self.n_samples}")
             return _slice_log(data, i)
         arr = np.asarray(data)
         if arr.shape[0] != self.n_samples:
-            raise ValueError(f"data has {arr.shape[0]} samples; warm-up was found on "
+            raise ImunoiseValueError(f"data has {arr.shape[0]} samples; warm-up was found on "
                              f"{self.n_samples}")
         return arr[i:]
 
@@ -273,15 +274,15 @@ def warmup(
     n = cols.n
     duration = n / fs
     if not 0 < alpha < 1:
-        raise ValueError(f"alpha must be in (0, 1); got {alpha!r}")
+        raise ImunoiseValueError(f"alpha must be in (0, 1); got {alpha!r}")
     if block is None:
         block = max(1.0, duration / BLOCKS)
     elif isinstance(block, bool) or not (np.isfinite(block) and block > 0):
-        raise ValueError(f"block must be positive and finite (s); got {block!r}")
+        raise ImunoiseValueError(f"block must be positive and finite (s); got {block!r}")
     size = max(1, int(round(block * fs)))
     m = n // size
     if m < MIN_BLOCKS:
-        raise ValueError(f"data must hold at least {MIN_BLOCKS} blocks of {block:g} s "
+        raise ImunoiseValueError(f"data must hold at least {MIN_BLOCKS} blocks of {block:g} s "
                          f"({MIN_BLOCKS * size} samples); got {n}")
     t = (np.arange(m) + 0.5) * size / fs
     with warnings.catch_warnings():
@@ -334,7 +335,8 @@ def _temperature(data, temperature, n) -> np.ndarray | None:
         return None
     temp = np.asarray(temperature, dtype=float).reshape(-1)
     if temp.shape[0] != n:
-        raise ValueError(f"temperature must have {n} samples (one per row); got {temp.shape[0]}")
+        raise ImunoiseValueError(
+            f"temperature must have {n} samples (one per row); got {temp.shape[0]}")
     return temp
 
 
@@ -512,7 +514,7 @@ def _tolerance(tolerance, cols, amp, tau, fs) -> np.ndarray:
     if tolerance is not None:
         tol = np.broadcast_to(np.asarray(tolerance, dtype=float), (k,)).copy()
         if not np.all(np.isfinite(tol) & (tol > 0)):
-            raise ValueError(f"tolerance must be positive and finite; got {tolerance!r}")
+            raise ImunoiseValueError(f"tolerance must be positive and finite; got {tolerance!r}")
         return tol
     floor = np.empty(k)
     for j in range(k):

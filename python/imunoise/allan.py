@@ -109,7 +109,13 @@ from imunoise._validate import (
     sample_rate,
     samples,
 )
-from imunoise.errors import CoverageWarning, GapWarning, ImunoiseWarning
+from imunoise.errors import (
+    CoverageWarning,
+    GapWarning,
+    ImunoiseTypeError,
+    ImunoiseValueError,
+    ImunoiseWarning,
+)
 from imunoise.taus import averaging_factors, keep_estimable
 
 if TYPE_CHECKING:
@@ -615,7 +621,7 @@ def theobr(x: npt.ArrayLike, fs: float, *, taus: TauSpec = "octave",
     m, user_given = _theo1_factors(taus, fs, n)
     m = _keep_theobr(m, n, fs, user_given, "theobr", lower=0.0)
     if m.size == 0:
-        raise ValueError(f"none of the taus is in range for theobr; got {taus!r}")
+        raise ImunoiseValueError(f"none of the taus is in range for theobr; got {taus!r}")
     ratio = _ratio_options(ratio_ladder, ratio_block, n)
     _warn_theobr_cost("theobr", n, m, data.shape[1], ratio)
     core = _core_allan.analyse(data, "theobr", m.astype(np.uint64), **ratio)
@@ -688,7 +694,7 @@ def theoh(x: npt.ArrayLike, fs: float, *, taus: TauSpec = "octave",
         m_theo, _ = _theo1_factors(taus, fs, n)
     m_theo = _keep_theobr(m_theo, n, fs, user_given, "theoh", lower=k)
     if m_avar.size + m_theo.size == 0:
-        raise ValueError(f"none of the taus is in range for theoh; got {taus!r}")
+        raise ImunoiseValueError(f"none of the taus is in range for theoh; got {taus!r}")
     ratio = _ratio_options(ratio_ladder, ratio_block, n)
     _warn_theobr_cost("theoh", n, m_theo, data.shape[1], ratio)
     m = np.concatenate([m_avar, m_theo]).astype(np.int64)
@@ -734,7 +740,7 @@ def _deviation(
     terms = _core_allan.estimator_terms(statistic, n + 1, m)
     m = keep_estimable(m.astype(np.int64), terms.astype(np.int64), fs, user_given, kind)
     if m.size == 0:
-        raise ValueError(
+        raise ImunoiseValueError(
             f"x has {n} samples, too few for any tau of {kind} "
             f"(the shortest tau needs at least {_minimum_samples(statistic)})"
         )
@@ -757,7 +763,7 @@ def _deviation(
         with np.errstate(over="ignore", invalid="ignore"):
             scaled = var * (tau**2 / 3.0)[:, None]
         if np.any(np.isfinite(var) & ~np.isfinite(scaled)):
-            raise ValueError(
+            raise ImunoiseValueError(
                 f"fs is too small ({fs!r} Hz): {kind} = tau·deviation/√3 overflows double "
                 f"precision at tau = {tau.max():g} s"
             )
@@ -807,7 +813,7 @@ def _keep_gapped(kind, m, var, terms, alpha, identified, edf, fs, user_given, da
     enough = terms >= 2
     keep = enough.any(axis=1)
     if not keep.any():
-        raise ValueError(
+        raise ImunoiseValueError(
             f"x's gaps leave {kind} fewer than 2 terms at every tau: no gap-free run is "
             f"long enough (pass gaps='splice' to join the runs)"
         )
@@ -910,7 +916,7 @@ def _theo_input(x, fs, confidence, gaps, kind: str, data_type: str):
 def _check_theo_length(kind: str, n: int) -> None:
     """ThêoBR's bias ratio exists from ``THEOBR_MIN_SAMPLES`` on (the core's number)."""
     if n < _core_allan.THEOBR_MIN_SAMPLES:
-        raise ValueError(
+        raise ImunoiseValueError(
             f"x has {n} samples, too few for {kind}: its bias ratio averages "
             f"n = floor(0.1·N/3) − 3 + 1 terms over the N = samples + 1 phase points, "
             f"which needs at least {_core_allan.THEOBR_MIN_SAMPLES} samples"
@@ -953,11 +959,11 @@ RATIO_LADDERS = ("taylor-howe", "sp1065")
 def _ratio_options(ladder, block, n: int) -> dict:
     """The checked ``ratio_ladder`` and ``ratio_block`` as the core's keywords."""
     if not isinstance(ladder, str) or ladder not in RATIO_LADDERS:
-        raise ValueError(f"ratio_ladder must be one of {RATIO_LADDERS}; got {ladder!r}")
+        raise ImunoiseValueError(f"ratio_ladder must be one of {RATIO_LADDERS}; got {ladder!r}")
     block = integer(block, "ratio_block", 1)
     need = _core_allan.THEOBR_MIN_SAMPLES
     if n // block < need:
-        raise ValueError(
+        raise ImunoiseValueError(
             f"ratio_block must leave at least {need} block averages of the {n} samples "
             f"(ratio_block <= {n // need}); got {block}"
         )
@@ -1016,17 +1022,17 @@ def _gapped_samples(x, gaps, kind: str, skips: bool):
     infinite = np.argwhere(np.isinf(data))
     if infinite.size:
         k, c = infinite[0]
-        raise ValueError(
+        raise ImunoiseValueError(
             f"x must be finite or NaN (a missing sample); sample {k} is {data[k, c]}"
             + (f" (channel {c})" if data.shape[1] > 1 else "")
         )
     if gaps == "skip":
-        raise ValueError(
+        raise ImunoiseValueError(
             f"x has {dropped} missing samples (NaN); {kind} cannot skip gaps: "
             "pass gaps='longest' or gaps='splice'"
         )
     if dropped == n:
-        raise ValueError(f"x has no valid samples: all {n} are NaN")
+        raise ImunoiseValueError(f"x has no valid samples: all {n} are NaN")
     if gaps == "longest":
         starts, ends = true_runs(~bad)
         i = int(np.argmax(ends - starts))
@@ -1061,7 +1067,7 @@ def _rate_samples(x, fs, data_type: str):
         return x, None
     data, one_d = samples(x)
     if data.shape[0] < 2:
-        raise ValueError(f"x as phase must have at least 2 points (one interval); got "
+        raise ImunoiseValueError(f"x as phase must have at least 2 points (one interval); got "
                          f"{data.shape[0]}")
     # checked before differencing: inf − inf would be NaN, a silent missing sample
     no_infinity(data)
@@ -1071,4 +1077,4 @@ def _rate_samples(x, fs, data_type: str):
 
 def _check_bool(name, value) -> None:
     if not isinstance(value, (bool, np.bool_)):
-        raise TypeError(f"{name} must be True or False; got {value!r}")
+        raise ImunoiseTypeError(f"{name} must be True or False; got {value!r}")

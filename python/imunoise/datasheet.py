@@ -30,6 +30,7 @@ from imunoise import _summary
 from imunoise import numbers as _numbers
 from imunoise import units as _units
 from imunoise._schema import axis_names
+from imunoise.errors import ImunoiseTypeError, ImunoiseValueError
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -72,7 +73,7 @@ def load_spec(spec) -> Spec:
     if isinstance(spec, Spec):
         return spec
     if not isinstance(spec, (str, Path)):
-        raise TypeError(f"spec must be a name, a path or a Spec; got {type(spec).__name__}")
+        raise ImunoiseTypeError(f"spec must be a name, a path or a Spec; got {type(spec).__name__}")
     path = Path(spec)
     name = str(spec).lower()
     # A file of that name wins; a name is the built-in datasheet only when no such
@@ -86,15 +87,15 @@ def load_spec(spec) -> Spec:
         origin = f"imunoise/specs/{name}.toml"
     elif path.suffix == ".toml" or path.exists():
         what = "is not a file" if path.exists() else "does not exist"
-        raise ValueError(f"spec file {str(path)!r} {what}")
+        raise ImunoiseValueError(f"spec file {str(path)!r} {what}")
     else:
-        raise ValueError(
+        raise ImunoiseValueError(
             f"spec must be one of {available_specs()} or a .toml path; got {spec!r}"
         )
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
-        raise ValueError(f"spec {origin}: invalid TOML: {exc}") from None
+        raise ImunoiseValueError(f"spec {origin}: invalid TOML: {exc}") from None
     items = []
     for sensor in _units.SENSORS:
         for i, entry in enumerate(data.get(sensor, [])):
@@ -110,16 +111,18 @@ def load_spec(spec) -> Spec:
                                              str(entry.get("limit", "max"))),
                 )
             except (KeyError, TypeError, ValueError) as exc:
-                raise ValueError(f"{where}: needs term, value and unit ({exc})") from None
+                raise ImunoiseValueError(f"{where}: needs term, value and unit ({exc})") from None
             if item.limit not in LIMITS:
-                raise ValueError(
+                raise ImunoiseValueError(
                     f"{where}: limit must be 'max', 'typical' or 'min'; got {item.limit!r}")
             if not (math.isfinite(item.value) and item.value > 0):
-                raise ValueError(f"{where}: value must be finite and > 0; got {item.value!r}")
+                raise ImunoiseValueError(
+                    f"{where}: value must be finite and > 0; got {item.value!r}")
             _units.unit_info(item.term, item.unit, sensor)  # validates term and unit
             items.append(item)
     if not items:
-        raise ValueError(f"spec {origin} specifies nothing (no [[gyro]] or [[accel]] entries)")
+        raise ImunoiseValueError(
+            f"spec {origin} specifies nothing (no [[gyro]] or [[accel]] entries)")
     return Spec(name=str(data.get("name", origin)), source=str(data.get("source", "")),
                 items=tuple(items))
 
@@ -224,9 +227,9 @@ def verdict(measured: float, std: float | None, spec: float, limit: str) -> tupl
     giving the ratio. A non-finite or non-positive ``measured`` is "not resolved".
     """
     if limit not in LIMITS:
-        raise ValueError(f"limit must be one of {LIMITS}; got {limit!r}")
+        raise ImunoiseValueError(f"limit must be one of {LIMITS}; got {limit!r}")
     if not (math.isfinite(spec) and spec > 0):
-        raise ValueError(f"spec must be finite and > 0; got {spec!r}")
+        raise ImunoiseValueError(f"spec must be finite and > 0; got {spec!r}")
     if measured is None or not math.isfinite(measured) or measured <= 0:
         return "not resolved", ""
     if limit == "typical":
@@ -272,18 +275,18 @@ def compare(models, spec="vn100", *, sensor: str = "gyro", input_units: dict | N
 
     if isinstance(models, NoiseModel):
         if sensor not in _units.SENSORS:
-            raise ValueError(f"sensor must be one of {_units.SENSORS}; got {sensor!r}")
+            raise ImunoiseValueError(f"sensor must be one of {_units.SENSORS}; got {sensor!r}")
         models = {sensor: models}
     if not isinstance(models, dict) or not models:
-        raise TypeError(
+        raise ImunoiseTypeError(
             "models must be a NoiseModel or a dict {'gyro': model, 'accel': model}; "
             f"got {type(models).__name__}"
         )
     for key, m in models.items():
         if key not in _units.SENSORS:
-            raise ValueError(f"models keys must be 'gyro' or 'accel'; got {key!r}")
+            raise ImunoiseValueError(f"models keys must be 'gyro' or 'accel'; got {key!r}")
         if not isinstance(m, NoiseModel):
-            raise TypeError(f"models[{key!r}] must be a NoiseModel; got {type(m).__name__}")
+            raise ImunoiseTypeError(f"models[{key!r}] must be a NoiseModel; got {type(m).__name__}")
     input_units = dict(input_units or {})
     spec = load_spec(spec)
     rows = []
@@ -329,7 +332,7 @@ def compare(models, spec="vn100", *, sensor: str = "gyro", input_units: dict | N
                 "remark": remark,
             })
     if not rows:
-        raise ValueError(
+        raise ImunoiseValueError(
             f"spec {spec.name!r} specifies nothing for the given models ({sorted(models)})"
         )
     return Comparison(spec=spec, rows=tuple(rows))

@@ -70,7 +70,7 @@ from imunoise._core import allan as _core_allan
 from imunoise._runs import true_runs
 from imunoise._validate import no_infinity, positive_finite, sample_rate, samples
 from imunoise.allan import ONE_SIGMA, AllanResult, adev, adev_by_column, chi2_interval
-from imunoise.errors import CoverageWarning
+from imunoise.errors import CoverageWarning, ImunoiseTypeError, ImunoiseValueError
 from imunoise.taus import averaging_factors
 
 if TYPE_CHECKING:
@@ -336,7 +336,7 @@ def dynamic_adev(
     n = data.shape[0]
     width = n // 10 if window is None else _samples_of("window", window, fs)
     if width < 3 or width > n:
-        raise ValueError(
+        raise ImunoiseValueError(
             f"window must hold between 3 and {n} samples (the record); got {width} "
             f"({width / fs:g} s at {fs:g} Hz)"
         )
@@ -344,7 +344,7 @@ def dynamic_adev(
     windows = (n - width) // stride + 1
     if windows > MAX_WINDOWS:
         shortest = -(-(n - width) // (MAX_WINDOWS - 1))
-        raise ValueError(
+        raise ImunoiseValueError(
             f"step={stride / fs:g} s gives {windows:,} windows; at most {MAX_WINDOWS:,} are "
             f"computed (every window keeps an ADEV per tau and channel): use a step of at "
             f"least {shortest / fs:g} s ({shortest} samples) for this record"
@@ -556,7 +556,7 @@ def _samples_of(name: str, seconds, fs: float) -> int:
     value = positive_finite(seconds, name, unit="s")
     count = int(round(value * fs))
     if count < 1:
-        raise ValueError(
+        raise ImunoiseValueError(
             f"{name} must be at least one sample (1/fs = {1 / fs:g} s); got {seconds!r}"
         )
     return count
@@ -564,7 +564,8 @@ def _samples_of(name: str, seconds, fs: float) -> int:
 
 def _window_factors(taus, fs: float, width: int) -> np.ndarray:
     if isinstance(taus, numbers.Real) and not isinstance(taus, (bool, numbers.Integral)):
-        raise TypeError(f"taus must be a grid name, points per decade or an array; got {taus!r}")
+        raise ImunoiseTypeError(
+            f"taus must be a grid name, points per decade or an array; got {taus!r}")
     m, user_given = averaging_factors(taus, fs, width)
     fits = (m >= 1) & (width + 1 - 2 * m >= 2)
     if user_given and not fits.all():
@@ -575,7 +576,7 @@ def _window_factors(taus, fs: float, width: int) -> np.ndarray:
         )
     m = np.unique(m[fits])
     if m.size == 0:
-        raise ValueError(
+        raise ImunoiseValueError(
             f"no tau fits a window of {width} samples: the largest is "
             f"{math.floor((width - 1) / 2) / fs:g} s"
         )

@@ -46,7 +46,7 @@ import numpy as np
 
 from imunoise import _atomic, _warn
 from imunoise import units as _units
-from imunoise.errors import CoverageWarning, ImunoiseDeprecationWarning
+from imunoise.errors import CoverageWarning, ImunoiseDeprecationWarning, ImunoiseValueError
 from imunoise.noise import gm_white_density, resonance_white_density
 
 __all__ = [
@@ -130,16 +130,16 @@ def kalibr_dict(gyro=None, accel=None, *, rostopic: str = "/imu0", update_rate=N
         Units of the rate data the models were fitted to (default rad/s, m/s²).
     """
     if gyro is None and accel is None:
-        raise ValueError("gyro and accel are both None; pass at least one NoiseModel")
+        raise ImunoiseValueError("gyro and accel are both None; pass at least one NoiseModel")
     if combine not in ("max", "rms"):
-        raise ValueError(f"combine must be 'max' or 'rms'; got {combine!r}")
+        raise ImunoiseValueError(f"combine must be 'max' or 'rms'; got {combine!r}")
     if not (math.isfinite(inflate) and inflate > 0):
-        raise ValueError(f"inflate must be finite and > 0; got {inflate!r}")
+        raise ImunoiseValueError(f"inflate must be finite and > 0; got {inflate!r}")
     if update_rate is None:
         update_rate = (gyro if gyro is not None else accel).fs
     update_rate = float(update_rate)
     if not (math.isfinite(update_rate) and update_rate > 0):
-        raise ValueError(f"update_rate must be finite and > 0; got {update_rate!r}")
+        raise ImunoiseValueError(f"update_rate must be finite and > 0; got {update_rate!r}")
     out: dict = {}
     if accel is not None:
         out["accelerometer_noise_density"] = inflate * _combine(
@@ -217,13 +217,13 @@ def openvins_yaml(gyro=None, accel=None, *, imu_name: str = "imu0", **kwargs) ->
 def model_json(model=None, **models) -> str:
     """JSON text of one model (``model_json(m)``) or several (``model_json(gyro=g, accel=a)``)."""
     if model is not None and models:
-        raise ValueError("pass either one model or keyword models, not both")
+        raise ImunoiseValueError("pass either one model or keyword models, not both")
     if model is not None:
         payload = model.to_dict()
     elif models:
         payload = {name: m.to_dict() for name, m in models.items()}
     else:
-        raise ValueError("model_json needs a NoiseModel")
+        raise ImunoiseValueError("model_json needs a NoiseModel")
     return json.dumps(payload, indent=2, allow_nan=False) + "\n"
 
 
@@ -292,9 +292,9 @@ def ekf_dict(gyro=None, accel=None, *, gyro_unit: str | None = None,
     warning, and ``upper_bounds`` names those terms.
     """
     if gyro is None and accel is None:
-        raise ValueError("gyro and accel are both None; pass at least one NoiseModel")
+        raise ImunoiseValueError("gyro and accel are both None; pass at least one NoiseModel")
     if not (math.isfinite(min_samples) and min_samples >= 0):
-        raise ValueError(f"min_samples must be finite and >= 0; got {min_samples!r}")
+        raise ImunoiseValueError(f"min_samples must be finite and >= 0; got {min_samples!r}")
     out: dict = {}
     for key, model, sensor, unit, rate, walk in (
             ("gyroscope", gyro, "gyro", gyro_unit, "rad/s", "rad/s^2"),

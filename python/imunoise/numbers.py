@@ -13,6 +13,8 @@ from __future__ import annotations
 
 import math
 
+from imunoise.errors import ImunoiseValueError
+
 #: The word for a value that could not be estimated (e.g. an unresolved term).
 NOT_RESOLVED = "not resolved"
 #: The word for an empty table cell.
@@ -46,7 +48,7 @@ def format_value(value, std=None, *, unit: str | None = None, digits: int = 4,
     gives ``missing``. ``unit`` is appended after a space.
     """
     if not isinstance(digits, int) or digits < 1:
-        raise ValueError(f"digits must be a positive integer; got {digits!r}")
+        raise ImunoiseValueError(f"digits must be a positive integer; got {digits!r}")
     if not _finite(value):
         return missing
     value = float(value)

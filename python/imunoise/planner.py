@@ -29,6 +29,7 @@ import numpy as np
 
 from imunoise._core import allan as _core_allan
 from imunoise._validate import sample_rate
+from imunoise.errors import ImunoiseValueError
 from imunoise.noise._terms import FLICKER, model_variance
 
 __all__ = ["PLAN_TERMS", "Plan", "TermPlan", "fit_line", "plan", "relative_uncertainty"]
@@ -209,7 +210,8 @@ def _coefficients(source, sensor: str) -> tuple[dict[str, float], str, tuple[str
 
     noise = noise_of_spec(source)
     if sensor not in noise:
-        raise ValueError(f"sensor must be one of {sorted(noise)} for this spec; got {sensor!r}")
+        raise ImunoiseValueError(
+            f"sensor must be one of {sorted(noise)} for this spec; got {sensor!r}")
     spec = load_spec(source)
     given = {item.term for item in spec.items if item.sensor == sensor}
     assumed = tuple(k for k in PLAN_TERMS if k not in given and noise[sensor].get(k, 0.0) > 0)
@@ -244,13 +246,13 @@ def plan(source="vn100", *, fs: float = 40.0, target: float = 0.2, confidence: f
     """
     fs = sample_rate(fs)
     if not (isinstance(target, int | float) and 0 < target < 1):
-        raise ValueError(f"target must be a relative uncertainty in (0, 1); got {target!r}")
+        raise ImunoiseValueError(f"target must be a relative uncertainty in (0, 1); got {target!r}")
     if not (isinstance(confidence, int | float) and 0 < confidence < 1):
-        raise ValueError(f"confidence must be in (0, 1); got {confidence!r}")
+        raise ImunoiseValueError(f"confidence must be in (0, 1); got {confidence!r}")
     coefficients, label, assumed = _coefficients(source, sensor)
     bad = {k: v for k, v in coefficients.items() if not (math.isfinite(v) and v >= 0)}
     if bad:
-        raise ValueError(f"coefficients must be finite and >= 0; got {bad}")
+        raise ImunoiseValueError(f"coefficients must be finite and >= 0; got {bad}")
     taus = _taus(coefficients["N"], coefficients["B"], coefficients["K"], fs)
     terms = {k: TermPlan(k, coefficients[k], tau,
                          _seconds(fs, tau, PLAN_TERMS[k], float(target), float(confidence)))

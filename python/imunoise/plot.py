@@ -29,6 +29,7 @@ import numpy as np
 from imunoise import _atomic, _summary
 from imunoise._schema import ATTITUDE_NAMES, CHANNELS, axis_names
 from imunoise.allan import AllanResult
+from imunoise.errors import ImunoiseTypeError, ImunoiseValueError
 from imunoise.noise import FLICKER, TERMS, NoiseModel, model_variance
 from imunoise.noise._terms import term_variances
 from imunoise.numbers import cell, format_value, rounded
@@ -165,7 +166,7 @@ def decimate_minmax(y: np.ndarray, columns: int) -> tuple[np.ndarray, np.ndarray
     y = np.asarray(y, dtype=np.float64)
     n = len(y)
     if columns < 1:
-        raise ValueError(f"columns must be >= 1; got {columns}")
+        raise ImunoiseValueError(f"columns must be >= 1; got {columns}")
     if n <= columns:
         idx = np.arange(n)
         return idx, y.copy(), y.copy()
@@ -224,7 +225,7 @@ def time_series(
     if isinstance(y, ImuLog):
         if fs is not None or unit or names is not None:
             given = [k for k, v in (("fs", fs), ("unit", unit), ("names", names)) if v]
-            raise ValueError(f"fs, unit and names must not be given with an ImuLog (it has "
+            raise ImunoiseValueError(f"fs, unit and names must not be given with an ImuLog (it has "
                              f"its own); got {', '.join(given)}")
         log = y
         chosen = _log_channels(log, channels)
@@ -239,13 +240,13 @@ def time_series(
             gaps = [(a - log.gaps.t0, d) for a, d, _k in log.gaps.largest(SHADED_GAPS).rows()]
         return _series_figure(blocks, log.fs, title or source, columns, gaps)
     if channels is not None:
-        raise ValueError(f"channels must be None for an array (it picks channels of an "
+        raise ImunoiseValueError(f"channels must be None for an array (it picks channels of an "
                          f"ImuLog); got {channels!r}")
     if fs is None:
-        raise ValueError("fs must be given for an array (the sample rate, Hz); got None")
+        raise ImunoiseValueError("fs must be given for an array (the sample rate, Hz); got None")
     if isinstance(y, list) and all(isinstance(c, np.ndarray) and c.ndim == 1 for c in y):
         if len({len(c) for c in y}) > 1:
-            raise ValueError(f"y's columns must have one length; got {[len(c) for c in y]}")
+            raise ImunoiseValueError(f"y's columns must have one length; got {[len(c) for c in y]}")
         k = len(y)
     else:
         y = np.asarray(y, dtype=np.float64).reshape(len(y), -1)
@@ -265,12 +266,12 @@ def _log_channels(log: ImuLog, channels: str | Sequence[str] | None) -> list[str
     """The channels of ``log`` to draw, checked."""
     if channels is None:
         if not log.channels:
-            raise ValueError(f"log must have a channel to plot; got none in {log.source}")
+            raise ImunoiseValueError(f"log must have a channel to plot; got none in {log.source}")
         return list(log.channels)
     chosen = [channels] if isinstance(channels, str) else list(channels)
     absent = [c for c in chosen if c not in log.channels]
     if absent or not chosen:
-        raise ValueError(f"channels must be among the log's {list(log.channels)}; got "
+        raise ImunoiseValueError(f"channels must be among the log's {list(log.channels)}; got "
                          f"{chosen!r}")
     return chosen
 
@@ -352,7 +353,8 @@ def histograms(
     dists = [dists] if isinstance(dists, Distribution) else list(dists)
     wrong = [type(d).__name__ for d in dists if not isinstance(d, Distribution)]
     if wrong or not dists:
-        raise TypeError(f"dists must be Distribution objects (imunoise.distribution of each "
+        raise ImunoiseTypeError(
+            f"dists must be Distribution objects (imunoise.distribution of each "
                         f"axis); got {wrong or 'none'}")
     k = len(dists)
     names = list(names) if names is not None else axis_names(k)
@@ -594,20 +596,21 @@ def allan(
     from matplotlib.ticker import NullFormatter
 
     if not isinstance(result, AllanResult):
-        raise TypeError(f"result must be an AllanResult (imunoise.adev and its family); got "
+        raise ImunoiseTypeError(
+            f"result must be an AllanResult (imunoise.adev and its family); got "
                         f"{type(result).__name__}")
     if model is not None and not isinstance(model, NoiseModel):
-        raise TypeError(f"model must be a NoiseModel (imunoise.fit) or None; got "
+        raise ImunoiseTypeError(f"model must be a NoiseModel (imunoise.fit) or None; got "
                         f"{type(model).__name__} (per-axis coefficients go in coefficients=)")
     if model is not None and coefficients is not None:
-        raise ValueError("model and coefficients must not both be given; got both")
+        raise ImunoiseValueError("model and coefficients must not both be given; got both")
     taus = np.asarray(result.taus, dtype=np.float64)
     dev = np.asarray(result.dev, dtype=np.float64).reshape(len(taus), -1)
     if model is not None and model.channels != dev.shape[1]:
-        raise ValueError(f"model must have the {dev.shape[1]} channel(s) of result; got "
+        raise ImunoiseValueError(f"model must have the {dev.shape[1]} channel(s) of result; got "
                          f"{model.channels}")
     if coefficients is not None and len(coefficients) != dev.shape[1]:
-        raise ValueError(f"coefficients must have one mapping per channel of result "
+        raise ImunoiseValueError(f"coefficients must have one mapping per channel of result "
                          f"({dev.shape[1]}); got {len(coefficients)}")
     lo = np.asarray(result.ci_low, dtype=np.float64).reshape(dev.shape)
     hi = np.asarray(result.ci_high, dtype=np.float64).reshape(dev.shape)
@@ -792,9 +795,10 @@ def spectrum(
 
     new_figure = _plt()
     if not isinstance(result, Spectrum):
-        raise TypeError(f"result must be a Spectrum (imunoise.psd); got {type(result).__name__}")
+        raise ImunoiseTypeError(
+            f"result must be a Spectrum (imunoise.psd); got {type(result).__name__}")
     if model is not None and not isinstance(model, NoiseModel):
-        raise TypeError(f"model must be a NoiseModel (imunoise.fit) or None; got "
+        raise ImunoiseTypeError(f"model must be a NoiseModel (imunoise.fit) or None; got "
                         f"{type(model).__name__}")
     s = result.smooth(bins_per_decade)
     k = result.channels
@@ -888,10 +892,10 @@ def dynamic(
 
     new_figure = _plt()
     if not isinstance(result, DynamicAllan):
-        raise TypeError(f"result must be a DynamicAllan (imunoise.dynamic_adev); got "
+        raise ImunoiseTypeError(f"result must be a DynamicAllan (imunoise.dynamic_adev); got "
                         f"{type(result).__name__}")
     if not (isinstance(limit, (int, float)) and limit > 1):
-        raise ValueError(f"limit must be a number > 1; got {limit!r}")
+        raise ImunoiseValueError(f"limit must be a number > 1; got {limit!r}")
     k = result.channels
     ratio = np.reshape(result.ratio, (len(result.times), len(result.taus), k))
     names = list(names) if names is not None else axis_names(k)

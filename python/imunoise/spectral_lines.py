@@ -34,6 +34,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import stats
 
+from imunoise.errors import ImunoiseValueError
+
 __all__ = ["SpectralLine", "check_line"]
 
 #: Chance that a line-free search window passes the test.
@@ -93,7 +95,7 @@ def check_line(spectrum, channel: int, f0: float, amplitude: float = math.nan) -
     """Whether ``spectrum`` (from :func:`imunoise.psd`, not smoothed) shows a line
     near ``f0`` Hz in ``channel``; see the module for the test."""
     if spectrum.bins_per_decade:
-        raise ValueError("spectrum must be on Welch's linear grid (imunoise.psd), not "
+        raise ImunoiseValueError("spectrum must be on Welch's linear grid (imunoise.psd), not "
                          f"smoothed; got bins_per_decade={spectrum.bins_per_decade}")
     f = np.asarray(spectrum.f, float)
     p = np.asarray(spectrum.psd, float)

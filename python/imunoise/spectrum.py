@@ -78,6 +78,7 @@ from imunoise._validate import (
     sample_rate,
     samples,
 )
+from imunoise.errors import ImunoiseTypeError, ImunoiseValueError
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -254,7 +255,7 @@ class Spectrum:
         bin's mean density, with the EDF that averaging gains; N is unchanged."""
         bins = integer(bins_per_decade, "bins_per_decade", 1)
         if self.bins_per_decade:
-            raise ValueError("this spectrum is already log-binned; smooth the original")
+            raise ImunoiseValueError("this spectrum is already log-binned; smooth the original")
         f, p, edf = _log_bins(self.f, _columns(self.psd), self.edf, bins,
                               self._bin_correlation)
         low, high = _chi2_band(p, edf, self.confidence)
@@ -360,7 +361,7 @@ def psd(
     confidence = confidence_level(confidence)
     n = data.shape[0]
     if n < 16:
-        raise ValueError(f"x must have at least 16 samples for a spectrum; got {n}")
+        raise ImunoiseValueError(f"x must have at least 16 samples for a spectrum; got {n}")
     present = ~np.isnan(data).any(axis=1)
     if nperseg is None:
         seg = _default_nperseg(n)
@@ -369,11 +370,11 @@ def psd(
     else:
         seg = integer(nperseg, "nperseg", 16)
     if seg > n:
-        raise ValueError(f"nperseg must be <= the number of samples ({n}); got {seg}")
+        raise ImunoiseValueError(f"nperseg must be <= the number of samples ({n}); got {seg}")
     starts = _segment_starts(present, seg)
     if not starts.size:
         longest = _longest_run(present)
-        raise ValueError(
+        raise ImunoiseValueError(
             f"x has no stretch of nperseg = {seg} samples without a missing (NaN) sample "
             f"(the longest is {longest}); pass nperseg <= {longest}"
             if longest >= 16 else
@@ -386,7 +387,7 @@ def psd(
     with np.errstate(over="ignore"):
         f, p = _welch(data, fs, seg, starts) if largest < 1e150 else (None, None)
     if p is None or not np.all(np.isfinite(p)):
-        raise ValueError(f"x is too large for a spectrum: its power overflows (largest |x| "
+        raise ImunoiseValueError(f"x is too large for a spectrum: its power overflows (largest |x| "
                          f"{largest:.3g})")
     edf = np.full(f.shape, _welch_edf(seg, starts))
     if seg % 2 == 0:
@@ -435,7 +436,7 @@ def coefficient_from_psd(term: str, level: npt.ArrayLike, f: npt.ArrayLike, *,
     unit = term_psd(term, 1.0, f, fs=fs)
     level = np.asarray(level, dtype=float)
     if np.any(level < 0):
-        raise ValueError("level must be >= 0 (a power spectral density)")
+        raise ImunoiseValueError("level must be >= 0 (a power spectral density)")
     return np.sqrt(level / unit)
 
 
@@ -646,7 +647,7 @@ def _read_white(f, p, edf, user_band):
     if user_band is not None:
         inside = (f >= user_band[0]) & (f <= user_band[1])
         if np.count_nonzero(inside) < 1:
-            raise ValueError(
+            raise ImunoiseValueError(
                 f"band {user_band} holds no frequency of the spectrum "
                 f"({f[0]:.4g}–{f[-1]:.4g} Hz)"
             )
@@ -724,11 +725,12 @@ def _check_band(band, fs: float) -> tuple[float, float]:
     try:
         low, high = band
     except (TypeError, ValueError):
-        raise TypeError(f"band must be a pair (f_low, f_high) in Hz; got {band!r}") from None
+        raise ImunoiseTypeError(
+            f"band must be a pair (f_low, f_high) in Hz; got {band!r}") from None
     low = positive_finite(low, "band[0]", unit="Hz")
     high = positive_finite(high, "band[1]", unit="Hz")
     if not low < high <= fs / 2:
-        raise ValueError(
+        raise ImunoiseValueError(
             f"band must satisfy 0 < f_low < f_high <= fs/2 = {fs / 2:g} Hz; got {band!r}"
         )
     return low, high
@@ -737,18 +739,18 @@ def _check_band(band, fs: float) -> tuple[float, float]:
 def _check_frequencies(f) -> np.ndarray:
     f = np.asarray(f, dtype=float)
     if not np.all(np.isfinite(f) & (f > 0)):
-        raise ValueError("f must hold positive finite frequencies (Hz)")
+        raise ImunoiseValueError("f must hold positive finite frequencies (Hz)")
     return f
 
 
 def _law(term) -> PowerLaw:
     if term not in POWER_LAWS:
-        raise ValueError(f"term must be one of {', '.join(POWER_LAWS)}; got {term!r}")
+        raise ImunoiseValueError(f"term must be one of {', '.join(POWER_LAWS)}; got {term!r}")
     return POWER_LAWS[term]
 
 
 def _need_fs():
-    raise ValueError("fs is required for term 'Q' (its PSD depends on the sample rate)")
+    raise ImunoiseValueError("fs is required for term 'Q' (its PSD depends on the sample rate)")
 
 
 def _columns(a: np.ndarray) -> np.ndarray:

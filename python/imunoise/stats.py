@@ -61,6 +61,7 @@ from scipy import stats as _sstats
 from imunoise import _schema, _summary
 from imunoise._deprecation import old_call_forms
 from imunoise._validate import sample_rate
+from imunoise.errors import ImunoiseTypeError, ImunoiseValueError
 from imunoise.readers.log import ImuLog
 
 __all__ = [
@@ -250,7 +251,7 @@ def describe(x, fs: float | None = None) -> Description:
         log = x
         fs = log.fs if fs is None else fs
         if len(log) < 2:
-            raise ValueError(f"x: the log {log.source!r} has {len(log) or 'no'} samples; "
+            raise ImunoiseValueError(f"x: the log {log.source!r} has {len(log) or 'no'} samples; "
                              "describe needs at least 2")
         blocks, names, sensors, units = [], [], [], []
         for sensor in SENSOR_CHANNELS:
@@ -270,7 +271,7 @@ def describe(x, fs: float | None = None) -> Description:
             sensors += [sensor] * len(labels)
             units += [unit] * len(labels)
         if not blocks:
-            raise ValueError(
+            raise ImunoiseValueError(
                 f"x has none of the channels {SENSOR_CHANNELS}; "
                 f"got channels {log.channels}"
             )
@@ -286,11 +287,11 @@ def describe(x, fs: float | None = None) -> Description:
         fs = sample_rate(fs)
     n = x.shape[0]
     if n < 2:
-        raise ValueError(f"x needs at least 2 samples; got {n}")
+        raise ImunoiseValueError(f"x needs at least 2 samples; got {n}")
     nan = np.isnan(x)
     missing = nan.sum(axis=0)
     if np.isinf(x).any():
-        raise ValueError("x must be finite or NaN (a missing sample); it contains inf")
+        raise ImunoiseValueError("x must be finite or NaN (a missing sample); it contains inf")
     t = None if fs is None else np.arange(n, dtype=np.float64) / fs
     if missing.any():
         columns = [
@@ -342,10 +343,10 @@ def _describe_valid(v: np.ndarray, t: np.ndarray | None) -> tuple:
 def _as_samples(x, name: str) -> np.ndarray:
     arr = np.asarray(x)
     if arr.dtype.kind not in "biuf":
-        raise TypeError(f"{name} must hold real numbers; got dtype {arr.dtype}")
+        raise ImunoiseTypeError(f"{name} must hold real numbers; got dtype {arr.dtype}")
     arr = arr.astype(np.float64, copy=False)
     if arr.ndim not in (1, 2):
-        raise ValueError(f"{name} must be 1-D (n,) or 2-D (n, k); got shape {arr.shape}")
+        raise ImunoiseValueError(f"{name} must be 1-D (n,) or 2-D (n, k); got shape {arr.shape}")
     return arr
 
 
@@ -579,14 +580,14 @@ def distribution(x, *, bins="auto", qq_points: int = 1001, extent: str = "bulk",
     """
     arr = np.asarray(x)
     if arr.dtype.kind not in "biuf":
-        raise TypeError(f"x must hold real numbers; got dtype {arr.dtype}")
+        raise ImunoiseTypeError(f"x must hold real numbers; got dtype {arr.dtype}")
     arr = arr.astype(np.float64, copy=False)
     if arr.ndim != 1:
-        raise ValueError(f"x must be 1-D; got shape {arr.shape}")
+        raise ImunoiseValueError(f"x must be 1-D; got shape {arr.shape}")
     if np.isinf(arr).any():
-        raise ValueError("x must be finite or NaN (a missing sample); it contains inf")
+        raise ImunoiseValueError("x must be finite or NaN (a missing sample); it contains inf")
     if not isinstance(overwrite_input, bool):
-        raise TypeError(f"overwrite_input must be True or False; got {overwrite_input!r}")
+        raise ImunoiseTypeError(f"overwrite_input must be True or False; got {overwrite_input!r}")
     owned = overwrite_input and arr is x  # x itself, not a float64 copy of it
     nan = np.isnan(arr)
     missing = int(np.count_nonzero(nan))
@@ -596,11 +597,11 @@ def distribution(x, *, bins="auto", qq_points: int = 1001, extent: str = "bulk",
     del nan
     if len(arr) < 3:
         extra = f" ({missing} NaN left out)" if missing else ""
-        raise ValueError(f"x needs at least 3 valid samples; got {len(arr)}{extra}")
+        raise ImunoiseValueError(f"x needs at least 3 valid samples; got {len(arr)}{extra}")
     if not (isinstance(qq_points, int | np.integer) and qq_points >= 2):
-        raise ValueError(f"qq_points must be an integer >= 2; got {qq_points!r}")
+        raise ImunoiseValueError(f"qq_points must be an integer >= 2; got {qq_points!r}")
     if extent not in ("bulk", "all"):
-        raise ValueError(f'extent must be "bulk" or "all"; got {extent!r}')
+        raise ImunoiseValueError(f'extent must be "bulk" or "all"; got {extent!r}')
 
     n = len(arr)
     means = _batch_means(arr)  # in time order, before the sort
@@ -818,13 +819,13 @@ def _edges(x: np.ndarray, bins, step: float | None) -> np.ndarray:
     if not isinstance(bins, str) and np.ndim(bins) == 1:
         edges = np.asarray(bins, dtype=np.float64)
         if len(edges) < 2 or np.any(np.diff(edges) <= 0):
-            raise ValueError("bins as an array must be at least 2 increasing edges")
+            raise ImunoiseValueError("bins as an array must be at least 2 increasing edges")
         return edges
     if isinstance(bins, str):
         try:
             rule = np.histogram_bin_edges(x, bins=bins)
         except ValueError as exc:
-            raise ValueError(
+            raise ImunoiseValueError(
                 f"bins must be a numpy bin rule, an int or edges; got {bins!r}"
             ) from exc
         width = float(rule[1] - rule[0]) if len(rule) > 1 else 0.0
@@ -835,7 +836,8 @@ def _edges(x: np.ndarray, bins, step: float | None) -> np.ndarray:
     elif isinstance(bins, int | np.integer) and not isinstance(bins, bool) and bins >= 1:
         width = (hi - lo) / int(bins)
     else:
-        raise ValueError(f"bins must be a numpy bin rule, a positive int or edges; got {bins!r}")
+        raise ImunoiseValueError(
+            f"bins must be a numpy bin rule, a positive int or edges; got {bins!r}")
     if step is None or hi == lo:
         nb = 1 if width <= 0 else int(min(MAX_BINS, max(1, np.ceil((hi - lo) / width))))
         return np.histogram_bin_edges(x, bins=nb)

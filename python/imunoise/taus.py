@@ -7,7 +7,7 @@ import numbers
 import numpy as np
 
 from imunoise import _warn
-from imunoise.errors import CoverageWarning
+from imunoise.errors import CoverageWarning, ImunoiseTypeError, ImunoiseValueError
 
 #: Named grids. Their largest m follows allantools: every m below the number of
 #: phase points, then any tau whose estimator has fewer than two terms is dropped.
@@ -45,17 +45,17 @@ def averaging_factors(taus, fs: float, n_samples: int) -> tuple[np.ndarray, bool
         elif taus == "all":
             m = np.arange(1, n_phase)
         else:
-            raise ValueError(
+            raise ImunoiseValueError(
                 f"taus must be one of {', '.join(map(repr, GRID_NAMES))}, an integer number "
                 f"of points per decade, or an array of seconds; got {taus!r}"
             )
         return _unique_in_range(m, n_phase), False
     if isinstance(taus, numbers.Integral) and not isinstance(taus, bool):
         if taus < 1:
-            raise ValueError(f"taus as points per decade must be >= 1; got {taus}")
+            raise ImunoiseValueError(f"taus as points per decade must be >= 1; got {taus}")
         most = max_points_per_decade(n_samples)
         if taus > most:
-            raise ValueError(
+            raise ImunoiseValueError(
                 f"taus as points per decade must be at most {most} for {n_samples} samples "
                 f"(3 per sample: denser grids give no new averaging factor; taus='all' "
                 f"takes every one); got {taus}"
@@ -65,28 +65,28 @@ def averaging_factors(taus, fs: float, n_samples: int) -> tuple[np.ndarray, bool
         m = np.round(10.0**exponents)
         return _unique_in_range(m, n_phase), False
     if isinstance(taus, (bool, numbers.Real)):
-        raise TypeError(
+        raise ImunoiseTypeError(
             f"taus must be a grid name, an integer number of points per decade, or an "
             f"array of seconds; got {type(taus).__name__} {taus!r}"
         )
     arr = np.asarray(taus)
     if arr.dtype.kind not in "iuf" or arr.ndim != 1:
-        raise TypeError(
+        raise ImunoiseTypeError(
             f"taus must be a 1-D array of seconds; got {arr.dtype} array of shape {arr.shape}"
         )
     if arr.size == 0:
-        raise ValueError("taus must not be empty")
+        raise ImunoiseValueError("taus must not be empty")
     if not np.all(np.isfinite(arr)):
-        raise ValueError("taus must be finite")
+        raise ImunoiseValueError("taus must be finite")
     if np.any(arr <= 0):
         i = int(np.flatnonzero(arr <= 0)[0])
-        raise ValueError(f"taus must be > 0 s; got taus[{i}] = {arr[i]:g}")
+        raise ImunoiseValueError(f"taus must be > 0 s; got taus[{i}] = {arr[i]:g}")
     # float m first: a huge tau must not wrap around when cast to int
     m = np.round(arr.astype(np.float64) * fs)
     outside = (m < 1) | (m >= n_phase)
     if outside.all():
         shown = ", ".join(f"taus[{i}] = {arr[i]:g} s" for i in np.flatnonzero(outside)[:3])
-        raise ValueError(
+        raise ImunoiseValueError(
             f"no tau is within the record: {shown}{' ...' if arr.size > 3 else ''}; "
             f"{n_samples} samples at {fs:g} Hz give taus from 1/fs = {1 / fs:g} s to "
             f"{max(n_samples, 1) / fs:g} s at most"

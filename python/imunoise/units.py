@@ -31,6 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from imunoise import _schema
+from imunoise.errors import ImunoiseTypeError, ImunoiseValueError
 
 __all__ = [
     "G",
@@ -169,11 +170,12 @@ def unit_choice(units, sensor: str) -> dict[str, str]:
         return {}
     if isinstance(units, str):
         if units != "datasheet":
-            raise ValueError(f"units must be 'datasheet', a dict of term -> unit or None; "
+            raise ImunoiseValueError(f"units must be 'datasheet', a dict of term -> unit or None; "
                              f"got {units!r}")
         return dict(DATASHEET_UNITS[sensor])
     if not isinstance(units, dict):
-        raise TypeError(f"units must be 'datasheet', a dict or None; got {type(units).__name__}")
+        raise ImunoiseTypeError(
+            f"units must be 'datasheet', a dict or None; got {type(units).__name__}")
     return dict(units)
 
 _ALIASES = {
@@ -198,7 +200,7 @@ def _normalise(name: str) -> str:
 
 def _check_sensor(sensor: str) -> str:
     if sensor not in SENSORS:
-        raise ValueError(f"sensor must be one of {SENSORS}; got {sensor!r}")
+        raise ImunoiseValueError(f"sensor must be one of {SENSORS}; got {sensor!r}")
     return sensor
 
 
@@ -209,7 +211,7 @@ def input_scale(sensor: str, input_unit: str | None = None) -> float:
     if input_unit is None:
         input_unit = next(iter(table))
     if input_unit not in table:
-        raise ValueError(
+        raise ImunoiseValueError(
             f"input_unit for a {sensor} must be one of {tuple(table)}; got {input_unit!r}"
         )
     return table[input_unit]
@@ -219,12 +221,12 @@ def unit_info(term: str, unit: str | None, sensor: str) -> Unit:
     """Look up a datasheet unit (``None`` gives the default unit of ``term``)."""
     _check_sensor(sensor)
     if term not in ("Q", "N", "B", "K", "R"):
-        raise ValueError(f"term must be one of Q, N, B, K, R; got {term!r}")
+        raise ImunoiseValueError(f"term must be one of Q, N, B, K, R; got {term!r}")
     name = DEFAULT_UNITS[sensor][term] if unit is None else _normalise(unit)
     info = UNITS.get((sensor, name))
     if info is None or info.term != term:
         known = [u.name for (s, _), u in UNITS.items() if s == sensor and u.term == term]
-        raise ValueError(f"unit for {sensor} {term} must be one of {known}; got {unit!r}")
+        raise ImunoiseValueError(f"unit for {sensor} {term} must be one of {known}; got {unit!r}")
     return info
 
 

@@ -6,7 +6,6 @@
 
 use numpy::ndarray::Array2;
 use numpy::{Element, IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
-use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 
@@ -65,9 +64,7 @@ fn analyse<'py>(
 /// The bias ratio's options from their Python names.
 fn ratio_options(ladder: &str, block: usize) -> PyResult<RatioOptions> {
     if block == 0 {
-        return Err(PyValueError::new_err(
-            "ratio_block must be at least 1; got 0",
-        ));
+        return Err(super::value_error("ratio_block must be at least 1; got 0"));
     }
     Ok(RatioOptions {
         ladder: ladder.parse::<Ladder>()?,
@@ -90,7 +87,7 @@ fn analyse_plan<'py>(
     let ratio = ratio_options(ratio_ladder, ratio_block)?;
     let ms = ms.as_array();
     if statistics.len() != ms.len() {
-        return Err(PyValueError::new_err(format!(
+        return Err(super::value_error(format!(
             "statistics and ms must have the same length; got {} and {}",
             statistics.len(),
             ms.len()
@@ -148,7 +145,7 @@ fn table<T: Element>(
     values: Vec<T>,
 ) -> PyResult<Py<PyArray2<T>>> {
     let array =
-        Array2::from_shape_vec(shape, values).map_err(|e| PyValueError::new_err(e.to_string()))?;
+        Array2::from_shape_vec(shape, values).map_err(|e| super::value_error(e.to_string()))?;
     Ok(array.into_pyarray(py).unbind())
 }
 
@@ -198,7 +195,7 @@ fn estimator_edf<'py>(
     let statistic = parse_statistic(statistic)?;
     let (alphas, ms) = (alphas.as_array(), ms.as_array());
     if alphas.len() != ms.len() {
-        return Err(PyValueError::new_err(format!(
+        return Err(super::value_error(format!(
             "alphas and ms must have the same length; got {} and {}",
             alphas.len(),
             ms.len()

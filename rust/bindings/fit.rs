@@ -6,7 +6,6 @@
 
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1};
-use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
 use crate::fit::{
@@ -45,7 +44,7 @@ struct PyNoiseFit {
 
 fn ieee_flags(terms: &[bool]) -> PyResult<[bool; IEEE_TERMS]> {
     if terms.len() != IEEE_TERMS {
-        return Err(PyValueError::new_err(format!(
+        return Err(super::value_error(format!(
             "terms must have {IEEE_TERMS} flags (Q, N, B, K, R); got {}",
             terms.len()
         )));
@@ -58,7 +57,7 @@ fn ieee_flags(terms: &[bool]) -> PyResult<[bool; IEEE_TERMS]> {
 fn to_matrix(rows: Vec<Vec<f64>>, cols: usize) -> PyResult<Array2<f64>> {
     let n = rows.len();
     Array2::from_shape_vec((n, cols), rows.into_iter().flatten().collect())
-        .map_err(|e| PyValueError::new_err(e.to_string()))
+        .map_err(|e| super::value_error(e.to_string()))
 }
 
 /// fit_noise(taus, var, edf, fs, terms, gm, select, tones, resonance, motion) -> NoiseFit
@@ -127,20 +126,20 @@ fn noise_terms<'py>(
     motion: Vec<(f64, f64)>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     if ieee.len() != IEEE_TERMS {
-        return Err(PyValueError::new_err(format!(
+        return Err(super::value_error(format!(
             "ieee must have {IEEE_TERMS} values (Q², N², B², K², R²); got {}",
             ieee.len()
         )));
     }
     if !(fs.is_finite() && fs > 0.0) {
-        return Err(PyValueError::new_err(format!(
+        return Err(super::value_error(format!(
             "fs must be finite and > 0; got {fs}"
         )));
     }
     let mut coef = [0.0; IEEE_TERMS];
     coef.copy_from_slice(&ieee);
     if let Some(&(_, f0)) = sine.iter().find(|s| !(s.1.is_finite() && s.1 > 0.0)) {
-        return Err(PyValueError::new_err(format!(
+        return Err(super::value_error(format!(
             "sine frequencies must be finite and > 0 Hz; got {f0}"
         )));
     }
@@ -148,17 +147,17 @@ fn noise_terms<'py>(
         .iter()
         .find(|r| !(r.1.is_finite() && r.1 > 0.0 && r.2.is_finite() && r.2 > 0.0))
     {
-        return Err(PyValueError::new_err(format!(
+        return Err(super::value_error(format!(
             "resonance frequency and damping time must be finite and > 0; got {f} Hz, {t} s"
         )));
     }
     if let Some(&(_, _, _, skew)) = resonance.iter().find(|r| r.3.is_nan() || r.3.abs() > 1.0) {
-        return Err(PyValueError::new_err(format!(
+        return Err(super::value_error(format!(
             "resonance skew must be in [-1, 1] (a non-negative spectrum); got {skew}"
         )));
     }
     if let Some(&(_, t)) = motion.iter().find(|m| !(m.1.is_finite() && m.1 > 0.0)) {
-        return Err(PyValueError::new_err(format!(
+        return Err(super::value_error(format!(
             "motion correlation times must be finite and > 0 s; got {t}"
         )));
     }

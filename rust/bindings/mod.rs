@@ -5,7 +5,8 @@
 //! folder.
 
 use pyo3::exceptions::{
-    PyFileNotFoundError, PyKeyboardInterrupt, PyOSError, PyPermissionError, PyValueError,
+    PyFileNotFoundError, PyKeyboardInterrupt, PyOSError, PyPermissionError, PyTypeError,
+    PyValueError,
 };
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -54,8 +55,31 @@ pub(crate) fn core_error_to_py(err: CoreError, source: Option<String>) -> PyErr 
             _ => PyOSError::new_err(message),
         },
         CoreError::Interrupted => PyKeyboardInterrupt::new_err("interrupted"),
-        other => PyValueError::new_err(other.to_string()),
+        other => value_error(other.to_string()),
     }
+}
+
+/// `imunoise.errors.<class>(message)`, the package's own error class (a subclass
+/// of the built-in one), so that `except imunoise.ImunoiseError` catches what the
+/// core raises too; the built-in `fallback` where the package cannot be imported.
+fn package_error(class: &str, message: String, fallback: fn(String) -> PyErr) -> PyErr {
+    Python::attach(|py| {
+        let made = || -> PyResult<PyErr> {
+            let cls = py.import("imunoise.errors")?.getattr(class)?;
+            Ok(PyErr::from_value(cls.call1((message.clone(),))?))
+        };
+        made().unwrap_or_else(|_| fallback(message.clone()))
+    })
+}
+
+/// A bad argument value: `imunoise.ImunoiseValueError` (a `ValueError`).
+pub(crate) fn value_error(message: impl Into<String>) -> PyErr {
+    package_error("ImunoiseValueError", message.into(), PyValueError::new_err)
+}
+
+/// An argument of the wrong type: `imunoise.ImunoiseTypeError` (a `TypeError`).
+pub(crate) fn type_error(message: impl Into<String>) -> PyErr {
+    package_error("ImunoiseTypeError", message.into(), PyTypeError::new_err)
 }
 
 /// Adds `imunoise._core.<name>` filled by `register`, and enters it in

@@ -2,7 +2,6 @@
 //! runs, which the CPU has, and forcing a lower one (the tests run every path;
 //! `IMUNOISE_SIMD` pins one for a reproducible run).
 
-use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
 use crate::simd::{self, Level};
@@ -34,7 +33,7 @@ fn force(name: Option<&str>) -> PyResult<()> {
         None => None,
         Some(n) => Some(Level::from_name(n).ok_or_else(|| {
             let known: Vec<&str> = Level::ALL.iter().map(|l| l.name()).collect();
-            PyValueError::new_err(format!(
+            super::value_error(format!(
                 "SIMD level must be one of {}; got {n:?}",
                 known.join(", ")
             ))

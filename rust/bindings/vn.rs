@@ -5,7 +5,6 @@ use std::collections::BTreeMap;
 use std::path::PathBuf;
 
 use numpy::{IntoPyArray, PyReadonlyArray1};
-use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict, PyList, PySlice};
 
@@ -33,7 +32,7 @@ fn tables_to_py<'py>(
         // a strided view of it, so adjacent columns (x, y, z) form (n, 3) views.
         let shape = (table.len, table.names.len());
         let matrix = numpy::ndarray::Array2::from_shape_vec(shape, table.values)
-            .map_err(|e| PyValueError::new_err(format!("table {name}: {e}")))?
+            .map_err(|e| super::value_error(format!("table {name}: {e}")))?
             .into_pyarray(py);
         let all = PySlice::full(py);
         for (k, col_name) in table.names.into_iter().enumerate() {
@@ -132,9 +131,9 @@ pub struct VnStream {
 
 impl VnStream {
     fn pieces(&mut self) -> PyResult<&mut stream::Pieces> {
-        self.pieces.as_mut().ok_or_else(|| {
-            PyValueError::new_err("VnStream is finished; feed must come before finish")
-        })
+        self.pieces
+            .as_mut()
+            .ok_or_else(|| super::value_error("VnStream is finished; feed must come before finish"))
     }
 }
 
@@ -164,7 +163,7 @@ impl VnStream {
                 .getattr("memoryview")?
                 .call1((data,))
                 .map_err(|_| {
-                    PyTypeError::new_err(format!(
+                    super::type_error(format!(
                         "data must be bytes or a buffer of bytes; got {}",
                         data.get_type()
                             .name()
@@ -173,7 +172,7 @@ impl VnStream {
                     ))
                 })?;
             if !view.getattr("c_contiguous")?.extract::<bool>()? {
-                return Err(PyValueError::new_err(
+                return Err(super::value_error(
                     "data must be a C-contiguous buffer of bytes",
                 ));
             }
@@ -194,7 +193,7 @@ impl VnStream {
 
     fn finish(&mut self, py: Python<'_>) -> PyResult<VnResult> {
         let pieces = self.pieces.take().ok_or_else(|| {
-            PyValueError::new_err("VnStream is finished; finish must be called once")
+            super::value_error("VnStream is finished; finish must be called once")
         })?;
         let data = py.detach(|| pieces.finish())?;
         to_result(py, data)
@@ -218,7 +217,7 @@ fn parse_vn<'py>(
         py.detach(|| stream::parse_bytes(slice, strict))?
     } else {
         let path: PathBuf = source.extract().map_err(|_| {
-            PyValueError::new_err(format!(
+            super::value_error(format!(
                 "source must be bytes or a path; got {}",
                 source
                     .get_type()
@@ -325,7 +324,7 @@ fn write_vn_binary<'py>(
     let mut arrays: Vec<PyReadonlyArray1<'py, f64>> = Vec::with_capacity(names.len());
     for name in &names {
         let item = columns.get_item(name)?.ok_or_else(|| {
-            PyValueError::new_err(format!(
+            super::value_error(format!(
                 "columns is missing {name:?}; this selection needs {names:?}"
             ))
         })?;

@@ -92,7 +92,14 @@ def objects(tmp_path_factory):
                     model_files=(Path("out/noise.json"), Path("out/imu.yaml")),
                     description=imunoise.describe(log), distributions={}, allan={"gyro": result},
                     models={"gyro": model}, logs=(log,))
+    units = tmp_path_factory.mktemp("fleet")
+    paths = [imunoise.simulate_log(units / f"unit{i}.bin", 0.05, 40.0, format="vn-binary",
+                                   seed=i) for i in range(3)]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        fleet = imunoise.fleet(paths, client=False, progress=False)
     return {
+        "Fleet": fleet,
         "ImuLog": log, "damaged ImuLog": damaged, "ParseIssues": damaged.issues,
         "Gaps": damaged.gaps, "AllanResult": result, "NoiseModel": model,
         "Components": model.components, "Prediction": model.predict(),
@@ -113,7 +120,7 @@ def objects(tmp_path_factory):
 NAMES = ("ImuLog", "damaged ImuLog", "ParseIssues", "Gaps", "AllanResult", "NoiseModel",
          "Components", "Prediction", "Description", "Distribution", "Comparison", "Spectrum",
          "DynamicAllan", "Stationarity", "Events", "Warmup", "Thermal", "Conversion", "Report",
-         "Plan", "Recording", "ThreeCorneredHat")
+         "Plan", "Recording", "ThreeCorneredHat", "Fleet")
 
 
 @pytest.mark.parametrize("name", NAMES)

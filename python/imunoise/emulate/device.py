@@ -32,6 +32,7 @@ from dataclasses import dataclass, field
 
 from imunoise.emulate.outputs import SampleSource, check_selection, encode
 from imunoise.emulate.registers import IMU_RATE, RegisterError, Registers
+from imunoise.errors import ImunoiseValueError
 from imunoise.recording.protocol import parse_reply, sentence
 
 __all__ = ["FAULT_KINDS", "MAX_SPEED", "Emulator", "Event", "Fault"]
@@ -63,13 +64,13 @@ class Fault:
 
     def __post_init__(self) -> None:
         if self.kind not in FAULT_KINDS:
-            raise ValueError(f"fault kind must be one of {FAULT_KINDS}; got {self.kind!r}")
+            raise ImunoiseValueError(f"fault kind must be one of {FAULT_KINDS}; got {self.kind!r}")
         # bounded: a wait beyond the thread's longest timeout (2^63 ns) killed the thread
         if not 0 <= self.at <= MAX_FAULT_SECONDS:
-            raise ValueError(f"fault time must be within 0 ... {MAX_FAULT_SECONDS:g} s; "
+            raise ImunoiseValueError(f"fault time must be within 0 ... {MAX_FAULT_SECONDS:g} s; "
                              f"got {self.at!r}")
         if self.kind in ("pause", "vanish") and not 0 < self.seconds <= MAX_FAULT_SECONDS:
-            raise ValueError(f"a {self.kind} fault needs seconds within (0, "
+            raise ImunoiseValueError(f"a {self.kind} fault needs seconds within (0, "
                              f"{MAX_FAULT_SECONDS:g}]; got {self.seconds!r}")
 
 
@@ -123,11 +124,11 @@ class Emulator:
     def __init__(self, path, *, speed: float = 1.0, seed=None, faults=(), keep_sent=True,
                  baud: int = 115200):
         if not (isinstance(speed, int | float) and 0 < speed <= MAX_SPEED):
-            raise ValueError(f"speed must be a number of sensor seconds per wall second "
+            raise ImunoiseValueError(f"speed must be a number of sensor seconds per wall second "
                              f"in (0, {MAX_SPEED:g}]; got {speed!r}")
         self.path = os.fspath(path)
         if os.path.lexists(self.path):
-            raise ValueError(f"path {self.path!r} exists; the emulator makes it")
+            raise ImunoiseValueError(f"path {self.path!r} exists; the emulator makes it")
         self.speed = float(speed)
         self.faults = sorted(faults, key=lambda f: f.at)
         self.sent = bytearray()

@@ -15,12 +15,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from imunoise import _schema, _summary
+from imunoise.errors import ImunoiseValueError
 from imunoise.noise._terms import GM_MAX, TERMS, TONES_MAX, term_variances
 
 
 def check_term(term: str) -> None:
     if term not in TERMS:
-        raise ValueError(f"term must be one of {TERMS}; got {term!r}")
+        raise ImunoiseValueError(f"term must be one of {TERMS}; got {term!r}")
 
 
 @dataclass(frozen=True, repr=False)
@@ -236,7 +237,8 @@ class Components(PerTerm):
         for the tones together, ``terms["resonance"]``, ``terms["motion"]``)."""
         t = np.asarray(taus, dtype=float)
         if t.ndim != 1 or t.size == 0 or not np.all(np.isfinite(t)) or np.any(t <= 0):
-            raise ValueError(f"taus must be a non-empty 1-D array of finite values > 0; got {t!r}")
+            raise ImunoiseValueError(
+                f"taus must be a non-empty 1-D array of finite values > 0; got {t!r}")
         gm_names = [f"GM{k + 1}" for k in range(GM_MAX)]
         names = [*TERMS, *gm_names, "sine", "resonance", "motion"]
         parts = np.zeros((t.size, len(names), self.channels))

@@ -16,7 +16,7 @@ import numpy as np
 from imunoise import _warn
 from imunoise._core import fit as _core_fit
 from imunoise._deprecation import old_call_forms
-from imunoise.errors import CoverageWarning
+from imunoise.errors import CoverageWarning, ImunoiseTypeError, ImunoiseValueError
 from imunoise.noise._components import Components
 from imunoise.noise._datasheet import datasheet_notes, datasheet_values, upper_bounds
 from imunoise.noise._model import NoiseModel
@@ -42,12 +42,12 @@ def _extract(result, tau_range):
     """Validate an Allan result; return taus (T,), var (T, C), edf (T, C), 1-D flag."""
     missing = [a for a in ("taus", "kind", "edf", "fs") if not hasattr(result, a)]
     if missing or not (hasattr(result, "var") or hasattr(result, "dev")):
-        raise TypeError(
+        raise ImunoiseTypeError(
             f"result must be an AllanResult (from imunoise.adev); got {type(result).__name__} "
             f"without {missing or ['var']}"
         )
     if result.kind != "adev":
-        raise ValueError(
+        raise ImunoiseValueError(
             f"result.kind must be 'adev' (the noise model is that of the Allan variance); "
             f"got {result.kind!r}"
         )
@@ -56,31 +56,32 @@ def _extract(result, tau_range):
                      dtype=float)
     edf = np.asarray(result.edf, dtype=float)
     if taus.ndim != 1 or taus.size == 0:
-        raise ValueError(f"result.taus must be a non-empty 1-D array; got shape {taus.shape}")
+        raise ImunoiseValueError(
+            f"result.taus must be a non-empty 1-D array; got shape {taus.shape}")
     one = var.ndim == 1
     if one:
         var, edf = var[:, None], edf[:, None]
     if var.ndim != 2 or var.shape[0] != taus.size or edf.shape != var.shape:
-        raise ValueError(
+        raise ImunoiseValueError(
             f"result.var and result.edf must have shape ({taus.size},) or ({taus.size}, k); "
             f"got {var.shape} and {edf.shape}"
         )
     if var.shape[1] == 0:
-        raise ValueError("result has no channels (var has 0 columns)")
+        raise ImunoiseValueError("result has no channels (var has 0 columns)")
     if not np.all(np.isfinite(taus)) or np.any(taus <= 0):
-        raise ValueError(f"result.taus must be finite and > 0; got {taus!r}")
+        raise ImunoiseValueError(f"result.taus must be finite and > 0; got {taus!r}")
     keep = np.ones(taus.size, dtype=bool)
     if tau_range is not None:
         try:
             lo, hi = (float(v) for v in tau_range)
         except (TypeError, ValueError):
             msg = f"tau_range must be (min, max) in seconds; got {tau_range!r}"
-            raise ValueError(msg) from None
+            raise ImunoiseValueError(msg) from None
         if not (lo <= hi):
-            raise ValueError(f"tau_range must satisfy min <= max; got {tau_range!r}")
+            raise ImunoiseValueError(f"tau_range must satisfy min <= max; got {tau_range!r}")
         keep = (taus >= lo) & (taus <= hi)
         if not keep.any():
-            raise ValueError(
+            raise ImunoiseValueError(
                 f"tau_range {tau_range!r} contains none of result.taus "
                 f"({taus.min():.3g} s .. {taus.max():.3g} s)"
             )
@@ -129,7 +130,7 @@ def _parse_terms(terms) -> tuple[np.ndarray, int, tuple[int, bool, bool], bool]:
     tones = names.count("sine")
     if (bad or not names or gm > GM_MAX or tones > TONES_MAX
             or any(names.count(once) > 1 for once in ("resonance", "motion"))):
-        raise ValueError(
+        raise ImunoiseValueError(
             f"terms must be 'auto' or a non-empty sequence of {allowed} with 'GM' at most "
             f"{GM_MAX} times, 'sine' at most {TONES_MAX} times and each of 'resonance', "
             f"'motion' at most once; got {terms!r}"
@@ -210,20 +211,20 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
     squares: u(N) = u(N²)/(2N); of a correlation time from that of ln τc.
     """
     if method not in ("wls", "slopes"):
-        raise ValueError(f"method must be 'wls' or 'slopes'; got {method!r}")
+        raise ImunoiseValueError(f"method must be 'wls' or 'slopes'; got {method!r}")
     if uncertainty not in ("independent", "bootstrap"):
-        raise ValueError(
+        raise ImunoiseValueError(
             f"uncertainty must be 'independent' or 'bootstrap'; got {uncertainty!r}"
         )
     if uncertainty == "bootstrap":
         if isinstance(replicates, bool) or not isinstance(replicates, numbers.Integral):
-            raise TypeError(f"replicates must be an integer; got {replicates!r}")
+            raise ImunoiseTypeError(f"replicates must be an integer; got {replicates!r}")
         if replicates < 5:
-            raise ValueError(f"replicates must be >= 5; got {replicates}")
+            raise ImunoiseValueError(f"replicates must be >= 5; got {replicates}")
         n_record = _record_length(result)  # the length of every simulated replicate
         if replicates * n_record > MAX_BOOTSTRAP_SAMPLES:
             most = MAX_BOOTSTRAP_SAMPLES // n_record
-            raise ValueError(
+            raise ImunoiseValueError(
                 (f"replicates must be at most {most:,} for a record of {n_record:,} samples"
                  if most >= 5 else
                  f"a record of {n_record:,} samples is too long for a bootstrap (use "
@@ -254,11 +255,11 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
     for c in range(channels):
         ok = np.isfinite(var[:, c]) & (var[:, c] > 0) & np.isfinite(edf[:, c]) & (edf[:, c] > 0)
         if not ok.any():
-            raise ValueError(
+            raise ImunoiseValueError(
                 f"result has no usable tau for channel {c}: var and edf must be finite and > 0"
             )
         if ok.sum() < 2:
-            raise ValueError(
+            raise ImunoiseValueError(
                 f"result has {ok.sum()} usable tau for channel {c}; the fit needs at least 2 "
                 "(var and edf finite and > 0)"
             )
@@ -388,17 +389,17 @@ def _check_spectrum(spectrum, result) -> None:
     from imunoise.spectrum import Spectrum
 
     if not isinstance(spectrum, Spectrum):
-        raise TypeError(f"spectrum must be a Spectrum (imunoise.psd) or None; got "
+        raise ImunoiseTypeError(f"spectrum must be a Spectrum (imunoise.psd) or None; got "
                         f"{type(spectrum).__name__}")
     channels = 1 if np.ndim(result.dev) == 1 else np.shape(result.dev)[1]
     if spectrum.channels != channels:
-        raise ValueError(f"spectrum has {spectrum.channels} channels; the Allan result has "
+        raise ImunoiseValueError(f"spectrum has {spectrum.channels} channels; the Allan result has "
                          f"{channels}")
     if not math.isclose(float(spectrum.fs), float(result.fs), rel_tol=1e-9):
-        raise ValueError(f"spectrum.fs must equal result.fs ({result.fs} Hz); got "
+        raise ImunoiseValueError(f"spectrum.fs must equal result.fs ({result.fs} Hz); got "
                          f"{spectrum.fs} Hz")
     if spectrum.bins_per_decade:
-        raise ValueError("spectrum must be on Welch's linear grid (imunoise.psd), not "
+        raise ImunoiseValueError("spectrum must be on Welch's linear grid (imunoise.psd), not "
                          f"smoothed; got bins_per_decade={spectrum.bins_per_decade}")
 
 
@@ -448,7 +449,7 @@ def _record_length(result) -> int:
         m0, n0 = int(np.asarray(result.m)[0]), int(np.max(np.asarray(result.n)[0]))
         overlapping = bool(result.overlapping)
     except (AttributeError, IndexError, TypeError):
-        raise TypeError(
+        raise ImunoiseTypeError(
             "uncertainty='bootstrap' needs an AllanResult from imunoise.adev (with m, n and "
             "overlapping)"
         ) from None
@@ -508,7 +509,7 @@ def _fit_wls(t, v, e, fs, mask, gm_count, oscillators, select):
             [bool(m) for m in mask], gm_count, select, tone, resonance, motion,
         )
     except ValueError as exc:
-        raise ValueError(f"cannot fit the noise model to result: {exc}") from None
+        raise ImunoiseValueError(f"cannot fit the noise model to result: {exc}") from None
     sq, gm, cov = r.ieee, r.gm, r.cov
     delta, chi2, n_eff = r.discrepancy, r.chi2, r.n_eff
     supported = sq > 0

@@ -13,7 +13,7 @@ from imunoise import _schema, _summary, _warn
 from imunoise import numbers as _numbers
 from imunoise import units as _units
 from imunoise._deprecation import old_call_forms
-from imunoise.errors import ImunoiseDeprecationWarning
+from imunoise.errors import ImunoiseDeprecationWarning, ImunoiseValueError
 from imunoise.noise._components import (
     Components,
     PerTerm,
@@ -288,7 +288,7 @@ class NoiseModel(PerTerm):
         units = _units.unit_choice(units, sensor)
         unknown = set(units) - set(TERMS)
         if unknown:
-            raise ValueError(f"units keys must be among {TERMS}; got {sorted(unknown)}")
+            raise ImunoiseValueError(f"units keys must be among {TERMS}; got {sorted(unknown)}")
         out = {}
         shape = np.shape(self.N)
         for term in TERMS:
@@ -413,7 +413,7 @@ class NoiseModel(PerTerm):
             return format_table(rows, axes, datasheet=True)
         sensor = kwargs.pop("sensor", which)
         if which not in ("gyro", sensor):
-            raise ValueError(f"table_text takes the sensor once; got {which!r} and "
+            raise ImunoiseValueError(f"table_text takes the sensor once; got {which!r} and "
                              f"sensor={sensor!r}")
         return format_table(self.table(sensor, **kwargs), axes)
 

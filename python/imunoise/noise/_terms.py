@@ -8,6 +8,7 @@ import math
 import numpy as np
 
 from imunoise._core import fit as _core_fit
+from imunoise.errors import ImunoiseValueError
 
 TERMS: tuple[str, ...] = tuple(_core_fit.IEEE_TERM_NAMES)
 """The five coefficients, in the order used everywhere (Q, N, B, K, R)."""
@@ -92,9 +93,9 @@ def resolution_noise(step: float, fs: float) -> tuple[float, float]:
     dither); slower, the rounding error is correlated and smaller at long τ. Which
     one a record has, its curve tells (slope −½ or −1 at the shortest taus)."""
     if not (math.isfinite(step) and step > 0):
-        raise ValueError(f"step must be finite and > 0; got {step!r}")
+        raise ImunoiseValueError(f"step must be finite and > 0; got {step!r}")
     if not (math.isfinite(fs) and fs > 0):
-        raise ValueError(f"fs must be finite and > 0; got {fs!r}")
+        raise ImunoiseValueError(f"fs must be finite and > 0; got {fs!r}")
     return step / math.sqrt(12.0 * fs), step / (fs * math.sqrt(12.0))
 
 

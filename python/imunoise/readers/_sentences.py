@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from imunoise._core import vn as _core_vn
+from imunoise.errors import ImunoiseValueError
 from imunoise.readers.log import CHANNELS, ISSUE_KINDS, ImuLog, ParseIssues
 
 #: How many locations per issue kind a reader keeps in ``ParseIssues.first``: the
@@ -107,7 +108,8 @@ def sentence_rows(
                         source=source,
                         where=where,
                     )
-                raise ValueError(f"{source}: {where} {locations[i]}: no $VN sentence in the field")
+                raise ImunoiseValueError(
+                    f"{source}: {where} {locations[i]}: no $VN sentence in the field")
             tally.add("malformed_field", locations[i])
             continue
         # one item per line: a line break inside the field would shift the line numbers
@@ -125,13 +127,13 @@ def sentence_rows(
         match = re.search(r"line (\d+)", str(exc))
         if match and 1 <= int(match.group(1)) <= len(line_loc):
             loc = line_loc[int(match.group(1)) - 1]
-            raise ValueError(f"{source}: {where} {loc}: {exc}") from exc
+            raise ImunoiseValueError(f"{source}: {where} {loc}: {exc}") from exc
         for k, c in enumerate(clean):  # the message names no line: find the item
             try:
                 parse_sentences(c + b"\n", strict=True, source=source)
             except ValueError as item_exc:
-                raise ValueError(f"{source}: {where} {line_loc[k]}: {item_exc}") from exc
-        raise ValueError(f"{source}: {exc}") from exc
+                raise ImunoiseValueError(f"{source}: {where} {line_loc[k]}: {item_exc}") from exc
+        raise ImunoiseValueError(f"{source}: {exc}") from exc
 
     # move the parser's issues from lines of `data` to container locations
     starts = np.concatenate(([0], np.cumsum([len(c) + 1 for c in clean])))

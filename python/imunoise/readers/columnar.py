@@ -24,7 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from imunoise._schema import CHANNELS, column_names
-from imunoise.errors import ParseError
+from imunoise.errors import ImunoiseTypeError, ImunoiseValueError, ParseError
 from imunoise.readers import metafile
 from imunoise.readers.grid import Gaps
 from imunoise.readers.log import ISSUE_KINDS, ImuLog, ParseIssues
@@ -286,11 +286,11 @@ def _read_npz(source, path: Path | None) -> ImuLog:
                      allow_pickle=False) as z:
             table = {k: z[k] for k in z.files}
     except Exception as exc:  # noqa: BLE001 - zipfile/zlib/numpy raise many kinds
-        raise ValueError(f"{where}: not a readable .npz ({exc})") from None
+        raise ImunoiseValueError(f"{where}: not a readable .npz ({exc})") from None
     if META_KEY not in table and "fs" in table:
         return _legacy_npz(table, where)
     if META_KEY not in table:
-        raise ValueError(f"{where}: an .npz of arrays {sorted(table)} without the metadata "
+        raise ImunoiseValueError(f"{where}: an .npz of arrays {sorted(table)} without the metadata "
                          f"imunoise convert writes; {_FROM_ARRAYS}")
     meta = check_meta(metafile.parse(str(table[META_KEY]), where), where)
     return log_from_meta(meta, _flat(table, meta["channels"], where), where)
@@ -300,7 +300,7 @@ def _legacy_npz(table: Mapping[str, np.ndarray], where: str) -> ImuLog:
     """An ``.npz`` of an earlier ``convert``: ``fs`` and flat columns, no metadata."""
     channels = [ch for ch in ("time", *CHANNELS) if all(n in table for n in column_names(ch))]
     if not [ch for ch in channels if ch != "time"]:
-        raise ValueError(f"{where}: an .npz of arrays {sorted(table)} with no imunoise "
+        raise ImunoiseValueError(f"{where}: an .npz of arrays {sorted(table)} with no imunoise "
                          f"channel columns; {_FROM_ARRAYS}")
     fs_value = np.asarray(table["fs"]).reshape(-1)
     if fs_value.size != 1 or fs_value.dtype.kind not in "iuf":
@@ -327,10 +327,10 @@ def _read_parquet(source, path: Path | None) -> ImuLog:
             handle.seek(0)
         table = pq.read_table(handle)
     except Exception as exc:  # noqa: BLE001 - pyarrow raises its own ArrowInvalid etc.
-        raise ValueError(f"{where}: not a readable Parquet file ({exc})") from None
+        raise ImunoiseValueError(f"{where}: not a readable Parquet file ({exc})") from None
     raw = kv.get(META_KEY.encode())
     if raw is None:
-        raise ValueError(f"{where}: a Parquet file without the metadata imunoise convert "
+        raise ImunoiseValueError(f"{where}: a Parquet file without the metadata imunoise convert "
                          f"writes (key {META_KEY!r}); {_FROM_ARRAYS}")
     meta = check_meta(metafile.parse(raw, where), where)
     columns = {n: table.column(n).to_numpy() for n in table.column_names}
@@ -365,7 +365,7 @@ def read_columnar(
         with open(path, "rb") as f:
             head = f.read(8)
     else:
-        raise TypeError(f"source must be a path or bytes; got {type(source).__name__}")
+        raise ImunoiseTypeError(f"source must be a path or bytes; got {type(source).__name__}")
     if head.startswith(_NPY_MAGIC):
         log = _read_npy(source, path)
     elif head.startswith(_ZIP_MAGIC):
@@ -373,7 +373,7 @@ def read_columnar(
     elif head.startswith(_PARQUET_MAGIC):
         log = _read_parquet(source, path)
     else:
-        raise ValueError(f"{path or '<bytes>'}: not a .npy, .npz or Parquet file")
+        raise ImunoiseValueError(f"{path or '<bytes>'}: not a .npy, .npz or Parquet file")
     if progress is not None:
         size = len(source) if path is None else os.path.getsize(path)
         progress(size, size)

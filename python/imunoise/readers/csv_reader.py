@@ -23,7 +23,13 @@ import numpy as np
 
 from imunoise import _warn
 from imunoise._schema import CHANNELS, COLUMN_SUFFIXES, G
-from imunoise.errors import AssumptionWarning, DataWarning, ParseError
+from imunoise.errors import (
+    AssumptionWarning,
+    DataWarning,
+    ImunoiseTypeError,
+    ImunoiseValueError,
+    ParseError,
+)
 from imunoise.readers import metafile
 from imunoise.readers._sentences import IssueTally, sentence_rows
 from imunoise.readers.columnar import check_meta, log_from_meta
@@ -163,10 +169,11 @@ def _unit_factor(channel: str, unit: str) -> tuple[float, float]:
     if key not in UNITS and channel == "mag" and key in ("g", "mg"):
         key = {"g": "gauss", "mg": "mgauss"}[key]
     if key not in UNITS:
-        raise ValueError(f"units[{channel!r}]: unknown unit {unit!r}; known units: {sorted(UNITS)}")
+        raise ImunoiseValueError(
+            f"units[{channel!r}]: unknown unit {unit!r}; known units: {sorted(UNITS)}")
     family, factor, offset = UNITS[key]
     if family != _FAMILY[channel]:
-        raise ValueError(
+        raise ImunoiseValueError(
             f"units[{channel!r}]: {unit!r} is a unit of {family}, not of {_FAMILY[channel]}"
         )
     return factor, offset
@@ -183,7 +190,7 @@ def _open(source) -> tuple[io.BufferedIOBase, int, str]:
     if isinstance(source, str | os.PathLike):
         path = os.fspath(source)
         return open(path, "rb"), os.path.getsize(path), path
-    raise TypeError(f"source must be a path or bytes; got {type(source).__name__}")
+    raise ImunoiseTypeError(f"source must be a path or bytes; got {type(source).__name__}")
 
 
 def _lines(fh, total: int, progress: Callable[[int, int], None] | None):
@@ -233,7 +240,7 @@ def _number(text: str) -> float:
     """``float(text)``, without Python's digit separators (``1_000``): a logger never
     writes them, so a field with one is damaged, not a thousand."""
     if "_" in text:
-        raise ValueError(f"digit separator in {text!r}")
+        raise ImunoiseValueError(f"digit separator in {text!r}")
     return float(text)
 
 
@@ -286,18 +293,19 @@ def _auto_columns(names: list[str], raw_col: int | None) -> dict[str, list[int]]
 
 def _resolve(spec, names: list[str] | None, ncols: int, what: str) -> int:
     if isinstance(spec, bool) or not isinstance(spec, int | str | np.integer):
-        raise TypeError(f"{what}: a column is a name or a 0-based index; got {spec!r}")
+        raise ImunoiseTypeError(f"{what}: a column is a name or a 0-based index; got {spec!r}")
     if isinstance(spec, str):
         if names is None:
-            raise ValueError(f"{what}: column {spec!r} given by name but the file has no header")
+            raise ImunoiseValueError(
+                f"{what}: column {spec!r} given by name but the file has no header")
         if spec in names:
             return names.index(spec)
         norm = [_normalise(n)[0] for n in names]
         if _normalise(spec)[0] in norm:
             return norm.index(_normalise(spec)[0])
-        raise ValueError(f"{what}: no column named {spec!r}; columns are {names}")
+        raise ImunoiseValueError(f"{what}: no column named {spec!r}; columns are {names}")
     if not 0 <= int(spec) < ncols:
-        raise ValueError(f"{what}: column index {spec} outside 0..{ncols - 1}")
+        raise ImunoiseValueError(f"{what}: column index {spec} outside 0..{ncols - 1}")
     return int(spec)
 
 
@@ -372,12 +380,13 @@ def read_csv(
         columns["time"] = time_column
     for ch in columns:
         if ch not in LAYOUT_CHANNELS:
-            raise ValueError(f"columns: unknown channel {ch!r}; use {list(LAYOUT_CHANNELS)}")
+            raise ImunoiseValueError(
+                f"columns: unknown channel {ch!r}; use {list(LAYOUT_CHANNELS)}")
     for ch in units:
         if ch not in _FAMILY:
-            raise ValueError(f"units: unknown channel {ch!r}; use {list(_FAMILY)}")
+            raise ImunoiseValueError(f"units: unknown channel {ch!r}; use {list(_FAMILY)}")
     if delimiter is not None and (not isinstance(delimiter, str) or len(delimiter) != 1):
-        raise ValueError(f"delimiter must be one character or None; got {delimiter!r}")
+        raise ImunoiseValueError(f"delimiter must be one character or None; got {delimiter!r}")
 
     fh, total, name = _open(source)
     tally = IssueTally()
@@ -437,7 +446,7 @@ class _Reader:
         raw_col = self._raw_column(names, sample_fields, explicit, auto)
         numeric = self._numeric_columns(names, raw_col, explicit, auto)
         if not numeric and raw_col is None:
-            raise ValueError(_no_columns_message(self.name, names, sample_fields))
+            raise ImunoiseValueError(_no_columns_message(self.name, names, sample_fields))
         self.numeric = numeric
         self.raw_col = raw_col
         self.names = names
@@ -493,7 +502,7 @@ class _Reader:
             specs = [spec] if isinstance(spec, int | str | np.integer) else list(spec)
             want = 1 if ch == "time" else CHANNELS[ch][0]
             if len(specs) != want:
-                raise ValueError(f"columns[{ch!r}] needs {want} column(s); got {spec!r}")
+                raise ImunoiseValueError(f"columns[{ch!r}] needs {want} column(s); got {spec!r}")
             numeric[ch] = [_resolve(s, names, self.ncols, f"columns[{ch!r}]") for s in specs]
         return numeric
 
@@ -639,7 +648,7 @@ class _Reader:
 
     def finish(self, fs: float | None) -> ImuLog:
         if not self.layout_done:
-            raise ValueError(f"{self.name}: no data lines")
+            raise ImunoiseValueError(f"{self.name}: no data lines")
         data = self.buf[: self.rows] if self.buf is not None else np.zeros((0, len(self.used)))
         if self.buf is not None and len(self.buf) > 1.1 * self.rows + 16:
             data = data.copy()  # do not keep a much larger buffer alive through views

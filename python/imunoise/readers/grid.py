@@ -54,6 +54,7 @@ import numpy as np
 
 from imunoise import _summary
 from imunoise._runs import true_runs
+from imunoise.errors import ImunoiseValueError
 
 __all__ = ["MAX_GRID_RATIO", "Gaps", "TimeGrid", "outlier_stamps"]
 
@@ -195,7 +196,7 @@ class Gaps:
             arr.flags.writeable = False
             object.__setattr__(self, name, arr)
         if len(self.index) != len(self.samples):
-            raise ValueError(
+            raise ImunoiseValueError(
                 f"index and samples must have equal lengths; got {len(self.index)} "
                 f"and {len(self.samples)}"
             )
@@ -468,7 +469,7 @@ class TimeGrid:
             pos_slot -= _phase(pos_slot)
         span = float(pos_slot.max() - pos_slot.min())
         if span > MAX_GRID_RATIO * n:
-            raise ValueError(
+            raise ImunoiseValueError(
                 f"time: the timestamps span {span:.4g} nominal steps of {dt:.4g} for {n} "
                 f"samples (more than {MAX_GRID_RATIO}x); they are not a sample clock"
             )
@@ -502,7 +503,7 @@ class TimeGrid:
         p = np.asarray(positions, dtype=np.int64).reshape(-1)
         p = p[(p > 0) & (p < n_records)]
         if n_records + len(p) > MAX_GRID_RATIO * n_records:
-            raise ValueError(
+            raise ImunoiseValueError(
                 f"{len(p)} damaged records among {n_records} good ones would be "
                 f"{len(p)} missing rows, more than {MAX_GRID_RATIO}x the samples: the log "
                 f"is not a sample sequence (a damaged or crafted file)"

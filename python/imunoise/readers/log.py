@@ -12,7 +12,13 @@ import numpy as np
 from imunoise import _schema, _summary, _warn
 from imunoise._core import vn as _core_vn
 from imunoise._validate import sample_rate
-from imunoise.errors import AssumptionWarning, DataWarning, GapWarning
+from imunoise.errors import (
+    AssumptionWarning,
+    DataWarning,
+    GapWarning,
+    ImunoiseTypeError,
+    ImunoiseValueError,
+)
 from imunoise.readers.grid import Gaps, TimeGrid
 
 if TYPE_CHECKING:
@@ -91,7 +97,7 @@ class ParseIssues:
         counts = {kind: int(self.counts.get(kind, 0)) for kind in ISSUE_KINDS}
         unknown = set(self.counts) - set(ISSUE_KINDS)
         if unknown:
-            raise ValueError(f"counts has unknown issue kinds {sorted(unknown)}")
+            raise ImunoiseValueError(f"counts has unknown issue kinds {sorted(unknown)}")
         object.__setattr__(self, "counts", MappingProxyType(counts))
         first = {kind: tuple(self.first.get(kind, ())) for kind in ISSUE_KINDS}
         object.__setattr__(self, "first", MappingProxyType(first))
@@ -222,7 +228,7 @@ class ImuLog:
             expected_ndim = 1 if cols == 1 else 2
             if arr.ndim != expected_ndim or (cols > 1 and arr.shape[1] != cols):
                 want = "(n,)" if cols == 1 else f"(n, {cols})"
-                raise ValueError(f"{name} must have shape {want}; got {arr.shape}")
+                raise ImunoiseValueError(f"{name} must have shape {want}; got {arr.shape}")
             arr.flags.writeable = False
             object.__setattr__(self, name, arr)
             lengths[name] = len(arr)
@@ -232,13 +238,13 @@ class ImuLog:
             object.__setattr__(self, "time", t)
             lengths["time"] = len(t)
         if len(set(lengths.values())) > 1:
-            raise ValueError(f"channels must have equal lengths; got {lengths}")
+            raise ImunoiseValueError(f"channels must have equal lengths; got {lengths}")
         object.__setattr__(self, "messages", MappingProxyType(dict(self.messages)))
         gaps = self.gaps
         if gaps is None:
             gaps = Gaps.from_valid(self._rows_without_nan(), self.fs)
         elif not isinstance(gaps, Gaps):
-            raise TypeError(f"gaps must be a Gaps table or None; got {type(gaps).__name__}")
+            raise ImunoiseTypeError(f"gaps must be a Gaps table or None; got {type(gaps).__name__}")
         object.__setattr__(self, "gaps", gaps)
         n = len(self)
         if (self.issues.samples_missing, self.issues.gaps, self.issues.samples) != (

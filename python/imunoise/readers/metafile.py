@@ -32,7 +32,7 @@ import stat
 from pathlib import Path
 
 from imunoise import _atomic
-from imunoise.errors import ParseError
+from imunoise.errors import ImunoiseValueError, ParseError
 
 __all__ = ["MAX_BYTES", "MAX_COUNT", "MAX_DEPTH", "MAX_FS", "SUFFIX", "bad_field", "check_tie",
            "count", "legacy_path", "load", "meta_path", "parse", "rate", "shown", "tie_errors",
@@ -77,7 +77,7 @@ def _fault(where, reason: str) -> ParseError:
 
 
 def _no_constant(name: str):
-    raise ValueError(f"{name} is not a JSON number")
+    raise ImunoiseValueError(f"{name} is not a JSON number")
 
 
 def _depth(value, where) -> None:

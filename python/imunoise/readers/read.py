@@ -11,7 +11,7 @@ from collections.abc import Callable, Mapping, Sequence
 
 from imunoise import _warn
 from imunoise._deprecation import old_call_forms
-from imunoise.errors import ParseError
+from imunoise.errors import ImunoiseTypeError, ImunoiseValueError, ParseError
 from imunoise.readers import registry
 from imunoise.readers.log import ImuLog
 from imunoise.readers.probe import Confidence, Probe
@@ -46,9 +46,9 @@ def detect_format(source: str | os.PathLike | bytes) -> str:
     if best is not None:
         return best
     if probe.is_dir:
-        raise ValueError(f"source {str(probe.path)!r} is a directory but not a ROS 2 bag")
+        raise ImunoiseValueError(f"source {str(probe.path)!r} is a directory but not a ROS 2 bag")
     name = "the bytes" if probe.path is None else repr(str(probe.path))
-    raise ValueError(
+    raise ImunoiseValueError(
         f"format='auto' could not recognise {name} (no VN sentence or packet, no ROS bag "
         "magic, no .npy/.npz/Parquet of imunoise convert, no delimited text); pass format= "
         f"one of {FORMATS[1:]}, or build the log from arrays with "
@@ -94,7 +94,7 @@ def read_stream(source) -> bytes:
             return f.read()
     data = source.read()
     if isinstance(data, str):
-        raise TypeError(f"{stream_name(source)}: a stream must be opened in binary mode "
+        raise ImunoiseTypeError(f"{stream_name(source)}: a stream must be opened in binary mode "
                         "(e.g. sys.stdin.buffer, open(path, 'rb'))")
     return bytes(data)
 
@@ -159,7 +159,7 @@ def read(
     """
     choices = ("auto", *registry.names())
     if format not in choices:
-        raise ValueError(f"format must be one of {choices}; got {format!r}")
+        raise ImunoiseValueError(f"format must be one of {choices}; got {format!r}")
     if is_stream(source):
         name = stream_name(source)
         with warnings.catch_warnings(record=True) as caught, naming(name):
@@ -171,14 +171,14 @@ def read(
             _warn.warn(str(w.message).replace(_BYTES, name), w.category)
         return dataclasses.replace(log, source=name) if log.source == _BYTES else log
     if not isinstance(source, (bytes, bytearray, memoryview, str, os.PathLike)):
-        raise TypeError(f"source must be a path, bytes or a binary file object; got "
+        raise ImunoiseTypeError(f"source must be a path, bytes or a binary file object; got "
                         f"{type(source).__name__}")
     layout = {k: v for k, v in (("columns", columns), ("units", units),
                                  ("delimiter", delimiter), ("time_column", time_column))
               if v is not None}
     if layout:
         if format not in ("auto", "csv"):
-            raise ValueError(
+            raise ImunoiseValueError(
                 f"{', '.join(layout)} describe a delimited text log; format must be 'auto' "
                 f"or 'csv' with them; got {format!r}"
             )
@@ -214,4 +214,4 @@ def naming(source):
     except ValueError as exc:
         if name in str(exc):
             raise
-        raise ValueError(f"{name}: {exc}") from exc
+        raise ImunoiseValueError(f"{name}: {exc}") from exc

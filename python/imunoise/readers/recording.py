@@ -28,7 +28,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from imunoise import _warn
-from imunoise.errors import DataWarning, ParseError
+from imunoise.errors import DataWarning, ImunoiseValueError, ParseError
 from imunoise.readers import metafile
 
 __all__ = ["GAPS", "MAX_OUTAGE", "META", "SPAN_SLACK", "TIMES", "Outage", "host_times",
@@ -167,7 +167,7 @@ def outages(path) -> list[Outage]:
         parts = line.split()
         try:
             if len(parts) != 3 or not parts[0].isdigit() or len(parts[0]) > 19:
-                raise ValueError
+                raise ImunoiseValueError
             outage = Outage(int(parts[0]), float(parts[1]), float(parts[2]), line=line_no)
         except ValueError:
             raise _bad_line(side, line_no, f"must be '<byte offset> <start> <end>' (an integer "

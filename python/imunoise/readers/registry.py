@@ -11,6 +11,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 from imunoise._core import vn as _core_vn
+from imunoise.errors import ImunoiseValueError
 from imunoise.readers import columnar, csv_reader, rosbag_reader
 from imunoise.readers.log import ImuLog
 from imunoise.readers.probe import Confidence, Probe
@@ -102,4 +103,4 @@ def get(name: str) -> Format:
     for fmt in FORMATS:
         if fmt.name == name:
             return fmt
-    raise ValueError(f"format must be one of {names()}; got {name!r}")
+    raise ImunoiseValueError(f"format must be one of {names()}; got {name!r}")

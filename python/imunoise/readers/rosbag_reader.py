@@ -40,7 +40,7 @@ from pathlib import Path
 import numpy as np
 
 from imunoise import _warn
-from imunoise.errors import AssumptionWarning, ParseError
+from imunoise.errors import AssumptionWarning, ImunoiseTypeError, ImunoiseValueError, ParseError
 from imunoise.readers._sentences import IssueTally, sentence_rows
 from imunoise.readers.log import ImuLog, log_on_grid
 from imunoise.readers.probe import Confidence, Probe
@@ -83,7 +83,8 @@ def _typestore(typestore, msg_defs: Mapping[str, str] | None):
         types = {}
         for name, text in msg_defs.items():
             if not isinstance(text, str):
-                raise TypeError(f"msg_defs[{name!r}] must be .msg text; got {type(text).__name__}")
+                raise ImunoiseTypeError(
+                    f"msg_defs[{name!r}] must be .msg text; got {type(text).__name__}")
             types.update(get_types_from_msg(text, name))
         store.register(types)
     return store
@@ -176,13 +177,14 @@ def read_rosbag(
         data = bytes(source)
         suffix = next((s for m, s in SIGNATURES.items() if data.startswith(m)), None)
         if suffix is None:
-            raise ValueError("source: bytes are not a ROS 1 bag, an MCAP file or a sqlite3 bag")
+            raise ImunoiseValueError(
+                "source: bytes are not a ROS 1 bag, an MCAP file or a sqlite3 bag")
         with tempfile.TemporaryDirectory() as tmp:
             path = Path(tmp) / f"bag{suffix}"
             path.write_bytes(data)
             return _read_bag(path, _BYTES, strict, fs, progress, topic, msg_defs, typestore)
     if not isinstance(source, str | os.PathLike):
-        raise TypeError(f"source must be a path or bytes; got {type(source).__name__}")
+        raise ImunoiseTypeError(f"source must be a path or bytes; got {type(source).__name__}")
     path = Path(source)
     if not path.exists():
         raise FileNotFoundError(errno.ENOENT, "no such bag", str(path))
@@ -208,7 +210,7 @@ def _read_bag(path, name, strict, fs, progress, topic, msg_defs, typestore) -> I
             reader.open()
         except AnyReaderError as exc:
             if default is not None or "type definitions" not in str(exc):
-                raise ValueError(f"{name}: cannot open bag: {exc}") from exc
+                raise ImunoiseValueError(f"{name}: cannot open bag: {exc}") from exc
             reader = AnyReader([path], default_typestore=_typestore(None, None))
             reader.open()
         try:
@@ -318,33 +320,35 @@ def _choose_topic(topics, kinds, topic, known, name) -> str:
     Imu topic, else the one MagneticField topic; an error if it cannot be read."""
     if topic is not None:
         if topic not in topics:
-            raise ValueError(f"topic: {topic!r} is not in the bag; topics are {sorted(topics)}")
+            raise ImunoiseValueError(
+                f"topic: {topic!r} is not in the bag; topics are {sorted(topics)}")
         chosen = topic
     else:
         for group in (("vn", "vn-bytes"), ("imu",), ("mag",)):
             cands = sorted(tp for tp, (k, _f) in kinds.items() if k in group)
             if len(cands) > 1:
-                raise ValueError(f"{name}: several IMU topics {cands}; choose one with topic=")
+                raise ImunoiseValueError(
+                    f"{name}: several IMU topics {cands}; choose one with topic=")
             if cands:
                 chosen = cands[0]
                 break
         else:
             listing = {tp: conns[0].msgtype for tp, conns in topics.items()}
-            raise ValueError(
+            raise ImunoiseValueError(
                 f"{name}: no IMU topic (sensor_msgs/msg/Imu, MagneticField or a message "
                 f"with a $VN sentence); topics are {listing}"
             )
     if kinds[chosen][0] == "temperature":
-        raise ValueError(f"{name}: topic {chosen!r} is a Temperature topic; choose the Imu "
+        raise ImunoiseValueError(f"{name}: topic {chosen!r} is a Temperature topic; choose the Imu "
                          "topic (the temperature is merged into it)")
     if kinds[chosen][0] == "other":
         msgtype = topics[chosen][0].msgtype
         if msgtype not in known:
-            raise ValueError(
+            raise ImunoiseValueError(
                 f"{name}: topic {chosen!r} has type {msgtype!r}, whose definition is not "
                 "in the bag; pass msg_defs={type: '.msg text'}"
             )
-        raise ValueError(
+        raise ImunoiseValueError(
             f"{name}: topic {chosen!r} ({msgtype}) is neither sensor_msgs Imu/MagneticField "
             "nor a message with a $VN sentence"
         )

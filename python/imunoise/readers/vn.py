@@ -44,7 +44,7 @@ from types import MappingProxyType
 import numpy as np
 
 from imunoise._core import vn as _core_vn
-from imunoise.errors import ParseError
+from imunoise.errors import ImunoiseTypeError, ParseError
 from imunoise.readers import recording
 from imunoise.readers.grid import MAX_GRID_RATIO, TimeGrid
 from imunoise.readers.log import ISSUE_KINDS, ImuLog, ParseIssues, log_on_grid
@@ -118,7 +118,7 @@ def _source_arg(source) -> bytes | str:
         if not os.path.exists(path):
             raise FileNotFoundError(errno.ENOENT, "no such file", path)
         return path
-    raise TypeError(f"source must be a path or bytes; got {type(source).__name__}")
+    raise ImunoiseTypeError(f"source must be a path or bytes; got {type(source).__name__}")
 
 
 def read_vn_tables(
@@ -363,5 +363,5 @@ def parse_vn_sentences(
     sentences is counted as skipped bytes, not an error.
     """
     if not isinstance(data, (bytes, bytearray, memoryview)):
-        raise TypeError(f"data must be bytes; got {type(data).__name__}")
+        raise ImunoiseTypeError(f"data must be bytes; got {type(data).__name__}")
     return vn_log(read_vn_tables(bytes(data), strict=strict), fs=fs, source=source, grid=False)

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import math
 
+from imunoise.errors import ImunoiseValueError
 from imunoise.recording.protocol import (
     ADOF_RATES,
     ADOR_MESSAGES,
@@ -153,7 +154,7 @@ def ascii_type(name: str) -> int:
     """Register 6 value of an ASCII type name (``"VNYMR"`` or ``"YMR"``)."""
     key = name.upper() if name.upper().startswith("VN") else "VN" + name.upper()
     if key not in _ADOR_OF:
-        raise ValueError(f"ascii type must be one of {sorted(_ADOR_OF)}; got {name!r}")
+        raise ImunoiseValueError(f"ascii type must be one of {sorted(_ADOR_OF)}; got {name!r}")
     return _ADOR_OF[key]
 
 
@@ -168,10 +169,11 @@ def binary_output(rate: float, fields: str) -> tuple[str, ...]:
     bound = (f"{IMU_RATE} Hz divided by a whole number from 1 to {MAX_DIVISOR} "
              f"({slowest:.4g} ... {IMU_RATE} Hz)")
     if not (isinstance(rate, int | float) and math.isfinite(rate) and rate > 0):
-        raise ValueError(f"binary rate must be a finite number of Hz, {bound}; got {rate!r}")
+        raise ImunoiseValueError(
+            f"binary rate must be a finite number of Hz, {bound}; got {rate!r}")
     divisor = IMU_RATE / rate
     if not (1 <= round(divisor) <= MAX_DIVISOR and abs(divisor - round(divisor)) < 1e-9):
-        raise ValueError(f"binary rate must be {bound}; got {rate!r}")
+        raise ImunoiseValueError(f"binary rate must be {bound}; got {rate!r}")
     divisor = round(divisor)
     table = _core_vn.vn_binary_fields()
     words: dict[int, int] = {}
@@ -179,7 +181,7 @@ def binary_output(rate: float, fields: str) -> tuple[str, ...]:
         group, sep, names = part.partition("=")
         group = group.strip().lower()
         if not sep or group not in table:
-            raise ValueError(f"binary fields must be GROUP=FIELDS with GROUP one of "
+            raise ImunoiseValueError(f"binary fields must be GROUP=FIELDS with GROUP one of "
                              f"{sorted(table)}; got {part!r}")
         index, known = table[group]
         mask = 0
@@ -189,16 +191,17 @@ def binary_output(rate: float, fields: str) -> tuple[str, ...]:
                 try:
                     value = int(name, 16)
                 except ValueError:
-                    raise ValueError(f"binary field mask {name!r} is not a hex number") from None
+                    raise ImunoiseValueError(
+                        f"binary field mask {name!r} is not a hex number") from None
                 # one 16-bit word per group on the wire: a wider mask would be cut
                 if not 0 < value <= MAX_MASK:
-                    raise ValueError(f"binary field mask of group {group} must be within "
+                    raise ImunoiseValueError(f"binary field mask of group {group} must be within "
                                      f"0x0001 ... 0x{MAX_MASK:04X} (16 bits); got {name}")
                 mask |= value
             elif name in known:
                 mask |= 1 << known[name]
             else:
-                raise ValueError(f"binary field {name!r} is not in group {group}; known: "
+                raise ImunoiseValueError(f"binary field {name!r} is not in group {group}; known: "
                                  f"{', '.join(sorted(known))}")
         words[index] = words.get(index, 0) | mask
     group_byte = sum(1 << i for i in words)
@@ -219,10 +222,10 @@ def wanted_outputs(previous: dict[int, tuple[str, ...]], *, ascii: str | None = 
         wanted[6] = ("0",) if ascii.lower() == "off" else (str(ascii_type(ascii)),)
     if rate is not None:
         if rate not in ADOF_RATES:
-            raise ValueError(f"rate must be one of {ADOF_RATES} Hz; got {rate:g}")
+            raise ImunoiseValueError(f"rate must be one of {ADOF_RATES} Hz; got {rate:g}")
         wanted[7] = (str(int(rate)),)
     if len(binary) > 3:
-        raise ValueError(f"at most 3 binary outputs; got {len(binary)}")
+        raise ImunoiseValueError(f"at most 3 binary outputs; got {len(binary)}")
     if binary:
         for k, reg in enumerate((75, 76, 77)):
             wanted[reg] = tuple(binary[k]) if k < len(binary) else ("0", "0", "00")

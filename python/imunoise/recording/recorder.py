@@ -34,7 +34,7 @@ import warnings
 from dataclasses import dataclass, field
 
 from imunoise import _atomic
-from imunoise.errors import DataWarning
+from imunoise.errors import DataWarning, ImunoiseValueError
 from imunoise.readers.recording import GAPS, META, TIMES, Outage
 from imunoise.recording import config
 from imunoise.recording.live import LiveView, Snapshot
@@ -209,7 +209,7 @@ class _Recorder:
                                       f"{', '.join(map(str, lacking))} refused): record "
                                       f"its ASCII output alone, without --binary")
                 if not output_rates({**self.previous, **self.wanted}):
-                    raise ValueError("with these settings the sensor sends nothing "
+                    raise ImunoiseValueError("with these settings the sensor sends nothing "
                                      "(ASCII output off, no binary output): nothing to "
                                      "record")
                 for note in self.notes:  # once the record will be made: one line if not
@@ -402,16 +402,16 @@ def record(port, output, *, seconds: float | None = None, baud: int | str = 1152
         up to then is complete, the loss in ``.gaps`` and the metadata.
     """
     if seconds is not None and not (math.isfinite(seconds) and seconds > 0):
-        raise ValueError(f"seconds must be a finite number > 0; got {seconds!r}")
+        raise ImunoiseValueError(f"seconds must be a finite number > 0; got {seconds!r}")
     if not (isinstance(outage_timeout, int | float) and math.isfinite(outage_timeout)
             and outage_timeout > 0):
-        raise ValueError(f"outage_timeout must be a finite number of seconds > 0; got "
+        raise ImunoiseValueError(f"outage_timeout must be a finite number of seconds > 0; got "
                          f"{outage_timeout!r}")
     stream = live_stream if live_stream is not None else sys.stdout
     if live is None:
         live = bool(getattr(stream, "isatty", lambda: False)())
     if baud != "auto" and (not isinstance(baud, int) or baud <= 0):
-        raise ValueError(f"baud must be a positive integer or 'auto'; got {baud!r}")
+        raise ImunoiseValueError(f"baud must be a positive integer or 'auto'; got {baud!r}")
     options = {"ascii": ascii, "rate": rate, "binary": tuple(binary), "crc": crc}
     config.wanted_outputs({}, **options)  # bad options fail before the port is opened
     check_output(output)  # and an output that cannot be written: the sensor is not touched

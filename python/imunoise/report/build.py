@@ -28,6 +28,7 @@ from imunoise._schema import ALLAN_SENSORS, SAMPLE_SENSORS, sensor_label
 from imunoise._thermal import Thermal, thermal
 from imunoise._warmup import Warmup, warmup
 from imunoise.datasheet import load_spec
+from imunoise.errors import ImunoiseValueError
 from imunoise.readers.log import DEFAULT_FS, ImuLog
 from imunoise.report import folder, sections
 from imunoise.report.document import Doc
@@ -404,11 +405,11 @@ def build(
         in-memory path (to rounding; the report's digits agree).
     """
     if trim not in (None, "auto"):
-        raise ValueError(f"trim must be None or 'auto'; got {trim!r}")
+        raise ImunoiseValueError(f"trim must be None or 'auto'; got {trim!r}")
     if units not in (None, "datasheet"):
-        raise ValueError(f"units must be None or 'datasheet'; got {units!r}")
+        raise ImunoiseValueError(f"units must be None or 'datasheet'; got {units!r}")
     if stream not in (None, True, False):
-        raise ValueError(f"stream must be None, True or False; got {stream!r}")
+        raise ImunoiseValueError(f"stream must be None, True or False; got {stream!r}")
     if spec is not None:
         # a wrong --spec is found before the analysis, not after it (17 s on an
         # hour's log), and before a folder is made

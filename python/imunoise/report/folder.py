@@ -22,6 +22,7 @@ from collections.abc import Iterable
 from pathlib import Path
 
 from imunoise import _atomic
+from imunoise.errors import ImunoiseValueError
 
 __all__ = ["MANIFEST", "Undo", "claim", "mark", "settle"]
 
@@ -65,13 +66,13 @@ def claim(out, *, force: bool = False, inputs: Iterable = ()) -> list[str]:
     """
     out = Path(os.fspath(out))
     if out.exists() and not out.is_dir():
-        raise ValueError(f"report output {str(out)!r} exists and is not a folder")
+        raise ImunoiseValueError(f"report output {str(out)!r} exists and is not a folder")
     previous: list[str] = []
     if out.is_dir():
         if (out / MANIFEST).is_file():
             previous = _listed(out)
         elif any(out.iterdir()) and not force:
-            raise ValueError(
+            raise ImunoiseValueError(
                 f"report output {str(out)!r} is an existing folder that holds other files "
                 f"and no {MANIFEST} (it is not a report): choose a new folder, or pass "
                 f"--force (force=True) to write the report into it"

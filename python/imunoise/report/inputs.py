@@ -9,6 +9,7 @@ from pathlib import Path
 
 from imunoise import _warn
 from imunoise._progress import byte_bar, wanted
+from imunoise.errors import ImunoiseValueError
 from imunoise.readers.log import ImuLog
 from imunoise.readers.read import read
 
@@ -95,7 +96,7 @@ def read_log(source, label: str = "input", *, fs: float | None = None,
         else:
             log = read(path, fs=fs, progress=callback, **read_options)
     if len(log) == 0:
-        raise ValueError(f"{label} log {name!r}: no usable records ({log.issues})")
+        raise ImunoiseValueError(f"{label} log {name!r}: no usable records ({log.issues})")
     for w in caught:
         _warn.warn(w.message, w.category)
     return log

@@ -11,6 +11,7 @@ import numpy as np
 from imunoise import datasheet
 from imunoise import units as _units
 from imunoise._schema import axis_names
+from imunoise.errors import ImunoiseValueError
 from imunoise.noise import NoiseModel, gm_white_density, resolution_noise
 from imunoise.noise._model import table_cell
 from imunoise.report.formatting import format_number
@@ -121,7 +122,7 @@ def model_sentences(model: NoiseModel, sensor: str,
     :meth:`NoiseModel.table`; σ and amplitudes in the unit of B). Emphasis is
     Markdown ``**``."""
     if steps is not None and len(steps) != model.channels:
-        raise ValueError(f"steps must have one value per channel ({model.channels}); "
+        raise ImunoiseValueError(f"steps must have one value per channel ({model.channels}); "
                          f"got {len(steps)}")
     chosen = _units.unit_choice(units_of(units, sensor), sensor)
     b_unit = _units.unit_info("B", chosen.get("B"), sensor)

@@ -17,6 +17,7 @@ from imunoise import _schema
 from imunoise._progress import Progress
 from imunoise.allan import adev
 from imunoise.datasheet import VERDICTS, compare, load_spec
+from imunoise.errors import ImunoiseTypeError, ImunoiseValueError
 from imunoise.noise import GM_MAX, fit
 from imunoise.readers.log import ISSUE_KINDS
 from imunoise.readers.read import read
@@ -41,14 +42,14 @@ def expand(paths) -> list[str]:
     out: list[str] = []
     for p in paths:
         if not isinstance(p, (str, os.PathLike)):
-            raise TypeError(f"paths must be paths or glob patterns; got {type(p).__name__}")
+            raise ImunoiseTypeError(f"paths must be paths or glob patterns; got {type(p).__name__}")
         text = os.fspath(p)
         matches = sorted(glob.glob(text)) if glob.has_magic(text) else [text]
         if not matches:
-            raise ValueError(f"paths: the pattern {text!r} matches no file")
+            raise ImunoiseValueError(f"paths: the pattern {text!r} matches no file")
         out += matches
     if not out:
-        raise ValueError("paths must name at least one log; got none")
+        raise ImunoiseValueError("paths must name at least one log; got none")
     return out
 
 
@@ -85,10 +86,10 @@ def analyse_log(path: str, spec=None, fs: float | None = None, *,
             warnings.simplefilter("ignore")
             log = read(path, fs=fs)
         if len(log) < 2:
-            raise ValueError(f"no usable records ({log.issues})")
+            raise ImunoiseValueError(f"no usable records ({log.issues})")
         sensors = [s for s in BATCH_SENSORS if getattr(log, s) is not None]
         if not sensors:
-            raise ValueError(f"no gyro or accel channel (has {', '.join(log.channels)})")
+            raise ImunoiseValueError(f"no gyro or accel channel (has {', '.join(log.channels)})")
         models = {s: fit(adev(getattr(log, s), log.fs, taus=BATCH_TAUS))
                   for s in sensors}
         verdicts: dict[tuple[str, str], dict[str, str]] = {}
@@ -240,7 +241,7 @@ def _run_dask(files, client, spec, fs, bar: Progress, components: bool) -> list[
     elif isinstance(client, str):
         client = own_client = Client(client)
     elif not isinstance(client, Client):
-        raise TypeError(
+        raise ImunoiseTypeError(
             "client must be None, False, a scheduler address or a distributed.Client; "
             f"got {type(client).__name__}"
         )

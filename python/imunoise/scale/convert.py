@@ -51,6 +51,7 @@ import numpy as np
 from imunoise import _atomic, _summary
 from imunoise._core import vn as _core_vn
 from imunoise._schema import CHANNELS, column_names
+from imunoise.errors import ImunoiseTypeError, ImunoiseValueError
 from imunoise.readers import metafile, registry
 from imunoise.readers.columnar import META_KEY, log_meta, read_columnar
 from imunoise.readers.grid import (
@@ -353,7 +354,7 @@ def _layout(out: Path) -> str:
     if suffix == ".parquet":
         return "parquet"
     if suffix:
-        raise ValueError(
+        raise ImunoiseValueError(
             f"out must be a directory (no suffix), a .npy or a .parquet file; got {str(out)!r}"
         )
     return "dir"
@@ -831,11 +832,11 @@ def convert(
     name = stream_name(path) if stream else str(Path(os.fspath(path)))
     out = Path(os.fspath(out))
     if isinstance(chunk_bytes, bool) or not isinstance(chunk_bytes, (int, np.integer)):
-        raise TypeError(f"chunk_bytes must be an int; got {type(chunk_bytes).__name__}")
+        raise ImunoiseTypeError(f"chunk_bytes must be an int; got {type(chunk_bytes).__name__}")
     if chunk_bytes < 4096:
-        raise ValueError(f"chunk_bytes must be at least 4096; got {chunk_bytes}")
+        raise ImunoiseValueError(f"chunk_bytes must be at least 4096; got {chunk_bytes}")
     if format not in FORMATS:
-        raise ValueError(f"format must be one of {FORMATS}; got {format!r}")
+        raise ImunoiseValueError(f"format must be one of {FORMATS}; got {format!r}")
     layout = _layout(out)
     if layout == "parquet":
         try:
@@ -865,7 +866,7 @@ def convert(
                 format = detect_format(path)
             _atomic.refuse_input(out, [path])
             if layout == "dir" and out.exists() and not out.is_dir():
-                raise ValueError(f"out {str(out)!r} exists and is not a directory")
+                raise ImunoiseValueError(f"out {str(out)!r} exists and is not a directory")
             if layout == "dir" and out.is_dir():
                 for our_file in _OUR_FILES:
                     _atomic.refuse_input(out / our_file, [path])
@@ -927,7 +928,7 @@ def _convert(name: str, source, out: Path, layout: str, *, fs, format: str,
             rate, issues, messages, fmt = log.fs, log.issues, log.messages, log.format
             gaps = log.gaps
         if primary is None:
-            raise ValueError(f"{name}: no usable records ({issues})")
+            raise ImunoiseValueError(f"{name}: no usable records ({issues})")
         sink = writer.sinks[primary]
         meta = log_meta(fs=rate, source=name, fmt=fmt, issues=issues, messages=messages,
                      samples=sink.rows, channels=sink.channels, table=primary, gaps=gaps)

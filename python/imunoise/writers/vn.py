@@ -14,6 +14,7 @@ import numpy as np
 
 from imunoise import _atomic
 from imunoise._core import vn as _core_vn
+from imunoise.errors import ImunoiseValueError
 from imunoise.readers.log import ImuLog
 
 # column base name -> (channel, column index or None for 1-D channels)
@@ -129,7 +130,7 @@ def write_vn_ascii(
     """
     fields = _core_vn.vn_message_fields()
     if message not in fields:
-        raise ValueError(f"message must be one of {sorted(fields)}; got {message!r}")
+        raise ImunoiseValueError(f"message must be one of {sorted(fields)}; got {message!r}")
     columns, missing = [], []
     for name in fields[message]:
         col = _column(data, name)
@@ -137,7 +138,7 @@ def write_vn_ascii(
             missing.append(name)
         columns.append(col)
     if missing:
-        raise ValueError(f"data lacks {missing} needed for {message}")
+        raise ImunoiseValueError(f"data lacks {missing} needed for {message}")
     opt = [
         None if a is None else np.ascontiguousarray(a, dtype=np.float64) for a in (count, status)
     ]
@@ -155,12 +156,13 @@ def _selection(fields) -> list[tuple[int, int]]:
         out = []
         for group, names in fields.items():
             if group not in table:
-                raise ValueError(f"fields group must be one of {sorted(table)}; got {group!r}")
+                raise ImunoiseValueError(
+                    f"fields group must be one of {sorted(table)}; got {group!r}")
             index, known = table[group]
             mask = 0
             for name in [names] if isinstance(names, str) else names:
                 if name not in known:
-                    raise ValueError(
+                    raise ImunoiseValueError(
                         f"fields[{group!r}] has unknown field {name!r}; known: {sorted(known)}"
                     )
                 mask |= 1 << known[name]
@@ -221,5 +223,5 @@ def write_vn_binary(
             missing.append(name)
         columns[name] = col
     if missing:
-        raise ValueError(f"data lacks {missing} needed for fields {fields!r}")
+        raise ImunoiseValueError(f"data lacks {missing} needed for fields {fields!r}")
     return _finish(_core_vn.write_vn_binary(selection, columns), path)
