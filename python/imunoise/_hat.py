@@ -38,7 +38,7 @@ from scipy import stats as _stats
 
 from imunoise import _summary, _warn, allan
 from imunoise._core import allan as _core_allan
-from imunoise._timefreq import _grid, _result, _valid_windows, pdev, phase_points
+from imunoise._timefreq import averaging_grid, pdev, phase_points, tau_result, valid_windows
 from imunoise._validate import confidence_level, samples
 from imunoise.allan import ONE_SIGMA, AllanResult, TauSpec, chi2_interval
 from imunoise.errors import ImunoiseValueError
@@ -121,12 +121,12 @@ def gcodev(a: npt.ArrayLike, b: npt.ArrayLike, fs: float, *, taus: TauSpec = "oc
     del arrays
     broken = broken_a | broken_b
     n_points, channels = xa.shape
-    m = _grid(taus, fs, n_points, "gcodev", lambda m: n_points - 2 * m)
+    m = averaging_grid(taus, fs, n_points, "gcodev", lambda m: n_points - 2 * m)
     cov = np.empty((m.size, channels))
     terms = np.empty((m.size, channels), dtype=np.int64)
     for t, mj in enumerate(int(v) for v in m):
         count = n_points - 2 * mj
-        valid = _valid_windows(broken, 2 * mj, count)
+        valid = valid_windows(broken, 2 * mj, count)
         da = xa[2 * mj:] - 2.0 * xa[mj:-mj] + xa[:count]
         db = xb[2 * mj:] - 2.0 * xb[mj:-mj] + xb[:count]
         terms[t] = valid.sum(axis=0)
@@ -139,7 +139,7 @@ def gcodev(a: npt.ArrayLike, b: npt.ArrayLike, fs: float, *, taus: TauSpec = "oc
     edf = np.minimum(own[0].edf, own[1].edf)
     spread = np.sqrt((own[0].var * own[1].var + cov**2) / edf)
     z = _stats.norm.ppf(0.5 + confidence / 2.0)
-    result = _result("gcodev", m, cov, dev, terms, edf, own[0].alpha,
+    result = tau_result("gcodev", m, cov, dev, terms, edf, own[0].alpha,
                      own[0].alpha_identified, fs=fs, confidence=confidence, one_d=one_d,
                      missing=missing_a + missing_b, gaps=gaps, n_points=n_points,
                      data_type=data_type)

@@ -41,8 +41,8 @@ DEFAULT_K = {"gyro": 2e-6, "accel": 3e-5}
 
 #: What a still, level VN-100 reads besides noise (Earth rate ignored).
 _STILL_MEAN = {"gyro": (0.0, 0.0, 0.0), "accel": (0.0, 0.0, -_schema.G)}
-_STILL_YPR = (-77.7, -1.3, 0.15)  # deg
-_STILL_MAG = (0.045, 0.247, -0.338)  # Gauss
+STILL_YPR = (-77.7, -1.3, 0.15)  # deg
+STILL_MAG = (0.045, 0.247, -0.338)  # Gauss
 _FORMATS = ("vn-ascii", "vn-binary")
 #: Most samples a simulated log may have (hours x 3600 x fs): 69 h at 40 Hz, 2.8 h at
 #: 1 kHz. The log is built in memory, about 400 bytes per sample (4 GB at the bound).
@@ -131,8 +131,8 @@ def still_log(hours: float, fs: float = 40.0, *, spec="vn100", seed=None) -> Imu
         channels[sensor] = simulate(n, fs, channels=3, seed=rng, **coefficients) + np.asarray(
             _STILL_MEAN[sensor]
         )
-    channels["ypr"] = np.broadcast_to(np.array(_STILL_YPR), (n, 3))
-    channels["mag"] = np.broadcast_to(np.array(_STILL_MAG), (n, 3))
+    channels["ypr"] = np.broadcast_to(np.array(STILL_YPR), (n, 3))
+    channels["mag"] = np.broadcast_to(np.array(STILL_MAG), (n, 3))
     label = "IMU" if isinstance(spec, dict) else load_spec(spec).name
     return ImuLog.from_arrays(fs, source=f"<simulated {label}, {hours:g} h>", **channels)
 

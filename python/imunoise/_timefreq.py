@@ -52,8 +52,8 @@ from imunoise.allan import (
     ONE_SIGMA,
     AllanResult,
     TauSpec,
-    _gapped_samples,
     chi2_interval,
+    gapped_samples,
 )
 from imunoise.errors import ImunoiseValueError
 from imunoise.taus import averaging_factors, keep_estimable
@@ -74,7 +74,7 @@ def phase_points(x, fs: float, data_type: str, gaps: str, kind: str):
         raise error(f"data_type must be one of 'freq', 'phase'; got {data_type!r}")
     fs = sample_rate(fs)
     if data_type == "freq":
-        data, one_d, missing = _gapped_samples(x, gaps, kind, True)
+        data, one_d, missing = gapped_samples(x, gaps, kind, True)
         nan = np.isnan(data)
         if missing is None:
             missing = nan.sum(axis=0)
@@ -130,7 +130,7 @@ def phase_points(x, fs: float, data_type: str, gaps: str, kind: str):
     return np.where(nan, 0.0, data), broken, one_d, missing, fs
 
 
-def _valid_windows(broken: np.ndarray, span: int, count: int) -> np.ndarray:
+def valid_windows(broken: np.ndarray, span: int, count: int) -> np.ndarray:
     """(count, channels) True where the window of phase points i … i + span holds
     no broken interval (intervals i … i + span − 1), for i < count."""
     runs = np.concatenate([np.zeros((1, broken.shape[1]), dtype=np.int64),
@@ -138,7 +138,7 @@ def _valid_windows(broken: np.ndarray, span: int, count: int) -> np.ndarray:
     return (runs[span:span + count] - runs[:count]) == 0
 
 
-def _grid(taus, fs: float, n_points: int, kind: str, terms) -> np.ndarray:
+def averaging_grid(taus, fs: float, n_points: int, kind: str, terms) -> np.ndarray:
     """The averaging factors of ``taus`` at which ``terms(m)`` (the number of
     terms of the statistic) is at least 2."""
     m, user_given = averaging_factors(taus, fs, n_points - 1)
@@ -151,7 +151,7 @@ def _grid(taus, fs: float, n_points: int, kind: str, terms) -> np.ndarray:
     return m
 
 
-def _result(kind, m, var, dev, terms, edf, alpha, identified, *, fs, confidence, one_d,
+def tau_result(kind, m, var, dev, terms, edf, alpha, identified, *, fs, confidence, one_d,
             missing, gaps, n_points, data_type) -> AllanResult:
     """An AllanResult from (T, channels) arrays."""
     ci_low, ci_high = chi2_interval(dev, edf, confidence)
@@ -216,13 +216,13 @@ def pdev(x: npt.ArrayLike, fs: float, *, taus: TauSpec = "octave",
     if n_points < 4:
         raise ImunoiseValueError(f"x has {n_points} phase points, too few for pdev (at least 4: "
                          f"two terms at m = 1)")
-    m = _grid(taus, fs, n_points, "pdev", _pdev_terms(n_points))
+    m = averaging_grid(taus, fs, n_points, "pdev", _pdev_terms(n_points))
     var = np.empty((m.size, channels))
     terms = np.empty((m.size, channels), dtype=np.int64)
     for t, mj in enumerate(int(v) for v in m):
         if mj == 1:
             values = phase[2:] - 2.0 * phase[1:-1] + phase[:-2]
-            valid = _valid_windows(broken, 2, n_points - 2)
+            valid = valid_windows(broken, 2, n_points - 2)
             scale = 2.0
         else:
             count = n_points - 2 * mj
@@ -235,7 +235,7 @@ def pdev(x: npt.ArrayLike, fs: float, *, taus: TauSpec = "octave",
                 _signal.correlate(lag[:count + mj - 1, c], weights, mode="valid")
                 for c in range(channels)])
             # allantools' sum stops one start short of the last: M = N − 2m terms
-            valid = _valid_windows(broken, 2 * mj - 1, count)
+            valid = valid_windows(broken, 2 * mj - 1, count)
             scale = mj**4 / 72.0
         values = np.where(valid, values, 0.0)
         terms[t] = valid.sum(axis=0)
@@ -243,7 +243,7 @@ def pdev(x: npt.ArrayLike, fs: float, *, taus: TauSpec = "octave",
             var[t] = (values**2).sum(axis=0) / (scale * terms[t]) * (fs / mj) ** 2
     var = np.where(terms >= 2, var, np.nan)
     alpha, identified, edf = _pdev_edf(phase, broken, m, n_points, fs, data_type)
-    return _result("pdev", m, var, np.sqrt(var), terms, edf, alpha, identified, fs=fs,
+    return tau_result("pdev", m, var, np.sqrt(var), terms, edf, alpha, identified, fs=fs,
                    confidence=confidence, one_d=one_d, missing=missing, gaps=gaps,
                    n_points=n_points, data_type=data_type)
 
@@ -266,13 +266,13 @@ def _pdev_edf(phase, broken, m, n_points, fs, data_type):
 
 
 def _tie_grid(taus, fs, n_points, kind):
-    return _grid(taus, fs, n_points, kind, lambda m: n_points - m)
+    return averaging_grid(taus, fs, n_points, kind, lambda m: n_points - m)
 
 
 def _no_interval(kind, m, dev, terms, *, fs, one_d, missing, gaps, n_points, data_type,
                  confidence):
     nan = np.full(dev.shape, np.nan)
-    return _result(kind, m, dev**2, dev, terms, nan, np.zeros(dev.shape, dtype=np.int64),
+    return tau_result(kind, m, dev**2, dev, terms, nan, np.zeros(dev.shape, dtype=np.int64),
                    np.zeros(dev.shape, dtype=bool), fs=fs, confidence=confidence,
                    one_d=one_d, missing=missing, gaps=gaps, n_points=n_points,
                    data_type=data_type)
@@ -321,7 +321,7 @@ def mtie(x: npt.ArrayLike, fs: float, *, taus: TauSpec = "octave",
         shift = points - width
         span = (np.maximum(hi[:count], hi[shift:shift + count])
                 - np.minimum(lo[:count], lo[shift:shift + count]))
-        valid = _valid_windows(broken, mj, count)
+        valid = valid_windows(broken, mj, count)
         terms[t] = valid.sum(axis=0)
         dev[t] = np.where(valid, span, -np.inf).max(axis=0)
     dev = np.where(terms >= 2, dev, np.nan)
@@ -356,7 +356,7 @@ def tierms(x: npt.ArrayLike, fs: float, *, taus: TauSpec = "octave",
     terms = np.empty((m.size, channels), dtype=np.int64)
     for t, mj in enumerate(int(v) for v in m):
         count = n_points - mj
-        valid = _valid_windows(broken, mj, count)
+        valid = valid_windows(broken, mj, count)
         step = np.where(valid, phase[mj:] - phase[:-mj], 0.0)
         terms[t] = valid.sum(axis=0)
         with np.errstate(invalid="ignore", divide="ignore"):

@@ -728,7 +728,7 @@ def _deviation(
     x, phase_missing = _rate_samples(x, fs, data_type)
     spec = _REGISTRY[kind]
     statistic = spec.non_overlapping if not overlapping and spec.non_overlapping else spec.statistic
-    data, one_d, missing = _gapped_samples(x, gaps, kind, statistic in _SKIPS_GAPS)
+    data, one_d, missing = gapped_samples(x, gaps, kind, statistic in _SKIPS_GAPS)
     fs = sample_rate(fs)
     confidence = confidence_level(confidence)
     _check_bool("bias_correction", bias_correction)
@@ -904,7 +904,7 @@ def _theo_input(x, fs, confidence, gaps, kind: str, data_type: str):
     """The checked rate samples, fs and confidence of a Thêo statistic (no gap
     skipping; a record long enough for ThêoBR)."""
     x, phase_missing = _rate_samples(x, fs, data_type)
-    data, one_d, missing = _gapped_samples(x, gaps, kind, False)
+    data, one_d, missing = gapped_samples(x, gaps, kind, False)
     if phase_missing is not None:
         missing = phase_missing
     fs = sample_rate(fs)
@@ -1003,7 +1003,7 @@ def longest_valid_run(data: np.ndarray) -> int:
     return best
 
 
-def _gapped_samples(x, gaps, kind: str, skips: bool):
+def gapped_samples(x, gaps, kind: str, skips: bool):
     """float64 (n, channels) samples ready for the core, whether x was 1-D, and the
     missing samples per channel (None when the core counts them: ``gaps="skip"``
     for a statistic that skips gaps, without a scan here)."""

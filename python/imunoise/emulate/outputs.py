@@ -30,7 +30,7 @@ import numpy as np
 from scipy.signal import lfilter
 
 from imunoise._simulate import simulate
-from imunoise._simulate_log import _STILL_MAG, _STILL_YPR, still_log
+from imunoise._simulate_log import STILL_MAG, STILL_YPR, still_log
 from imunoise.emulate.registers import ADOR_MESSAGES, IMU_RATE, Registers
 from imunoise.writers.vn import write_vn_ascii, write_vn_binary
 
@@ -69,7 +69,7 @@ def _still_block(seed, spec) -> dict[str, np.ndarray]:
     rng = np.random.default_rng(seed)
     log = still_log(BLOCK / IMU_RATE / 3600.0, IMU_RATE, spec=spec, seed=rng)
     gyro, accel = np.asarray(log.gyro), np.asarray(log.accel)
-    mag = np.asarray(_STILL_MAG) + simulate(BLOCK, IMU_RATE, N=MAG_N, B=MAG_B, channels=3,
+    mag = np.asarray(STILL_MAG) + simulate(BLOCK, IMU_RATE, N=MAG_N, B=MAG_B, channels=3,
                                             seed=rng)
     dt = 1.0 / IMU_RATE
     # the tilt and heading the noisy accelerometer and magnetometer show (body x
@@ -77,13 +77,13 @@ def _still_block(seed, spec) -> dict[str, np.ndarray]:
     g = np.linalg.norm(accel, axis=1)
     pitch = np.arcsin(np.clip(accel[:, 0] / g, -1, 1))
     roll = np.arctan2(-accel[:, 1], -accel[:, 2])
-    heading = np.arctan2(mag[:, 1], mag[:, 0]) - np.arctan2(_STILL_MAG[1], _STILL_MAG[0])
+    heading = np.arctan2(mag[:, 1], mag[:, 0]) - np.arctan2(STILL_MAG[1], STILL_MAG[0])
     ypr = np.column_stack([
         _complementary(gyro[:, 2], heading, dt),
         _complementary(gyro[:, 1], pitch, dt),
         _complementary(gyro[:, 0], roll, dt),
     ])
-    ypr = np.asarray(_STILL_YPR) + np.degrees(ypr)
+    ypr = np.asarray(STILL_YPR) + np.degrees(ypr)
     return {"gyro": gyro, "accel": accel, "mag": mag, "ypr": ypr}
 
 

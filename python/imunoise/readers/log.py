@@ -453,6 +453,6 @@ def fs_from_median_step(
         return sample_rate(fs)
     _warn.warn(
         f"{source}: no timestamps and no fs given; assuming {DEFAULT_FS:g} Hz "
-        "(pass fs= to set the sample rate)", AssumptionWarning
+        "(pass fs= to set the sample rate; on the command line, --fs)", AssumptionWarning
     )
     return DEFAULT_FS
