@@ -1,7 +1,7 @@
 """The report's sections, in reading order: one function ``(ctx, doc) -> None`` each,
 writing its text, tables and figures below the heading that :mod:`.build` numbers.
 
-A section reads the logs and the analyses from the :class:`~.build.Context` (which
+A section reads the logs and the analyses from the :class:`~.context.Context` (which
 computes each analysis once, on first use) and adds its figures through it.
 """
 
@@ -36,7 +36,7 @@ from imunoise.report.model_text import (
 )
 
 if TYPE_CHECKING:
-    from imunoise.report.build import Context
+    from imunoise.report.context import Context
     from imunoise.report.document import Doc
 
 __all__ = [
