@@ -47,7 +47,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from imunoise import _summary
-from imunoise import numbers as _numbers
+from imunoise import display as _display
 from imunoise import units as _units
 from imunoise.datasheet import VERDICTS, Spec, load_spec
 from imunoise.errors import ImunoiseValueError
@@ -274,7 +274,7 @@ def _outlier_phrase(o: dict) -> str:
 
 def _outlier_cells(o: dict) -> list[str]:
     return [o["unit"], o["sensor"], o["axis"], o["term"],
-            f"{_numbers.cell(o['value'], o['std'])} {o['label']}",
+            f"{_display.cell(o['value'], o['std'])} {o['label']}",
             f"{_summary.number(o['median'])} {o['label']}", f"{o['ratio']:.3g}×",
             f"{o['z']:+.3g}"]
 

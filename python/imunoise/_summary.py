@@ -14,7 +14,7 @@ from pathlib import PurePath
 
 import numpy as np
 
-from imunoise import numbers as _numbers
+from imunoise import display as _display
 
 #: Characters of a repr line before the next part goes to a new line.
 LINE_WIDTH = 110
@@ -35,13 +35,13 @@ def number(value) -> str:
 
 
 def estimate(value, std) -> str:
-    """``value ± std`` rounded to the uncertainty (GUM, :func:`imunoise.numbers.format_value`),
+    """``value ± std`` rounded to the uncertainty (GUM, :func:`imunoise.display.format_value`),
     ``value`` to four significant digits without one, ``—`` when missing."""
-    return _numbers.cell(value, std)
+    return _display.cell(value, std)
 
 
-#: ``"10 ms"``, ``"12.5 s"``, ``"5.51 min"`` or ``"3.2 h"`` (:func:`imunoise.numbers.duration`).
-duration = _numbers.duration
+#: ``"10 ms"``, ``"12.5 s"``, ``"5.51 min"`` or ``"3.2 h"`` (:func:`imunoise.display.duration`).
+duration = _display.duration
 
 
 def tau_span(taus) -> str:

@@ -34,8 +34,8 @@ import numpy as np
 
 from imunoise import _schema, _summary
 from imunoise._channels import rate_channels
+from imunoise.display import format_value
 from imunoise.errors import ImunoiseValueError
-from imunoise.numbers import format_value
 from imunoise.readers.log import ImuLog
 
 __all__ = ["Thermal", "thermal", "DATASHEET_UNITS"]

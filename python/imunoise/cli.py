@@ -24,8 +24,8 @@ from imunoise._schema import (
     sensor_label,
 )
 from imunoise.allan import KINDS
+from imunoise.display import duration
 from imunoise.errors import DataWarning
-from imunoise.numbers import duration
 from imunoise.readers.csv_reader import (
     LAYOUT_CHANNELS,  # the --kind choices: every public Allan-family statistic
 )
@@ -510,7 +510,7 @@ def _cmd_report(args) -> int:
 
 
 def _cmd_adev(args) -> int:
-    from imunoise import allan, numbers, report
+    from imunoise import allan, display, report
 
     log = _read(args)
     y = getattr(log, args.sensor)
@@ -526,7 +526,7 @@ def _cmd_adev(args) -> int:
     for i, tau in enumerate(r.taus):
         row = [f"{tau:.6g}", report.terms_used(r, i)]
         for j in range(r.dev.shape[1]):
-            row += numbers.interval_cells(r.dev[i, j], r.ci_low[i, j], r.ci_high[i, j])
+            row += display.interval_cells(r.dev[i, j], r.ci_low[i, j], r.ci_high[i, j])
         rows.append(row)
     print(f"# {args.kind} of {args.sensor}, {len(y)} samples at {log.fs:.6g} Hz, "
           f"CI {r.confidence:.1%}")
@@ -597,7 +597,7 @@ def _plan_line(model, log, sensor: str) -> str:
 
 
 def _cmd_stats(args) -> int:
-    from imunoise import _stream, numbers, stats
+    from imunoise import _stream, display, stats
 
     log = _read(args)
     desc = _stream.describe(log) if _stream.is_mapped(log.gyro) else stats.describe(log)
@@ -616,9 +616,9 @@ def _cmd_stats(args) -> int:
                 name,
                 f"{d.step:.6g}" if d.step else "-",
                 f"{d.level_spacing:.6g}" if d.level_spacing else "-",
-                numbers.cell(d.mu, d.mu_std), numbers.cell(d.sigma, d.sigma_std),
+                display.cell(d.mu, d.mu_std), display.cell(d.sigma, d.sigma_std),
             ] + [
-                numbers.cell(v) for v in (d.ks_statistic, d.ks_pvalue, d.ad_statistic,
+                display.cell(v) for v in (d.ks_statistic, d.ks_pvalue, d.ad_statistic,
                                           d.skewness, d.excess_kurtosis)
             ])
     _print_table(head, rows)
@@ -680,7 +680,7 @@ def _sensor_samples(args):
 
 def _cmd_psd(args) -> int:
     from imunoise import plot, spectrum
-    from imunoise.numbers import format_value
+    from imunoise.display import format_value
 
     log, y = _sensor_samples(args)
     band = tuple(args.band) if args.band else None
@@ -875,7 +875,7 @@ def _cmd_events(args) -> int:
 def _cmd_thermal(args) -> int:
     from imunoise._thermal import thermal
     from imunoise._warmup import warmup
-    from imunoise.numbers import format_value
+    from imunoise.display import format_value
 
     log = _read(args)
     w = warmup(log)

@@ -27,7 +27,7 @@ from pathlib import Path
 import numpy as np
 
 from imunoise import _summary
-from imunoise import numbers as _numbers
+from imunoise import display as _display
 from imunoise import units as _units
 from imunoise._schema import axis_names
 from imunoise.errors import ImunoiseTypeError, ImunoiseValueError
@@ -165,11 +165,11 @@ class Comparison:
         the ratio and the verdict."""
         body = []
         for r in self.rows:
-            spec = _numbers.cell(r["spec"])
+            spec = _display.cell(r["spec"])
             body.append([r["sensor"], f"{r['quantity']} ({r['term']})", r["axis"],
-                         _numbers.cell(r["measured"], r["std"]),
+                         _display.cell(r["measured"], r["std"]),
                          f"{r['limit']} {spec} {r['label']}",
-                         _numbers.cell(r["ratio"], r["ratio_std"]), r["verdict"]])
+                         _display.cell(r["ratio"], r["ratio_std"]), r["verdict"]])
         return _summary.html_table(
             ["sensor", "quantity", "axis", "measured", "spec", "ratio", "verdict"], body,
             caption=f"Comparison with {self.spec.name}, "
@@ -190,10 +190,10 @@ class Comparison:
             word = r["verdict"] + (f" ({r['remark']})" if r.get("remark") else "")
             body.append([
                 r["sensor"], f"{r['quantity']} ({r['term']})", r["axis"],
-                (_numbers.format_value(r["measured"], r["std"]) if np.isfinite(r["measured"])
-                 else _numbers.upper_bound(r.get("upper"))),
+                (_display.format_value(r["measured"], r["std"]) if np.isfinite(r["measured"])
+                 else _display.upper_bound(r.get("upper"))),
                 f"{bound} {r['spec']:g} {r['label']}",
-                _numbers.cell(r["ratio"], r["ratio_std"]),
+                _display.cell(r["ratio"], r["ratio_std"]),
                 word,
             ])
         widths = [max(len(x[i]) for x in [header, *body]) for i in range(len(header))]

@@ -65,7 +65,7 @@ import numpy.typing as npt
 from scipy import stats as _stats
 
 from imunoise import _schema, _stream, _summary, _warn
-from imunoise import numbers as _numbers
+from imunoise import display as _display
 from imunoise._core import allan as _core_allan
 from imunoise._runs import true_runs
 from imunoise._validate import no_infinity, positive_finite, sample_rate, samples
@@ -150,7 +150,7 @@ class Stationarity:
     def __repr__(self) -> str:
         found = ", ".join(
             f"{_summary.number(d.start)}–{_summary.number(d.end)} s ch{d.channel} "
-            f"×{_numbers.rounded(d.ratio, d.ratio_std)}" for d in self.intervals[:3]
+            f"×{_display.rounded(d.ratio, d.ratio_std)}" for d in self.intervals[:3]
         ) or "none"
         more = f" (+{len(self.intervals) - 3})" if len(self.intervals) > 3 else ""
         return _summary.lines("Stationarity(", [
@@ -164,7 +164,7 @@ class Stationarity:
         """The departures (the first :data:`~imunoise._summary.HTML_ROWS`), ratio
         rounded to its uncertainty as in the repr."""
         rows = [[_summary.number(d.start), _summary.number(d.end), d.channel,
-                 _numbers.rounded(d.ratio, d.ratio_std)]
+                 _display.rounded(d.ratio, d.ratio_std)]
                 for d in self.intervals[:_summary.HTML_ROWS]]
         caption = (f"Stationarity: outside {_summary.number(np.max(self.outside))} (expected "
                    f"{_summary.number(self.expected_outside)}), max |z| "

@@ -108,7 +108,7 @@ class Plan:
 
     def line(self, seconds: float | None = None) -> str:
         """One line: what each term needs, and (given a record length) what it has."""
-        from imunoise.numbers import duration
+        from imunoise.display import duration
 
         if not self.terms:
             return f"plan{' ' + self.label if self.label else ''}: no N, B or K to plan for"
@@ -142,7 +142,7 @@ class Plan:
 
 
 def _length(seconds: float) -> str:
-    from imunoise.numbers import duration
+    from imunoise.display import duration
 
     return duration(seconds) if seconds <= _LONGEST else f"> {duration(_LONGEST)}"
 

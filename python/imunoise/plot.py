@@ -29,10 +29,10 @@ import numpy as np
 from imunoise import _atomic, _summary
 from imunoise._schema import ATTITUDE_NAMES, CHANNELS, axis_names
 from imunoise.allan import AllanResult
+from imunoise.display import cell, format_value, rounded
 from imunoise.errors import ImunoiseTypeError, ImunoiseValueError
 from imunoise.noise import FLICKER, TERMS, NoiseModel, model_variance
 from imunoise.noise._terms import term_variances
-from imunoise.numbers import cell, format_value, rounded
 from imunoise.readers.log import ImuLog
 from imunoise.stats import Distribution
 

@@ -393,7 +393,7 @@ def test_cli_prints_the_long_tau_family(tmp_path, capsys, kind):
     np.testing.assert_allclose([float(row[0]) for row in rows], r.taus, rtol=1e-5)
     # deviation and bounds rounded together to the interval (GUM, numbers.interval_cells)
     assert [row[2:5] for row in rows] == [
-        list(imunoise.numbers.interval_cells(r.dev[i, 0], r.ci_low[i, 0], r.ci_high[i, 0]))
+        list(imunoise.display.interval_cells(r.dev[i, 0], r.ci_low[i, 0], r.ci_high[i, 0]))
         for i in range(len(r.taus))]
     np.testing.assert_allclose([float(row[2]) for row in rows], r.dev[:, 0], rtol=0.02)
 

@@ -7,7 +7,7 @@ import imunoise
 import numpy as np
 import pytest
 from imunoise.cli import main
-from imunoise.numbers import format_value
+from imunoise.display import format_value
 
 
 @pytest.fixture
@@ -112,7 +112,7 @@ def test_stats_adev_convert_on_bundled_log(tmp_path, capsys, read):
     code, out, _ = _run(["stats", str(bundled_log())], capsys)
     assert code == 0 and "gyro X" in out
     d = imunoise.distribution(log.accel[:, 2])
-    assert imunoise.numbers.format_value(d.mu, d.mu_std) in out  # μ rounded to its uncertainty
+    assert imunoise.display.format_value(d.mu, d.mu_std) in out  # μ rounded to its uncertainty
     code, out, _ = _run(["adev", str(bundled_log()), "--sensor", "gyro"], capsys)
     assert code == 0
     rows = [line.split() for line in out.splitlines()[2:]]

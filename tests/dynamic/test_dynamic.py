@@ -8,7 +8,7 @@ import imunoise
 import numpy as np
 import pytest
 from allantools import ci as at_ci
-from imunoise import numbers
+from imunoise import display
 from imunoise._core import allan as core_allan
 from imunoise.allan import chi2_interval
 
@@ -106,7 +106,7 @@ def test_stationarity_finds_twenty_minutes_of_doubled_noise(seed):
         # "×1.98731")
         assert 0.005 < dep.ratio_std < 0.2 * dep.ratio
         assert abs(dep.ratio - 2.0) < 4 * dep.ratio_std
-        assert f"×{numbers.rounded(dep.ratio, dep.ratio_std)}" in repr(summary)
+        assert f"×{display.rounded(dep.ratio, dep.ratio_std)}" in repr(summary)
     assert not summary.stationary
     assert np.all(summary.worst_z > 5)
     assert np.all(np.abs(summary.worst_time - 7800.0) <= d.window / 2)

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 from helpers.data import shared_file
 from helpers.noise_fit import clean_five_term_fits, quiet_fit
-from imunoise import export, numbers, units
+from imunoise import display, export, units
 from imunoise.noise import gm_white_density
 from imunoise.report import model_text
 
@@ -97,7 +97,7 @@ def test_not_resolved_means_one_thing():
     assert np.all(m.upper["B"] > 0) and np.all(np.isnan(m.upper["N"]))
     rows = {r["term"]: r for r in m.table()}
     assert all(not rows["B"][ax + "_supported"] for ax in "XYZ")
-    bounds = [numbers.upper_bound(rows["B"][ax + "_upper"]) for ax in "XYZ"]
+    bounds = [display.upper_bound(rows["B"][ax + "_upper"]) for ax in "XYZ"]
     assert all(b.startswith("< ") for b in bounds)
     assert all(b in m.table_text() for b in bounds)
     header, body = model_text.datasheet_rows(m, "gyro")

@@ -12,7 +12,7 @@ import pytest
 from helpers.noise_fit import allan
 from hypothesis import given
 from hypothesis import strategies as st
-from imunoise import export, numbers, units
+from imunoise import display, export, units
 
 DEG = math.pi / 180
 G = 9.80665
@@ -104,7 +104,7 @@ def test_in_units_and_table(gyro_model):
     assert "°/√h" in text and "X" in text and "R rate ramp" in text
     r_row = next(r for r in rows if r["term"] == "R")
     assert all(not r_row[ax + "_supported"] and r_row[ax + "_upper"] > 0 for ax in "XYZ")
-    assert numbers.upper_bound(r_row["X_upper"]) in text
+    assert display.upper_bound(r_row["X_upper"]) in text
     with pytest.raises(ValueError, match="axes"):
         model.table("gyro", axes=["X", "Y"])
 
@@ -138,8 +138,8 @@ def test_compare_verdicts(gyro_model, accel_model):
     assert "above typical (2× typical)" in cmp.text() and "not resolved" in cmp.text()
     # the ratio is rounded to its uncertainty like the measured value (GUM), not to noise digits
     b = by[("gyro", "B", "X")]
-    assert imunoise.numbers.format_value(b["ratio"], b["ratio_std"]) in cmp.text()
-    assert imunoise.numbers.format_value(b["ratio"], b["ratio_std"]) in cmp._repr_html_()
+    assert imunoise.display.format_value(b["ratio"], b["ratio_std"]) in cmp.text()
+    assert imunoise.display.format_value(b["ratio"], b["ratio_std"]) in cmp._repr_html_()
     only = imunoise.compare(mg, "vn100")
     assert only.passed and {r["sensor"] for r in only.rows} == {"gyro"}
 

@@ -3,7 +3,7 @@
 import imunoise
 import numpy as np
 import pytest
-from imunoise import numbers, units
+from imunoise import display, units
 from imunoise.report.model_text import model_sentences
 
 
@@ -19,13 +19,13 @@ def test_gauss_markov_and_readoffs_carry_their_uncertainty(gm_model):
     sigma_deg, sigma_std_deg = units.convert(
         np.array([sigma, float(np.ravel(gm_model.components.gm_sigma_std)[0])]), "B", "deg/h",
         sensor="gyro")
-    assert f"σ = {numbers.format_value(sigma_deg, sigma_std_deg)} °/h" in sentence
+    assert f"σ = {display.format_value(sigma_deg, sigma_std_deg)} °/h" in sentence
     tau_std = float(np.ravel(gm_model.components.gm_tau_std)[0])
-    assert f"τc = {numbers.format_value(tau, tau_std)} s" in sentence
+    assert f"τc = {display.format_value(tau, tau_std)} s" in sentence
     read = gm_model.readoff["N"]
     n_deg, n_std = units.convert(np.array([float(read["value"]), float(read["std"])]), "N",
                                  "deg/sqrt(h)", sensor="gyro")
-    assert f"N read-off {numbers.format_value(n_deg, n_std)} vs model " in sentence
+    assert f"N read-off {display.format_value(n_deg, n_std)} vs model " in sentence
     assert " ± " in sentence.split("vs model")[1]
 
 

@@ -1,10 +1,10 @@
-"""Value ± uncertainty formatting (imunoise.numbers) and datasheet verdicts (#14)."""
+"""Value ± uncertainty formatting (imunoise.display) and datasheet verdicts (#14)."""
 import math
 
 import pytest
 from imunoise import _summary
 from imunoise.datasheet import COVERAGE_K, verdict
-from imunoise.numbers import cell, duration, format_value, rounded
+from imunoise.display import cell, duration, format_value, rounded
 from imunoise.report.formatting import format_duration
 
 NAN = math.nan

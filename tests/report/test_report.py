@@ -7,7 +7,7 @@ from pathlib import Path
 import imunoise
 import numpy as np
 import pytest
-from imunoise import datasheet, numbers, report
+from imunoise import datasheet, display, report
 from imunoise.stats import describe, distribution
 
 FS = 40.0
@@ -110,8 +110,8 @@ def test_distribution_table_matches_api(built):
             assert float(b[3]) == pytest.approx(d.level_spacing, rel=1e-5)
             assert int(b[4]) == len(d.counts)
             # μ and σ rounded to their uncertainties (GUM), the statistics to 4 digits
-            assert r[2] == numbers.format_value(d.mu, d.mu_std)
-            assert r[3] == numbers.format_value(d.sigma, d.sigma_std)
+            assert r[2] == display.format_value(d.mu, d.mu_std)
+            assert r[3] == display.format_value(d.sigma, d.sigma_std)
             got = [float(v) for v in (r[4], r[6], r[7], r[8])]
             want = [d.ks_statistic, d.ad_statistic, d.skewness, d.excess_kurtosis]
             np.testing.assert_allclose(got, want, rtol=5e-4)
@@ -194,8 +194,8 @@ def test_model_files_and_tables_match_fit(built):
             assert got[1] == want["term"]
             for j, axis in enumerate("XYZ"):
                 if not want[f"{axis}_supported"]:  # a value's 95 % bound, never 0
-                    assert got[3 + j] == (numbers.upper_bound(want[f"{axis}_upper"])
-                                          if want["missing"] == numbers.NOT_RESOLVED
+                    assert got[3 + j] == (display.upper_bound(want[f"{axis}_upper"])
+                                          if want["missing"] == display.NOT_RESOLVED
                                           else want["missing"])
                     continue
                 value, std = _value_std(got[3 + j])

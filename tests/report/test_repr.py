@@ -112,10 +112,10 @@ def test_reprs_say_what_matters(objects):
     assert "bins" in repr(objects["distribution"])
     # values with an uncertainty are rounded to it (GUM), not printed to fixed digits
     d = objects["distribution"]
-    assert f"μ={imunoise.numbers.format_value(d.mu, d.mu_std)} " in repr(d)
+    assert f"μ={imunoise.display.format_value(d.mu, d.mu_std)} " in repr(d)
     m = objects["model"]
     term = next(t for t in imunoise.noise.TERMS if np.atleast_1d(m.supported[t])[0])
-    shown = imunoise.numbers.format_value(np.ravel(m.value(term))[0], np.ravel(m.std(term))[0])
+    shown = imunoise.display.format_value(np.ravel(m.value(term))[0], np.ravel(m.std(term))[0])
     assert f"X: {term}={shown}" in model and " ± " in shown
     # (the verdict counts may wrap the line)
     assert " ".join(repr(objects["comparison"]).split()).startswith(

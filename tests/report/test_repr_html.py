@@ -149,7 +149,7 @@ def test_html_escapes_text(objects):
 def test_model_table_rounds_like_the_repr(objects):
     model = objects["NoiseModel"]
     page = model._repr_html_()
-    n = imunoise.numbers.format_value(model.value("N")[0], model.std("N")[0])
+    n = imunoise.display.format_value(model.value("N")[0], model.std("N")[0])
     assert f"N={n}" in repr(model) and f"<td>{n}</td>" in page
 
 

@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from imunoise import _schema, _summary, _warn
-from imunoise import numbers as _numbers
+from imunoise import display as _display
 from imunoise import units as _units
 from imunoise._deprecation import old_call_forms
 from imunoise.errors import ImunoiseDeprecationWarning, ImunoiseValueError
@@ -252,7 +252,7 @@ class NoiseModel(PerTerm):
             for t in TERMS:
                 v, e = self.value(t)[c], self.std(t)[c]
                 row.append(_summary.estimate(v, e) if self.resolved(t)[c]
-                           else _numbers.NOT_RESOLVED)
+                           else _display.NOT_RESOLVED)
             row.append(self.components.structure(c))
             row.append(f"{100 * float(np.atleast_1d(self.coverage)[c]):.3g} %")
             rows.append(row)
@@ -333,7 +333,7 @@ class NoiseModel(PerTerm):
             check_term(term)
             c = conv[term]
             row = {"term": term, "quantity": SENSOR_NAMES[sensor].get(term, NAMES[term]),
-                   "unit": c["unit"], "label": c["label"], "missing": _numbers.NOT_RESOLVED}
+                   "unit": c["unit"], "label": c["label"], "missing": _display.NOT_RESOLVED}
             vals, stds, ups, sup = (np.atleast_1d(c[k])
                                     for k in ("value", "std", "upper", "supported"))
             for i, ax in enumerate(axes):
@@ -354,7 +354,7 @@ class NoiseModel(PerTerm):
                 return float(_units.convert(v, as_term, shown, sensor=sensor,
                                             input_unit=input_unit))
 
-            row = {"term": term, "quantity": "component: " + quantity, "missing": _numbers.EMPTY,
+            row = {"term": term, "quantity": "component: " + quantity, "missing": _display.EMPTY,
                    "unit": shown, "label": conv[as_term]["label"] if as_term else unit}
             for i, ax in enumerate(axes):
                 v, e = float(values[i]), float(stds[i])
@@ -475,9 +475,9 @@ def table_cell(row: dict, axis: str, number) -> str:
     (``not resolved`` without a bound) and ``—`` for a component the axis lacks."""
     if row[axis + "_supported"]:
         return number(row[axis], row[axis + "_std"])
-    if row.get("missing") == _numbers.NOT_RESOLVED:
-        return _numbers.upper_bound(row.get(axis + "_upper"))
-    return row.get("missing", _numbers.NOT_RESOLVED)
+    if row.get("missing") == _display.NOT_RESOLVED:
+        return _display.upper_bound(row.get(axis + "_upper"))
+    return row.get("missing", _display.NOT_RESOLVED)
 
 
 def format_table(rows: list[dict], axes: Sequence[str], *, datasheet: bool = False) -> str:
@@ -486,12 +486,12 @@ def format_table(rows: list[dict], axes: Sequence[str], *, datasheet: bool = Fal
     Terms the data do not resolve print as ``< bound`` (their 95 % upper bound;
     ``not resolved`` without one: the report's and ``imunoise fit``'s wording
     too), a component an axis's model does not have as ``—``; values carry ``± std``, rounded to it
-    (:func:`imunoise.numbers.format_value`). With ``datasheet`` (rows of
+    (:func:`imunoise.display.format_value`). With ``datasheet`` (rows of
     :meth:`NoiseModel.lab_table`), two more columns: the datasheet's value in the
     row's unit and as the datasheet prints it.
     """
     def cell(row, ax):
-        return table_cell(row, ax, _numbers.format_value)
+        return table_cell(row, ax, _display.format_value)
 
     header = ["coefficient", "unit", *axes]
     body = [[f"{r['term']} {r['quantity']}", r["label"], *(cell(r, a) for a in axes)]
@@ -499,7 +499,7 @@ def format_table(rows: list[dict], axes: Sequence[str], *, datasheet: bool = Fal
     if datasheet:
         header += ["datasheet", "as printed"]
         for line, r in zip(body, rows, strict=True):
-            line += [_numbers.cell(r["spec"], digits=3), r["spec_text"]]
+            line += [_display.cell(r["spec"], digits=3), r["spec_text"]]
     widths = [max(len(str(x[i])) for x in [header, *body]) for i in range(len(header))]
     lines = ["  ".join(str(x).ljust(w) for x, w in zip(line, widths, strict=True)).rstrip()
              for line in [header, *body]]

@@ -23,8 +23,8 @@ import numpy as np
 from imunoise._core import vn as _core_vn
 from imunoise._simulate_log import DEFAULT_K
 from imunoise.allan import AllanResult, adev
+from imunoise.display import duration
 from imunoise.noise._terms import FLICKER
-from imunoise.numbers import duration
 from imunoise.planner import plan as make_plan
 from imunoise.readers.log import DEFAULT_FS
 from imunoise.readers.vn import richest_table, table_channels

@@ -24,7 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from imunoise import _atomic, _summary, plot
-from imunoise import numbers as _numbers
+from imunoise import display as _display
 from imunoise._core import __version__
 from imunoise._fleet import MIN_UNITS, TERMS, Fleet, outlier_rule
 from imunoise._schema import ALLAN_SENSORS
@@ -115,8 +115,8 @@ def figure(f: Fleet, sensor: str, term: str):
 
 def _value(r: dict) -> str:
     if r["resolved"]:
-        return _numbers.cell(r["value"], r["std"])
-    return _numbers.upper_bound(r["upper"])
+        return _display.cell(r["value"], r["std"])
+    return _display.upper_bound(r["upper"])
 
 
 def write(f: Fleet, out_dir, *, force: bool = False, inputs=None) -> tuple[Path, ...]:
@@ -195,7 +195,7 @@ def _outliers_section(doc: Doc, f: Fleet) -> None:
     doc.table(["unit", "sensor", "axis", "term", "value", "fleet median", "ratio", "z",
                "cut"],
               [[o["unit"], o["sensor"], o["axis"], o["term"],
-                f"{_numbers.cell(o['value'], o['std'])} {o['label']}",
+                f"{_display.cell(o['value'], o['std'])} {o['label']}",
                 f"{_summary.number(o['median'])} {o['label']}", f"{o['ratio']:.3g}×",
                 f"{o['z']:+.3g}", f"{o['cut']:.3g}"] for o in f.outliers],
               f"{_summary.plural(len(f.outliers), 'outlier')}, farthest first "
@@ -254,8 +254,8 @@ def _coefficients_section(doc: Doc, f: Fleet) -> None:
     gm: dict[tuple[str, str, str], list[str]] = {}
     for g in f.gauss_markov:
         gm.setdefault((g["unit"], g["sensor"], g["axis"]), []).append(
-            f"{_numbers.cell(g['sigma'], g['sigma_std'])} {g['label']} @ "
-            f"{_numbers.cell(g['tau_c'], g['tau_c_std'])} s")
+            f"{_display.cell(g['sigma'], g['sigma_std'])} {g['label']} @ "
+            f"{_display.cell(g['tau_c'], g['tau_c_std'])} s")
     for sensor in ALLAN_SENSORS:
         mine = [r for r in f.rows if r["sensor"] == sensor]
         if not mine:

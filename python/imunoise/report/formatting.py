@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from imunoise import numbers as _numbers
+from imunoise import display as _display
 
 __all__ = ["DOCS_URL", "docs_link", "format_duration", "format_number", "gap_note",
            "missing_text", "terms_used", "unit_text"]
@@ -37,14 +37,14 @@ def unit_text(unit: str) -> str:
 
 def format_number(v: float, std: float | None = None) -> str:
     """``v ± std`` rounded to the uncertainty (GUM style,
-    :func:`imunoise.numbers.format_value`), a bare ``v`` to six significant digits
+    :func:`imunoise.display.format_value`), a bare ``v`` to six significant digits
     (report tables are compared with the API's numbers), ``—`` for NaN and inf."""
-    return _numbers.cell(v, std, digits=6)
+    return _display.cell(v, std, digits=6)
 
 
 #: ``"10 ms"``, ``"12.5 s"``, ``"3.2 min"`` or ``"5 h"``: the one time formatter of the
-#: library (:func:`imunoise.numbers.duration`), under the report's name.
-format_duration = _numbers.duration
+#: library (:func:`imunoise.display.duration`), under the report's name.
+format_duration = _display.duration
 
 
 def terms_used(result, i: int) -> str:

@@ -14,10 +14,10 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from imunoise import _stream, _warn, noise, numbers, plot, stats, units
+from imunoise import _stream, _warn, display, noise, plot, stats, units
 from imunoise import allan as _allan
 from imunoise._schema import CHANNELS, SAMPLE_SENSORS, axis_names
-from imunoise.numbers import format_value
+from imunoise.display import format_value
 from imunoise.planner import fit_line
 from imunoise.report.formatting import (
     docs_link,
@@ -179,7 +179,7 @@ def distribution_fits(ctx: Context, doc: Doc) -> None:
         for name, d in per_axis.items():
             rows.append([
                 name, unit, format_number(d.mu, d.mu_std), format_number(d.sigma, d.sigma_std),
-                *(numbers.cell(v) for v in (d.ks_statistic, d.ks_pvalue, d.ad_statistic,
+                *(display.cell(v) for v in (d.ks_statistic, d.ks_pvalue, d.ad_statistic,
                                             d.skewness, d.excess_kurtosis)),
             ])
             bins.append([name, unit, format_number(d.step) if d.step else "—",
@@ -447,7 +447,7 @@ def dynamic_allan(ctx: Context, doc: Doc) -> None:
         names = axis_names(d.channels)
         where = "; ".join(
             f"{format_duration(v.start)} – {format_duration(v.end)} ({names[v.channel]}, "
-            f"ADEV ×{numbers.rounded(v.ratio, v.ratio_std)})" for v in st.intervals[:6])
+            f"ADEV ×{display.rounded(v.ratio, v.ratio_std)})" for v in st.intervals[:6])
         more = f" and {len(st.intervals) - 6} more" if len(st.intervals) > 6 else ""
         doc.p(f"The {sensor} noise is not stationary: it departs from its typical level at "
               f"{where}{more} (from the first sample; {share} of the window intervals exclude "
@@ -502,7 +502,7 @@ def events_section(ctx: Context, doc: Doc) -> None:
         ["start [s]", "end [s]", "duration [s]", "kind", "channels", "peak [σ]",
          "RMS ÷ quiet RMS"],
         [[format_number(found.start[i] + offset), format_number(found.end[i] + offset),
-          numbers.cell(found.duration[i], digits=3), kind(i), ", ".join(found.channels[i]),
+          display.cell(found.duration[i], digits=3), kind(i), ", ".join(found.channels[i]),
           f"{found.peak[i]:.3g}", loudest(i)]
          for i in sorted(order)],
         caption=f"Events of {_short(ctx)} ({min(len(found), EVENT_ROWS)} largest of "
@@ -536,7 +536,7 @@ def events_section(ctx: Context, doc: Doc) -> None:
         for j, axis in enumerate(axis_names(y.shape[1])):
             with_ = list(ctx.sensor_distributions[sensor].values())[j]  # the same samples
             std, std_without, without = per_axis[j]
-            rows.append([f"{sensor} {axis}", *(numbers.cell(v) for v in (
+            rows.append([f"{sensor} {axis}", *(display.cell(v) for v in (
                 std, std_without, with_.excess_kurtosis,
                 without.excess_kurtosis, with_.ks_statistic, without.ks_statistic))])
         _stream.release(y)
@@ -622,7 +622,7 @@ def long_log_events(ctx: Context, doc: Doc) -> None:
                 if outside:
                     changed.append(f"{sensor} {axis} at {format_duration(tau)}")
                 rows.append([f"{sensor} {axis}", _unit(sensor), format_duration(tau),
-                             numbers.cell(dev[i, j]), numbers.cell(dev_out[i, j]),
+                             display.cell(dev[i, j]), display.cell(dev_out[i, j]),
                              f"{dev_out[i, j] / dev[i, j]:.3g}" if dev[i, j] > 0 else "—",
                              "yes" if outside else "no"])
     level = f"{100 * next(iter(ctx.allan.values())).confidence:.3g} %"
@@ -687,7 +687,7 @@ def warmup_section(ctx: Context, doc: Doc) -> None:
         [[r["name"], _unit_of(r["name"]),
           format_number(r["amplitude"], r["amplitude_std"]) if r["significant"] else "—",
           format_duration(r["tau"]) if r["significant"] else "—", f"{r['p_value']:.2g}",
-          numbers.cell(r["tolerance"]),
+          display.cell(r["tolerance"]),
           format_duration(r["settle_time"]) if r["significant"] else
           "slow drift (τ > half the log)" if r["p_value"] < w.alpha else "no transient"]
          for r in w.rows()],
