@@ -213,14 +213,9 @@ def replacing(target, *, inputs: Iterable = ()) -> Iterator[BinaryIO]:
     ``target`` is left as it was. ``inputs`` are refused as the target.
     """
     target = Path(os.fspath(target))
-    refuse_input(target, inputs)
-    tmp = temporary_beside(target)
-    fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_BINARY", 0), 0o666)
+    with staged(target, inputs=inputs) as (fh, tmp):
+        yield fh
     try:
-        with os.fdopen(fd, "wb") as fh:
-            yield fh
-            fh.flush()
-            os.fsync(fh.fileno())
         _keep_mode(tmp, target)
         os.replace(tmp, target)
     except BaseException:
