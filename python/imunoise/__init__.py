@@ -9,6 +9,7 @@ plots and reports. Start with ``imunoise.adev(x, fs)``.
 # for the command line's start-up (exit 130 and one line, not a traceback from
 # inside numpy); in any other process it does nothing.
 from imunoise import _interrupt, export, units  # noqa: F401
+from imunoise._allan_stream import AllanStream
 from imunoise._core import __version__
 from imunoise._cpu import apply_environment as _apply_simd_environment
 from imunoise._events import Events, events
@@ -62,6 +63,7 @@ _apply_simd_environment()
 
 __all__ = [
     "__version__",
+    "AllanStream",
     "AssumptionWarning",
     "CoverageWarning",
     "DataWarning",
