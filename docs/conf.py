@@ -45,6 +45,8 @@ myst_enable_extensions = ["dollarmath"]
 # -- API reference ---------------------------------------------------------------------
 autodoc_typehints = "none"  # numpydoc's Parameters sections carry the types
 autodoc_member_order = "bysource"
+# Signatures show defaults as written (confidence=ONE_SIGMA), not as 0.6826894921370859.
+autodoc_preserve_defaults = True
 numpydoc_show_class_members = False
 numpydoc_class_members_toctree = False
 numpydoc_xref_param_type = False
