@@ -15,6 +15,9 @@ use _core::allan::fast::theo1_sweep::theo1_sums;
 use _core::interrupt::Interrupt;
 use _core::simd::{self, Level};
 
+mod common;
+use common::cpu_seconds;
+
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let n: usize = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(720_000);
@@ -139,27 +142,4 @@ fn timed(reps: usize, mut f: impl FnMut()) -> (f64, f64) {
         best = best.min(t.elapsed().as_secs_f64());
     }
     (best, (cpu_seconds() - cpu0) / reps as f64)
-}
-
-/// CPU seconds of this process, all threads (CLOCK_PROCESS_CPUTIME_ID = 2 on Linux).
-#[cfg(all(target_os = "linux", target_pointer_width = "64"))]
-fn cpu_seconds() -> f64 {
-    #[repr(C)]
-    struct Timespec {
-        sec: i64,
-        nsec: i64,
-    }
-    extern "C" {
-        fn clock_gettime(clock: i32, ts: *mut Timespec) -> i32;
-    }
-    let mut ts = Timespec { sec: 0, nsec: 0 };
-    // SAFETY: clock_gettime writes one timespec through a valid pointer.
-    unsafe { clock_gettime(2, &mut ts) };
-    ts.sec as f64 + ts.nsec as f64 * 1e-9
-}
-
-/// Elsewhere the CPU column reads NaN.
-#[cfg(not(all(target_os = "linux", target_pointer_width = "64")))]
-fn cpu_seconds() -> f64 {
-    f64::NAN
 }
