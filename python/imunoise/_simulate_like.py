@@ -109,16 +109,18 @@ def _from_spectrum(f, p, n: int, fs: float, channels, rng) -> np.ndarray:
         raise ImunoiseValueError("spectrum densities must be finite and >= 0")
     grid = np.fft.rfftfreq(n, 1.0 / fs)
     log_f = np.log(f)
-    out = np.empty((n, 0))
+    columns = []
     for c in _channels(channels, p.shape[1]):
         # log-log interpolation; a zero density stays zero
         level = np.exp(np.interp(np.log(np.maximum(grid, f[0])), log_f,
                                  np.log(np.maximum(p[:, c], 1e-300))))
-        level[p[:, c].max() == 0] = 0.0
+        if p[:, c].max() == 0:
+            level[:] = 0.0
         scale = np.sqrt(level * fs * n / 4.0)  # each of re, im: variance S·fs·n/4
         spectrum = scale * (rng.standard_normal(grid.size) + 1j * rng.standard_normal(grid.size))
         spectrum[0] = 0.0
         if n % 2 == 0:  # the Nyquist bin is real: all its variance in re
             spectrum[-1] = np.sqrt(level[-1] * fs * n / 2.0) * rng.standard_normal()
-        out = np.column_stack([out, np.fft.irfft(spectrum, n)])
+        columns.append(np.fft.irfft(spectrum, n))
+    out = np.column_stack(columns)
     return out[:, 0] if out.shape[1] == 1 and (channels is None or channels == 1) else out

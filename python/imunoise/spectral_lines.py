@@ -36,7 +36,7 @@ from scipy import stats
 
 from imunoise.errors import ImunoiseValueError
 
-__all__ = ["SpectralLine", "check_line"]
+__all__ = ["SpectralLine", "check_line", "require_linear_grid"]
 
 #: Chance that a line-free search window passes the test.
 FALSE_LINE = 1e-3
@@ -91,12 +91,17 @@ def unchecked(amplitude: float, f0: float) -> SpectralLine:
                         frequency=f0)
 
 
+def require_linear_grid(spectrum) -> None:
+    """The test reads neighbouring Welch bins: a smoothed spectrum has none."""
+    if spectrum.bins_per_decade:
+        raise ImunoiseValueError("spectrum must be on Welch's linear grid (imunoise.psd), not "
+                                 f"smoothed; got bins_per_decade={spectrum.bins_per_decade}")
+
+
 def check_line(spectrum, channel: int, f0: float, amplitude: float = math.nan) -> SpectralLine:
     """Whether ``spectrum`` (from :func:`imunoise.psd`, not smoothed) shows a line
     near ``f0`` Hz in ``channel``; see the module for the test."""
-    if spectrum.bins_per_decade:
-        raise ImunoiseValueError("spectrum must be on Welch's linear grid (imunoise.psd), not "
-                         f"smoothed; got bins_per_decade={spectrum.bins_per_decade}")
+    require_linear_grid(spectrum)
     f = np.asarray(spectrum.f, float)
     p = np.asarray(spectrum.psd, float)
     p = p if p.ndim == 1 else p[:, channel]

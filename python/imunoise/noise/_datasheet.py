@@ -225,12 +225,12 @@ def upper_bounds(taus, var, edf) -> dict[str, np.ndarray]:
     ok = np.isfinite(var) & (var > 0) & np.isfinite(edf) & (edf > 0)
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         limit = np.where(ok, var * edf / stats.chi2.ppf(alpha, np.where(ok, edf, 1.0)), np.inf)
+    # each IEEE term's own column at unit coefficient: its variance per coefficient²
+    per_unit = term_variances(taus, 1.0, np.ones(len(TERMS)))
     out = {}
-    for term in TERMS:
-        unit = [1.0 if t == term else 0.0 for t in TERMS]
-        per_unit = term_variances(taus, 1.0, unit)[:, TERMS.index(term), None]
+    for k, term in enumerate(TERMS):
         with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-            bound = np.sqrt(np.min(limit / per_unit, axis=0))
+            bound = np.sqrt(np.min(limit / per_unit[:, k, None], axis=0))
         out[term] = np.where(np.isfinite(bound), bound, np.nan)
     return out
 

@@ -386,6 +386,7 @@ def _check_spectrum(spectrum, result) -> None:
     """``spectrum`` must be a Welch PSD of the result's channels at its rate."""
     if spectrum is None:
         return
+    from imunoise.spectral_lines import require_linear_grid
     from imunoise.spectrum import Spectrum
 
     if not isinstance(spectrum, Spectrum):
@@ -398,9 +399,7 @@ def _check_spectrum(spectrum, result) -> None:
     if not math.isclose(float(spectrum.fs), float(result.fs), rel_tol=1e-9):
         raise ImunoiseValueError(f"spectrum.fs must equal result.fs ({result.fs} Hz); got "
                          f"{spectrum.fs} Hz")
-    if spectrum.bins_per_decade:
-        raise ImunoiseValueError("spectrum must be on Welch's linear grid (imunoise.psd), not "
-                         f"smoothed; got bins_per_decade={spectrum.bins_per_decade}")
+    require_linear_grid(spectrum)
 
 
 def _lines(components, spectrum, channel: int) -> tuple:
