@@ -51,6 +51,7 @@ from imunoise.noise._terms import (
     SINE_SLOT,
     SKEW_SLOT,
     TERMS,
+    core_terms,
     gm_white_density,
     is_log_time,
     resonance_white_density,
@@ -141,13 +142,13 @@ def model_floor(p: np.ndarray, taus: np.ndarray, fs: float) -> tuple[float, floa
     osc = [_resonance(p)] if p[RES_SLOT] > 0 else []
     moving = [(p[MOTION_SLOT], math.exp(p[MOTION_SLOT + 1]))] if p[MOTION_SLOT] > 0 else []
     grid = np.geomspace(taus[0], taus[-1], _B_GRID)
-    dev = np.sqrt(_core_fit.noise_terms(grid, fs, list(p[:5]), gm, tone, osc, moving)
+    dev = np.sqrt(_core_fit.allan_terms(grid, fs, core_terms(p[:5], gm, tone, osc, moving))
                   .sum(axis=1))
     i = int(np.argmin(dev))
     slope = np.log(dev[-1] / dev[-2]) / np.log(grid[-1] / grid[-2])
     if i == grid.size - 1 and slope < FLAT_SLOPE:
         # the curve without its oscillators: a tone's comb has a zero at every period
-        smooth = np.sqrt(_core_fit.noise_terms(grid, fs, list(p[:5]), gm, [], [], moving)
+        smooth = np.sqrt(_core_fit.allan_terms(grid, fs, core_terms(p[:5], gm, motion=moving))
                          .sum(axis=1))
         with np.errstate(divide="ignore", invalid="ignore"):  # 0 without other terms: no floor
             slope = np.gradient(np.log(smooth), np.log(grid))

@@ -22,6 +22,7 @@ from imunoise.noise._components import (
     finite_list,
 )
 from imunoise.noise._terms import NAMES, SENSOR_NAMES, TERMS
+from imunoise.noise._typed import Term
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -90,8 +91,15 @@ class NoiseModel(PerTerm):
         :func:`imunoise.fit` (``in_spectrum`` None where none was given): a tone is
         reported as a line only where the spectrum shows one, at its frequency
         (:mod:`imunoise.spectral_lines`).
+    terms : tuple of tuple of Term
+        Per channel, the fitted terms, typed (``imunoise.noise.White``,
+        ``GaussMarkov``, ``Tone``, …, each with its parameters and their standard
+        uncertainties), in the model's order: the IEEE terms, Gauss–Markov terms by
+        increasing τc, tones by increasing frequency, the resonance, the motion.
+        ``model.terms[0]`` is the first channel's.
     components : Components
-        The fitted components: IEEE coefficients of the fit, Gauss–Markov terms
+        The same fitted terms as parallel arrays (superseded by :attr:`terms`,
+        kept for one release): IEEE coefficients of the fit, Gauss–Markov terms
         (σ, τc), the tone (A, f0) and the resonance (σ, f_r, τr), with their
         uncertainties, covariance and support ranges.
     method : str
@@ -128,6 +136,7 @@ class NoiseModel(PerTerm):
     """
 
     components: Components
+    terms: tuple[tuple[Term, ...], ...] = field(repr=False)
     method: str
     kind: str
     fs: float
