@@ -5,7 +5,7 @@
 //! Python never writes them again.
 
 use numpy::ndarray::Array2;
-use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 
 use crate::fit::filter::OutputFilter;
@@ -121,12 +121,102 @@ fn allan_terms<'py>(
         )));
     }
     let filter = output_filter(filter)?;
-    let typed = (terms.iter())
-        .map(|(kind, p)| Term::new(Kind::from_name(kind)?, p))
-        .collect::<Result<Vec<Term>, _>>()?;
+    let typed = typed_terms(&terms)?;
     let taus = taus.as_array().to_vec();
     let rows = py.detach(|| fit::allan_terms(&taus, fs, &typed, filter.as_ref()));
     Ok(to_matrix(rows, typed.len())?.into_pyarray(py))
+}
+
+/// The core's typed terms of (kind, parameters) pairs.
+fn typed_terms(terms: &[(String, Vec<f64>)]) -> PyResult<Vec<Term>> {
+    (terms.iter())
+        .map(|(kind, p)| Term::new(Kind::from_name(kind)?, p))
+        .collect::<Result<Vec<Term>, _>>()
+        .map_err(PyErr::from)
+}
+
+fn check_model(taus: &[f64], fs: f64) -> PyResult<()> {
+    if !(fs.is_finite() && fs > 0.0) {
+        return Err(super::value_error(format!(
+            "fs must be finite and > 0; got {fs}"
+        )));
+    }
+    if taus.is_empty() {
+        return Err(super::value_error("taus must not be empty".to_string()));
+    }
+    if let Some(t) = taus.iter().find(|t| !(t.is_finite() && **t > 0.0)) {
+        return Err(super::value_error(format!(
+            "taus must be finite and > 0; got {t}"
+        )));
+    }
+    Ok(())
+}
+
+/// datasheet(terms, cov, taus, fs, filter=None) -> {"N"|"B"|"K": (value, std)}:
+/// the datasheet values of a model (NaN where not resolved) with their
+/// uncertainty propagated from `cov`, the covariance of the terms' coordinates.
+#[pyfunction]
+#[pyo3(signature = (terms, cov, taus, fs, filter=None))]
+fn datasheet<'py>(
+    py: Python<'py>,
+    terms: Vec<(String, Vec<f64>)>,
+    cov: PyReadonlyArray2<'py, f64>,
+    taus: PyReadonlyArray1<'py, f64>,
+    fs: f64,
+    filter: Option<PyReadonlyArray1<'py, f64>>,
+) -> PyResult<Vec<(&'static str, (f64, f64))>> {
+    let typed = typed_terms(&terms)?;
+    let taus = taus.as_array().to_vec();
+    check_model(&taus, fs)?;
+    let filter = output_filter(filter)?;
+    let size: usize = typed
+        .iter()
+        .map(|t| t.kind().coordinate_names().len())
+        .sum();
+    let cov = cov.as_array();
+    if cov.shape() != [size, size] {
+        return Err(super::value_error(format!(
+            "cov must be {size} x {size} (the terms' coordinates); got {:?}",
+            cov.shape()
+        )));
+    }
+    let cov: Vec<Vec<f64>> = cov.rows().into_iter().map(|r| r.to_vec()).collect();
+    let model = fit::datasheet::Model {
+        terms: &typed,
+        taus: &taus,
+        fs,
+        filter: filter.as_ref(),
+    };
+    Ok(py.detach(|| {
+        (fit::datasheet::Datasheet::ALL.iter())
+            .map(|&d| {
+                let v = fit::datasheet::propagated(d, &model, &cov);
+                (d.name(), (v.value, v.std))
+            })
+            .collect()
+    }))
+}
+
+/// model_floor(terms, taus, fs, filter=None) -> (τ, σ) or None: the floor of the
+/// model's deviation over `taus`, where B is read.
+#[pyfunction]
+#[pyo3(signature = (terms, taus, fs, filter=None))]
+fn model_floor<'py>(
+    terms: Vec<(String, Vec<f64>)>,
+    taus: PyReadonlyArray1<'py, f64>,
+    fs: f64,
+    filter: Option<PyReadonlyArray1<'py, f64>>,
+) -> PyResult<Option<(f64, f64)>> {
+    let typed = typed_terms(&terms)?;
+    let taus = taus.as_array().to_vec();
+    check_model(&taus, fs)?;
+    let filter = output_filter(filter)?;
+    Ok(fit::datasheet::floor(&fit::datasheet::Model {
+        terms: &typed,
+        taus: &taus,
+        fs,
+        filter: filter.as_ref(),
+    }))
 }
 
 /// filter_factor(taus, fs, filter) -> c(τ): the white term's Allan variance
@@ -173,9 +263,13 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
         .collect();
     m.add("TERM_KINDS", kinds)?;
     m.add("FLICKER_FACTOR", FLICKER_FACTOR)?;
+    m.add("GM_PEAK", fit::term::GM_PEAK)?;
+    m.add("FLAT_SLOPE", fit::datasheet::FLAT_SLOPE)?;
     m.add_class::<PyNoiseFit>()?;
     m.add_function(wrap_pyfunction!(fit_noise, m)?)?;
     m.add_function(wrap_pyfunction!(allan_terms, m)?)?;
     m.add_function(wrap_pyfunction!(filter_factor, m)?)?;
+    m.add_function(wrap_pyfunction!(datasheet, m)?)?;
+    m.add_function(wrap_pyfunction!(model_floor, m)?)?;
     Ok(())
 }

@@ -27,6 +27,7 @@
 //! Lawson & Hanson (1974) for NNLS.
 
 pub mod basis;
+pub mod datasheet;
 pub mod estimate;
 pub mod filter;
 pub mod nnls;

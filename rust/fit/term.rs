@@ -389,6 +389,76 @@ impl Term {
     }
 }
 
+/// τ/τc where a first-order Gauss–Markov term's Allan variance peaks (IEEE 952
+/// Annex C): its hump. Below it the term rises like a random walk.
+pub const GM_PEAK: f64 = 1.8926;
+
+impl Term {
+    /// The coordinates of [`Kind::coordinate_names`]: the variance, the
+    /// logarithm of each time and frequency, the skew.
+    pub fn coordinates(&self) -> Vec<f64> {
+        (self
+            .parameters()
+            .into_iter()
+            .zip(self.kind().coordinate_names()))
+        .map(|(p, name)| if name.starts_with("ln_") { p.ln() } else { p })
+        .collect()
+    }
+
+    /// The term of kind `kind` at `coordinates` ([`Term::coordinates`]).
+    pub fn from_coordinates(kind: Kind, coordinates: &[f64]) -> CoreResult<Term> {
+        let parameters: Vec<f64> = (coordinates.iter().zip(kind.coordinate_names()))
+            .map(|(&x, name)| if name.starts_with("ln_") { x.exp() } else { x })
+            .collect();
+        Term::new(kind, &parameters)
+    }
+
+    /// What the term adds to the datasheet's N² (the white level a reader draws
+    /// through τ = 1 s): the white term itself, and the −½ asymptote of a
+    /// Gauss–Markov term or a resonance faster than 1 s (white at that read-off;
+    /// a sensor's filter passes its input's white noise). Nothing for the rest.
+    pub fn white_share(&self, fs: f64) -> f64 {
+        match *self {
+            Term::White { variance } => variance,
+            Term::GaussMarkov { variance, tau_c } if tau_c <= 1.0 => {
+                let phi = (-1.0 / (fs * tau_c)).exp();
+                variance * (1.0 + phi) / ((1.0 - phi) * fs)
+            }
+            Term::Resonance {
+                variance,
+                freq,
+                tau,
+                skew,
+            } if tau <= 1.0 => {
+                // σ²·Re[(1 − iβ)(1 + z)/(1 − z)]/fs: its spectrum at zero frequency.
+                let (u, theta) = basis::resonance_rates(freq, tau, fs);
+                let z = rustfft::num_complex::Complex64::from_polar((-u).exp(), theta);
+                let bound = basis::quadrature_bound(u, theta);
+                let beta = if bound.is_finite() { skew * bound } else { 0.0 };
+                let zero = rustfft::num_complex::Complex64::new(1.0, -beta) * (1.0 + z) / (1.0 - z);
+                variance * zero.re / fs
+            }
+            _ => 0.0,
+        }
+    }
+
+    /// What the term adds to the datasheet's K² over a record whose longest
+    /// fitted tau is `longest`: the random walk itself, and the short-τ walk rate
+    /// 2σ²/τc of a Gauss–Markov term whose hump lies beyond the record (over the
+    /// record it rises like a walk). A bump within the record is a bias state of
+    /// its own and adds nothing: taken as K it would inflate an EKF's bias
+    /// process noise by the bump's height over the walk's.
+    pub fn walk_share(&self, longest: f64) -> f64 {
+        match *self {
+            Term::RandomWalk { variance } => variance,
+            Term::GaussMarkov { variance, tau_c } if tau_c > 1.0 && GM_PEAK * tau_c > longest => {
+                2.0 * variance / tau_c
+            }
+            _ => 0.0,
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

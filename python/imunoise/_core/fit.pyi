@@ -16,6 +16,10 @@ TERM_KINDS: list[tuple[str, list[str], list[str]]]
 covariance coordinate names)."""
 FLICKER_FACTOR: float
 """(2 ln 2)/π: the Allan variance of flicker rate noise per unit B²."""
+GM_PEAK: float
+"""τ/τc where a first-order Gauss–Markov term's Allan variance peaks (its hump)."""
+FLAT_SLOPE: float
+"""A deviation curve whose log-log slope is above this has flattened (B's floor)."""
 
 @final
 class NoiseFit:
@@ -80,3 +84,22 @@ def filter_factor(
 ) -> npt.NDArray[np.float64]:
     """c(τ): the white term's Allan variance through the output filter ``filter``
     (power gain from 0 Hz to fs/2, G(0) = 1) over the one without."""
+
+def datasheet(
+    terms: list[tuple[str, list[float]]],
+    cov: npt.NDArray[np.float64],
+    taus: npt.NDArray[np.float64],
+    fs: float,
+    filter: npt.NDArray[np.float64] | None = None,
+) -> list[tuple[str, tuple[float, float]]]:
+    """(name, (value, std)) of N, B, K of a model given as (kind, parameters) terms
+    with ``cov`` the covariance of their coordinates; NaN where not resolved."""
+
+def model_floor(
+    terms: list[tuple[str, list[float]]],
+    taus: npt.NDArray[np.float64],
+    fs: float,
+    filter: npt.NDArray[np.float64] | None = None,
+) -> tuple[float, float] | None:
+    """(τ, σ) of the floor of the model's deviation over ``taus`` (where B is read),
+    or None where the curve has none."""

@@ -252,6 +252,7 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
     moving_std = np.full((channels, 2), np.nan)
     stats = np.full((channels, 3), np.nan)  # discrepancy, chi2, n_eff
     cov = np.full((channels, PARAMS, PARAMS), np.nan)
+    core: list = [None] * channels  # per channel: the core's terms and their covariance
     usable = []
     for c in range(channels):
         ok = np.isfinite(var[:, c]) & (var[:, c] > 0) & np.isfinite(edf[:, c]) & (edf[:, c] > 0)
@@ -276,7 +277,7 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
             fits = list(pool.map(fit_channel, range(channels)))
         for c, out in enumerate(fits):
             coef[c], std[c], sup[c], gm[c], gm_std[c], sine[c], sine_std[c], osc[c], \
-                osc_std[c], moving[c], moving_std[c], stats[c], cov[c] = out
+                osc_std[c], moving[c], moving_std[c], stats[c], cov[c], core[c] = out
             markov = [(a, b) for a, b in gm[c] if np.isfinite(a)]
             tones = [tuple(p) for p in sine[c] if np.isfinite(p[0])]
             oscs = [tuple(osc[c])] if np.isfinite(osc[c, 0]) else []
@@ -344,7 +345,7 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
         cov=shaped(cov),
         fs=float(result.fs),
     )
-    sheet = datasheet_values(components, taus, method)
+    sheet = datasheet_values(components, core, taus, method)
     if uncertainty == "bootstrap":
         sheet = {k: (v, sheet_std[:, i]) for i, (k, (v, _)) in enumerate(sheet.items())}
     resolved = {k: (v > 0) & np.isfinite(v) for k, (v, _) in sheet.items()}
@@ -515,7 +516,8 @@ def _fit_wls(t, v, e, fs, mask, gm_count, oscillators, select):
         raise ImunoiseValueError(f"cannot fit the noise model to result: {exc}") from None
     terms = _typed.from_core(r.terms, np.asarray(r.cov))
     return _legacy_arrays(terms) + (
-        (r.discrepancy, r.chi2, r.n_eff), _slot_covariance(r.terms, np.asarray(r.cov)))
+        (r.discrepancy, r.chi2, r.n_eff), _slot_covariance(r.terms, np.asarray(r.cov)),
+        (r.terms, np.asarray(r.cov)))
 
 
 def _legacy_arrays(terms):

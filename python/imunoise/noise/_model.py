@@ -12,6 +12,7 @@ import numpy as np
 from imunoise import _schema, _summary, _warn
 from imunoise import display as _display
 from imunoise import units as _units
+from imunoise._core import fit as _core_fit
 from imunoise._deprecation import old_call_forms
 from imunoise.errors import ImunoiseDeprecationWarning, ImunoiseValueError
 from imunoise.noise._components import (
@@ -172,12 +173,10 @@ class NoiseModel(PerTerm):
     def floor(self, channel: int = 0) -> tuple[float, float] | None:
         """(τ, σ(τ)) of the model's floor over the fitted taus, where ``B`` is read
         (B = σ/√(2 ln2/π)); None where the curve has none (B not resolved)."""
-        from imunoise.noise._datasheet import model_floor, parameters
-
         if self.method != "wls":
             return None
-        p = parameters(self.components, channel)
-        return model_floor(p, np.asarray(self.taus, float), float(self.fs))
+        return _core_fit.model_floor([t.core() for t in self.terms[channel]],
+                                     np.ascontiguousarray(self.taus, dtype=float), float(self.fs))
 
     def plot(self, result: AllanResult, **kwargs) -> Figure:
         """The model over ``result``, the Allan result it was fitted to, with its terms,

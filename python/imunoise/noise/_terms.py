@@ -31,7 +31,7 @@ SENSOR_NAMES = {
 # straight line is read (IEEE 952 Annex C).
 SLOPE = {"Q": -1.0, "N": -0.5, "B": 0.0, "K": 0.5, "R": 1.0}
 READ_TAU = {"Q": math.sqrt(3.0), "N": 1.0, "K": 3.0, "R": math.sqrt(2.0)}
-GM_PEAK = 1.8926
+GM_PEAK: float = _core_fit.GM_PEAK
 """τ/τc where a first-order Gauss–Markov term's Allan variance peaks (IEEE 952
 Annex C): its hump. Below it the term rises like a random walk, above it falls
 like white noise."""
@@ -110,13 +110,7 @@ def quadrature_bound(f_r: float, tau_r: float, fs: float) -> float:
     return math.inf if s < 1e-12 else math.sinh(1.0 / (fs * tau_r)) / s
 
 
-def is_log_time(slot: int) -> bool:
-    """Whether covariance slot ``slot`` holds a logarithm (ln τc, ln f0, ln f_r, ln τr)."""
-    return slot in (RES_SLOT + 1, RES_SLOT + 2, MOTION_SLOT + 1) or (
-        5 <= slot < RES_SLOT and (slot - 5) % 2 == 1)
-
-
-FLAT_SLOPE = -0.25
+FLAT_SLOPE: float = _core_fit.FLAT_SLOPE
 """A curve whose log-log slope is above this has flattened: a minimum at its end is
 a bias-instability floor (slope −½ is white noise, 0 the floor)."""
 
