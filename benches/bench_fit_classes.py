@@ -41,6 +41,7 @@ import warnings
 import imunoise
 import numpy as np
 from imunoise import _cpu
+from imunoise.noise._typed import structure
 from scipy.signal import butter, lfilter
 
 ARCSEC = np.pi / 180 / 3600
@@ -164,9 +165,9 @@ def main() -> int:
             limit = len(x) / fs / 10
             cov = [coverage(r.taus, r.dev[:, c], r.edf[:, c], p[:, c], limit) for c in range(3)]
             n_err = np.abs(np.ravel(m.N) / n_true - 1)
-            rows.append((name, seed, cov, m.components.structure(0), n_err, took))
+            rows.append((name, seed, cov, structure(m.terms[0]), n_err, took))
             print(f"| {name} | {seed} | {' / '.join(f'{c:.0%}' for c in cov)} | "
-                  f"{m.components.structure(0)} | {np.median(n_err):.1%} | {took:.2f} s |",
+                  f"{structure(m.terms[0])} | {np.median(n_err):.1%} | {took:.2f} s |",
                   flush=True)
     every = [c for row in rows for c in row[2]]
     if every:

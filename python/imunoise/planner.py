@@ -196,7 +196,7 @@ def _coefficients(source, sensor: str) -> tuple[dict[str, float], str, tuple[str
     """The coefficients to plan with, the plan's label and the terms assumed."""
     if isinstance(source, Mapping):
         return {k: float(source.get(k, 0.0)) for k in PLAN_TERMS}, "", ()
-    if hasattr(source, "components") and hasattr(source, "N"):  # a NoiseModel
+    if hasattr(source, "terms") and hasattr(source, "N"):  # a NoiseModel
         # The median over the axes that resolve the term; a term no axis resolves
         # (NaN) is planned as absent, as a datasheet that omits it.
         out = {}

@@ -31,7 +31,7 @@ from imunoise._schema import ATTITUDE_NAMES, CHANNELS, axis_names
 from imunoise.allan import AllanResult
 from imunoise.display import cell, format_value, rounded
 from imunoise.errors import ImunoiseTypeError, ImunoiseValueError
-from imunoise.noise import FLICKER, TERMS, NoiseModel, model_variance
+from imunoise.noise import FLICKER, TERMS, NoiseModel, _typed, model_variance
 from imunoise.noise._terms import term_variances
 from imunoise.readers.log import ImuLog
 from imunoise.stats import Distribution
@@ -532,7 +532,7 @@ def _tone_envelope(model: NoiseModel, grid: np.ndarray, channel: int,
     peak (below one period, ≈ 0.37/f0), its upper envelope beyond — the sampled form
     2·(A²/2)·sin⁴(πνm)/(m² sin²πν) with sin⁴ → 1, A/(m·|sin πν|), ν = f0/fs,
     m = τ·fs, capped at the peak — and the tones' variances added."""
-    tones = model.components.sine(channel)
+    tones = _typed.pairs(model.terms[channel], _typed.Tone, "amplitude", "freq")
     if not tones:
         return curve
     fs = float(model.fs)

@@ -59,7 +59,8 @@ def test_terms_add_up_to_the_model_curve(model):
 def test_uncertainties_are_finite_and_positive(model):
     for terms in model.terms:
         for term in terms:
-            stds = [getattr(term, f) for f in map(attrgetter("name"), fields(term)) if f.endswith("_std")]
+            stds = [getattr(term, f) for f in map(attrgetter("name"), fields(term))
+                    if f.endswith("_std")]
             assert all(math.isfinite(s) and s > 0 for s in stds), term
 
 
@@ -82,3 +83,22 @@ def test_a_bad_term_is_refused_by_the_core():
         noise.GaussMarkov(1.0, -2.0).allan_variance([1.0], FS)
     with pytest.raises(imunoise.ImunoiseValueError, match="skew must be in"):
         noise.Resonance(1.0, 5.0, 0.1, skew=2.0).allan_variance([1.0], FS)
+
+
+def test_components_is_a_deprecated_view_of_the_terms(model):
+    with pytest.warns(imunoise.ImunoiseDeprecationWarning, match="use model.terms"):
+        parts = model.components
+    assert parts.structure(1) == " + ".join(t.label() for t in model.terms[1])
+
+
+def test_the_library_reads_terms_not_the_deprecated_view(model, tmp_path):
+    """Tables, repr, exports, the planner and simulate(like=) never warn."""
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", imunoise.ImunoiseDeprecationWarning)
+        repr(model), model._repr_html_(), model.table_text("gyro"), model.to_dict()
+        imunoise.export.ekf_dict(gyro=model)
+        imunoise.spectrum.model_psd(model, np.array([0.1, 1.0, 10.0]))
+        imunoise.simulate(1000, None, like=model, seed=1)
+        imunoise.plan(model, sensor="gyro")

@@ -357,7 +357,7 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
         upper={k: shaped(np.where(resolved[k], np.nan, bounds[k])) for k in TERMS},
         notes=tuple(datasheet_notes(components, taus, c, method) for c in range(channels)),
         lines=tuple(_lines(components, spectrum, c) for c in range(channels)),
-        components=components,
+        _arrays=components,
         terms=typed,
         method=method,
         kind=result.kind,
@@ -480,7 +480,7 @@ def _bootstrap_std(result, n, coef, markov, oscillators, replicates, rng, option
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)
         refit = fit(again, **options)
-    parts = refit.components
+    parts = refit._arrays
     values = np.stack([np.atleast_1d(parts.value(t)) for t in TERMS], axis=1)
     gm = np.stack([np.reshape(parts.gm_sigma, (-1, GM_MAX)),
                    np.reshape(parts.gm_tau, (-1, GM_MAX))], axis=-1)

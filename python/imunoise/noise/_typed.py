@@ -20,6 +20,7 @@ from typing import ClassVar
 
 import numpy as np
 
+from imunoise import _summary
 from imunoise._core import fit as _core_fit
 
 
@@ -51,6 +52,19 @@ class Term:
         t = np.ascontiguousarray(np.atleast_1d(np.asarray(taus, dtype=float)))
         return _core_fit.allan_terms(t, float(fs), [self.core()])[:, 0]
 
+    def label(self) -> str:
+        """The term in a structure's words: ``"N"``, ``"GM(0.05 s)"``, ``"tone 13.4 Hz"``."""
+        raise NotImplementedError
+
+    def to_dict(self) -> dict:
+        """Plain-Python view: ``kind`` and every parameter and its ``*_std``
+        (None where not finite: JSON has no NaN)."""
+        out: dict = {"kind": self.kind}
+        for f in fields(self):
+            v = float(getattr(self, f.name))
+            out[f.name] = v if math.isfinite(v) else None
+        return out
+
     def _describe(self) -> str:
         values = [f"{f.name}={getattr(self, f.name):.4g}" for f in fields(self)
                   if not f.name.endswith("_std")]
@@ -73,6 +87,9 @@ class _Ieee(Term):
 
     def core(self) -> tuple[str, list[float]]:
         return self.kind, [self.value**2]
+
+    def label(self) -> str:
+        return self.name
 
     @classmethod
     def from_core(cls, parameters, cov):
@@ -145,6 +162,9 @@ class GaussMarkov(Term):
     def core(self) -> tuple[str, list[float]]:
         return self.kind, [self.sigma**2, self.tau_c]
 
+    def label(self) -> str:
+        return f"GM({_summary.number(self.tau_c)} s)"
+
     @classmethod
     def from_core(cls, parameters, cov):
         sigma, u_sigma = _sigma(parameters[0], cov[0, 0])
@@ -163,6 +183,9 @@ class Tone(Term):
 
     def core(self) -> tuple[str, list[float]]:
         return self.kind, [self.amplitude**2 / 2, self.freq]
+
+    def label(self) -> str:
+        return f"tone {_summary.number(self.freq)} Hz"
 
     @classmethod
     def from_core(cls, parameters, cov):
@@ -192,6 +215,10 @@ class Resonance(Term):
     def core(self) -> tuple[str, list[float]]:
         return self.kind, [self.sigma**2, self.freq, self.tau, self.skew]
 
+    def label(self) -> str:
+        skew = f" (skew {self.skew:.2g})" if self.skew else ""
+        return f"resonance {_summary.number(self.freq)} Hz{skew}"
+
     @classmethod
     def from_core(cls, parameters, cov):
         sigma, u_sigma = _sigma(parameters[0], cov[0, 0])
@@ -215,6 +242,9 @@ class Motion(Term):
 
     def core(self) -> tuple[str, list[float]]:
         return self.kind, [self.sigma**2, self.tau_c]
+
+    def label(self) -> str:
+        return f"motion({_summary.number(self.tau_c)} s)"
 
     @classmethod
     def from_core(cls, parameters, cov):
@@ -254,3 +284,27 @@ def allan_variances(terms, taus, fs: float) -> np.ndarray:
     if not terms:
         return np.zeros((t.size, 0))
     return _core_fit.allan_terms(t, float(fs), [term.core() for term in terms])
+
+
+def ieee_term(terms, name: str) -> _Ieee | None:
+    """The IEEE term of coefficient ``name`` (Q, N, B, K or R) among one channel's
+    terms, or None."""
+    return next((t for t in terms if isinstance(t, _Ieee) and t.name == name), None)
+
+
+def coefficient(terms, name: str) -> float:
+    """The fitted IEEE coefficient ``name`` of one channel's terms; 0 where the
+    structure has none."""
+    term = ieee_term(terms, name)
+    return 0.0 if term is None else term.value
+
+
+def pairs(terms, cls: type[Term], *names: str) -> list[tuple[float, ...]]:
+    """``names``' values of each term of class ``cls``, as tuples, in order."""
+    return [tuple(float(getattr(t, n)) for n in names) for t in terms if isinstance(t, cls)]
+
+
+def structure(terms) -> str:
+    """One channel's fitted structure in words: ``"N + K + GM(0.05 s) + tone 13.4 Hz"``
+    (``"none"`` when empty)."""
+    return " + ".join(t.label() for t in terms) or "none"
