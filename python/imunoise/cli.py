@@ -422,7 +422,7 @@ def _number_in(low: float, high: float, unit: str = "", *, low_open: bool = True
 
 
 #: Sample rates (Hz) the command line takes: slower than a sample per 1000 s or
-#: faster than 1 MHz is no IMU, and 1e300 Hz overflowed the planner's arithmetic.
+#: faster than 1 MHz is no IMU, and the bound keeps the planner's arithmetic finite.
 _FS = _number_in(1e-3, 1e6, "Hz", low_open=False)
 #: Hours of a simulated log (the simulator bounds the samples further).
 _HOURS = _number_in(0, 1e5, "h")
