@@ -24,7 +24,7 @@ from imunoise._schema import (
     sensor_label,
 )
 from imunoise.allan import KINDS
-from imunoise.display import duration
+from imunoise.display import duration, percent
 from imunoise.errors import DataWarning
 from imunoise.readers.csv_reader import (
     LAYOUT_CHANNELS,  # the --kind choices: every public Allan-family statistic
@@ -529,7 +529,7 @@ def _cmd_adev(args) -> int:
             row += display.interval_cells(r.dev[i, j], r.ci_low[i, j], r.ci_high[i, j])
         rows.append(row)
     print(f"# {args.kind} of {args.sensor}, {len(y)} samples at {log.fs:.6g} Hz, "
-          f"CI {r.confidence:.1%}")
+          f"CI {percent(r.confidence, digits=1)}")
     _print_table(head, rows)
     if args.plot:
         from imunoise import plot

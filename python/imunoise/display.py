@@ -173,3 +173,15 @@ def upper_bound(bound, *, digits: int = 3) -> str:
 def cell(value, std=None, *, digits: int = 4) -> str:
     """A table cell: as :func:`format_value`, with "—" for a missing value."""
     return format_value(value, std, digits=digits, missing=EMPTY)
+
+
+def percent(fraction, *, digits: int = 0) -> str:
+    """A fraction as a percentage, written as the SI writes it, with a space before
+    the sign: ``percent(0.6827, digits=1)`` is ``"68.3 %"``, ``percent(1.0)`` is
+    ``"100 %"``; "—" when not finite. One spelling for every percentage of the report,
+    its figures and the command line (``f"{x:.0%}"`` leaves the space out)."""
+    if not _finite(fraction):
+        return EMPTY
+    if isinstance(digits, bool) or not isinstance(digits, int) or digits < 0:
+        raise ImunoiseValueError(f"digits must be an integer >= 0; got {digits!r}")
+    return f"{100.0 * float(fraction):.{digits}f} %"

@@ -29,7 +29,7 @@ import numpy as np
 from imunoise import _atomic, _summary
 from imunoise._schema import ATTITUDE_NAMES, CHANNELS, axis_names
 from imunoise.allan import AllanResult
-from imunoise.display import cell, format_value, rounded
+from imunoise.display import cell, format_value, percent, rounded
 from imunoise.errors import ImunoiseTypeError, ImunoiseValueError
 from imunoise.noise import FLICKER, TERMS, NoiseModel, model_variance
 from imunoise.noise._terms import term_variances
@@ -639,7 +639,8 @@ def allan(
             yerr = np.vstack([dev[:, j] - lo[:, j], hi[:, j] - dev[:, j]])
             ax.errorbar(
                 taus, dev[:, j], yerr=yerr, fmt="o", ms=2.5, color=color,
-                elinewidth=0.8, capsize=1.5, label=f"{kind} ({result.confidence:.1%} CI)",
+                elinewidth=0.8, capsize=1.5,
+                label=f"{kind} ({percent(result.confidence, digits=1)} CI)",
             )
             marks: dict[str, float] = {}
             if model is not None:
@@ -731,7 +732,7 @@ def allan(
             finite = ratio[np.isfinite(ratio)]
             spans.append(max(0.1, float(np.max(np.abs(finite - 1)))) if finite.size else 0.1)
             cover = np.atleast_1d(model.coverage)[j]
-            ax.text(0.02, 0.06, f"follows {cover:.0%} of taus", transform=ax.transAxes,
+            ax.text(0.02, 0.06, f"follows {percent(cover)} of taus", transform=ax.transAxes,
                     fontsize=7)
             if j == 0:
                 ax.set_ylabel("data/model\n[ratio]")

@@ -11,6 +11,7 @@ import numpy as np
 from imunoise import datasheet
 from imunoise import units as _units
 from imunoise._schema import axis_names
+from imunoise.display import percent
 from imunoise.errors import ImunoiseValueError
 from imunoise.noise import NoiseModel, gm_white_density, resolution_noise
 from imunoise.noise._model import table_cell
@@ -134,8 +135,9 @@ def model_sentences(model: NoiseModel, sensor: str,
         parts_of = model.components
         cover = float(np.atleast_1d(model.coverage)[c])
         delta = float(np.atleast_1d(model.discrepancy)[c])
-        parts.append(f"follows {cover:.0%} of the taus (inside the 95 % interval or within 5 %)"
-                     + (f", residual discrepancy {delta / 2:.1%} in σ" if delta > 0.01 else ""))
+        parts.append(f"follows {percent(cover)} of the taus (inside the 95 % interval or "
+                     "within 5 %)" + (f", residual discrepancy {percent(delta / 2, digits=1)} "
+                                      "in σ" if delta > 0.01 else ""))
         if cover < POOR_COVERAGE:
             parts.append("**the model does not describe this curve: read its coefficients "
                          "as a summary only** (see the data/model panel)")
@@ -246,7 +248,7 @@ def _resolution_sentence(model: NoiseModel, c: int, step, sensor: str, units) ->
         text = (f"the samples are whole multiples of {float(shown):.3g} "
                 f"{b_unit.label}: rounding to it adds white noise of "
                 f"{float(added):.3g} {n_unit.label}"
-                + (f", {share:.0%} of N" if math.isfinite(share) else ""))
+                + (f", {percent(share)} of N" if math.isfinite(share) else ""))
         if share >= RESOLUTION_LIMITS:
             text += (" — **the log's resolution limits the N measured here** (record with "
                      "more digits, or the sensor's binary output)")
@@ -283,7 +285,7 @@ def _correlated_white_sentence(model: NoiseModel, c: int) -> list[str]:
         share = gm_white_density(sigma, tau_c, model.fs) / n2
         if tau_c < 1.0 and share > CARRIES_N and 1.9 * tau_c > float(model.taus[1]):
             out.append(
-                f"N is {share:.0%} the white tail of the Gauss–Markov term of τc "
+                f"N is {percent(share)} the white tail of the Gauss–Markov term of τc "
                 f"{tau_c:.2g} s, whose hump the curve shows near {1.9 * tau_c:.2g} s: "
                 "the sensor's own output filter, or a disturbance of the mount (a "
                 "vehicle's or a machine's vibration), which the Allan deviation cannot "
