@@ -19,6 +19,10 @@ from imunoise.errors import ImunoiseValueError
 NOT_RESOLVED = "not resolved"
 #: The word for an empty table cell.
 EMPTY = "—"
+#: Units as logs and arguments spell them in ASCII, and the symbols every table, caption
+#: and figure writes instead: one spelling of a unit wherever a reader meets it.
+UNIT_SYMBOLS = (("m/s^2", "m/s²"), ("m/s^3", "m/s³"), ("sqrt(Hz)", "√Hz"), ("sqrt(h)", "√h"),
+                ("sqrt(s)", "√s"), ("deg/s", "°/s"), ("deg/h", "°/h"))
 
 
 def _finite(x) -> bool:
@@ -173,6 +177,14 @@ def upper_bound(bound, *, digits: int = 3) -> str:
 def cell(value, std=None, *, digits: int = 4) -> str:
     """A table cell: as :func:`format_value`, with "—" for a missing value."""
     return format_value(value, std, digits=digits, missing=EMPTY)
+
+
+def unit_symbols(unit: str) -> str:
+    """A unit as tables and figures write it: ``"m/s^2"`` is ``"m/s²"``,
+    ``"deg/h/sqrt(Hz)"`` is ``"°/h/√Hz"`` (:data:`UNIT_SYMBOLS`); other text unchanged."""
+    for ascii_, symbol in UNIT_SYMBOLS:
+        unit = unit.replace(ascii_, symbol)
+    return unit
 
 
 def percent(fraction, *, digits: int = 0) -> str:
