@@ -1087,6 +1087,8 @@ def compensation(before: AllanResult, after: AllanResult, *, title: str = "",
                  unit: str = "") -> Figure:
     """Allan deviation per axis before (solid) and after (dashed) a correction, e.g.
     the temperature compensation of :func:`imunoise.thermal`."""
+    from matplotlib.ticker import NullFormatter
+
     new_figure = _plt()
     b = np.asarray(before.dev).reshape(len(before.taus), -1)
     a = np.asarray(after.dev).reshape(len(after.taus), -1)
@@ -1100,7 +1102,13 @@ def compensation(before: AllanResult, after: AllanResult, *, title: str = "",
             ax.loglog(after.taus, a[:, j], color=color, linestyle="--", label=f"{name} after")
         ax.set_xlabel("τ [s]")
         ax.set_ylabel(_label("σ(τ)", unit))
+        # decades only, as plot.allan labels them: matplotlib labels the minor ticks
+        # ("6 × 10⁻⁴") of an axis that spans under two decades (kept where no decade
+        # falls inside the axis, which would then have no label at all)
+        low, high = ax.get_ylim()
+        if np.floor(np.log10(high)) >= np.ceil(np.log10(low)):
+            ax.yaxis.set_minor_formatter(NullFormatter())
         ax.legend(ncol=2)
         fig.suptitle(title or "Allan deviation before and after compensation")
         _margins(fig, left=0.9, bottom=0.5, title=True)
-    return fig
+    return plain_ticks(fig)
