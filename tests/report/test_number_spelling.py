@@ -37,3 +37,17 @@ def test_resolution_sentences_write_exponents_as_the_tables_do():
     assert with_q, sentences  # the capture's Z axis has a quantization term
     for sentence in sentences:
         assert not PYTHON_EXPONENT.search(sentence), sentence
+
+
+def test_the_bundled_capture_report_has_one_spelling_of_numbers(tmp_path):
+    from imunoise import report
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        rep = report.build(imunoise.read(BUNDLED, fs=40.0), None, tmp_path / "r",
+                           progress=False)
+    md = rep.markdown.read_text(encoding="utf-8")
+    assert "false events per sample" in md
+    assert not PYTHON_EXPONENT.search(md), PYTHON_EXPONENT.search(md)
+    glued = re.search(r".{40}\d%.{20}", md)  # "68.3%" beside "68.3 %"
+    assert glued is None, glued.group(0)

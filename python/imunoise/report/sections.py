@@ -470,7 +470,8 @@ def events_section(ctx: Context, doc: Doc) -> None:
     found, log = ctx.events, ctx.short
     doc.p(f"Spikes (Hampel test) and bursts (sliding energy, window "
           f"{format_duration(found.window / found.fs)}) per channel of {_short(ctx)}, "
-          f"thresholds set for {found.false_alarm:.0e} false events per sample and channel "
+          f"thresholds set for {format_value(found.false_alarm, digits=1)} false events per "
+          "sample and channel "
           f"(measured on white noise: {docs_link('events')}). "
           f"{len(found)} events cover {100 * found.share:.3g} % of the samples.")
     # with --trim auto on one log the short log starts at the settle point: times
