@@ -74,8 +74,8 @@ MIN_BLOCKS = 20
 #: Records of the sensor's stationary noise the significance test simulates.
 NULL_RECORDS = 1999
 #: Confidence of the upper limit of the Allan variance that bounds the null's
-#: rate random walk (see ``_random_walk_bound``): one-sigma. At 95 % the null is
-#: so loud that a 20-minute transient 5× the random walk's wander is missed.
+#: rate random walk (see ``_random_walk_bound``): one-sigma, because a 95 % bound
+#: makes the null so loud that a transient several times that wander is missed.
 BOUND_CONFIDENCE = 0.683
 #: Correlation times of the exponential fit: this many per log, log-spaced.
 TAU_GRID = 80

@@ -11,6 +11,7 @@ import numpy as np
 from imunoise import datasheet
 from imunoise import units as _units
 from imunoise._schema import axis_names
+from imunoise.display import format_value, percent
 from imunoise.errors import ImunoiseValueError
 from imunoise.noise import NoiseModel, _typed, gm_white_density, resolution_noise
 from imunoise.noise._model import table_cell
@@ -134,8 +135,9 @@ def model_sentences(model: NoiseModel, sensor: str,
         parts = [f"{axis}: fitted components {_typed.structure(terms)}"]
         cover = float(np.atleast_1d(model.coverage)[c])
         delta = float(np.atleast_1d(model.discrepancy)[c])
-        parts.append(f"follows {cover:.0%} of the taus (inside the 95 % interval or within 5 %)"
-                     + (f", residual discrepancy {delta / 2:.1%} in σ" if delta > 0.01 else ""))
+        parts.append(f"follows {percent(cover)} of the taus (inside the 95 % interval or "
+                     "within 5 %)" + (f", residual discrepancy {percent(delta / 2, digits=1)} "
+                                      "in σ" if delta > 0.01 else ""))
         if cover < POOR_COVERAGE:
             parts.append("**the model does not describe this curve: read its coefficients "
                          "as a summary only** (see the data/model panel)")
@@ -155,7 +157,7 @@ def model_sentences(model: NoiseModel, sensor: str,
             elif line.in_spectrum:
                 parts.append(f"a line of amplitude {format_number(value, value_std)} "
                              f"{b_unit.label} at {line.frequency:.4g} Hz (the spectrum's "
-                             f"peak, {line.ratio:.3g}× its background)")
+                             f"peak, {_g(line.ratio)}× its background)")
             else:
                 parts.append(f"the Allan curve bends like a tone near "
                              f"{line.allan_frequency:.3g} Hz, but the spectrum shows no line "
@@ -238,10 +240,10 @@ def _resolution_sentence(model: NoiseModel, c: int, step, sensor: str, units) ->
     if share >= RESOLUTION_SHOWN:
         shown = _units.convert(float(step), "B", b_unit.name, sensor=sensor)
         added = _units.convert(n_round, "N", n_unit.name, sensor=sensor)
-        text = (f"the samples are whole multiples of {float(shown):.3g} "
+        text = (f"the samples are whole multiples of {_g(shown)} "
                 f"{b_unit.label}: rounding to it adds white noise of "
-                f"{float(added):.3g} {n_unit.label}"
-                + (f", {share:.0%} of N" if math.isfinite(share) else ""))
+                f"{_g(added)} {n_unit.label}"
+                + (f", {percent(share)} of N" if math.isfinite(share) else ""))
         if share >= RESOLUTION_LIMITS:
             text += (" — **the log's resolution limits the N measured here** (record with "
                      "more digits, or the sensor's binary output)")
@@ -253,11 +255,17 @@ def _resolution_sentence(model: NoiseModel, c: int, step, sensor: str, units) ->
         times = f"{ratio:.0f}" if ratio >= 10 else f"{ratio:.2g}"
         integral = "velocity" if sensor == "accel" else "angle"
         out.append(f"counts of an integrated {integral} of the samples' resolution "
-                   f"({float(shown):.3g} {b_unit.label}) would give Q = "
-                   f"{float(counted):.3g} {q_unit.label}; the model's Q is {times}× that"
+                   f"({_g(shown)} {b_unit.label}) would give Q = "
+                   f"{_g(counted)} {q_unit.label}; the model's Q is {times}× that"
                    + (": more than the log's resolution explains (the sensor's own "
                       "quantization, or its filter)" if ratio > Q_OWN else ""))
     return out
+
+
+def _g(value) -> str:
+    """Three significant digits as the tables write them ("4.14e-7", "1230"), not
+    Python's "4.14e-07" or "1.23e+03"."""
+    return format_value(float(value), digits=3)
 
 
 #: Share of the datasheet N² above which a term's white tail "carries" N.
@@ -278,7 +286,7 @@ def _correlated_white_sentence(model: NoiseModel, c: int) -> list[str]:
         share = gm_white_density(sigma, tau_c, model.fs) / n2
         if tau_c < 1.0 and share > CARRIES_N and 1.9 * tau_c > float(model.taus[1]):
             out.append(
-                f"N is {share:.0%} the white tail of the Gauss–Markov term of τc "
+                f"N is {percent(share)} the white tail of the Gauss–Markov term of τc "
                 f"{tau_c:.2g} s, whose hump the curve shows near {1.9 * tau_c:.2g} s: "
                 "the sensor's own output filter, or a disturbance of the mount (a "
                 "vehicle's or a machine's vibration), which the Allan deviation cannot "
