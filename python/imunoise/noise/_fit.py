@@ -13,7 +13,7 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
-from imunoise import _warn
+from imunoise import _warn, display
 from imunoise._core import fit as _core_fit
 from imunoise._deprecation import old_call_forms
 from imunoise.errors import CoverageWarning, ImunoiseTypeError, ImunoiseValueError
@@ -379,7 +379,8 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
     for c in np.flatnonzero(cover < 0.8) if method == "wls" and warn_coverage else ():
         _warn.warn(
             f"the noise model follows the Allan deviation of channel {c} at only "
-            f"{cover[c]:.0%} of the taus (inside the 95 % interval or within 5 %); its "
+            f"{display.percent(cover[c])} of the taus (inside the 95 % interval or within "
+            "5 %); its "
             "coefficients summarise a curve they do not describe: plot it with "
             "result.plot(model) or imunoise.plot.allan(result, model=model)",
             CoverageWarning,
