@@ -102,3 +102,20 @@ def test_the_library_reads_terms_not_the_deprecated_view(model, tmp_path):
         imunoise.spectrum.model_psd(model, np.array([0.1, 1.0, 10.0]))
         imunoise.simulate(1000, None, like=model, seed=1)
         imunoise.plan(model, sensor="gyro")
+
+
+def test_a_requested_term_the_data_put_at_zero_is_said_not_lost():
+    x = imunoise.simulate(100_000, FS, N=1e-3, seed=4)
+    r = imunoise.adev(x, FS, taus=10)
+    with pytest.warns(imunoise.CoverageWarning, match=r"channel 0: B\b"):
+        m = imunoise.fit(r, terms=["N", "B", "K"])
+    labels = [t.label() for t in m.terms[0]]
+    assert "B" not in labels and labels[0] == "N"
+    assert any("requested B" in note and "came out at 0" in note for note in m.notes[0])
+    # every requested term placed: no note, no warning
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", imunoise.CoverageWarning)
+        full = imunoise.fit(r, terms=["N"])
+    assert not any("requested" in note for note in full.notes[0])

@@ -311,6 +311,12 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
     std[~sup] = np.nan
     typed = tuple(_typed_terms(coef[c], std[c], gm[c], gm_std[c], sine[c], sine_std[c], osc[c],
                                osc_std[c], moving[c], moving_std[c]) for c in range(channels))
+    requested = () if select or method != "wls" else tuple(terms)
+    unplaced = [_unplaced(requested, typed[c]) for c in range(channels)]
+    if any(unplaced):
+        where = "; ".join(f"channel {c}: {', '.join(u)}" for c, u in enumerate(unplaced) if u)
+        _warn.warn(f"fit(terms=...): the data put requested terms at 0 ({where}); the model "
+                   "has the others (model.notes says which)", CoverageWarning)
 
     def shaped(a):
         out = np.array(a[0] if one else a)
@@ -355,7 +361,8 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
         **{k + "_std": shaped(np.where(resolved[k], e, np.nan)) for k, (_, e) in sheet.items()},
         supported={k: shaped(v) for k, v in resolved.items()},
         upper={k: shaped(np.where(resolved[k], np.nan, bounds[k])) for k in TERMS},
-        notes=tuple(datasheet_notes(components, taus, c, method) for c in range(channels)),
+        notes=tuple(datasheet_notes(components, taus, c, method)
+                    + _unplaced_note(unplaced[c]) for c in range(channels)),
         lines=tuple(_lines(components, spectrum, c) for c in range(channels)),
         _arrays=components,
         terms=typed,
@@ -552,6 +559,29 @@ def _legacy_arrays(terms):
     supported = coef > 0
     return (coef, std, supported, markov, markov_std, sine, sine_std, osc, osc_std, moving,
             moving_std)
+
+
+#: The name ``fit(terms=...)`` gives each kind of term.
+_REQUESTED = {_typed.GaussMarkov: "GM", _typed.Tone: "sine", _typed.Resonance: "resonance",
+              _typed.Motion: "motion"}
+
+
+def _unplaced(requested, terms) -> list[str]:
+    """The requested terms (``fit(terms=...)`` names) that one channel's fit has not:
+    the data put their variance at 0."""
+    left = list(requested)
+    for term in terms:
+        name = term.name if isinstance(term, _typed._Ieee) else _REQUESTED[type(term)]
+        if name in left:
+            left.remove(name)
+    return left
+
+
+def _unplaced_note(names) -> tuple[str, ...]:
+    if not names:
+        return ()
+    return (f"requested {', '.join(names)} came out at 0: the data hold none of "
+            f"{'it' if len(names) == 1 else 'them'} at this record's length and noise",)
 
 
 def _typed_terms(coef, std, gm, gm_std, sine, sine_std, osc, osc_std, moving, moving_std):
