@@ -339,8 +339,11 @@ def own_variance(base: AllanResult, var: np.ndarray, spread: np.ndarray, confide
     with np.errstate(invalid="ignore", divide="ignore"):
         edf = np.where(below, np.nan, 2.0 * var**2 / spread**2)
         dev = np.where(below, np.nan, np.sqrt(np.abs(var)))
-    low, high = chi2_interval(dev, edf, confidence)
-    low = np.where(below, 0.0, low)
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        low, high = chi2_interval(dev, edf, confidence)
+    # an EDF far below 1 (a variance near 0 against its spread) puts both χ² quantiles
+    # at 0 in floating point: the interval's lower end is then 0, not inf
+    low = np.where(below | ~np.isfinite(low), 0.0, low)
     high = np.where(below, np.sqrt(np.maximum(var + z * spread, 0.0)), high)
     return _replace(base, var=var, dev=dev, edf=edf, ci_low=low, ci_high=high,
                     **fields), below

@@ -73,10 +73,11 @@ def test_a_log_off_the_reference_rate_loses_samples_counted():
 def test_files_are_read_and_aligned(tmp_path):
     logs = mount_logs(4000, FS, WHITE[:2], starts=(0, 100), ends=(4000, 3900), seed=4,
                       clock_offsets=(10.0, 10.0))
-    paths = [imunoise.write_vn_binary(log, path=tmp_path / f"s{i}.bin")
-             for i, log in enumerate(logs)]
-    al = imunoise.align([tmp_path / "s0.bin", tmp_path / "s1.bin"])
-    assert paths and al.n_samples == 3800 and list(al.before) == [100, 0]
+    paths = [tmp_path / f"s{i}.bin" for i in range(2)]
+    for log, path in zip(logs, paths, strict=True):
+        imunoise.write_vn_binary(log, path=path)
+    al = imunoise.align(paths)
+    assert al.n_samples == 3800 and list(al.before) == [100, 0]
     np.testing.assert_allclose(al[1].gyro, logs[1].gyro[:3800], rtol=1e-6)
 
 
