@@ -134,7 +134,7 @@ def own_noise(logs: Aligned | Sequence[ImuLog | str | os.PathLike], *, sensor: s
     taus, confidence
         As for :func:`imunoise.adev`.
     kind : str
-        The statistic, one of :data:`imunoise._hat.HAT_KINDS` for three logs; two
+        The statistic, one of ``imunoise._hat.HAT_KINDS`` for three logs; two
         logs take ``"adev"`` only.
     clock : {"timestamps", "motion"}
         How to align logs that are not aligned yet (:func:`imunoise.align`).
