@@ -6,10 +6,11 @@ The method (docs/mount.md)
 1. Every log is on its own uniform grid (:mod:`imunoise.readers.grid`): row r of
    log i is at time t0_i + r/f_i. The **reference** is the first log; the common
    grid is its own grid, so the reference is never resampled, only cut.
-2. The rates must agree: |f_i/f_0 − 1| ≤ ``tolerance`` (default 0.1 %, crystals of
-   one nominal rate). A larger difference is refused, not resampled: interpolation
-   filters white noise (linear interpolation half-way between two samples halves
-   its variance), so it would change the very noise the logs are read for.
+2. The rates must agree: f_i differs from f_0 by at most ``tolerance`` (default
+   0.1 %, crystals of one nominal rate). A larger difference is refused, not
+   resampled: interpolation filters white noise (linear interpolation half-way
+   between two samples halves its variance), so it would change the very noise the
+   logs are read for.
 3. Where each log starts on the reference's clock, t0_i:
 
    * ``clock="timestamps"``: the logs' timestamps are on one clock (a host clock,
@@ -86,7 +87,7 @@ class Aligned:
         reference's row 0 (0 for the reference).
     phase : ndarray of float
         Mean timing error of each log's samples against the common grid, s
-        (|phase| ≤ half a period; 0 for the reference).
+        (at most half a period either way; 0 for the reference).
     correlation : ndarray of float
         With ``clock="motion"``, each log's peak correlation with the reference
         (1 for the reference); NaN with ``clock="timestamps"``.

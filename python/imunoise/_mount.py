@@ -13,6 +13,7 @@ one is higher the motion does.
 from __future__ import annotations
 
 import os
+import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -25,7 +26,12 @@ from imunoise._schema import ALLAN_SENSORS, axis_names
 from imunoise._timefreq import pdev
 from imunoise._validate import confidence_level
 from imunoise.allan import ONE_SIGMA, AllanResult, TauSpec
-from imunoise.errors import CoverageWarning, ImunoiseTypeError, ImunoiseValueError
+from imunoise.errors import (
+    CoverageWarning,
+    ImunoiseTypeError,
+    ImunoiseValueError,
+    ImunoiseWarning,
+)
 from imunoise.readers.log import ImuLog
 
 __all__ = ["OwnNoise", "own_noise"]
@@ -167,7 +173,10 @@ def own_noise(logs: Aligned | Sequence[ImuLog | str | os.PathLike], *, sensor: s
         data.append(y)
     fs = logs.fs
     if len(logs) == 3:
-        hat = three_cornered_hat(*data, fs, taus=taus, kind=kind, confidence=confidence)
+        with warnings.catch_warnings():  # said below, naming the logs, not a, b, c
+            warnings.filterwarnings("ignore", message="three_cornered_hat: sensor",
+                                    category=ImunoiseWarning)
+            hat = three_cornered_hat(*data, fs, taus=taus, kind=kind, confidence=confidence)
         own = tuple(hat)
         negative = hat.negative
     else:
@@ -179,10 +188,20 @@ def own_noise(logs: Aligned | Sequence[ImuLog | str | os.PathLike], *, sensor: s
     for r in plain:
         common = np.intersect1d(common, r.m)
     rows = np.searchsorted(own[0].m, common)
-    return OwnNoise(sensor=sensor, method=METHODS[len(logs)],
-                    own=tuple(at_m(r, common) for r in own),
-                    plain=tuple(at_m(r, common) for r in plain),
-                    negative=np.asarray(negative)[:, rows], aligned=logs)
+    result = OwnNoise(sensor=sensor, method=METHODS[len(logs)],
+                      own=tuple(at_m(r, common) for r in own),
+                      plain=tuple(at_m(r, common) for r in plain),
+                      negative=np.asarray(negative)[:, rows], aligned=logs)
+    for i in range(len(logs)):
+        below = result.negative_taus(i)
+        if below.size:
+            shown = ", ".join(f"{t:g}" for t in below[:8])
+            more = f" and {below.size - 8} more" if below.size > 8 else ""
+            _warn.warn(f"own_noise: log {i}'s own {kind} variance ({result.method}) is "
+                       f"negative at tau = {shown}{more} s: its noise is below what the other "
+                       "logs resolve there; its dev is NaN, ci_high the upper bound "
+                       "(result.negative_taus)", CoverageWarning)
+    return result
 
 
 def _two(data: list[np.ndarray], fs: float, taus: TauSpec, confidence: float):
@@ -199,16 +218,9 @@ def _two(data: list[np.ndarray], fs: float, taus: TauSpec, confidence: float):
     with np.errstate(invalid="ignore", divide="ignore"):
         spread_cov = np.sqrt((va * vb + g**2) / np.asarray(cov.edf, dtype=np.float64))
     own, negative = [], []
-    for i, (r, v) in enumerate(zip(plain, (va, vb), strict=True)):
+    for r, v in zip(plain, (va, vb), strict=True):
         spread = v * np.sqrt(2.0 / np.asarray(r.edf, dtype=np.float64)) + spread_cov
         result, below = own_variance(r, v - g, spread, confidence)
         own.append(result)
         negative.append(below)
-        if below.any():
-            shown = ", ".join(f"{t:g}" for t in
-                              r.taus[below.reshape(len(r.taus), -1).any(axis=1)][:8])
-            _warn.warn(f"own_noise: log {i}'s own Allan variance (its variance less the "
-                       f"Groslambert covariance) is negative at tau = {shown} s: its noise "
-                       "is below the other's estimation error there; dev is NaN, ci_high "
-                       "the upper bound", CoverageWarning)
     return tuple(own), np.array(negative)

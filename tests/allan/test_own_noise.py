@@ -55,14 +55,17 @@ def test_two_logs_on_one_clock_each_gyro_within_ten_percent():
 def test_a_negative_own_variance_is_stated_with_its_taus():
     logs = mount_logs(40_000, FS, (0.01, 0.01, 1e-6), starts=(0, 0, 0),
                       ends=(40_000,) * 3, motion=2.0, seed=9)
-    with pytest.warns(imunoise.ImunoiseWarning, match="sensor c's adev variance is negative"):
+    with pytest.warns(imunoise.CoverageWarning, match=r"log 2's own adev variance "
+                      r"\(three-cornered hat\) is negative at tau = ") as said:
         result = imunoise.own_noise(logs, taus="octave")
+    assert len(said) == 1  # the hat's own warning (sensor "c") is not repeated
     assert result.negative[2].any() and result.negative_taus(2).size > 0
     below = result.negative[2]
     assert np.all(np.isnan(result.own[2].dev[below])) and np.all(result.own[2].ci_high[below] > 0)
     two = mount_logs(40_000, FS, (0.01, 0.01), starts=(0, 0), ends=(40_000,) * 2,
                      motion=2.0, seed=9)
-    with pytest.warns(imunoise.CoverageWarning, match=r"log \d's own Allan variance .* "
+    with pytest.warns(imunoise.CoverageWarning, match=r"log \d's own adev variance "
+                                                      r"\(Groslambert covariance\) is "
                                                       r"negative at tau = "):
         result = imunoise.own_noise(two)
     assert result.negative.any()
