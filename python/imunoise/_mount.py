@@ -28,7 +28,6 @@ from imunoise._validate import confidence_level
 from imunoise.allan import ONE_SIGMA, AllanResult, TauSpec
 from imunoise.errors import (
     CoverageWarning,
-    ImunoiseTypeError,
     ImunoiseValueError,
     ImunoiseWarning,
 )
@@ -168,8 +167,8 @@ def own_noise(logs: Aligned | Sequence[ImuLog | str | os.PathLike], *, sensor: s
     for i, log in enumerate(logs):
         y = getattr(log, sensor)
         if not isinstance(y, np.ndarray):
-            raise ImunoiseTypeError(f"logs[{i}] has no {sensor} channel; it has "
-                                    f"{', '.join(log.channels) or 'none'}")
+            raise ImunoiseValueError(f"logs[{i}] has no {sensor} channel; it has "
+                                     f"{', '.join(log.channels) or 'none'}")
         data.append(y)
     fs = logs.fs
     if len(logs) == 3:
@@ -179,10 +178,10 @@ def own_noise(logs: Aligned | Sequence[ImuLog | str | os.PathLike], *, sensor: s
             hat = three_cornered_hat(*data, fs, taus=taus, kind=kind, confidence=confidence)
         own = tuple(hat)
         negative = hat.negative
+        function = pdev if kind == "pdev" else getattr(allan, kind)
+        plain = [function(y, fs, taus=taus, confidence=confidence) for y in data]
     else:
-        own, negative = _two(data, fs, taus, confidence)
-    function = pdev if kind == "pdev" else getattr(allan, kind)
-    plain = [function(y, fs, taus=taus, confidence=confidence) for y in data]
+        own, negative, plain = _two(data, fs, taus, confidence)
     # gaps can leave the results different taus: the section compares them at each
     common = own[0].m
     for r in plain:
@@ -205,8 +204,8 @@ def own_noise(logs: Aligned | Sequence[ImuLog | str | os.PathLike], *, sensor: s
 
 
 def _two(data: list[np.ndarray], fs: float, taus: TauSpec, confidence: float):
-    """Each of two sensors' own Allan variance, σ²_a − GCOV(a, b), and where it is
-    negative."""
+    """Each of two sensors' own Allan variance, σ²_a − GCOV(a, b), where it is
+    negative, and their plain Allan deviations (at the same taus)."""
     cov = gcodev(data[0], data[1], fs, taus=taus, confidence=confidence)
     plain = [at_m(allan.adev(y, fs, taus=cov.taus, confidence=confidence), cov.m)
              for y in data]
@@ -223,4 +222,4 @@ def _two(data: list[np.ndarray], fs: float, taus: TauSpec, confidence: float):
         result, below = own_variance(r, v - g, spread, confidence)
         own.append(result)
         negative.append(below)
-    return tuple(own), np.array(negative)
+    return tuple(own), np.array(negative), plain

@@ -81,7 +81,7 @@ def test_bad_requests_are_named():
         imunoise.own_noise([*logs, logs[0]])
     with pytest.raises(imunoise.ImunoiseValueError, match="sensor must be one of"):
         imunoise.own_noise(logs, sensor="mag")
-    with pytest.raises(imunoise.ImunoiseTypeError, match=r"logs\[0\] has no accel"):
+    with pytest.raises(imunoise.ImunoiseValueError, match=r"logs\[0\] has no accel"):
         imunoise.own_noise(logs, sensor="accel")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")

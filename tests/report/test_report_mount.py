@@ -61,6 +61,8 @@ def test_the_section_compares_own_and_plain_and_counts_the_losses(built):
     np.testing.assert_allclose(own[0][i], 0.01 / np.sqrt(result.taus[i]), rtol=0.15)
     np.testing.assert_allclose(own[1][i], 0.02 / np.sqrt(result.taus[i]), rtol=0.15)
     assert any(p.name == "mount_gyro.png" for p in rep.figures)
+    # the report's logs are the logs as read, not their aligned copies
+    assert [len(log) for log in rep.logs] == [N - 200, N - 300, N - 550]
 
 
 def test_negative_variances_are_stated_with_their_taus(built):

@@ -302,6 +302,7 @@ def _build(short, long, out: Path, previous, inputs, options, workdirs: list[Pat
         start = time.perf_counter()
         _trim_warmup(ctx)
         ctx.stage(f"warm-up of the {'' if ctx.one_log else 'long '}log (--trim auto)", start)
+    others: list[ImuLog] = []  # the mount logs as read (the report's logs)
     if mount:
         # before any analysis: a log that cannot be aligned fails the report at once
         others = [source if isinstance(source, ImuLog) else read(source, f"mount {i}")
@@ -354,8 +355,7 @@ def _build(short, long, out: Path, previous, inputs, options, workdirs: list[Pat
         distributions=ctx.distributions,
         allan=ctx.allan,
         models=ctx.models,
-        logs=tuple(log for _label, log in ctx.logs) + tuple(
-            log for log in (ctx.aligned or ())[1:]),
+        logs=tuple(log for _label, log in ctx.logs) + tuple(others),
         attitude=ctx.attitude_distributions,
         own_noise=ctx.own_noise,
     )
