@@ -261,7 +261,6 @@ fn prune_insignificant(data: &Data, fs: f64, mut best: Candidate) -> CoreResult<
     // two free removals can pay for a costly third (K and R, nearly collinear
     // with B at the longest taus, would take B with them).
     let allowance = PRUNE_PENALTIES * data.n_eff().max(2.0).ln();
-    let by_score = std::env::var("IMUNOISE_PRUNE").is_ok_and(|v| v == "score");
     let selected = best.solution.loss;
     let mut removed = 0.0;
     'outer: loop {
@@ -280,7 +279,7 @@ fn prune_insignificant(data: &Data, fs: f64, mut best: Candidate) -> CoreResult<
         let weak = |candidates: Vec<(Removal, f64)>| {
             let mut out: Vec<(Removal, f64)> = candidates
                 .into_iter()
-                .filter(|(_, z)| by_score || (z.is_finite() && *z < MIN_Z))
+                .filter(|(_, z)| z.is_finite() && *z < MIN_Z)
                 .collect();
             out.sort_by(|a, b| a.1.total_cmp(&b.1));
             out
@@ -338,12 +337,7 @@ fn prune_insignificant(data: &Data, fs: f64, mut best: Candidate) -> CoreResult<
             if let Ok(next) = search::candidate(data, fs, ieee, times, extras, best.solution.d2) {
                 let step = next.solution.loss - best.solution.loss;
                 let total = next.solution.loss - selected;
-                let accept = if by_score {
-                    next.score() <= best.score()
-                } else {
-                    step < allowance && total < allowance * (removed + 1.0)
-                };
-                if accept {
+                if step < allowance && total < allowance * (removed + 1.0) {
                     best = next;
                     removed += 1.0;
                     continue 'outer;
