@@ -15,7 +15,7 @@ key                              noise-model coefficient  unit
 (N in rad/√s is numerically rad/s/√Hz, K in rad/s/√s is rad/s²/√Hz.) Kalibr's
 model has no Gauss–Markov state, so the values written are the model's
 datasheet values (``model.N``, ``model.K``: the numbers every view prints): Gauss–Markov terms
-faster than 1 s are folded into the white noise, a slow one whose hump lies beyond
+whose hump lies before 1 s are folded into the white noise, a slow one whose hump lies beyond
 the record into the random walk (over the record it rises like one); a bump within
 the record is no walk and stays out. The :func:`ekf_dict` export keeps the
 Gauss–Markov terms as bias states instead. A value the data do not resolve is

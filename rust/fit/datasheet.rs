@@ -253,6 +253,26 @@ mod tests {
     }
 
     #[test]
+    fn a_gauss_markov_term_counts_in_n_only_past_its_hump() {
+        let taus = [0.01, 1000.0];
+        let white = Term::White { variance: 1e-6 };
+        let n_with = |tau_c: f64| {
+            let terms = [
+                white,
+                Term::GaussMarkov {
+                    variance: 1e-4,
+                    tau_c,
+                },
+            ];
+            value(Datasheet::N, &model(&terms, &taus))
+        };
+        // a sensor filter's fast term: white at the 1 s read-off, in N
+        assert!(n_with(0.01) > 1.1e-3, "{}", n_with(0.01));
+        // a bump whose hump (1.89 s) lies beyond 1 s: a bias state, not N
+        assert_eq!(n_with(1.0), 1e-3);
+    }
+
+    #[test]
     fn b_is_the_flat_minimum_over_the_flicker_factor() {
         let taus = [0.01, 1e4];
         let terms = [

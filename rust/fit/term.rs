@@ -414,13 +414,15 @@ impl Term {
     }
 
     /// What the term adds to the datasheet's N² (the white level a reader draws
-    /// through τ = 1 s): the white term itself, and the −½ asymptote of a
-    /// Gauss–Markov term or a resonance faster than 1 s (white at that read-off;
-    /// a sensor's filter passes its input's white noise). Nothing for the rest.
+    /// through τ = 1 s): the white term itself; the −½ asymptote of a Gauss–Markov
+    /// term whose hump (τ ≈ 1.89 τc) lies before τ = 1 s (past its hump it falls
+    /// toward that asymptote; before it, it rises like a walk and is a bump, no
+    /// part of a −½ line); and that of a resonance damped faster than 1 s (a
+    /// sensor's filter passes its input's white noise). Nothing for the rest.
     pub fn white_share(&self, fs: f64) -> f64 {
         match *self {
             Term::White { variance } => variance,
-            Term::GaussMarkov { variance, tau_c } if tau_c <= 1.0 => {
+            Term::GaussMarkov { variance, tau_c } if GM_PEAK * tau_c <= 1.0 => {
                 let phi = (-1.0 / (fs * tau_c)).exp();
                 variance * (1.0 + phi) / ((1.0 - phi) * fs)
             }

@@ -48,7 +48,7 @@ variance is the real part of the AR1 form continued to z = ρe^(iθ).
     R at τ = √2 s (slope +1), and B = σ_flat/√(2 ln2/π) at the point of slope 0.
 
 What a user reads, ``model.N``, ``B``, ``K``, ``Q``, ``R``, are the datasheet values of
-the whole fitted model (``_datasheet``): a Gauss–Markov term faster than 1 s counts in
+the whole fitted model (``_datasheet``): a Gauss–Markov term whose hump lies before 1 s counts in
 N, a slower one's +½ slope in K, B is the model's flat minimum / 0.6643; every view
 prints these. The fit's own parameters are :attr:`NoiseModel.terms`, one typed
 term per fitted component (``_typed``: :class:`White`, :class:`GaussMarkov`,

@@ -103,7 +103,7 @@ class Components(PerTerm):
 
     These are the fit's own parameters. The datasheet values a user quotes are
     the model's ``N``, ``B``, ``K``, ``Q``, ``R``, computed from all of these
-    together (e.g. a Gauss–Markov term faster than 1 s adds to the white-noise
+    together (e.g. a Gauss–Markov term whose hump lies before 1 s adds to the white-noise
     density N; see :class:`~imunoise.noise.NoiseModel`). All arrays are read-only.
 
     Attributes

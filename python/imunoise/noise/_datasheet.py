@@ -4,7 +4,8 @@ uncertainty: the numbers :class:`~imunoise.noise.NoiseModel` shows as ``N``, ``B
 A datasheet quotes what the curve shows, not which components made it:
 
 - ``N``, the white-noise density: the fitted N together with every Gauss–Markov
-  term faster than 1 s (white at the τ = 1 s read-off: σ²(1+φ)/((1−φ)·fs)) and a
+  term whose hump (τ ≈ 1.89 τc) lies before τ = 1 s (falling toward its white tail at
+  the read-off: σ²(1+φ)/((1−φ)·fs)) and a
   resonance damped faster than 1 s (its spectrum at zero frequency, quadrature
   included: a sensor's second-order filter passes its input's white noise). What a
   filter's white-noise input should be.
@@ -124,7 +125,7 @@ def datasheet_notes(components, taus, channel: int, method: str) -> tuple[str, .
     taus = np.asarray(taus, float)
     notes = []
     for _, tau_c in components.gauss_markov(channel):
-        if tau_c <= 1.0:
+        if GM_PEAK * tau_c <= 1.0:  # in N: its hump lies before the 1 s read-off
             continue
         if walks_beyond(tau_c, taus):
             notes.append(f"K includes a Gauss–Markov term of τc {tau_c:.3g} s whose hump "

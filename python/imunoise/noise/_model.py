@@ -48,7 +48,7 @@ class NoiseModel(PerTerm):
 
     ====  ==================================================================
     N     the white rate noise level, the −½ line at τ = 1 s: the fitted N with
-          every Gauss–Markov term faster than 1 s (white at that read-off)
+          every Gauss–Markov term whose hump (1.89 τc) lies before 1 s (white there)
     B     the model curve's flat minimum / 0.6643 over the fitted taus
     K     a random walk that keeps rising to the end of the record: the fitted K
           with any Gauss–Markov term whose hump (τ ≈ 1.89 τc) lies beyond the
