@@ -8,6 +8,7 @@ use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1};
 use pyo3::prelude::*;
 
+use crate::fit::filter::OutputFilter;
 use crate::fit::{
     self, Options, FLICKER_FACTOR, IEEE_TERMS, IEEE_TERM_NAMES, MAX_GM, MAX_TONES, MOTION_SLOT,
     PARAMETERS, RESONANCE_SLOT, SINE_SLOT, SKEW_SLOT,
@@ -54,16 +55,23 @@ fn ieee_flags(terms: &[bool]) -> PyResult<[bool; IEEE_TERMS]> {
     Ok(mask)
 }
 
+/// The output filter's gains, checked by the core.
+fn output_filter(gain: Option<PyReadonlyArray1<'_, f64>>) -> PyResult<Option<OutputFilter>> {
+    gain.map(|g| OutputFilter::new(g.as_array().to_vec()))
+        .transpose()
+        .map_err(PyErr::from)
+}
+
 fn to_matrix(rows: Vec<Vec<f64>>, cols: usize) -> PyResult<Array2<f64>> {
     let n = rows.len();
     Array2::from_shape_vec((n, cols), rows.into_iter().flatten().collect())
         .map_err(|e| super::value_error(e.to_string()))
 }
 
-/// fit_noise(taus, var, edf, fs, terms, gm, select, tones, resonance, motion) -> NoiseFit
+/// fit_noise(taus, var, edf, fs, terms, gm, select, tones, resonance, motion, filter) -> NoiseFit
 #[pyfunction]
 #[allow(clippy::too_many_arguments)] // mirrors the Python keyword arguments
-#[pyo3(signature = (taus, var, edf, fs, terms, gm=3, select=true, tones=2, resonance=true, motion=true))]
+#[pyo3(signature = (taus, var, edf, fs, terms, gm=3, select=true, tones=2, resonance=true, motion=true, filter=None))]
 fn fit_noise<'py>(
     py: Python<'py>,
     taus: PyReadonlyArray1<'py, f64>,
@@ -76,7 +84,9 @@ fn fit_noise<'py>(
     tones: usize,
     resonance: bool,
     motion: bool,
+    filter: Option<PyReadonlyArray1<'py, f64>>,
 ) -> PyResult<PyNoiseFit> {
+    let filter = output_filter(filter)?;
     let opts = Options {
         ieee: ieee_flags(&terms)?,
         gm,
@@ -88,7 +98,7 @@ fn fit_noise<'py>(
     let taus = taus.as_array().to_vec();
     let var = var.as_array().to_vec();
     let edf = edf.as_array().to_vec();
-    let r = py.detach(|| fit::fit_noise(&taus, &var, &edf, fs, &opts))?;
+    let r = py.detach(|| fit::fit_noise(&taus, &var, &edf, fs, &opts, filter.as_ref()))?;
     let gm_rows: Vec<Vec<f64>> = r.gm.iter().map(|&(q2, tc)| vec![q2, tc]).collect();
     let sine_rows: Vec<Vec<f64>> = r.sine.iter().map(|&(s2, f0)| vec![s2, f0]).collect();
     let res_rows: Vec<Vec<f64>> = (r.resonance.iter())
@@ -114,7 +124,7 @@ fn fit_noise<'py>(
 /// Allan variance of each term
 #[pyfunction]
 #[allow(clippy::too_many_arguments)] // mirrors the Python keyword arguments
-#[pyo3(signature = (taus, fs, ieee, gm, sine=Vec::new(), resonance=Vec::new(), motion=Vec::new()))]
+#[pyo3(signature = (taus, fs, ieee, gm, sine=Vec::new(), resonance=Vec::new(), motion=Vec::new(), filter=None))]
 fn noise_terms<'py>(
     py: Python<'py>,
     taus: PyReadonlyArray1<'py, f64>,
@@ -124,7 +134,9 @@ fn noise_terms<'py>(
     sine: Vec<(f64, f64)>,
     resonance: Vec<(f64, f64, f64, f64)>,
     motion: Vec<(f64, f64)>,
+    filter: Option<PyReadonlyArray1<'py, f64>>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let filter = output_filter(filter)?;
     if ieee.len() != IEEE_TERMS {
         return Err(super::value_error(format!(
             "ieee must have {IEEE_TERMS} values (Q², N², B², K², R²); got {}",
@@ -163,8 +175,38 @@ fn noise_terms<'py>(
     }
     let cols = IEEE_TERMS + gm.len() + sine.len() + resonance.len() + motion.len();
     let taus = taus.as_array().to_vec();
-    let rows = fit::terms(&taus, fs, &coef, &gm, (&sine, &resonance, &motion));
+    let oscillators = (sine.as_slice(), resonance.as_slice(), motion.as_slice());
+    let rows = fit::terms(&taus, fs, &coef, &gm, oscillators, filter.as_ref());
     Ok(to_matrix(rows, cols)?.into_pyarray(py))
+}
+
+/// filter_factor(taus, fs, filter) -> c(τ): the white term's Allan variance
+/// through the output filter over the one without.
+#[pyfunction]
+fn filter_factor<'py>(
+    py: Python<'py>,
+    taus: PyReadonlyArray1<'py, f64>,
+    fs: f64,
+    filter: PyReadonlyArray1<'py, f64>,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    if !(fs.is_finite() && fs > 0.0) {
+        return Err(super::value_error(format!(
+            "fs must be finite and > 0; got {fs}"
+        )));
+    }
+    let filter = OutputFilter::new(filter.as_array().to_vec())?;
+    let taus = taus.as_array().to_vec();
+    if let Some(t) = taus.iter().find(|t| !(t.is_finite() && **t > 0.0)) {
+        return Err(super::value_error(format!(
+            "taus must be finite and > 0; got {t}"
+        )));
+    }
+    let factors = py.detach(|| {
+        taus.iter()
+            .map(|t| filter.white_factor(t * fs))
+            .collect::<Vec<f64>>()
+    });
+    Ok(factors.into_pyarray(py))
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -180,5 +222,6 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyNoiseFit>()?;
     m.add_function(wrap_pyfunction!(fit_noise, m)?)?;
     m.add_function(wrap_pyfunction!(noise_terms, m)?)?;
+    m.add_function(wrap_pyfunction!(filter_factor, m)?)?;
     Ok(())
 }

@@ -28,6 +28,8 @@
 
 use faer::Mat;
 
+use super::basis::{self, IEEE_TERMS};
+use super::filter::OutputFilter;
 use super::nnls::nnls;
 use super::special::{digamma_minus_log, trigamma};
 use crate::error::{CoreError, CoreResult};
@@ -41,6 +43,9 @@ pub struct Data {
     pub y: Vec<f64>,
     pub v: Vec<f64>,
     pub omega: Vec<f64>,
+    /// Per tau, the white term's factor through the sensor's output filter
+    /// (`filter::OutputFilter::white_factor`; 1 without one).
+    pub white: Vec<f64>,
 }
 
 fn invalid(msg: String) -> CoreError {
@@ -100,7 +105,24 @@ impl Data {
             y,
             v,
             omega: octave_shares(taus),
+            white: vec![1.0; n],
         })
+    }
+
+    /// The same data with the white term seen through `filter`.
+    pub fn with_filter(mut self, filter: Option<&OutputFilter>) -> Data {
+        if let Some(f) = filter {
+            self.white = self.m.iter().map(|&m| f.white_factor(m)).collect();
+        }
+        self
+    }
+
+    /// Value of each IEEE basis function at tau `i`, the white one through the
+    /// output filter.
+    pub fn ieee(&self, i: usize) -> [f64; IEEE_TERMS] {
+        let mut b = basis::ieee(self.taus[i]);
+        b[1] *= self.white[i];
+        b
     }
 
     pub fn len(&self) -> usize {

@@ -28,6 +28,7 @@
 
 pub mod basis;
 pub mod estimate;
+pub mod filter;
 pub mod nnls;
 pub mod oscillators;
 pub mod search;
@@ -37,6 +38,7 @@ pub use basis::{FLICKER_FACTOR, IEEE_TERMS, IEEE_TERM_NAMES};
 
 use crate::error::{CoreError, CoreResult};
 use estimate::Data;
+use filter::OutputFilter;
 use search::Candidate;
 
 /// Most Gauss–Markov terms a model may have.
@@ -132,13 +134,15 @@ pub struct NoiseFit {
 }
 
 /// Fit one channel: `taus` (s, increasing), `var` (σ̂² > 0) and `edf` (> 0) per
-/// tau, `fs` the sample rate of the data behind them.
+/// tau, `fs` the sample rate of the data behind them, `filter` the sensor's
+/// output filter if the spectrum showed one (the white term is seen through it).
 pub fn fit_noise(
     taus: &[f64],
     var: &[f64],
     edf: &[f64],
     fs: f64,
     opts: &Options,
+    filter: Option<&OutputFilter>,
 ) -> CoreResult<NoiseFit> {
     if opts.tones > MAX_TONES {
         return Err(CoreError::InvalidArgument(format!(
@@ -152,7 +156,7 @@ pub fn fit_noise(
             opts.gm
         )));
     }
-    let data = Data::new(taus, var, edf, fs)?;
+    let data = Data::new(taus, var, edf, fs)?.with_filter(filter);
     let chosen = if opts.select {
         let selected = |motion: bool| -> CoreResult<Candidate> {
             let kinds = (opts.tones, opts.resonance, motion);
@@ -402,17 +406,21 @@ fn summarise(data: &Data, fs: f64, c: &Candidate) -> NoiseFit {
 /// Model Allan variance of every term at `taus`: row i holds the five IEEE
 /// terms, then one value per Gauss–Markov term (q², τc), then one per tone
 /// (s², f₀), then one per resonance (r², f_r, τr, skew), then one per bounded motion
-/// (σθ², τc).
+/// (σθ², τc). The white term is seen through `filter`, if given.
 pub fn terms(
     taus: &[f64],
     fs: f64,
     ieee: &[f64; IEEE_TERMS],
     gm: &[(f64, f64)],
     (sine, resonance, motion): Oscillators,
+    filter: Option<&OutputFilter>,
 ) -> Vec<Vec<f64>> {
     taus.iter()
         .map(|&t| {
-            let b = basis::ieee(t);
+            let mut b = basis::ieee(t);
+            if let Some(f) = filter {
+                b[1] *= f.white_factor(t * fs);
+            }
             let mut row: Vec<f64> = (0..IEEE_TERMS).map(|j| b[j] * ieee[j]).collect();
             row.extend(
                 gm.iter()
@@ -483,7 +491,7 @@ fn covariance(
     let rows: Vec<(f64, Vec<f64>)> = (0..data.len())
         .map(|i| {
             let t = data.taus[i];
-            let b = basis::ieee(t);
+            let b = data.ieee(i);
             let gmv =
                 |q2: f64, tc: f64| q2 * basis::gauss_markov(data.m[i], basis::gm_rate(tc, fs));
             let tone = |s2: f64, f0: f64| s2 * basis::sinusoid(data.m[i], f0 / fs);
@@ -615,7 +623,7 @@ mod tests {
         gm: &[(f64, f64)],
         oscillators: Oscillators,
     ) -> Vec<f64> {
-        terms(taus, FS, ieee, gm, oscillators)
+        terms(taus, FS, ieee, gm, oscillators, None)
             .iter()
             .map(|r| r.iter().sum())
             .collect()
@@ -629,7 +637,7 @@ mod tests {
     /// 1e-6 is negligible, and BIC does not chase rounding-level differences).
     fn fit_exact(taus: &[f64], var: &[f64]) -> NoiseFit {
         let edf = vec![1e6; taus.len()];
-        fit_noise(taus, var, &edf, FS, &Options::default()).unwrap()
+        fit_noise(taus, var, &edf, FS, &Options::default(), None).unwrap()
     }
 
     #[test]
@@ -727,7 +735,7 @@ mod tests {
                 ..Options::default()
             };
             let edf = vec![1e6; taus.len()];
-            let single = fit_noise(&taus, &var, &edf, FS, &one).unwrap();
+            let single = fit_noise(&taus, &var, &edf, FS, &one, None).unwrap();
             assert!(
                 single.sine.len() <= 1 && single.bic > fit.bic + 10.0,
                 "{single:?}"
@@ -806,6 +814,42 @@ mod tests {
     }
 
     #[test]
+    fn white_noise_through_a_known_filter_is_white_noise_alone() {
+        // A 4-tap moving average (a sensor's decimating FIR): with its gain the
+        // fit needs no resonance, tone or Gauss–Markov term to draw the short taus.
+        let gain: Vec<f64> = (0..257)
+            .map(|k| {
+                let nu = 0.5 * k as f64 / 256.0;
+                let s = (std::f64::consts::PI * nu).sin();
+                if s == 0.0 {
+                    1.0
+                } else {
+                    ((4.0 * std::f64::consts::PI * nu).sin() / (4.0 * s)).powi(2)
+                }
+            })
+            .collect();
+        let filter = OutputFilter::new(gain).unwrap();
+        let truth = [0.0, 4e-6, 1e-6, 1e-10, 0.0];
+        let taus = grid(10.0, 0.01, 2000.0);
+        let var: Vec<f64> = (terms(&taus, FS, &truth, &[], (&[], &[], &[]), Some(&filter)).iter())
+            .map(|r| r.iter().sum())
+            .collect();
+        let edf = vec![1e6; taus.len()];
+        let fit = fit_noise(&taus, &var, &edf, FS, &Options::default(), Some(&filter)).unwrap();
+        assert!(
+            fit.gm.is_empty() && fit.sine.is_empty() && fit.resonance.is_empty(),
+            "{fit:?}"
+        );
+        assert!(
+            (fit.ieee[1] / truth[1] - 1.0).abs() < 1e-3,
+            "{:?}",
+            fit.ieee
+        );
+        let blind = fit_noise(&taus, &var, &edf, FS, &Options::default(), None).unwrap();
+        assert!(blind.bic > fit.bic, "{blind:?}");
+    }
+
+    #[test]
     fn covariance_shrinks_with_edf() {
         let truth = [0.0, 4e-6, 1e-6, 1e-10, 0.0];
         let taus = grid(5.0, 0.01, 2000.0);
@@ -822,8 +866,8 @@ mod tests {
             motion: false,
             ieee: [false, true, true, true, false],
         };
-        let lo = fit_noise(&taus, &var, &edf_white(&taus, 1e4), FS, &opts).unwrap();
-        let hi = fit_noise(&taus, &var, &edf_white(&taus, 1e6), FS, &opts).unwrap();
+        let lo = fit_noise(&taus, &var, &edf_white(&taus, 1e4), FS, &opts, None).unwrap();
+        let hi = fit_noise(&taus, &var, &edf_white(&taus, 1e6), FS, &opts, None).unwrap();
         for j in [1, 2, 3] {
             assert!(lo.cov[j][j] > hi.cov[j][j], "{j}");
         }
@@ -832,19 +876,19 @@ mod tests {
     #[test]
     fn bad_inputs_are_errors_not_panics() {
         let o = Options::default();
-        assert!(fit_noise(&[], &[], &[], FS, &o).is_err());
-        assert!(fit_noise(&[1.0], &[1.0, 2.0], &[1.0], FS, &o).is_err());
-        assert!(fit_noise(&[1.0, f64::NAN], &[1.0, 2.0], &[1.0, 1.0], FS, &o).is_err());
-        assert!(fit_noise(&[1.0, 2.0], &[1.0, -2.0], &[1.0, 1.0], FS, &o).is_err());
-        assert!(fit_noise(&[2.0, 1.0], &[1.0, 2.0], &[1.0, 1.0], FS, &o).is_err());
-        assert!(fit_noise(&[1.0, 2.0], &[1.0, 2.0], &[0.0, 1.0], FS, &o).is_err());
-        assert!(fit_noise(&[1.0, 2.0], &[1.0, 2.0], &[1.0, 1.0], 0.0, &o).is_err());
+        assert!(fit_noise(&[], &[], &[], FS, &o, None).is_err());
+        assert!(fit_noise(&[1.0], &[1.0, 2.0], &[1.0], FS, &o, None).is_err());
+        assert!(fit_noise(&[1.0, f64::NAN], &[1.0, 2.0], &[1.0, 1.0], FS, &o, None).is_err());
+        assert!(fit_noise(&[1.0, 2.0], &[1.0, -2.0], &[1.0, 1.0], FS, &o, None).is_err());
+        assert!(fit_noise(&[2.0, 1.0], &[1.0, 2.0], &[1.0, 1.0], FS, &o, None).is_err());
+        assert!(fit_noise(&[1.0, 2.0], &[1.0, 2.0], &[0.0, 1.0], FS, &o, None).is_err());
+        assert!(fit_noise(&[1.0, 2.0], &[1.0, 2.0], &[1.0, 1.0], 0.0, &o, None).is_err());
         let too_many = Options {
             gm: MAX_GM + 1,
             ..o
         };
-        assert!(fit_noise(&[1.0, 2.0], &[1.0, 2.0], &[1.0, 1.0], FS, &too_many).is_err());
-        let one = fit_noise(&[1.0], &[1.0], &[5.0], FS, &o).unwrap();
+        assert!(fit_noise(&[1.0, 2.0], &[1.0, 2.0], &[1.0, 1.0], FS, &too_many, None).is_err());
+        let one = fit_noise(&[1.0], &[1.0], &[5.0], FS, &o, None).unwrap();
         assert!(one.ieee.iter().all(|c| c.is_finite() && *c >= 0.0));
     }
 }

@@ -141,7 +141,7 @@ pub fn design(data: &Data, fs: f64, gm_tau: &[f64], extras: Extras) -> Mat<f64> 
     let k = tone + extra_columns(extras);
     Mat::from_fn(data.len(), k, |i, j| {
         if j < IEEE_TERMS {
-            basis::ieee(data.taus[i])[j]
+            data.ieee(i)[j]
         } else if j < tone {
             basis::gauss_markov(data.m[i], basis::gm_rate(gm_tau[j - IEEE_TERMS], fs))
         } else if j < osc {

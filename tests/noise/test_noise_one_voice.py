@@ -5,6 +5,7 @@ old spellings warn and name the new one."""
 
 from __future__ import annotations
 
+import html
 import json
 import math
 
@@ -198,3 +199,13 @@ def test_datasheet_units_are_what_datasheets_write(fast_gm_model):
     assert accel["N"]["unit"] == "ug/sqrt(Hz)" and accel["B"]["unit"] == "ug"
     with pytest.raises(ValueError, match="units must be 'datasheet'"):
         m.table("gyro", units="lab")
+
+
+def test_html_prints_the_bound_of_an_unresolved_value():
+    """The notebook table says what the text tables say: ``< bound``, not a bare
+    "not resolved", where the record cannot show a term."""
+    x = imunoise.simulate(36_000, 100.0, N=1e-3, B=0.0, K=0.0, seed=3)
+    m = imunoise.fit(imunoise.adev(x, 100.0))
+    assert not m.resolved("K")[0]
+    bound = display.upper_bound(np.atleast_1d(m.upper["K"])[0])
+    assert bound.startswith("< ") and html.escape(bound) in m._repr_html_()

@@ -77,11 +77,14 @@ def fit_noise(
     tones: int = 2,
     resonance: bool = True,
     motion: bool = True,
+    filter: npt.NDArray[np.float64] | None = None,
 ) -> NoiseFit:
     """Log-space, octave-weighted fit of the noise model (IEEE terms, up to
     ``gm`` Gauss–Markov terms, up to ``tones`` tones, with ``resonance`` a
     damped oscillator and with ``motion`` a bounded motion of the mount) to one
-    channel; structure chosen by BIC when ``select``."""
+    channel; structure chosen by BIC when ``select``. ``filter``: the sensor's
+    output-filter power gain G at L ≥ 2 frequencies evenly spaced from 0 Hz
+    (G = 1) to fs/2; the white term is seen through it."""
 
 def noise_terms(
     taus: npt.NDArray[np.float64],
@@ -91,7 +94,16 @@ def noise_terms(
     sine: list[tuple[float, float]] = ...,
     resonance: list[tuple[float, float, float, float]] = ...,
     motion: list[tuple[float, float]] = ...,
+    filter: npt.NDArray[np.float64] | None = None,
 ) -> npt.NDArray[np.float64]:
     """Allan variance of each model term at ``taus``: (len(taus), 5 + len(gm) +
     len(sine) + len(resonance) + len(motion)), ``sine`` as (s², f₀) pairs,
     ``resonance`` as (r², f_r, τr, skew) quadruples, ``motion`` as (σθ², τc) pairs."""
+
+def filter_factor(
+    taus: npt.NDArray[np.float64],
+    fs: float,
+    filter: npt.NDArray[np.float64],
+) -> npt.NDArray[np.float64]:
+    """c(τ): the white term's Allan variance through the output filter ``filter``
+    (power gain from 0 Hz to fs/2, G(0) = 1) over the one without."""

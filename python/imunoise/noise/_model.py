@@ -243,8 +243,9 @@ class NoiseModel(PerTerm):
 
     def _repr_html_(self) -> str:
         """One row per axis: each datasheet value ± standard uncertainty in the
-        input's units, rounded to it as in the repr (``not resolved`` where the data
-        do not resolve it), the fitted components and the coverage."""
+        input's units, rounded to it as in the repr (``< bound``, its 95 % upper
+        bound, where the data do not resolve it), the fitted components and the
+        coverage."""
         units = _INPUT_UNITS
         rows = []
         for c, name in enumerate(_schema.axis_names(self.channels)):
@@ -252,7 +253,7 @@ class NoiseModel(PerTerm):
             for t in TERMS:
                 v, e = self.value(t)[c], self.std(t)[c]
                 row.append(_summary.estimate(v, e) if self.resolved(t)[c]
-                           else _display.NOT_RESOLVED)
+                           else _display.upper_bound(np.atleast_1d(self.upper[t])[c]))
             row.append(self.components.structure(c))
             row.append(f"{100 * float(np.atleast_1d(self.coverage)[c]):.3g} %")
             rows.append(row)
