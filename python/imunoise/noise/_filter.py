@@ -223,7 +223,13 @@ def estimate_filter(spectrum, channel: int = 0) -> OutputFilter | None:
     if fitted is None:
         return None
     (h0, h1, h2), top, u_h0 = fitted
-    if not _attenuates(fb, pb / (h0 + h1 / fb + h2 / fb**2), eb, u_h0):
+    # G is 1 up to the middle (in log f) of the white band, from where flicker and
+    # walk have faded to where the filter shows: a gentle filter (an FIR's 1 − αf²)
+    # starts below the point where the band test can see it, and is measured there.
+    start = math.sqrt(_crossover(h0, h1, h2, fb[0]) * top)
+    tested = fb > start
+    if not _attenuates(fb[tested], pb[tested] / (h0 + h1 / fb[tested] + h2 / fb[tested] ** 2),
+                       eb[tested], u_h0):
         return None
     fs = float(spectrum.fs)
     size = spectrum.nperseg // 2 + 1
@@ -233,10 +239,6 @@ def estimate_filter(spectrum, channel: int = 0) -> OutputFilter | None:
     numerator = np.interp(grid, np.r_[0.0, f], np.r_[smooth[0], smooth])
     low = np.zeros(size)
     low[1:] = h1 / grid[1:] + h2 / grid[1:] ** 2
-    # G is 1 up to the middle (in log f) of the white band, from where flicker and
-    # walk have faded to where the filter shows: a gentle filter (an FIR's 1 − αf²)
-    # starts below the point where the band test can see it, and is measured there.
-    start = math.sqrt(_crossover(h0, h1, h2, fb[0]) * top)
     return OutputFilter(f=grid, gain=_gain(grid, numerator, low, h0, start), fs=fs,
                         white_top=float(start), white=float(h0), psd=numerator, low=low)
 
@@ -289,21 +291,19 @@ def _white_fit(f, p, edf):
     beside it: a filter's start inside the band pulls h0 down, the 1/f terms bending to
     follow it). Returns ((h0, h₋₁, h₋₂), the band's top in Hz, relative standard error
     of h0), or None without a white level."""
-    top = min(MIN_BINS, f.size)
-    h, cov = _fit_levels(_basis(f[:top]), p[:top], edf[:top])
-    while top < f.size:
-        # The next bins, out of sample: the fit cannot bend to a roll-off it has not
-        # seen. Their mean misses the fit by its sampling error and the fit's own.
-        edge = slice(top, min(top + EDGE_BINS, f.size))
-        b = _basis(f[edge])
-        model = b @ h
-        weight = edf[edge] / np.sum(edf[edge])
-        off = np.sum(weight * (p[edge] / model - 1))
-        spread = weight / model @ b
-        if not abs(off) <= EDGE_Z * math.sqrt(2 / np.sum(edf[edge]) + spread @ cov @ spread):
-            break
-        top += 1
+    top = f.size
+    while True:
         h, cov = _fit_levels(_basis(f[:top]), p[:top], edf[:top])
+        edge = slice(max(top - EDGE_BINS, 0), top)
+        model = _basis(f[edge]) @ h
+        off = np.sum(edf[edge] * (p[edge] / model - 1)) / np.sum(edf[edge])
+        # The top must also be white (h0 above flicker and walk there): deep in a
+        # roll-off, a fit whose 1/f terms bend with it may pass the edge test.
+        white = h[0] > h[1] / f[top - 1] + h[2] / f[top - 1] ** 2
+        if top <= MIN_BINS or (white and abs(off) <= EDGE_Z * math.sqrt(
+                2 / np.sum(edf[edge]))):
+            break
+        top -= 1
     if not h[0] > 0:
         return None
     return (h[0], h[1], h[2]), float(f[top - 1]), math.sqrt(cov[0, 0]) / h[0]
@@ -336,11 +336,14 @@ def _fit_levels(basis, p, edf):
 
 def _attenuates(f, relative, edf, u_level) -> bool:
     """Whether some bin of the log-binned spectrum over the white level (``relative``)
-    lies below 1 by more than its χ² error and the level's relative error
-    ``u_level``, one-sided at :data:`FALSE_FILTER` shared over the bins."""
-    u = np.sqrt(2 / edf + u_level**2)
-    z = _stats.norm.isf(FALSE_FILTER / relative.size)
-    return bool(np.any(np.log(relative) < -z * u))
+    lies below 1 by more than its sampling error (the χ²_ν/ν quantile: a bin of few
+    Welch values is skewed) and the level's relative error ``u_level``, one-sided at
+    :data:`FALSE_FILTER` shared over the bins."""
+    if not relative.size:
+        return False
+    share = FALSE_FILTER / relative.size
+    low = _stats.chi2.ppf(share, edf) / edf * math.exp(-_stats.norm.isf(share) * u_level)
+    return bool(np.any(relative < low))
 
 
 def _hann_bin_correlation(seg: int) -> np.ndarray:
