@@ -152,6 +152,19 @@ def test_false_filters_are_rare_on_white_noise():
     assert found <= stats.binom.ppf(0.999, 40, 0.05) - 1
 
 
+def test_a_fast_gauss_markov_bias_is_no_filter():
+    """A bias of τc 1 s over white noise has a low-pass's shape (its plateau falls
+    to the white floor above 0.16 Hz), but two and a half decades below fs/2: the
+    Gauss–Markov term's, not an output filter's."""
+    from scipy.signal import lfilter as ar
+
+    rng = np.random.default_rng(4)
+    phi = math.exp(-1 / FS)
+    bias = ar([1.0], [1.0, -phi], rng.standard_normal(360_000) * 1e-2 * math.sqrt(1 - phi**2))
+    x = imunoise.simulate(360_000, FS, N=1e-3, seed=4) + bias
+    assert estimate_filter(imunoise.psd(x, FS)) is None
+
+
 def test_no_filter_on_a_rising_quantization_floor():
     """Counted angles (quantization's f² above the white region) are no filter: an
     output filter attenuates; the rise is the Q term's."""

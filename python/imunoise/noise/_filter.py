@@ -10,12 +10,19 @@ the white term's Allan variance.
 
 The estimate, per channel (:func:`estimate_filter`):
 
-- **The white level** is the spectrum's own read-off (:class:`imunoise.Spectrum`:
-  h0 + h₋₁/f + h₋₂/f² fitted from the lowest frequency up to the top of the band it
-  still describes, ``Spectrum.band``); the filter acts on all of it, so
-  G = PSD/(h0 + h₋₁/f + h₋₂/f²).
-- **G = 1 up to the band's top**: the low frequencies belong to flicker and random
-  walk, and the read-off found the spectrum white there.
+- **The white level.** The line-free Welch values (below), averaged in bins of 1/20
+  decade, are fitted with h0 + h₋₁/f + h₋₂/f² (white, flicker, walk; non-negative,
+  weighted by each bin's χ² variance) from the lowest frequency up to the highest
+  top whose quarter decade below it misses the fit by no more than 2 standard errors
+  of its mean, and where white still dominates (:func:`_white_fit`). The filter acts
+  on all of it, so G = PSD/(h0 + h₋₁/f + h₋₂/f²).
+- **G = 1 up to the middle of the white band** (in log f, between where flicker and
+  walk equal the white level and the band's top; the top must lie within two decades
+  below fs/2, or the roll-off is a slow correlated process, no output filter): below
+  it the low frequencies
+  belong to flicker and walk; above it a gentle filter may already have started
+  (|H|² of a real filter is even in f, so an FIR's or a CIC's starts as 1 − αf², and
+  the band's top is only where that became visible), so it is measured there.
 - **Above it, a running median** of the linear Welch grid over :data:`HALF_WIDTH`
   bins on either side, divided by the median of χ²_ν/ν (a median of Welch values is
   that much below their mean). A median keeps a monotone shape exactly (the median of
@@ -23,19 +30,28 @@ The estimate, per channel (:func:`estimate_filter`):
   removes whatever is narrower than half its window: a line, which is a tone of the
   model, never the filter. The window is reflected at fs/2 (the spectrum of a sampled
   process is even about fs/2), so the last bins are estimated as well as the others.
-- **Whether there is a filter** (:func:`estimate_filter` returns None when not): the
-  line-free Welch bins above the band's top are averaged in bins of 1/20 decade, and
-  a filter is there where one of those averages differs from 1 by more than its
-  sampling error (χ² of the Welch EDF, and the white level's own uncertainty) at a
-  two-sided 5 % shared over the bins tested (Bonferroni). White noise passes this
-  test 95 % of the time whatever the record's length; a filter passes it only where
-  its gain departs from 1 by less than the spectrum can resolve, where it cannot
-  move the Allan curve beyond its own scatter either.
+  A band broader than the window (a filter's own peak, a mode of the sensor) is part
+  of the measured shape and of G.
+- **Whether there is a filter** (:func:`estimate_filter` returns None when not): an
+  output filter attenuates. A Welch value above its local median beyond the χ²
+  quantile at 10⁻³ shared over the bins is a line and left out; the others, averaged
+  in 1/20-decade bins above the middle of the white band, must fall below the white
+  level by more than their χ²_ν/ν quantile (and the level's own uncertainty) at a
+  one-sided 5 % shared over the bins tested (Bonferroni), and the top quarter decade
+  below fs/2 must lie lower than the spectrum around fs/20 (:func:`_falls_to_the_top`:
+  a roll-off that ends in a floor by fs/20 is a slow correlated process above white
+  noise, which the Gauss–Markov terms describe). White noise passes as "no filter"
+  95 % of the time whatever the record's length; so does a spectrum that only rises
+  above its white level (quantization's f², which the Q term describes).
 
-What G cannot tell: a band broader than the median's window (a resonance of the
-sensor or of its mount) is part of the measured shape and enters G, where the Allan
-prediction needs it just the same; a line stays a tone. The grid of G is Welch's:
-f_k = k·(fs/2)/(L−1), k = 0…L−1, G[0] = 1.
+The white level's error is G's common factor above the middle of the band: a filter
+that starts inside the white band pulls h0 down (by 1–3 % on simulated FIR, CIC and
+Butterworth filters, 1 h at 100 Hz), and the fit's N follows it by half that. The grid
+of G is Welch's: f_k = k·(fs/2)/(L−1), k = 0…L−1, G[0] = 1.
+
+The core (`_core.fit`) passes only the white term through G. The flicker and walk pass
+the filter too; :meth:`OutputFilter.excess` is their share (from the spectrum's own
+levels), which :func:`imunoise.fit` takes off the measured Allan variance.
 
 The white term's Allan variance with the filter is (N²/τ)·c(τ),
 
@@ -52,7 +68,7 @@ finite cosine sum), in O(L log L + taus).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 
 import numpy as np
 from scipy import optimize as _optimize
@@ -80,6 +96,9 @@ EDGE_Z = 2.0
 #: Top bins of the band that must all follow the fit (a quarter decade: one bin that
 #: happens to fit must not stretch the band).
 EDGE_BINS = 5
+#: Most times below fs/2 the white band's top may lie for its roll-off to be an output
+#: filter's (two decades: a sensor sampled at over 100 times its bandwidth).
+SLOWEST_FILTER = 100.0
 #: Fewest log bins the white fit keeps (four coefficients and their scatter).
 MIN_BINS = 8
 
@@ -98,9 +117,12 @@ class OutputFilter:
     fs : float
         Sample rate, Hz.
     white_top : float
-        Top of the white region, Hz (the spectrum's read-off band).
+        G is 1 up to here, Hz (the middle of the white band, in log f).
     white : float
         The one-sided white level h0 (units²/Hz) G is relative to.
+    psd, low : ndarray, (L,)
+        The running median of the PSD on ``f`` and the flicker and walk part of the
+        level, h₋₁/f + h₋₂/f² (:meth:`excess`).
     """
 
     f: np.ndarray
@@ -118,14 +140,6 @@ class OutputFilter:
             a = np.array(getattr(self, name), dtype=float)
             a.flags.writeable = False
             object.__setattr__(self, name, a)
-
-    def normalised(self, white: float) -> OutputFilter:
-        """The same measured spectrum over another white level ``white`` (one-sided
-        h0, units²/Hz): the fit's own N, 2N², once it is known."""
-        if self.psd is None or not (white > 0 and math.isfinite(white)):
-            return self
-        return replace(self, gain=_gain(self.f, self.psd, self.low, white, self.white_top),
-                       white=float(white))
 
     def excess(self, taus) -> np.ndarray:
         """Allan variance the filter takes from the flicker and random walk of the
@@ -223,13 +237,20 @@ def estimate_filter(spectrum, channel: int = 0) -> OutputFilter | None:
     if fitted is None:
         return None
     (h0, h1, h2), top, u_h0 = fitted
+    # A white band that ends more than two decades below fs/2 is no output filter's
+    # passband (a sensor sampled at over 100 times its bandwidth): a shape that slow
+    # is a correlated process, a Gauss–Markov bias whose plateau the fit took for
+    # the white level.
+    if top < float(spectrum.fs) / 2 / SLOWEST_FILTER:
+        return None
     # G is 1 up to the middle (in log f) of the white band, from where flicker and
     # walk have faded to where the filter shows: a gentle filter (an FIR's 1 − αf²)
     # starts below the point where the band test can see it, and is measured there.
     start = math.sqrt(_crossover(h0, h1, h2, fb[0]) * top)
     tested = fb > start
-    if not _attenuates(fb[tested], pb[tested] / (h0 + h1 / fb[tested] + h2 / fb[tested] ** 2),
-                       eb[tested], u_h0):
+    relative = pb / (h0 + h1 / fb + h2 / fb**2)
+    if not (_attenuates(fb[tested], relative[tested], eb[tested], u_h0)
+            and _falls_to_the_top(fb, relative, eb, float(spectrum.fs))):
         return None
     fs = float(spectrum.fs)
     size = spectrum.nperseg // 2 + 1
@@ -344,6 +365,25 @@ def _attenuates(f, relative, edf, u_level) -> bool:
     share = FALSE_FILTER / relative.size
     low = _stats.chi2.ppf(share, edf) / edf * math.exp(-_stats.norm.isf(share) * u_level)
     return bool(np.any(relative < low))
+
+
+def _falls_to_the_top(f, relative, edf, fs) -> bool:
+    """Whether the spectrum over the white level is lower in the top quarter decade
+    below fs/2 than around fs/20 (within ±1/8 decade), one-sided at
+    :data:`FALSE_FILTER`: an output filter bounds the band below fs/2 and attenuates
+    most at its top. A spectrum that has fallen to a floor by fs/20 and stays there
+    is white noise above a slower correlated process (a Gauss–Markov bias whose
+    plateau the white fit took for the level), the model's own terms; fs/20 is where
+    the resonance search stops for the same reason (a slower shape spans more than 20
+    samples)."""
+    top = f >= fs / 2 * 10**-0.25
+    ref = np.abs(np.log10(f / (fs / 20))) <= 0.125
+    if not top.any() or not ref.any():
+        return True
+    w_top, w_ref = edf[top] / edf[top].sum(), edf[ref] / edf[ref].sum()
+    drop = math.log(np.sum(w_top * relative[top]) / np.sum(w_ref * relative[ref]))
+    spread = math.sqrt(2 / edf[top].sum() + 2 / edf[ref].sum())
+    return drop < -_stats.norm.isf(FALSE_FILTER) * spread
 
 
 def _hann_bin_correlation(seg: int) -> np.ndarray:
