@@ -14,8 +14,10 @@ The estimate, per channel (:func:`estimate_filter`):
   decade, are fitted with h0 + h₋₁/f + h₋₂/f² (white, flicker, walk; non-negative,
   weighted by each bin's χ² variance) from the lowest frequency up to the highest
   top whose quarter decade below it misses the fit by no more than 2 standard errors
-  of its mean, and where white still dominates (:func:`_white_fit`). The filter acts
-  on all of it, so G = PSD/(h0 + h₋₁/f + h₋₂/f²).
+  of its mean, and where white still dominates (:func:`_white_fit`); the levels are
+  then read below that quarter decade, which passed only within its errors and may
+  hold the filter's start. The filter acts on all of it, so
+  G = PSD/(h0 + h₋₁/f + h₋₂/f²).
 - **G = 1 up to the middle of the white band** (in log f, between where flicker and
   walk equal the white level and the band's top; the top must lie within two decades
   below fs/2, or the roll-off is a slow correlated process, no output filter): below
@@ -44,9 +46,9 @@ The estimate, per channel (:func:`estimate_filter`):
   95 % of the time whatever the record's length; so does a spectrum that only rises
   above its white level (quantization's f², which the Q term describes).
 
-The white level's error is G's common factor above the middle of the band: a filter
-that starts inside the white band pulls h0 down (by 1–3 % on simulated FIR, CIC and
-Butterworth filters, 1 h at 100 Hz), and the fit's N follows it by half that. The grid
+The white level's error is G's common factor above the middle of the band, and the fit's
+N follows it by half: on simulated FIR, CIC and Butterworth filters (1 h at 100 Hz) N from
+h0 is within ±1 % (read up to the band's top, a filter's start pulled it 1–3 % low). The grid
 of G is Welch's: f_k = k·(fs/2)/(L−1), k = 0…L−1, G[0] = 1.
 
 The core (`_core.fit`) passes only the white term through G. The flicker and walk pass
@@ -325,6 +327,12 @@ def _white_fit(f, p, edf):
                 2 / np.sum(edf[edge]))):
             break
         top -= 1
+    # The level is read below the top EDGE_BINS: they passed the test only within two
+    # standard errors, and a filter may have started there (they hold the most Welch
+    # values of the band, so even a 1 % start there pulls h0 down by most of it).
+    below = top - EDGE_BINS
+    if below >= MIN_BINS:
+        h, cov = _fit_levels(_basis(f[:below]), p[:below], edf[:below])
     if not h[0] > 0:
         return None
     return (h[0], h[1], h[2]), float(f[top - 1]), math.sqrt(cov[0, 0]) / h[0]
