@@ -121,8 +121,8 @@ def test_gain_of_a_simulated_filter_is_recovered_within_its_sampling_error(case)
     """Above the white region, where the filter is above 10⁻³: the shape of the
     measured G over |H|² stays within 4 standard errors of the running median (33
     Welch values, each χ²_ν/ν, correlated as Hann bins are) except on ≤ 1 % of the
-    bins, and its common factor — the white level's error, which a filter starting
-    inside the white band pulls down (1–3 % on these classes) — is within 4 %."""
+    bins, and its common factor — the white level's error, whose standard uncertainty
+    is 0.4–1.1 % here (measured: 0.3–1.6 %) — is within 3 %."""
     make, truth = CASES[case]
     s = imunoise.psd(make(7), FS)
     found = estimate_filter(s)
@@ -133,7 +133,7 @@ def test_gain_of_a_simulated_filter_is_recovered_within_its_sampling_error(case)
     nu = float(np.median(s.edf))
     sigma = math.sqrt(math.pi / 2) * math.sqrt(2 * 1.9 / (33 * nu))
     assert np.mean(np.abs(ratio - np.median(ratio)) > 4 * sigma) <= 0.01
-    assert abs(np.median(ratio)) < 0.04
+    assert abs(np.median(ratio)) < 0.03
 
 
 @pytest.mark.parametrize("seed", range(10))
