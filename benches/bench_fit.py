@@ -7,7 +7,7 @@ gives none), no Q or R. Compute the overlapping Allan deviation at octave taus
 (imunoise.adev), then estimate N, B, K with
 
 * imunoise.fit(method="wls")     weighted NNLS on σ², EDF weights (Rust, faer): the
-                                  fitted coefficients (model.components) against the
+                                  fitted coefficients (model.terms) against the
                                   simulated ones, and the datasheet values (model.N, B,
                                   K) against those of the simulated curve
                                   (B = its minimum / 0.6643)
@@ -35,7 +35,8 @@ import allan_variance
 import imunoise
 import numpy as np
 from imunoise import _cpu
-from imunoise.noise import FLICKER, model_variance
+from imunoise.noise import FLICKER, GaussMarkov, Resonance, Tone, model_variance
+from imunoise.noise._typed import coefficient
 
 DEG = math.pi / 180
 FS = 40.0
@@ -49,6 +50,11 @@ TRUTH = {
 
 GM_SIGMA = 10.0 * DEG / 3600  # rad/s
 GM_TAU = 60.0  # s
+
+
+def kinds(model, channel, *classes):
+    """The fitted terms of ``channel`` of any of ``classes``."""
+    return [t for t in model.terms[channel] if isinstance(t, classes)]
 
 
 def tau_c_bound(n: int = N_SAMPLES) -> float:
@@ -107,18 +113,18 @@ def main() -> None:
         r = imunoise.adev(x, FS, taus="octave", overlapping=True)
         for method in ("wls", "slopes"):
             m = imunoise.fit(r, method=method)
-            parts = m.components
             if method == "wls":
-                false_tones += sum(bool(parts.sine(c)) for c in range(3))
-                false_resonances += sum(bool(parts.resonance(c)) for c in range(3))
-                spurious += sum(bool(parts.gauss_markov(c) or parts.sine(c)
-                                     or parts.resonance(c)) for c in range(3))
+                false_tones += sum(bool(kinds(m, c, Tone)) for c in range(3))
+                false_resonances += sum(bool(kinds(m, c, Resonance)) for c in range(3))
+                spurious += sum(bool(kinds(m, c, GaussMarkov, Tone, Resonance))
+                                for c in range(3))
                 sheet = true_datasheet(m.taus)
                 for k in TRUTH:
                     err["wls datasheet"][k].extend(np.abs(m.value(k) / sheet[k] - 1))
             # the fitted coefficients estimate the simulated ones
             for k, v in TRUTH.items():
-                err[method][k].extend(np.abs(parts.value(k) / v - 1))
+                fitted = np.array([coefficient(terms, k) for terms in m.terms])
+                err[method][k].extend(np.abs(fitted / v - 1))
         params, _ = allan_variance.estimate_parameters(r.taus, r.var)
         for k, col in (("N", "white"), ("B", "flicker"), ("K", "walk")):
             err["allan-variance"][k].extend(np.abs(params[col].to_numpy() / TRUTH[k] - 1))
@@ -128,10 +134,11 @@ def main() -> None:
         x = imunoise.simulate(N_SAMPLES, FS, channels=3, seed=100 + seed, N=TRUTH["N"],
                               K=TRUTH["K"], gm=[(GM_SIGMA, GM_TAU)])
         m = imunoise.fit(imunoise.adev(x, FS, taus=10))
-        false_tones += sum(bool(m.components.sine(c)) for c in range(3))
-        false_resonances += sum(bool(m.components.resonance(c)) for c in range(3))
+        false_tones += sum(bool(kinds(m, c, Tone)) for c in range(3))
+        false_resonances += sum(bool(kinds(m, c, Resonance)) for c in range(3))
         for c in range(3):
-            near = [g for g in m.components.gauss_markov(c) if 0.2 < g[1] / GM_TAU < 5]
+            near = [(g.sigma, g.tau_c) for g in kinds(m, c, GaussMarkov)
+                    if 0.2 < g.tau_c / GM_TAU < 5]
             if near:
                 gm_found += 1
                 gm_err["sigma"].append(abs(near[0][0] / GM_SIGMA - 1))

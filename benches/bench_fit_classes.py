@@ -42,6 +42,7 @@ import imunoise
 import numpy as np
 from imunoise import _cpu
 from imunoise.noise import filtered_prediction
+from imunoise.noise._typed import structure
 from scipy.signal import butter, lfilter
 
 ARCSEC = np.pi / 180 / 3600
@@ -169,9 +170,9 @@ def main() -> int:
             cov = [coverage(r.taus, r.dev[:, c], r.edf[:, c], p[:, c], limit) for c in range(3)]
             n_err = np.abs(np.ravel(m.N) / n_true - 1)
             measured = sum(f is not None for f in m.filter)
-            rows.append((name, seed, cov, m.components.structure(0), n_err, took))
+            rows.append((name, seed, cov, structure(m.terms[0]), n_err, took))
             print(f"| {name} | {seed} | {' / '.join(f'{c:.0%}' for c in cov)} | "
-                  f"{m.components.structure(0)} | {np.median(n_err):.1%} | {measured}/3 | "
+                  f"{structure(m.terms[0])} | {np.median(n_err):.1%} | {measured}/3 | "
                   f"{took:.2f} s |", flush=True)
     every = [c for row in rows for c in row[2]]
     if every:

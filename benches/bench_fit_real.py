@@ -10,7 +10,7 @@ For every long still recording in ../shared/data (skipped when absent), per chan
 * out of sample, half against half: fit the first half, and score the coverage of
   the second half's Allan deviation (τ ≤ T_half/10) by that model, by the first
   half's own measured curve and by allan-variance fitted on the first half;
-* the fitted structure (model.components) and the number of its components;
+* the fitted structure (model.terms) and the number of its terms;
 * tau-grid stability of the datasheet values model.N, B, K fitted on octave, 5, 10,
   20 and 50 taus per decade: the spread max − min in units of the largest
   standard uncertainty, and in brackets without the octave grid (fit warns there);
@@ -94,12 +94,13 @@ def allan_variance_dev(taus, var):
 
 
 def structure(model):
-    parts = model.components
-    terms = [t for t in imunoise.noise.TERMS if bool(parts.supported[t])]
-    gm = [f"GM({tc:.3g} s)" for _, tc in parts.gauss_markov()]
-    tone = [f"sine({f0:.3g} Hz)" for _, f0 in parts.sine()]
-    res = [f"res({f:.3g} Hz, Q {math.pi * f * tr:.2g}" + (f", skew {b:.2g})" if b else ")")
-           for _, f, tr, b in parts.resonance()]
+    fitted = model.terms[0]
+    terms = [t.name for t in fitted if hasattr(t, "name")]
+    gm = [f"GM({t.tau_c:.3g} s)" for t in fitted if isinstance(t, imunoise.noise.GaussMarkov)]
+    tone = [f"sine({t.freq:.3g} Hz)" for t in fitted if isinstance(t, imunoise.noise.Tone)]
+    res = [f"res({t.freq:.3g} Hz, Q {math.pi * t.freq * t.tau:.2g}"
+           + (f", skew {t.skew:.2g})" if t.skew else ")")
+           for t in fitted if isinstance(t, imunoise.noise.Resonance)]
     return "+".join(terms + gm + tone + res)
 
 
@@ -178,7 +179,7 @@ def main() -> int:
             fig = imunoise.plot.allan(r, model=model, title=name)
             fig.savefig(args.plots / (name.replace(" ", "_") + ".png"), dpi=70)
         rows.append(dict(name=name, ours=ours, theirs=theirs, struct=structure(model),
-                         count=model.components.count(), b=b_against_readoff(model),
+                         count=len(model.terms[0]), b=b_against_readoff(model),
                          halves=half_against_half(x, fs), spread=grid_spread(x, fs)))
     print(f"{len(rows)} real channels; imunoise.fit total {fit_time:.2f} s")
     print()

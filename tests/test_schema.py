@@ -15,14 +15,20 @@ def test_fit_constants_are_the_rust_ones():
     assert noise.TERMS == ("Q", "N", "B", "K", "R") == tuple(core_fit.IEEE_TERM_NAMES)
     assert noise.GM_MAX == core_fit.MAX_GAUSS_MARKOV == 3
     assert noise.TONES_MAX == core_fit.MAX_TONES == 2
-    # IEEE terms, (σ², ln τc) per Gauss–Markov slot, (A²/2, ln f0) per tone slot, then
-    # the resonance's (σ², ln f_r, ln τr, skew), then the bounded motion's (σθ², ln τc)
-    assert core_fit.SINE_SLOT == 5 + 2 * noise.GM_MAX
-    assert core_fit.RESONANCE_SLOT == core_fit.SINE_SLOT + 2 * noise.TONES_MAX
-    assert core_fit.SKEW_SLOT == core_fit.RESONANCE_SLOT + 3
-    assert core_fit.MOTION_SLOT == core_fit.RESONANCE_SLOT + 4
-    assert core_fit.PARAMETERS == core_fit.MOTION_SLOT + 2
+    # one Python class per Rust term kind, with the same parameters
+    kinds = {name: (params, coords) for name, params, coords in core_fit.TERM_KINDS}
+    assert list(kinds) == list(noise._typed.KINDS)
+    assert [k for k in kinds if len(kinds[k][0]) == 1] == [
+        cls.kind for cls in noise._typed.IEEE.values()]
+    for name, cls in noise._typed.KINDS.items():
+        assert len(cls.from_core(*_unit_core(kinds[name])).core()[1]) == len(kinds[name][0])
     assert noise.FLICKER == pytest.approx(math.sqrt(2 * math.log(2) / math.pi), rel=1e-15)
+
+
+def _unit_core(names):
+    params, coords = names
+    values = [0.5 if p == "skew" else 1.0 for p in params]
+    return values, np.eye(len(coords))
 
 
 def test_channel_table_and_gravity_have_one_home():

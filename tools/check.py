@@ -14,9 +14,10 @@ Steps:
         public name and CLI subcommand checked (tools/check_docs.py; the docs extra);
         about a minute, so part of the default run: a docstring that breaks the site
         fails the check where it is written
-  wheel not in the default run (a release build, minutes): build the abi3 wheel,
-        install it into a fresh venv with no Rust on PATH, smoke import, versions,
-        `imunoise demo` (tools/check_wheel.py)
+  wheel not in the default run (a release build, minutes): build the abi3 wheel
+        (manylinux2014 with Zig where installed, its tag asserted), install it into a
+        fresh venv with no Rust on PATH, smoke import, versions, `imunoise demo`
+        (tools/check_wheel.py)
 
 Each step prints what it runs; the first failing command ends the run with its exit code.
 """

@@ -2,8 +2,14 @@
 
     python3 tools/check_wheel.py         # what `python3 tools/check.py wheel` runs
     python3 tools/check_wheel.py --wheel dist/imunoise-….whl   # test a wheel already built
+    python3 tools/check_wheel.py --wheel dist/*.whl --expect-tag manylinux_2_17_x86_64
 
-1. ``maturin build --release`` (abi3: one ``cp310-abi3`` wheel for CPython >= 3.10);
+1. ``maturin build --release`` (abi3: one ``cp310-abi3`` wheel for CPython >= 3.10). On
+   Linux with Zig available (``pip install ziglang``) the wheel is built as the release
+   workflow ships it, ``--zig --compatibility manylinux2014``: linked against glibc 2.17
+   whatever this machine's glibc, and the check asserts the ``manylinux_2_17`` tag (the
+   file name, and ``auditwheel show`` when auditwheel is installed). Without Zig it is
+   built for this machine's glibc (fine here, not for publishing) and no tag is asserted;
 2. a fresh venv, entered with an environment that has no Rust: PATH without any folder
    holding cargo, rustc or rustup, and no CARGO_*/RUSTUP_* variables (checked);
 3. ``pip install`` the wheel (its dependencies from the package index) in that venv;
@@ -19,6 +25,8 @@ from __future__ import annotations
 
 import argparse
 import os
+import platform
+import re
 import shutil
 import subprocess
 import sys
@@ -57,12 +65,49 @@ def run(command: list[str], **kwargs) -> None:
     subprocess.run(command, check=True, **kwargs)
 
 
-def build(out: Path) -> Path:
-    run(["maturin", "build", "--release", "--out", str(out)], cwd=ROOT)
+def zig_available() -> bool:
+    """Zig for maturin's ``--zig``: on PATH or as the ziglang package."""
+    import importlib.util
+
+    return bool(shutil.which("zig")) or importlib.util.find_spec("ziglang") is not None
+
+
+def manylinux2014_tag() -> str | None:
+    """The tag a manylinux2014 wheel of this machine carries, or None off Linux."""
+    if not sys.platform.startswith("linux"):
+        return None
+    return f"manylinux_2_17_{platform.machine()}"
+
+
+def build(out: Path, *, zig: bool) -> Path:
+    command = ["maturin", "build", "--release", "--out", str(out)]
+    if zig:
+        command += ["--zig", "--compatibility", "manylinux2014"]
+    run(command, cwd=ROOT)
     wheels = sorted(out.glob("imunoise-*.whl"))
     if len(wheels) != 1:
         raise SystemExit(f"check_wheel: expected one wheel in {out}; got {wheels}")
     return wheels[0]
+
+
+def check_tag(wheel: Path, tag: str) -> None:
+    """The wheel's file name carries ``tag``, and auditwheel (when installed) agrees
+    that the shared library needs nothing newer."""
+    if tag not in wheel.name.removesuffix(".whl").split("-")[-1].split("."):
+        raise SystemExit(f"check_wheel: {wheel.name} is not tagged {tag}")
+    import importlib.util
+
+    if importlib.util.find_spec("auditwheel") is None:
+        print(f"tag ok: {tag} (file name; auditwheel not installed)")
+        return
+    shown = subprocess.run([sys.executable, "-m", "auditwheel", "show", str(wheel)],
+                           check=True, capture_output=True, text=True).stdout
+    found = re.search(r'consistent with the following platform tag:\s*"([^"]+)"',
+                      " ".join(shown.split()))
+    if found is None or found.group(1) != tag:
+        raise SystemExit(f"check_wheel: auditwheel says {found and found.group(1)!r}, "
+                         f"not {tag!r}:\n{shown}")
+    print(f"tag ok: {tag} (file name and auditwheel show)")
 
 
 def without_rust(venv: Path) -> dict[str, str]:
@@ -84,12 +129,28 @@ def without_rust(venv: Path) -> dict[str, str]:
 def main(argv: list[str]) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--wheel", type=Path, help="test this wheel instead of building one")
+    parser.add_argument("--expect-tag", metavar="TAG",
+                        help="platform tag the wheel must carry, e.g. manylinux_2_17_x86_64 "
+                             "(default: asserted only for a wheel built here with Zig)")
+    parser.add_argument("--no-zig", action="store_true",
+                        help="build for this machine's glibc even where Zig is available")
     args = parser.parse_args(argv)
     with tempfile.TemporaryDirectory(prefix="imunoise-wheel-") as tmp:
         tmp = Path(tmp)
-        wheel = args.wheel.resolve() if args.wheel else build(tmp / "dist")
+        tag = args.expect_tag
+        if args.wheel:
+            wheel = args.wheel.resolve()
+        else:
+            zig = (not args.no_zig and manylinux2014_tag() is not None and zig_available())
+            if not zig:
+                print("check_wheel: no Zig (or not Linux): the wheel is built for this "
+                      "machine only and its tag is not checked", flush=True)
+            wheel = build(tmp / "dist", zig=zig)
+            tag = tag or (manylinux2014_tag() if zig else None)
         if "-cp310-abi3-" not in wheel.name:
             raise SystemExit(f"check_wheel: {wheel.name} is not an abi3 (cp310-abi3) wheel")
+        if tag:
+            check_tag(wheel, tag)
         venv = tmp / "venv"
         run([sys.executable, "-m", "venv", str(venv)])
         env = without_rust(venv)

@@ -66,10 +66,10 @@ model = imunoise.fit(result)
 model
 
 # %%
-# Behind those values are the fitted components (``model.components``): the IEEE
-# coefficients the fit chose and what it found beyond them — here a tone near 18.7 Hz
-# on X and Y, which no sum of power laws follows:
-model.components
+# Behind those values are the fitted terms (``model.terms``, one tuple per axis): the
+# IEEE coefficients the fit chose and what it found beyond them — here a tone near
+# 18.7 Hz on X and Y, which no sum of power laws follows:
+model.terms
 
 # %%
 # The Allan deviation with the model, its terms and the data/model panel:

@@ -75,11 +75,11 @@ INNER_MIN_WINDOWS = 10
 #: Default design rate of false events per sample and channel.
 FALSE_ALARM = 1e-7
 #: Threshold crossings of a sliding energy window per independent window under
-#: white noise, relative to ``n/w·p_w`` (measured: about 2.5–3.5 for w = 10–400;
-#: 4 keeps the design rate an upper bound).
+#: white noise, relative to ``n/w·p_w``: an upper bound of that ratio over the windows
+#: used, so the design false-alarm rate stays a bound (tests/events/test_events.py).
 OVERLAP_FACTOR = 4.0
 #: Fewest degrees of freedom of the Student-t likelihood that places a burst's
-#: edges (bounded influence of single samples; measured on the MTi-G record,
+#: edges: heavy tails bound the influence of single samples on an edge (evidence in
 #: docs/events.md). A record with lighter tails gets more (Gaussian in the limit).
 CHANGE_POINT_DOF = 10.0
 #: Energy windows per channel: ``window``, ``window``/2, … (``BURST_SCALES`` of them).
@@ -88,14 +88,12 @@ BURST_SCALES = 3
 MIN_WINDOW = 4
 #: Significance at which a burst's raw (unwhitened) energy over its span must exceed
 #: the quiet noise's: the whitened test also answers to a change of the noise's
-#: spectral shape (the VN-100 live capture's 15–20 Hz band), which adds no power a
-#: person could see (18.4 and 222.5 s there: RMS ×1.05 and ×1.11 of the quiet level).
-#: 1e-2 drops both; 1e-3 also cost weak injected bursts (2–3σ onset: 84 → 72 % found
-#: on the VN-100 capture, 80 % at 1e-2), 5e-2 kept 222.5 s (docs/events.md).
+#: spectral shape alone, which adds no power a person could see; a stricter level
+#: also drops weak real bursts (the trade-off measured: docs/events.md).
 CONFIRM_P = 1e-2
 #: Most coefficients of the whitening predictor of the burst test (fewer when the
-#: energy window is shorter): 8 and 16 found the same bursts in the VN-100 live
-#: capture (its 13.5 Hz line and 15–20 Hz band), docs/events.md.
+#: energy window is shorter): enough to whiten a line and a band of the sensor's own
+#: (docs/events.md).
 WHITENING_ORDER = 16
 
 
@@ -404,10 +402,10 @@ def events(
         if valid.all():
             valid = None  # no missing sample
         # first pass with the noise law of the whole channel, then once more with
-        # the law of its quiet part: a record with vibration of its own (the VN-100
-        # live capture, 20 % of it) otherwise sets thresholds for quiet noise from
-        # its loud stretches (ν 10.5 instead of 19.9 there). The last pass's energy
-        # test sees the record whitened by the predictor of that quiet part: the
+        # the law of its quiet part: a record with vibration of its own otherwise
+        # sets thresholds for quiet noise from its loud stretches (docs/events.md).
+        # The last pass's energy test sees the record whitened by the predictor of
+        # that quiet part: the
         # sensor's own resonance or filter is then neither taken for energy nor
         # hides a burst's onset, while a vibration the quiet part does not have (a
         # machine's line for a few minutes) is not whitened away. (Whitening after

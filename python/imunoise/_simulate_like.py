@@ -23,6 +23,7 @@ import numpy as np
 
 from imunoise._validate import integer, sample_rate
 from imunoise.errors import ImunoiseTypeError, ImunoiseValueError
+from imunoise.noise import _typed
 
 __all__ = ["simulate_like"]
 
@@ -82,16 +83,17 @@ def _channels(channels, available: int) -> list[int]:
 def _from_model(model, n: int, fs: float, channels, rng) -> np.ndarray:
     from imunoise._simulate import simulate
 
-    parts = model.components
     picked = _channels(channels, model.channels)
     columns = []
     for c in picked:
-        coef = {t: float(np.nan_to_num(parts.value(t)[c])) for t in "QNBKR"}
-        resonance = parts.resonance(c)
-        motion = parts.motion(c)
+        terms = model.terms[c]
+        coef = {t: _typed.coefficient(terms, t) for t in "QNBKR"}
+        resonance = _typed.pairs(terms, _typed.Resonance, "sigma", "freq", "tau", "skew")
+        motion = _typed.pairs(terms, _typed.Motion, "sigma", "tau_c")
         columns.append(simulate(
-            n, fs, **coef, seed=rng, gm=parts.gauss_markov(c),
-            sinusoid=parts.sine(c) or None,
+            n, fs, **coef, seed=rng,
+            gm=_typed.pairs(terms, _typed.GaussMarkov, "sigma", "tau_c"),
+            sinusoid=_typed.pairs(terms, _typed.Tone, "amplitude", "freq") or None,
             resonance=resonance[0] if resonance else None,
             motion=motion[0] if motion else None))
     out = np.column_stack(columns)

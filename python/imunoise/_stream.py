@@ -185,10 +185,10 @@ class _Moments:
         self.stx += sums[2]
 
 
-#: Channels analysed at once by :func:`each_channel`: numpy's sort and scipy's normal
-#: CDFs release the GIL, so two distributions take 0.58× the time of one after the
-#: other (2 × 2·10⁷ samples: 2.50 s against 4.34 s on 2 cores), and each holds about
-#: one channel length, so two stay within the streamed report's memory.
+#: Channels analysed at once by :func:`each_channel`: two, because numpy's sort and
+#: scipy's normal CDFs release the GIL (two run in about 0.6× the time of one after the
+#: other, docs/benchmarks.md) and each holds about one channel length, so two stay
+#: within the streamed report's memory.
 CHANNEL_WORKERS = 2
 
 

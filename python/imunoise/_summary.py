@@ -125,10 +125,14 @@ def html_table(
     *,
     caption: str = "",
 ) -> str:
-    """A small HTML table (escaped text, numbers right-aligned by the notebook's style)."""
+    """A small HTML table (escaped text, numbers right-aligned by the notebook's style);
+    a column headed "unit" is written in symbols ("m/s²"), as the report's tables are."""
     cells = "".join(f"<th>{html.escape(str(h))}</th>" for h in header)
+    unit_column = list(header).index("unit") if "unit" in header else None
     body = "".join(
-        "<tr>" + "".join(f"<td>{html.escape(str(c))}</td>" for c in row) + "</tr>"
+        "<tr>" + "".join(
+            f"<td>{html.escape(_display.unit_symbols(str(c)) if k == unit_column else str(c))}</td>"
+            for k, c in enumerate(row)) + "</tr>"
         for row in rows
     )
     cap = f"<caption>{html.escape(caption)}</caption>" if caption else ""

@@ -60,7 +60,7 @@ from imunoise._channels import rate_columns
 from imunoise._simulate import simulate
 from imunoise.allan import adev, adev_by_column
 from imunoise.errors import ImunoiseValueError
-from imunoise.noise import fit, model_variance
+from imunoise.noise import _typed, fit, model_variance
 from imunoise.readers.log import ImuLog
 
 __all__ = ["Warmup", "warmup", "ALPHA"]
@@ -74,8 +74,8 @@ MIN_BLOCKS = 20
 #: Records of the sensor's stationary noise the significance test simulates.
 NULL_RECORDS = 1999
 #: Confidence of the upper limit of the Allan variance that bounds the null's
-#: rate random walk (see ``_random_walk_bound``): one-sigma. At 95 % the null is
-#: so loud that a 20-minute transient 5× the random walk's wander is missed.
+#: rate random walk (see ``_random_walk_bound``): one-sigma, because a 95 % bound
+#: makes the null so loud that a transient several times that wander is missed.
 BOUND_CONFIDENCE = 0.683
 #: Correlation times of the exponential fit: this many per log, log-spaced.
 TAU_GRID = 80
@@ -410,7 +410,8 @@ def _null_p_values(cols, fs, t, bias, duration, seed) -> np.ndarray:
         coef = {term: _upper(model, term, c) for term in ("N", "B", "K")}
         coef["K"] = max(coef["K"], float(k_floor[c]))
         null = simulate(len(t), block_rate, channels=NULL_RECORDS, seed=rng,
-                        gm=model.components.gauss_markov(c), **coef)
+                        gm=_typed.pairs(model.terms[c], _typed.GaussMarkov, "sigma", "tau_c"),
+                        **coef)
         p[j] = _bootstrap_p(observed, _explained(t[kept], null[kept], taus))
     return p
 
@@ -439,7 +440,7 @@ def _random_walk_bound(result, model, min_edf: float = 5.0) -> np.ndarray:
         if usable.size:
             i = usable[-1]
             tau = result.taus[i : i + 1]
-            others = {t: float(model.components.value(t)[c]) for t in ("Q", "N", "B")}
+            others = {t: _typed.coefficient(model.terms[c], t) for t in ("Q", "N", "B")}
             upper = dev[i, c] ** 2 * edf[i, c] / _stats.chi2.ppf(1 - BOUND_CONFIDENCE,
                                                                   edf[i, c])
             rest = upper - float(model_variance(tau, **others)[0])
@@ -451,8 +452,10 @@ def _upper(model, term: str, c: int) -> float:
     """A coefficient of the null model at its value + 2 standard uncertainties: half a
     log estimates the wander loosely, and a null that is too quiet calls wander a
     transient."""
-    value = float(model.components.value(term)[c])
-    std = float(model.components.std(term)[c])
+    fitted = _typed.ieee_term(model.terms[c], term)
+    if fitted is None:
+        return 0.0
+    value, std = fitted.value, float(getattr(fitted, term + "_std"))
     return value + 2 * std if value > 0 and np.isfinite(std) else value
 
 

@@ -24,7 +24,7 @@ from imunoise._schema import (
     sensor_label,
 )
 from imunoise.allan import KINDS
-from imunoise.display import duration
+from imunoise.display import duration, percent
 from imunoise.errors import DataWarning
 from imunoise.readers.csv_reader import (
     LAYOUT_CHANNELS,  # the --kind choices: every public Allan-family statistic
@@ -422,7 +422,7 @@ def _number_in(low: float, high: float, unit: str = "", *, low_open: bool = True
 
 
 #: Sample rates (Hz) the command line takes: slower than a sample per 1000 s or
-#: faster than 1 MHz is no IMU, and 1e300 Hz overflowed the planner's arithmetic.
+#: faster than 1 MHz is no IMU, and the bound keeps the planner's arithmetic finite.
 _FS = _number_in(1e-3, 1e6, "Hz", low_open=False)
 #: Hours of a simulated log (the simulator bounds the samples further).
 _HOURS = _number_in(0, 1e5, "h")
@@ -529,7 +529,7 @@ def _cmd_adev(args) -> int:
             row += display.interval_cells(r.dev[i, j], r.ci_low[i, j], r.ci_high[i, j])
         rows.append(row)
     print(f"# {args.kind} of {args.sensor}, {len(y)} samples at {log.fs:.6g} Hz, "
-          f"CI {r.confidence:.1%}")
+          f"CI {percent(r.confidence, digits=1)}")
     _print_table(head, rows)
     if args.plot:
         from imunoise import plot

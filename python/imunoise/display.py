@@ -19,6 +19,10 @@ from imunoise.errors import ImunoiseValueError
 NOT_RESOLVED = "not resolved"
 #: The word for an empty table cell.
 EMPTY = "—"
+#: Units as logs and arguments spell them in ASCII, and the symbols every table, caption
+#: and figure writes instead: one spelling of a unit wherever a reader meets it.
+UNIT_SYMBOLS = (("m/s^2", "m/s²"), ("m/s^3", "m/s³"), ("sqrt(Hz)", "√Hz"), ("sqrt(h)", "√h"),
+                ("sqrt(s)", "√s"), ("deg/s", "°/s"), ("deg/h", "°/h"))
 
 
 def _finite(x) -> bool:
@@ -173,3 +177,23 @@ def upper_bound(bound, *, digits: int = 3) -> str:
 def cell(value, std=None, *, digits: int = 4) -> str:
     """A table cell: as :func:`format_value`, with "—" for a missing value."""
     return format_value(value, std, digits=digits, missing=EMPTY)
+
+
+def unit_symbols(unit: str) -> str:
+    """A unit as tables and figures write it: ``"m/s^2"`` is ``"m/s²"``,
+    ``"deg/h/sqrt(Hz)"`` is ``"°/h/√Hz"`` (:data:`UNIT_SYMBOLS`); other text unchanged."""
+    for ascii_, symbol in UNIT_SYMBOLS:
+        unit = unit.replace(ascii_, symbol)
+    return unit
+
+
+def percent(fraction, *, digits: int = 0) -> str:
+    """A fraction as a percentage, written as the SI writes it, with a space before
+    the sign: ``percent(0.6827, digits=1)`` is ``"68.3 %"``, ``percent(1.0)`` is
+    ``"100 %"``; "—" when not finite. One spelling for every percentage of the report,
+    its figures and the command line (``f"{x:.0%}"`` leaves the space out)."""
+    if not _finite(fraction):
+        return EMPTY
+    if isinstance(digits, bool) or not isinstance(digits, int) or digits < 0:
+        raise ImunoiseValueError(f"digits must be an integer >= 0; got {digits!r}")
+    return f"{100.0 * float(fraction):.{digits}f} %"

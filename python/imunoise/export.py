@@ -47,7 +47,7 @@ import numpy as np
 from imunoise import _atomic, _warn
 from imunoise import units as _units
 from imunoise.errors import CoverageWarning, ImunoiseDeprecationWarning, ImunoiseValueError
-from imunoise.noise import gm_white_density, resonance_white_density
+from imunoise.noise import _typed, gm_white_density, resonance_white_density
 
 __all__ = [
     "ekf_dict",
@@ -234,17 +234,18 @@ def _ekf_axes(model, sensor: str, input_unit, min_samples: float) -> dict:
     # The state-space model is built from the fitted components (a slow
     # Gauss–Markov term is a state of its own, not part of K); the datasheet
     # values the other views print go beside it.
-    parts = model.components
     sheet = {t: _value_or_bound(model, t, sensor) for t in ("N", "B", "K")}
     for c, name in enumerate(names):
-        white2 = float(parts.value("N")[c]) ** 2
+        terms = model.terms[c]
+        white2 = _typed.coefficient(terms, "N") ** 2
         # A resonance (like a tone) is no bias state; what it adds to the white
         # floor (its spectrum at zero frequency) is measurement noise. A bounded
         # motion is the test mount's, not the sensor's: no state, no noise.
-        for sigma, f_r, tau_r, skew in parts.resonance(c):
+        for sigma, f_r, tau_r, skew in _typed.pairs(terms, _typed.Resonance, "sigma", "freq",
+                                                    "tau", "skew"):
             white2 += resonance_white_density(sigma, f_r, tau_r, model.fs, skew)
         states = []
-        for sigma, tau_c in parts.gauss_markov(c):
+        for sigma, tau_c in _typed.pairs(terms, _typed.GaussMarkov, "sigma", "tau_c"):
             if tau_c * model.fs < min_samples:
                 # Too fast to be a filter state at the IMU rate: white noise.
                 white2 += gm_white_density(sigma, tau_c, model.fs)
@@ -256,7 +257,7 @@ def _ekf_axes(model, sensor: str, input_unit, min_samples: float) -> dict:
             })
         # The walk's driving noise: the fitted K; where the data do not resolve K,
         # its bound (a slow Gauss–Markov term standing in for K is a state above).
-        walk = float(parts.value("K")[c])
+        walk = _typed.coefficient(terms, "K")
         if not model.resolved("K")[c]:
             walk = float(sheet["K"][c])
         axes[name] = {
@@ -285,7 +286,7 @@ def ekf_dict(gyro=None, accel=None, *, gyro_unit: str | None = None,
     var w[k] = σ²(1 − e^(−2Δt/τc)). A Gauss–Markov term faster than
     ``min_samples`` samples cannot be a state at the IMU rate and is folded
     into the white noise. These state-space values come from the fitted
-    components (``model.components``); ``datasheet`` holds the model's datasheet
+    terms (``model.terms``); ``datasheet`` holds the model's datasheet
     values N, B, K (``model.N``…, the numbers the report and the other exports
     print) in the same SI units, for reference. Where the data do not resolve N,
     B or K, the value written is its 95 % upper bound (``model.upper``), with a

@@ -108,7 +108,7 @@ class Plan:
 
     def line(self, seconds: float | None = None) -> str:
         """One line: what each term needs, and (given a record length) what it has."""
-        from imunoise.display import duration
+        from imunoise.display import duration, format_value
 
         if not self.terms:
             return f"plan{' ' + self.label if self.label else ''}: no N, B or K to plan for"
@@ -119,7 +119,9 @@ class Plan:
             text += (f" ({', '.join(self.assumed)}: not on the datasheet, a typical value is "
                      "assumed; its record length is a guide only)")
         if seconds is not None:
-            have = ", ".join(f"{k} ±{100 * u:.2g} %" if math.isfinite(u) and u < 10
+            # two digits in plain decimals: "±100 %" (":.2g" wrote "±1e+02 %")
+            have = ", ".join(f"{k} ±{format_value(100 * u, digits=2)} %"
+                             if math.isfinite(u) and u < 10
                              else f"{k} not yet (its τ is beyond the record)"
                              for k, u in self.uncertainty(seconds).items())
             text += f"; this record ({duration(seconds)}) resolves {have}"
@@ -196,7 +198,7 @@ def _coefficients(source, sensor: str) -> tuple[dict[str, float], str, tuple[str
     """The coefficients to plan with, the plan's label and the terms assumed."""
     if isinstance(source, Mapping):
         return {k: float(source.get(k, 0.0)) for k in PLAN_TERMS}, "", ()
-    if hasattr(source, "components") and hasattr(source, "N"):  # a NoiseModel
+    if hasattr(source, "terms") and hasattr(source, "N"):  # a NoiseModel
         # The median over the axes that resolve the term; a term no axis resolves
         # (NaN) is planned as absent, as a datasheet that omits it.
         out = {}

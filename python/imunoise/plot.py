@@ -29,9 +29,9 @@ import numpy as np
 from imunoise import _atomic, _summary
 from imunoise._schema import ATTITUDE_NAMES, CHANNELS, axis_names
 from imunoise.allan import AllanResult
-from imunoise.display import cell, format_value, rounded
+from imunoise.display import cell, format_value, percent, rounded
 from imunoise.errors import ImunoiseTypeError, ImunoiseValueError
-from imunoise.noise import FLICKER, TERMS, NoiseModel, filtered_prediction, model_variance
+from imunoise.noise import FLICKER, TERMS, NoiseModel, _typed, filtered_prediction, model_variance
 from imunoise.noise._terms import term_variances
 from imunoise.readers.log import ImuLog
 from imunoise.stats import Distribution
@@ -533,7 +533,7 @@ def _tone_envelope(model: NoiseModel, grid: np.ndarray, channel: int,
     peak (below one period, ≈ 0.37/f0), its upper envelope beyond — the sampled form
     2·(A²/2)·sin⁴(πνm)/(m² sin²πν) with sin⁴ → 1, A/(m·|sin πν|), ν = f0/fs,
     m = τ·fs, capped at the peak — and the tones' variances added."""
-    tones = model.components.sine(channel)
+    tones = _typed.pairs(model.terms[channel], _typed.Tone, "amplitude", "freq")
     if not tones:
         return curve
     fs = float(model.fs)
@@ -640,7 +640,8 @@ def allan(
             yerr = np.vstack([dev[:, j] - lo[:, j], hi[:, j] - dev[:, j]])
             ax.errorbar(
                 taus, dev[:, j], yerr=yerr, fmt="o", ms=2.5, color=color,
-                elinewidth=0.8, capsize=1.5, label=f"{kind} ({result.confidence:.1%} CI)",
+                elinewidth=0.8, capsize=1.5,
+                label=f"{kind} ({percent(result.confidence, digits=1)} CI)",
             )
             marks: dict[str, float] = {}
             if model is not None:
@@ -732,7 +733,7 @@ def allan(
             finite = ratio[np.isfinite(ratio)]
             spans.append(max(0.1, float(np.max(np.abs(finite - 1)))) if finite.size else 0.1)
             cover = np.atleast_1d(model.coverage)[j]
-            ax.text(0.02, 0.06, f"follows {cover:.0%} of taus", transform=ax.transAxes,
+            ax.text(0.02, 0.06, f"follows {percent(cover)} of taus", transform=ax.transAxes,
                     fontsize=7)
             if j == 0:
                 ax.set_ylabel("data/model\n[ratio]")
@@ -1087,6 +1088,8 @@ def compensation(before: AllanResult, after: AllanResult, *, title: str = "",
                  unit: str = "") -> Figure:
     """Allan deviation per axis before (solid) and after (dashed) a correction, e.g.
     the temperature compensation of :func:`imunoise.thermal`."""
+    from matplotlib.ticker import NullFormatter
+
     new_figure = _plt()
     b = np.asarray(before.dev).reshape(len(before.taus), -1)
     a = np.asarray(after.dev).reshape(len(after.taus), -1)
@@ -1100,7 +1103,13 @@ def compensation(before: AllanResult, after: AllanResult, *, title: str = "",
             ax.loglog(after.taus, a[:, j], color=color, linestyle="--", label=f"{name} after")
         ax.set_xlabel("τ [s]")
         ax.set_ylabel(_label("σ(τ)", unit))
+        # decades only, as plot.allan labels them: matplotlib labels the minor ticks
+        # ("6 × 10⁻⁴") of an axis that spans under two decades (kept where no decade
+        # falls inside the axis, which would then have no label at all)
+        low, high = ax.get_ylim()
+        if np.floor(np.log10(high)) >= np.ceil(np.log10(low)):
+            ax.yaxis.set_minor_formatter(NullFormatter())
         ax.legend(ncol=2)
         fig.suptitle(title or "Allan deviation before and after compensation")
         _margins(fig, left=0.9, bottom=0.5, title=True)
-    return fig
+    return plain_ticks(fig)

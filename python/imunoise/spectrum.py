@@ -454,12 +454,14 @@ def model_psd_terms(model: NoiseModel, f: npt.ArrayLike) -> dict[str, np.ndarray
     keys "Q", "N", "B", "K", "R", "GM1", … (GM: the sampled AR1, see the module) and
     "resonance" (:func:`resonance_psd`). A tone is a line, no density: plots mark
     its frequency (:attr:`NoiseModel.lines`)."""
+    from imunoise.noise import _typed
+
     f = _check_frequencies(f)
     fs = float(model.fs)
     channels = 1 if model.one_channel else model.channels
     out: dict[str, np.ndarray] = {}
     for term in POWER_LAWS:
-        c = model.components.value(term).astype(float)
+        c = np.array([_typed.coefficient(terms, term) for terms in model.terms])
         if np.any(c > 0):
             out[term] = term_psd(term, c[None, :], f[:, None], fs=fs)
     if "N" in out:  # the white term through each channel's measured output filter
@@ -467,12 +469,15 @@ def model_psd_terms(model: NoiseModel, f: npt.ArrayLike) -> dict[str, np.ndarray
             if found is not None:
                 out["N"][:, j] = out["N"][:, j] * np.interp(f, found.f, found.gain)
     for j in range(channels):
-        for k, (sigma, tau_c) in enumerate(model.components.gauss_markov(j)):
+        terms = model.terms[j]
+        for k, (sigma, tau_c) in enumerate(_typed.pairs(terms, _typed.GaussMarkov, "sigma",
+                                                        "tau_c")):
             phi = math.exp(-1.0 / (fs * tau_c))
             gm = (2 * sigma**2 * (1 - phi**2) / fs
                   / np.abs(1 - phi * np.exp(-2j * np.pi * f / fs)) ** 2)
             out.setdefault(f"GM{k + 1}", np.zeros((f.size, channels)))[:, j] = gm
-        for sigma, f_r, tau_r, skew in model.components.resonance(j):
+        for sigma, f_r, tau_r, skew in _typed.pairs(terms, _typed.Resonance, "sigma", "freq",
+                                                    "tau", "skew"):
             out.setdefault("resonance", np.zeros((f.size, channels)))[:, j] = resonance_psd(
                 sigma, f_r, tau_r, skew, f, fs)
     return {k: (v[:, 0] if model.one_channel else v) for k, v in out.items()}

@@ -1,35 +1,26 @@
 //! Bindings for the noise-model fit: one channel per call (the problem has one
 //! row per tau, so it is small next to the Allan computation), and the model's
-//! per-term curves for plots and predictions. The model's constants (term names,
-//! most Gauss–Markov terms, parameter slots, flicker factor) are exported here so
+//! per-term curves for plots and predictions. The model's constants (term kinds
+//! and their parameters, most Gauss–Markov terms, flicker factor) are exported here so
 //! Python never writes them again.
 
 use numpy::ndarray::Array2;
-use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 
 use crate::fit::filter::OutputFilter;
 use crate::fit::{
-    self, Options, FLICKER_FACTOR, IEEE_TERMS, IEEE_TERM_NAMES, MAX_GM, MAX_TONES, MOTION_SLOT,
-    PARAMETERS, RESONANCE_SLOT, SINE_SLOT, SKEW_SLOT,
+    self, Kind, Options, Term, FLICKER_FACTOR, IEEE_TERMS, IEEE_TERM_NAMES, MAX_GM, MAX_TONES,
 };
 
 /// The fit of one channel, as `_core.fit.NoiseFit`.
 #[pyclass(name = "NoiseFit", module = "imunoise._core.fit", frozen, get_all)]
 struct PyNoiseFit {
-    /// (Q², N², B², K², R²).
-    ieee: Py<PyArray1<f64>>,
-    /// (k, 2) rows of (q², τc), one per Gauss–Markov term.
-    gm: Py<PyArray2<f64>>,
-    /// (k, 2) rows of (s², f₀), k ≤ MAX_TONES: the tones.
-    sine: Py<PyArray2<f64>>,
-    /// (k, 4) rows of (r², f_r, τr, skew), k ≤ 1: the resonance.
-    resonance: Py<PyArray2<f64>>,
-    /// (k, 2) rows of (σθ², τc), k ≤ 1: the bounded motion.
-    motion: Py<PyArray2<f64>>,
-    /// PARAMETERS × PARAMETERS covariance of (Q²…R², then q², ln τc per slot,
-    /// then s², ln f₀ per tone slot, then r², ln f_r, ln τr, skew, then σθ², ln τc;
-    /// NaN variance of ln f_r at fs/2 and of the skew at ±1).
+    /// (kind, parameters) of each term, in the model's order (`TERM_KINDS` names
+    /// the parameters of each kind).
+    terms: Vec<(&'static str, Vec<f64>)>,
+    /// Covariance of the terms' coordinates, term after term (`TERM_KINDS` names
+    /// the coordinates of each kind); NaN variance for a coordinate on a bound.
     cov: Py<PyArray2<f64>>,
     /// δ, the relative model discrepancy.
     discrepancy: f64,
@@ -99,19 +90,12 @@ fn fit_noise<'py>(
     let var = var.as_array().to_vec();
     let edf = edf.as_array().to_vec();
     let r = py.detach(|| fit::fit_noise(&taus, &var, &edf, fs, &opts, filter.as_ref()))?;
-    let gm_rows: Vec<Vec<f64>> = r.gm.iter().map(|&(q2, tc)| vec![q2, tc]).collect();
-    let sine_rows: Vec<Vec<f64>> = r.sine.iter().map(|&(s2, f0)| vec![s2, f0]).collect();
-    let res_rows: Vec<Vec<f64>> = (r.resonance.iter())
-        .map(|&(a, f, t, skew)| vec![a, f, t, skew])
-        .collect();
-    let motion_rows: Vec<Vec<f64>> = r.motion.iter().map(|&(v, tc)| vec![v, tc]).collect();
+    let size = r.cov.len();
     Ok(PyNoiseFit {
-        ieee: r.ieee.to_vec().into_pyarray(py).unbind(),
-        gm: to_matrix(gm_rows, 2)?.into_pyarray(py).unbind(),
-        sine: to_matrix(sine_rows, 2)?.into_pyarray(py).unbind(),
-        resonance: to_matrix(res_rows, 4)?.into_pyarray(py).unbind(),
-        motion: to_matrix(motion_rows, 2)?.into_pyarray(py).unbind(),
-        cov: to_matrix(r.cov, PARAMETERS)?.into_pyarray(py).unbind(),
+        terms: (r.terms.iter())
+            .map(|t| (t.kind().name(), t.parameters()))
+            .collect(),
+        cov: to_matrix(r.cov, size)?.into_pyarray(py).unbind(),
         discrepancy: r.discrepancy,
         chi2: r.chi2,
         n_eff: r.n_eff,
@@ -120,64 +104,119 @@ fn fit_noise<'py>(
     })
 }
 
-/// noise_terms(taus, fs, ieee, gm, sine, resonance, motion) -> (len(taus), 5 + k + j + l + n)
-/// Allan variance of each term
+/// allan_terms(taus, fs, terms, filter=None) -> (len(taus), len(terms)): the
+/// Allan variance of each term, given as (kind, parameters).
 #[pyfunction]
-#[allow(clippy::too_many_arguments)] // mirrors the Python keyword arguments
-#[pyo3(signature = (taus, fs, ieee, gm, sine=Vec::new(), resonance=Vec::new(), motion=Vec::new(), filter=None))]
-fn noise_terms<'py>(
+#[pyo3(signature = (taus, fs, terms, filter=None))]
+fn allan_terms<'py>(
     py: Python<'py>,
     taus: PyReadonlyArray1<'py, f64>,
     fs: f64,
-    ieee: Vec<f64>,
-    gm: Vec<(f64, f64)>,
-    sine: Vec<(f64, f64)>,
-    resonance: Vec<(f64, f64, f64, f64)>,
-    motion: Vec<(f64, f64)>,
+    terms: Vec<(String, Vec<f64>)>,
     filter: Option<PyReadonlyArray1<'py, f64>>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let filter = output_filter(filter)?;
-    if ieee.len() != IEEE_TERMS {
-        return Err(super::value_error(format!(
-            "ieee must have {IEEE_TERMS} values (Q², N², B², K², R²); got {}",
-            ieee.len()
-        )));
-    }
     if !(fs.is_finite() && fs > 0.0) {
         return Err(super::value_error(format!(
             "fs must be finite and > 0; got {fs}"
         )));
     }
-    let mut coef = [0.0; IEEE_TERMS];
-    coef.copy_from_slice(&ieee);
-    if let Some(&(_, f0)) = sine.iter().find(|s| !(s.1.is_finite() && s.1 > 0.0)) {
-        return Err(super::value_error(format!(
-            "sine frequencies must be finite and > 0 Hz; got {f0}"
-        )));
-    }
-    if let Some(&(_, f, t, _)) = resonance
-        .iter()
-        .find(|r| !(r.1.is_finite() && r.1 > 0.0 && r.2.is_finite() && r.2 > 0.0))
-    {
-        return Err(super::value_error(format!(
-            "resonance frequency and damping time must be finite and > 0; got {f} Hz, {t} s"
-        )));
-    }
-    if let Some(&(_, _, _, skew)) = resonance.iter().find(|r| r.3.is_nan() || r.3.abs() > 1.0) {
-        return Err(super::value_error(format!(
-            "resonance skew must be in [-1, 1] (a non-negative spectrum); got {skew}"
-        )));
-    }
-    if let Some(&(_, t)) = motion.iter().find(|m| !(m.1.is_finite() && m.1 > 0.0)) {
-        return Err(super::value_error(format!(
-            "motion correlation times must be finite and > 0 s; got {t}"
-        )));
-    }
-    let cols = IEEE_TERMS + gm.len() + sine.len() + resonance.len() + motion.len();
+    let filter = output_filter(filter)?;
+    let typed = typed_terms(&terms)?;
     let taus = taus.as_array().to_vec();
-    let oscillators = (sine.as_slice(), resonance.as_slice(), motion.as_slice());
-    let rows = fit::terms(&taus, fs, &coef, &gm, oscillators, filter.as_ref());
-    Ok(to_matrix(rows, cols)?.into_pyarray(py))
+    let rows = py.detach(|| fit::allan_terms(&taus, fs, &typed, filter.as_ref()));
+    Ok(to_matrix(rows, typed.len())?.into_pyarray(py))
+}
+
+/// The core's typed terms of (kind, parameters) pairs.
+fn typed_terms(terms: &[(String, Vec<f64>)]) -> PyResult<Vec<Term>> {
+    (terms.iter())
+        .map(|(kind, p)| Term::new(Kind::from_name(kind)?, p))
+        .collect::<Result<Vec<Term>, _>>()
+        .map_err(PyErr::from)
+}
+
+fn check_model(taus: &[f64], fs: f64) -> PyResult<()> {
+    if !(fs.is_finite() && fs > 0.0) {
+        return Err(super::value_error(format!(
+            "fs must be finite and > 0; got {fs}"
+        )));
+    }
+    if taus.is_empty() {
+        return Err(super::value_error("taus must not be empty".to_string()));
+    }
+    if let Some(t) = taus.iter().find(|t| !(t.is_finite() && **t > 0.0)) {
+        return Err(super::value_error(format!(
+            "taus must be finite and > 0; got {t}"
+        )));
+    }
+    Ok(())
+}
+
+/// datasheet(terms, cov, taus, fs, filter=None) -> {"N"|"B"|"K": (value, std)}:
+/// the datasheet values of a model (NaN where not resolved) with their
+/// uncertainty propagated from `cov`, the covariance of the terms' coordinates.
+#[pyfunction]
+#[pyo3(signature = (terms, cov, taus, fs, filter=None))]
+fn datasheet<'py>(
+    py: Python<'py>,
+    terms: Vec<(String, Vec<f64>)>,
+    cov: PyReadonlyArray2<'py, f64>,
+    taus: PyReadonlyArray1<'py, f64>,
+    fs: f64,
+    filter: Option<PyReadonlyArray1<'py, f64>>,
+) -> PyResult<Vec<(&'static str, (f64, f64))>> {
+    let typed = typed_terms(&terms)?;
+    let taus = taus.as_array().to_vec();
+    check_model(&taus, fs)?;
+    let filter = output_filter(filter)?;
+    let size: usize = typed
+        .iter()
+        .map(|t| t.kind().coordinate_names().len())
+        .sum();
+    let cov = cov.as_array();
+    if cov.shape() != [size, size] {
+        return Err(super::value_error(format!(
+            "cov must be {size} x {size} (the terms' coordinates); got {:?}",
+            cov.shape()
+        )));
+    }
+    let cov: Vec<Vec<f64>> = cov.rows().into_iter().map(|r| r.to_vec()).collect();
+    let model = fit::datasheet::Model {
+        terms: &typed,
+        taus: &taus,
+        fs,
+        filter: filter.as_ref(),
+    };
+    Ok(py.detach(|| {
+        (fit::datasheet::Datasheet::ALL.iter())
+            .map(|&d| {
+                let v = fit::datasheet::propagated(d, &model, &cov);
+                (d.name(), (v.value, v.std))
+            })
+            .collect()
+    }))
+}
+
+/// model_floor(terms, taus, fs, filter=None) -> (τ, σ) or None: the floor of the
+/// model's deviation over `taus`, where B is read.
+#[pyfunction]
+#[pyo3(signature = (terms, taus, fs, filter=None))]
+fn model_floor<'py>(
+    terms: Vec<(String, Vec<f64>)>,
+    taus: PyReadonlyArray1<'py, f64>,
+    fs: f64,
+    filter: Option<PyReadonlyArray1<'py, f64>>,
+) -> PyResult<Option<(f64, f64)>> {
+    let typed = typed_terms(&terms)?;
+    let taus = taus.as_array().to_vec();
+    check_model(&taus, fs)?;
+    let filter = output_filter(filter)?;
+    Ok(fit::datasheet::floor(&fit::datasheet::Model {
+        terms: &typed,
+        taus: &taus,
+        fs,
+        filter: filter.as_ref(),
+    }))
 }
 
 /// filter_factor(taus, fs, filter) -> c(τ): the white term's Allan variance
@@ -213,15 +252,24 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("IEEE_TERM_NAMES", IEEE_TERM_NAMES.to_vec())?;
     m.add("MAX_GAUSS_MARKOV", MAX_GM)?;
     m.add("MAX_TONES", MAX_TONES)?;
-    m.add("PARAMETERS", PARAMETERS)?;
-    m.add("SINE_SLOT", SINE_SLOT)?;
-    m.add("RESONANCE_SLOT", RESONANCE_SLOT)?;
-    m.add("SKEW_SLOT", SKEW_SLOT)?;
-    m.add("MOTION_SLOT", MOTION_SLOT)?;
+    let kinds: Vec<(&str, Vec<&str>, Vec<&str>)> = (Kind::ALL.iter())
+        .map(|k| {
+            (
+                k.name(),
+                k.parameter_names().to_vec(),
+                k.coordinate_names().to_vec(),
+            )
+        })
+        .collect();
+    m.add("TERM_KINDS", kinds)?;
     m.add("FLICKER_FACTOR", FLICKER_FACTOR)?;
+    m.add("GM_PEAK", fit::term::GM_PEAK)?;
+    m.add("FLAT_SLOPE", fit::datasheet::FLAT_SLOPE)?;
     m.add_class::<PyNoiseFit>()?;
     m.add_function(wrap_pyfunction!(fit_noise, m)?)?;
-    m.add_function(wrap_pyfunction!(noise_terms, m)?)?;
+    m.add_function(wrap_pyfunction!(allan_terms, m)?)?;
     m.add_function(wrap_pyfunction!(filter_factor, m)?)?;
+    m.add_function(wrap_pyfunction!(datasheet, m)?)?;
+    m.add_function(wrap_pyfunction!(model_floor, m)?)?;
     Ok(())
 }

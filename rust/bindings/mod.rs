@@ -105,9 +105,9 @@ fn add_submodule(
 /// Loads NumPy's C API now, while `import imunoise._core` can still fail with
 /// a Python exception. rust-numpy loads it on the first array it touches and
 /// panics (`expect`) if that import raises: a Ctrl-C landing in it (NumPy's
-/// version check runs Python code) reached the CLI as a Rust panic, exit 1,
-/// instead of an interrupt (`benches/faults.py`, SIGINT 1.25 s into
-/// `convert`). Here the panic is caught and a KeyboardInterrupt raised again.
+/// version check runs Python code) would reach the CLI as a Rust panic, exit 1,
+/// instead of an interrupt (`benches/faults.py` sends such a Ctrl-C). Here the
+/// panic is caught and a KeyboardInterrupt raised again.
 fn load_numpy_api(py: Python<'_>) -> PyResult<()> {
     let loaded = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
         numpy::PyArray1::<f64>::zeros(py, 0, false);

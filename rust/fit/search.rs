@@ -48,6 +48,7 @@ use faer::Mat;
 use super::basis::{self, IEEE_TERMS};
 use super::estimate::{self, Data, Solution};
 pub use super::oscillators::{Resonance, Tones, MAX_TONES};
+use super::term::Term;
 use crate::error::CoreResult;
 
 /// Grid of candidate correlation times per decade.
@@ -633,6 +634,58 @@ impl Candidate {
     /// asked of every component beyond the IEEE terms.
     pub fn score(&self) -> f64 {
         self.bic + COMPONENT_EVIDENCE * self.components() as f64
+    }
+
+    /// The typed terms of the candidate: every term whose fitted variance is > 0,
+    /// in the order of [`super::Kind::ALL`].
+    pub fn terms(&self, fs: f64) -> Vec<Term> {
+        let c = self;
+        let theta = &c.solution.theta;
+        let mut terms: Vec<Term> = (0..IEEE_TERMS)
+            .filter(|&j| theta[j] > 0.0)
+            .map(|j| Term::ieee(j, theta[j]))
+            .collect();
+        terms.extend(
+            (c.gm_tau.iter().enumerate())
+                .filter(|(k, _)| theta[IEEE_TERMS + k] > 0.0)
+                .map(|(k, &tau_c)| Term::GaussMarkov {
+                    variance: theta[IEEE_TERMS + k],
+                    tau_c,
+                }),
+        );
+        let tone_column = IEEE_TERMS + c.gm_tau.len();
+        let mut tones: Vec<Term> = (c.sine.as_slice().iter().enumerate())
+            .filter(|(k, _)| theta[tone_column + k] > 0.0)
+            .map(|(k, &freq)| Term::Tone {
+                variance: theta[tone_column + k],
+                freq,
+            })
+            .collect();
+        tones.sort_by(|a, b| match (a, b) {
+            (Term::Tone { freq: x, .. }, Term::Tone { freq: y, .. }) => x.total_cmp(y),
+            _ => std::cmp::Ordering::Equal,
+        });
+        terms.extend(tones);
+        let res_column = tone_column + c.sine.len();
+        let res_columns = c.resonance.map_or(0, Resonance::columns);
+        if let Some(r) = c.resonance {
+            let (variance, skew) = r.variance_and_skew(&theta[res_column..], fs);
+            if variance > 0.0 {
+                terms.push(Term::Resonance {
+                    variance,
+                    freq: r.freq,
+                    tau: r.tau,
+                    skew,
+                });
+            }
+        }
+        if let Some(tau_c) = c.motion {
+            let variance = theta[res_column + res_columns];
+            if variance > 0.0 {
+                terms.push(Term::Motion { variance, tau_c });
+            }
+        }
+        terms
     }
 }
 

@@ -120,11 +120,11 @@ def test_old_spellings_warn_and_name_the_new_one(fast_gm_model):
         np.testing.assert_array_equal(m.equivalent("N"), m.value("N"))
     with pytest.warns(DeprecationWarning, match=r"use model\.K_std"):
         np.testing.assert_array_equal(m.equivalent_std("K"), m.std("K"))
-    with pytest.warns(DeprecationWarning, match=r"model\.components\.gm_sigma"):
+    with pytest.warns(DeprecationWarning, match=r"NoiseModel\.gm_sigma .*use model\.terms"):
         np.testing.assert_array_equal(m.gm_sigma, m.components.gm_sigma)
-    with pytest.warns(DeprecationWarning, match=r"model\.components\.gauss_markov"):
+    with pytest.warns(DeprecationWarning, match=r"NoiseModel\.gauss_markov.*use model\.terms"):
         assert m.gauss_markov(0) == m.components.gauss_markov(0)
-    with pytest.warns(DeprecationWarning, match=r"model\.components\.cov"):
+    with pytest.warns(DeprecationWarning, match=r"NoiseModel\.cov .*use model\.terms"):
         assert m.cov.shape == m.components.cov.shape
     with pytest.raises(AttributeError, match="no attribute 'nonsense'"):
         _ = m.nonsense

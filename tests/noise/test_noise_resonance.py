@@ -26,7 +26,6 @@ from imunoise.noise import resonance_white_density
 matplotlib.use("Agg")
 
 FS = 100.0
-NO_IEEE = [0.0] * 5
 TRUTH = {"N": 1e-3, "K": 2e-5, "sigma": 2e-2, "f_r": 30.0, "tau_r": 0.05}
 
 
@@ -34,8 +33,9 @@ def _curve(taus, *, tone=(), resonance=()):
     """Allan variance of one tone (s², f0) or resonance (σ², f_r, τr) alone, from the
     Rust closed forms."""
     t = np.ascontiguousarray(taus, dtype=float)
-    oscillators = [tuple(r) if len(r) == 4 else (*r, 0.0) for r in resonance]
-    return core_fit.noise_terms(t, FS, NO_IEEE, [], list(tone), oscillators)[:, -1]
+    terms = [("tone", [float(v) for v in r]) for r in tone]
+    terms += [("resonance", [*map(float, r), 0.0][:4]) for r in resonance]
+    return core_fit.allan_terms(t, FS, terms)[:, -1]
 
 
 @pytest.fixture(scope="module")

@@ -27,7 +27,7 @@ FS = 100.0
 
 def _curve(taus, resonance):
     t = np.ascontiguousarray(taus, dtype=float)
-    return core_fit.noise_terms(t, FS, [0.0] * 5, [], [], [resonance])[:, -1]
+    return core_fit.allan_terms(t, FS, [("resonance", [float(v) for v in resonance])])[:, 0]
 
 
 @pytest.mark.parametrize("skew", [1.0, 0.4, -0.6, -1.0])

@@ -42,9 +42,9 @@ def test_white_term_is_drawn_through_the_filter():
     fs, taps = 200.0, np.ones(4)
     taus = np.array([0.005, 0.02, 1.0])
     gain = fir_gain(taps, 513)
-    ieee = [0.0, 2.0, 0.0, 0.0, 0.0]
-    through = core_fit.noise_terms(taus, fs, ieee, [], filter=gain)[:, 1]
-    plain = core_fit.noise_terms(taus, fs, ieee, [])[:, 1]
+    white = [("white", [2.0])]
+    through = core_fit.allan_terms(taus, fs, white, filter=gain)[:, 0]
+    plain = core_fit.allan_terms(taus, fs, white)[:, 0]
     np.testing.assert_allclose(through / plain, core_fit.filter_factor(taus, fs, gain))
     assert through[0] < 0.5 * plain[0] and abs(through[-1] / plain[-1] - 1) < 0.01
 

@@ -11,45 +11,27 @@ MAX_GAUSS_MARKOV: int
 """Most first-order Gauss–Markov terms a model may have."""
 MAX_TONES: int
 """Most tones a model may have."""
-PARAMETERS: int
-"""Slots of the covariance: Q²…R², then (q², ln τc) per Gauss–Markov term, then
-(s², ln f₀) per tone slot, then (r², ln f_r, ln τr, skew) of the resonance, then
-(σθ², ln τc) of the bounded motion."""
-SINE_SLOT: int
-"""Slot of the first tone's variance s² (its ln f₀ follows, then the next tone's)."""
-RESONANCE_SLOT: int
-"""Slot of the resonance's variance r² (its ln f_r, ln τr, skew follow)."""
-SKEW_SLOT: int
-"""Slot of the resonance's skew in [−1, 1], its quadrature part."""
-MOTION_SLOT: int
-"""Slot of the bounded motion's variance σθ² (its ln τc follows)."""
+TERM_KINDS: list[tuple[str, list[str], list[str]]]
+"""Every kind of term in the order a model lists them: (name, parameter names,
+covariance coordinate names)."""
 FLICKER_FACTOR: float
 """(2 ln 2)/π: the Allan variance of flicker rate noise per unit B²."""
+GM_PEAK: float
+"""τ/τc where a first-order Gauss–Markov term's Allan variance peaks (its hump)."""
+FLAT_SLOPE: float
+"""A deviation curve whose log-log slope is above this has flattened (B's floor)."""
 
 @final
 class NoiseFit:
     """The fit of one channel."""
 
     @property
-    def ieee(self) -> npt.NDArray[np.float64]:
-        """(Q², N², B², K², R²)."""
-    @property
-    def gm(self) -> npt.NDArray[np.float64]:
-        """(k, 2) rows of (q², τc), one per Gauss–Markov term."""
-    @property
-    def sine(self) -> npt.NDArray[np.float64]:
-        """(k, 2) rows of (s², f₀), k ≤ MAX_TONES: the tones."""
-    @property
-    def resonance(self) -> npt.NDArray[np.float64]:
-        """(k, 4) rows of (r², f_r, τr, skew), k ≤ 1: the resonance."""
-    @property
-    def motion(self) -> npt.NDArray[np.float64]:
-        """(k, 2) rows of (σθ², τc), k ≤ 1: the bounded motion."""
+    def terms(self) -> list[tuple[str, list[float]]]:
+        """(kind, parameters) of each term, in the model's order."""
     @property
     def cov(self) -> npt.NDArray[np.float64]:
-        """(PARAMETERS, PARAMETERS) covariance of (Q²…R², then q², ln τc per slot,
-        then s², ln f₀ per tone slot, then r², ln f_r, ln τr, skew, then σθ², ln τc; NaN
-        variance of ln f_r at fs/2 and of the skew at ±1)."""
+        """Covariance of the terms' coordinates, term after term (NaN variance for
+        a coordinate on a bound)."""
     @property
     def discrepancy(self) -> float:
         """δ, the relative model discrepancy."""
@@ -86,19 +68,14 @@ def fit_noise(
     output-filter power gain G at L ≥ 2 frequencies evenly spaced from 0 Hz
     (G = 1) to fs/2; the white term is seen through it."""
 
-def noise_terms(
+def allan_terms(
     taus: npt.NDArray[np.float64],
     fs: float,
-    ieee: list[float],
-    gm: list[tuple[float, float]],
-    sine: list[tuple[float, float]] = ...,
-    resonance: list[tuple[float, float, float, float]] = ...,
-    motion: list[tuple[float, float]] = ...,
+    terms: list[tuple[str, list[float]]],
     filter: npt.NDArray[np.float64] | None = None,
 ) -> npt.NDArray[np.float64]:
-    """Allan variance of each model term at ``taus``: (len(taus), 5 + len(gm) +
-    len(sine) + len(resonance) + len(motion)), ``sine`` as (s², f₀) pairs,
-    ``resonance`` as (r², f_r, τr, skew) quadruples, ``motion`` as (σθ², τc) pairs."""
+    """Allan variance of each term, given as (kind, parameters) (``TERM_KINDS``),
+    at ``taus``: (len(taus), len(terms)); the white term through ``filter``."""
 
 def filter_factor(
     taus: npt.NDArray[np.float64],
@@ -107,3 +84,22 @@ def filter_factor(
 ) -> npt.NDArray[np.float64]:
     """c(τ): the white term's Allan variance through the output filter ``filter``
     (power gain from 0 Hz to fs/2, G(0) = 1) over the one without."""
+
+def datasheet(
+    terms: list[tuple[str, list[float]]],
+    cov: npt.NDArray[np.float64],
+    taus: npt.NDArray[np.float64],
+    fs: float,
+    filter: npt.NDArray[np.float64] | None = None,
+) -> list[tuple[str, tuple[float, float]]]:
+    """(name, (value, std)) of N, B, K of a model given as (kind, parameters) terms
+    with ``cov`` the covariance of their coordinates; NaN where not resolved."""
+
+def model_floor(
+    terms: list[tuple[str, list[float]]],
+    taus: npt.NDArray[np.float64],
+    fs: float,
+    filter: npt.NDArray[np.float64] | None = None,
+) -> tuple[float, float] | None:
+    """(τ, σ) of the floor of the model's deviation over ``taus`` (where B is read),
+    or None where the curve has none."""

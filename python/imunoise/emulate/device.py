@@ -46,7 +46,7 @@ _STEP = 0.02
 _CORRUPT_AT = 10
 #: Fastest time compression (sensor seconds per wall second): an hour of sensor
 #: time in 3.6 s, 800 000 IMU samples a second, already more than a pty carries
-#: at 800 Hz binary; 1e300 overflowed the sensor's clock and killed its thread.
+#: at 800 Hz binary; a bound also keeps the sensor's clock finite.
 MAX_SPEED = 1000.0
 #: Latest fault time and longest pause or vanish (s of sensor time): a year.
 MAX_FAULT_SECONDS = 365 * 86400.0

@@ -56,8 +56,9 @@ G(f) = |H(f)|² from the spectrum's shape above its white region
 What a user reads, ``model.N``, ``B``, ``K``, ``Q``, ``R``, are the datasheet values of
 the whole fitted model (``_datasheet``): a Gauss–Markov term faster than 1 s counts in
 N, a slower one's +½ slope in K, B is the model's flat minimum / 0.6643; every view
-prints these. The fit's own parameters are :attr:`NoiseModel.components`
-(``_components``).
+prints these. The fit's own parameters are :attr:`NoiseModel.terms`, one typed
+term per fitted component (``_typed``: :class:`White`, :class:`GaussMarkov`,
+:class:`Tone`, …); :attr:`NoiseModel.components` holds them as parallel arrays.
 
 Whatever the method, :attr:`NoiseModel.readoff` holds the datasheet read-offs
 of the data (N at 1 s, K at 3 s, B = σ_min/0.6643) next to the model, and
@@ -91,8 +92,21 @@ from imunoise.noise._terms import (
     resolution_noise,
     resonance_white_density,
 )
+from imunoise.noise._typed import (
+    Flicker,
+    GaussMarkov,
+    Motion,
+    Quantization,
+    Ramp,
+    RandomWalk,
+    Resonance,
+    Term,
+    Tone,
+    White,
+)
 
 __all__ = ["TERMS", "FLICKER", "GM_MAX", "TONES_MAX", "Components", "NoiseModel", "OutputFilter",
            "Prediction", "estimate_filter", "filter_factor", "filtered_prediction", "fit",
            "format_table", "gm_white_density", "model_variance", "resolution_noise",
-           "resonance_white_density"]
+           "resonance_white_density", "Term", "Quantization", "White", "Flicker", "RandomWalk",
+           "Ramp", "GaussMarkov", "Tone", "Resonance", "Motion"]

@@ -29,8 +29,11 @@ A bounded motion of the mount (the platform's, not the sensor's) is part of the
 curve B is read from, but neither N nor K: under it a sensor's own white noise may
 not show at all, and N is then not resolved rather than the platform's rocking.
 
-With ``method="slopes"`` every value is the read-off coefficient. Uncertainties
-are propagated from the fit's covariance through a numerical gradient.
+With ``method="slopes"`` every value is the read-off coefficient. The values of a
+``"wls"`` fit and their uncertainties, propagated from the fit's covariance through
+a numerical gradient, come from the core (``rust/fit/datasheet.rs``; each term's
+share of N and K is its own, ``rust/fit/term.rs``); :func:`upper_bounds` and the
+notes are here.
 """
 
 from __future__ import annotations
@@ -41,19 +44,8 @@ import numpy as np
 
 from imunoise._core import fit as _core_fit
 from imunoise.noise._terms import (
-    FLAT_SLOPE,
-    FLICKER,
-    GM_MAX,
     GM_PEAK,
-    MOTION_SLOT,
-    PARAMS,
-    RES_SLOT,
-    SINE_SLOT,
-    SKEW_SLOT,
     TERMS,
-    gm_white_density,
-    is_log_time,
-    resonance_white_density,
     term_variances,
 )
 
@@ -61,142 +53,30 @@ from imunoise.noise._terms import (
 _B_GRID = 200
 
 
-def datasheet_values(components, taus, method: str) -> dict[str, tuple[np.ndarray, np.ndarray]]:
-    """``{term: (values, stds)}``, each of shape (channels,), for Q, N, B, K, R."""
-    out = {}
-    for term in TERMS:
-        if method != "wls" or term not in ("N", "B", "K"):
-            out[term] = (components.value(term).astype(float),
-                         components.std(term).astype(float))
-        else:
-            out[term] = _propagated(components, np.asarray(taus, float), term)
+def datasheet_values(components, core, taus,
+                     method: str) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    """``{term: (values, stds)}``, each of shape (channels,), for Q, N, B, K, R.
+    ``core``: per channel, the core fit's (kind, parameters) terms and the
+    covariance of their coordinates (``"wls"``), from which N, B, K and their
+    uncertainties come (Rust: ``rust/fit/datasheet.rs``)."""
+    out = {term: (components.value(term).astype(float), components.std(term).astype(float))
+           for term in TERMS}
+    if method != "wls":
+        return out
+    taus = np.ascontiguousarray(taus, dtype=float)
+    values = {t: np.full(components.channels, np.nan) for t in ("N", "B", "K")}
+    stds = {t: np.full(components.channels, np.nan) for t in ("N", "B", "K")}
+    for c, (terms, cov) in enumerate(core):
+        for name, (v, e) in _core_fit.datasheet(terms, cov, taus, float(components.fs)):
+            values[name][c], stds[name][c] = v, e
+    out.update({t: (values[t], stds[t]) for t in values})
     return out
-
-
-def _propagated(components, taus, term: str) -> tuple[np.ndarray, np.ndarray]:
-    channels = components.channels
-    values = np.zeros(channels)
-    stds = np.full(channels, np.nan)
-    cov = np.reshape(components.cov, (channels, PARAMS, PARAMS))
-    fs = float(components.fs)
-    for c in range(channels):
-        p = parameters(components, c)
-        f0 = value_of(term, p, taus, fs)
-        values[c] = f0
-        if not f0 > 0:
-            continue
-        active = np.flatnonzero(np.diag(cov[c]) > 0)
-        grad = np.zeros(PARAMS)
-        for j in active:
-            up, down = p.copy(), p.copy()
-            if j == SKEW_SLOT:  # either sign, within [−1, 1]
-                h = 1e-4
-                up[j], down[j] = min(p[j] + h, 1.0), max(p[j] - h, -1.0)
-            else:
-                h = 1e-4 if is_log_time(j) else 1e-4 * p[j]
-                up[j] += h
-                down[j] = max(down[j] - h, 0.0) if not is_log_time(j) else down[j] - h
-            grad[j] = (value_of(term, up, taus, fs) - value_of(term, down, taus, fs)) / (
-                up[j] - down[j])
-        # Over the free parameters only: one not free (a frequency at fs/2, a skew at
-        # ±1) has a NaN variance and no covariance.
-        g = grad[active]
-        stds[c] = math.sqrt(max(float(g @ cov[c][np.ix_(active, active)] @ g), 0.0))
-    return values, stds
-
-
-def parameters(components, channel: int) -> np.ndarray:
-    """(Q², N², B², K², R², then σ², ln τc per Gauss–Markov slot, then A²/2,
-    ln f0 per tone slot, then σ², ln f_r, ln τr, skew of the resonance, then σθ², ln τc
-    of the bounded motion) of a channel."""
-    p = np.zeros(PARAMS)
-    p[:5] = [float(components.value(t)[channel]) ** 2 for t in TERMS]
-    for k, (sigma, tau_c) in enumerate(components.gauss_markov(channel)):
-        p[5 + 2 * k], p[6 + 2 * k] = sigma**2, math.log(tau_c)
-    for k, (amplitude, f0) in enumerate(components.sine(channel)):
-        p[SINE_SLOT + 2 * k], p[SINE_SLOT + 2 * k + 1] = amplitude**2 / 2, math.log(f0)
-    for sigma, f_r, tau_r, skew in components.resonance(channel):
-        p[RES_SLOT:SKEW_SLOT + 1] = sigma**2, math.log(f_r), math.log(tau_r), skew
-    for sigma, tau_c in components.motion(channel):
-        p[MOTION_SLOT], p[MOTION_SLOT + 1] = sigma**2, math.log(tau_c)
-    return p
-
-
-def model_floor(p: np.ndarray, taus: np.ndarray, fs: float) -> tuple[float, float] | None:
-    """(τ, σ) of the floor of the model's deviation over the fitted taus, where B is
-    read; None where the curve has none.
-
-    The floor is the curve's minimum. Where that minimum is the last tau and the
-    curve still falls there (slope below −¼), it is the lowest valley of the curve
-    (where its slope turns from falling to rising), else the lowest point of its
-    flat parts (log-log slope ≥ −¼): a slow Gauss–Markov bump beyond a flat bottom
-    falls again past its peak, and the bottom before it is the bias floor a reader
-    sees. A curve that never flattens after falling has none (a filter's rising
-    head at the shortest taus is no floor). The tone, the resonance and a
-    bounded motion are part of the curve whose floor B is read from; the tone and
-    the resonance are neither white nor a walk, so N and K leave them out.
-    """
-    gm = _gauss_markov(p)
-    tone = [(p[s], math.exp(p[s + 1])) for s in range(SINE_SLOT, RES_SLOT, 2) if p[s] > 0]
-    osc = [_resonance(p)] if p[RES_SLOT] > 0 else []
-    moving = [(p[MOTION_SLOT], math.exp(p[MOTION_SLOT + 1]))] if p[MOTION_SLOT] > 0 else []
-    grid = np.geomspace(taus[0], taus[-1], _B_GRID)
-    dev = np.sqrt(_core_fit.noise_terms(grid, fs, list(p[:5]), gm, tone, osc, moving)
-                  .sum(axis=1))
-    i = int(np.argmin(dev))
-    slope = np.log(dev[-1] / dev[-2]) / np.log(grid[-1] / grid[-2])
-    if i == grid.size - 1 and slope < FLAT_SLOPE:
-        # the curve without its oscillators: a tone's comb has a zero at every period
-        smooth = np.sqrt(_core_fit.noise_terms(grid, fs, list(p[:5]), gm, [], [], moving)
-                         .sum(axis=1))
-        with np.errstate(divide="ignore", invalid="ignore"):  # 0 without other terms: no floor
-            slope = np.gradient(np.log(smooth), np.log(grid))
-        # only where the curve has fallen into it: a head that rises or stays flat
-        # and then falls is a filter's or a fast Gauss–Markov term's hump, no bias
-        # floor (a sensor low-pass filtered at 100 Hz read B 40× the truth there)
-        flat = (slope >= FLAT_SLOPE) & (np.cumsum(slope < FLAT_SLOPE) > 0)
-        if not flat.any():
-            return None
-        # a valley (the slope turns from falling to rising) where the curve has
-        # one; else the lowest point of a shoulder
-        valley = np.zeros_like(flat)
-        valley[1:] = (slope[:-1] < 0) & (slope[1:] >= 0)
-        i = int(np.argmin(np.where(valley if valley.any() else flat, smooth, np.inf)))
-    return float(grid[i]), float(dev[i])
-
-
-def _resonance(p: np.ndarray) -> tuple[float, float, float, float]:
-    """(σ², f_r, τr, skew) of the resonance of ``p``."""
-    return p[RES_SLOT], math.exp(p[RES_SLOT + 1]), math.exp(p[RES_SLOT + 2]), p[SKEW_SLOT]
-
-
-def _gauss_markov(p: np.ndarray) -> list[tuple[float, float]]:
-    """(σ², τc) of each Gauss–Markov slot of ``p`` in use."""
-    return [(p[5 + 2 * k], math.exp(p[6 + 2 * k])) for k in range(GM_MAX) if p[5 + 2 * k] > 0]
 
 
 def walks_beyond(tau_c: float, taus: np.ndarray) -> bool:
     """Whether a Gauss–Markov term of correlation time ``tau_c`` still rises at the
     longest fitted tau (its hump lies beyond the record), and so may stand in for K."""
     return GM_PEAK * tau_c > float(taus[-1])
-
-
-def value_of(term: str, p: np.ndarray, taus: np.ndarray, fs: float) -> float:
-    """The datasheet value of ``term`` for the parameter vector ``p``; NaN where
-    not resolved."""
-    if term == "B":
-        floor = model_floor(p, taus, fs)
-        return math.nan if floor is None else floor[1] / FLICKER
-    total = p[1] if term == "N" else p[3]
-    if term == "N" and p[RES_SLOT] > 0 and p[RES_SLOT + 2] <= 0.0:  # τr ≤ 1 s
-        r2, f_r, tau_r, skew = _resonance(p)
-        total += resonance_white_density(1.0, f_r, tau_r, fs, skew) * r2
-    for q2, tau_c in _gauss_markov(p):
-        if term == "N" and tau_c <= 1.0:
-            total += q2 * gm_white_density(1.0, tau_c, fs)
-        elif term == "K" and tau_c > 1.0 and walks_beyond(tau_c, taus):
-            total += 2.0 * q2 / tau_c
-    return math.sqrt(total) if total > 0 else math.nan
 
 
 #: Confidence of the bound on a value the data do not resolve.

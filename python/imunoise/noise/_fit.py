@@ -13,10 +13,11 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
-from imunoise import _warn
+from imunoise import _warn, display
 from imunoise._core import fit as _core_fit
 from imunoise._deprecation import old_call_forms
 from imunoise.errors import CoverageWarning, ImunoiseTypeError, ImunoiseValueError
+from imunoise.noise import _typed
 from imunoise.noise._components import Components
 from imunoise.noise._datasheet import datasheet_notes, datasheet_values, upper_bounds
 from imunoise.noise._filter import OutputFilter, estimate_filter
@@ -268,6 +269,7 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
     moving_std = np.full((channels, 2), np.nan)
     stats = np.full((channels, 3), np.nan)  # discrepancy, chi2, n_eff
     cov = np.full((channels, PARAMS, PARAMS), np.nan)
+    core: list = [None] * channels  # per channel: the core's terms and their covariance
     usable = []
     for c in range(channels):
         ok = np.isfinite(var[:, c]) & (var[:, c] > 0) & np.isfinite(edf[:, c]) & (edf[:, c] > 0)
@@ -292,7 +294,7 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
             fits = list(pool.map(fit_channel, range(channels)))
         for c, out in enumerate(fits):
             coef[c], std[c], sup[c], gm[c], gm_std[c], sine[c], sine_std[c], osc[c], \
-                osc_std[c], moving[c], moving_std[c], stats[c], cov[c] = out
+                osc_std[c], moving[c], moving_std[c], stats[c], cov[c], core[c] = out
             markov = [(a, b) for a, b in gm[c] if np.isfinite(a)]
             tones = [tuple(p) for p in sine[c] if np.isfinite(p[0])]
             oscs = [tuple(osc[c])] if np.isfinite(osc[c, 0]) else []
@@ -326,6 +328,14 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
                 _bootstrap_std(result, n_record, coef[c], markov, (tones, oscs, motions),
                                int(replicates), generator, options)
     std[~sup] = np.nan
+    typed = tuple(_typed_terms(coef[c], std[c], gm[c], gm_std[c], sine[c], sine_std[c], osc[c],
+                               osc_std[c], moving[c], moving_std[c]) for c in range(channels))
+    requested = () if select or method != "wls" else tuple(terms)
+    unplaced = [_unplaced(requested, typed[c]) for c in range(channels)]
+    if any(unplaced):
+        where = "; ".join(f"channel {c}: {', '.join(u)}" for c, u in enumerate(unplaced) if u)
+        _warn.warn(f"fit(terms=...): the data put requested terms at 0 ({where}); the model "
+                   "has the others (model.notes says which)", CoverageWarning)
 
     def shaped(a):
         out = np.array(a[0] if one else a)
@@ -360,7 +370,7 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
         cov=shaped(cov),
         fs=float(result.fs),
     )
-    sheet = datasheet_values(components, taus, method)
+    sheet = datasheet_values(components, core, taus, method)
     if uncertainty == "bootstrap":
         sheet = {k: (v, sheet_std[:, i]) for i, (k, (v, _)) in enumerate(sheet.items())}
     resolved = {k: (v > 0) & np.isfinite(v) for k, (v, _) in sheet.items()}
@@ -370,11 +380,12 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
         **{k + "_std": shaped(np.where(resolved[k], e, np.nan)) for k, (_, e) in sheet.items()},
         supported={k: shaped(v) for k, v in resolved.items()},
         upper={k: shaped(np.where(resolved[k], np.nan, bounds[k])) for k in TERMS},
-        notes=tuple((*datasheet_notes(components, taus, c, method),
+        notes=tuple((*datasheet_notes(components, taus, c, method), *_unplaced_note(unplaced[c]),
                      *_filter_notes(filters[c], spectrum, output_filter, method))
                     for c in range(channels)),
         lines=tuple(_lines(components, spectrum, c) for c in range(channels)),
-        components=components,
+        _arrays=components,
+        terms=typed,
         method=method,
         kind=result.kind,
         fs=float(result.fs),
@@ -397,7 +408,8 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
     for c in np.flatnonzero(cover < 0.8) if method == "wls" and warn_coverage else ():
         _warn.warn(
             f"the noise model follows the Allan deviation of channel {c} at only "
-            f"{cover[c]:.0%} of the taus (inside the 95 % interval or within 5 %); its "
+            f"{display.percent(cover[c])} of the taus (inside the 95 % interval or within "
+            "5 %); its "
             "coefficients summarise a curve they do not describe: plot it with "
             "result.plot(model) or imunoise.plot.allan(result, model=model)",
             CoverageWarning,
@@ -575,7 +587,7 @@ def _bootstrap_std(result, n, coef, markov, oscillators, replicates, rng, option
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)
         refit = fit(again, **options)
-    parts = refit.components
+    parts = refit._arrays
     values = np.stack([np.atleast_1d(parts.value(t)) for t in TERMS], axis=1)
     gm = np.stack([np.reshape(parts.gm_sigma, (-1, GM_MAX)),
                    np.reshape(parts.gm_tau, (-1, GM_MAX))], axis=-1)
@@ -612,52 +624,107 @@ def _fit_wls(t, v, e, fs, mask, gm_count, oscillators, select, found=None):
                                     filter=np.ascontiguousarray(found.gain))
     except ValueError as exc:
         raise ImunoiseValueError(f"cannot fit the noise model to result: {exc}") from None
-    sq, gm, cov = r.ieee, r.gm, r.cov
-    delta, chi2, n_eff = r.discrepancy, r.chi2, r.n_eff
-    supported = sq > 0
-    coef = np.sqrt(np.maximum(sq, 0.0))
-    var_sq = np.diag(cov)[:5]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        std = np.where(supported, np.sqrt(np.maximum(var_sq, 0.0)) / (2.0 * coef), np.nan)
-    markov = np.full((GM_MAX, 2), np.nan)
-    markov_std = np.full((GM_MAX, 2), np.nan)
-    for k, (q2, tau_c) in enumerate(gm):
-        sigma = math.sqrt(q2)
-        markov[k] = sigma, tau_c
-        u_q2, u_log_tau = cov[5 + 2 * k, 5 + 2 * k], cov[6 + 2 * k, 6 + 2 * k]
-        markov_std[k] = math.sqrt(max(u_q2, 0.0)) / (2 * sigma), tau_c * math.sqrt(
-            max(u_log_tau, 0.0))
-    sine = np.full((TONES_MAX, 2), np.nan)
-    sine_std = np.full((TONES_MAX, 2), np.nan)
-    for k, (s2, f0) in enumerate(r.sine):
-        # s² = A²/2, so u(A) = u(s²)/A.
-        amplitude = math.sqrt(2 * s2)
-        slot = SINE_SLOT + 2 * k
-        sine[k] = amplitude, f0
-        sine_std[k] = (math.sqrt(max(cov[slot, slot], 0.0)) / amplitude,
-                       f0 * math.sqrt(max(cov[slot + 1, slot + 1], 0.0)))
-    osc = np.full(4, np.nan)
-    osc_std = np.full(4, np.nan)
-    for r2, f_r, tau_r, skew in r.resonance:
-        # u(σ) = u(σ²)/(2σ); f_r, τr from their logarithms (NaN: f_r on the fs/2
-        # bound); the skew as it is (0 without a quadrature part, NaN at ±1).
-        sigma = math.sqrt(r2)
-        osc[:] = sigma, f_r, tau_r, skew
-        u_skew = cov[SKEW_SLOT, SKEW_SLOT]
-        osc_std[:] = (math.sqrt(max(cov[RES_SLOT, RES_SLOT], 0.0)) / (2 * sigma),
-                      f_r * math.sqrt(cov[RES_SLOT + 1, RES_SLOT + 1]) if np.isfinite(
-                          cov[RES_SLOT + 1, RES_SLOT + 1]) else np.nan,
-                      tau_r * math.sqrt(max(cov[RES_SLOT + 2, RES_SLOT + 2], 0.0)),
-                      math.sqrt(max(u_skew, 0.0)) if np.isfinite(u_skew) else np.nan)
-    moving = np.full(2, np.nan)
-    moving_std = np.full(2, np.nan)
-    for v2, tau_c in r.motion:
-        sigma = math.sqrt(v2)
-        moving[:] = sigma, tau_c
-        moving_std[:] = (math.sqrt(max(cov[MOTION_SLOT, MOTION_SLOT], 0.0)) / (2 * sigma),
-                         tau_c * math.sqrt(max(cov[MOTION_SLOT + 1, MOTION_SLOT + 1], 0.0)))
-    return (np.where(supported, coef, 0.0), std, supported, markov, markov_std, sine, sine_std,
-            osc, osc_std, moving, moving_std, (delta, chi2, n_eff), cov)
+    terms = _typed.from_core(r.terms, np.asarray(r.cov))
+    return _legacy_arrays(terms) + (
+        (r.discrepancy, r.chi2, r.n_eff), _slot_covariance(r.terms, np.asarray(r.cov)),
+        (r.terms, np.asarray(r.cov)))
+
+
+def _legacy_arrays(terms):
+    """The deprecated ``Components`` arrays of one channel from its typed terms:
+    IEEE coefficients, their stds and support, then (value, std) per Gauss–Markov
+    slot, tone slot, the resonance and the motion (NaN in unused slots)."""
+    coef, std = np.zeros(5), np.full(5, np.nan)
+    markov, markov_std = np.full((GM_MAX, 2), np.nan), np.full((GM_MAX, 2), np.nan)
+    sine, sine_std = np.full((TONES_MAX, 2), np.nan), np.full((TONES_MAX, 2), np.nan)
+    osc, osc_std = np.full(4, np.nan), np.full(4, np.nan)
+    moving, moving_std = np.full(2, np.nan), np.full(2, np.nan)
+    k_gm = k_tone = 0
+    for term in terms:
+        if isinstance(term, _typed._Ieee):
+            j = TERMS.index(term.name)
+            coef[j], std[j] = term.value, getattr(term, term.name + "_std")
+        elif isinstance(term, _typed.GaussMarkov):
+            markov[k_gm] = term.sigma, term.tau_c
+            markov_std[k_gm] = term.sigma_std, term.tau_c_std
+            k_gm += 1
+        elif isinstance(term, _typed.Tone):
+            sine[k_tone] = term.amplitude, term.freq
+            sine_std[k_tone] = term.amplitude_std, term.freq_std
+            k_tone += 1
+        elif isinstance(term, _typed.Resonance):
+            osc[:] = term.sigma, term.freq, term.tau, term.skew
+            osc_std[:] = term.sigma_std, term.freq_std, term.tau_std, term.skew_std
+        elif isinstance(term, _typed.Motion):
+            moving[:] = term.sigma, term.tau_c
+            moving_std[:] = term.sigma_std, term.tau_c_std
+    supported = coef > 0
+    return (coef, std, supported, markov, markov_std, sine, sine_std, osc, osc_std, moving,
+            moving_std)
+
+
+#: The name ``fit(terms=...)`` gives each kind of term.
+_REQUESTED = {_typed.GaussMarkov: "GM", _typed.Tone: "sine", _typed.Resonance: "resonance",
+              _typed.Motion: "motion"}
+
+
+def _unplaced(requested, terms) -> list[str]:
+    """The requested terms (``fit(terms=...)`` names) that one channel's fit has not:
+    the data put their variance at 0."""
+    left = list(requested)
+    for term in terms:
+        name = term.name if isinstance(term, _typed._Ieee) else _REQUESTED[type(term)]
+        if name in left:
+            left.remove(name)
+    return left
+
+
+def _unplaced_note(names) -> tuple[str, ...]:
+    if not names:
+        return ()
+    return (f"requested {', '.join(names)} came out at 0: the data hold none of "
+            f"{'it' if len(names) == 1 else 'them'} at this record's length and noise",)
+
+
+def _typed_terms(coef, std, gm, gm_std, sine, sine_std, osc, osc_std, moving, moving_std):
+    """One channel's typed terms from its arrays (after a bootstrap has replaced
+    their uncertainties): the terms present, in the model's order."""
+    terms: list[_typed.Term] = [
+        _typed.IEEE[name](float(coef[j]), float(std[j]))
+        for j, name in enumerate(TERMS) if coef[j] > 0]
+    terms += [_typed.GaussMarkov(*map(float, (*gm[k], *gm_std[k])))
+              for k in range(len(gm)) if np.isfinite(gm[k, 0])]
+    terms += [_typed.Tone(*map(float, (*sine[k], *sine_std[k])))
+              for k in range(len(sine)) if np.isfinite(sine[k, 0])]
+    if np.isfinite(osc[0]):
+        terms.append(_typed.Resonance(*map(float, (*osc, *osc_std))))
+    if np.isfinite(moving[0]):
+        terms.append(_typed.Motion(*map(float, (*moving, *moving_std))))
+    return tuple(terms)
+
+
+def _slot_covariance(core_terms, cov):
+    """The core's covariance, term after term, laid out in the deprecated
+    ``Components.cov`` slots (0 for slots no term fills)."""
+    out = np.zeros((PARAMS, PARAMS))
+    slots = []
+    counts = {"gauss_markov": 0, "tone": 0}
+    for kind, _ in core_terms:
+        if kind in _typed.KINDS and issubclass(_typed.KINDS[kind], _typed._Ieee):
+            slots.append(TERMS.index(_typed.KINDS[kind].name))
+        elif kind == "gauss_markov":
+            slots += [5 + 2 * counts[kind], 6 + 2 * counts[kind]]
+            counts[kind] += 1
+        elif kind == "tone":
+            slots += [SINE_SLOT + 2 * counts[kind], SINE_SLOT + 2 * counts[kind] + 1]
+            counts[kind] += 1
+        elif kind == "resonance":
+            slots += [RES_SLOT, RES_SLOT + 1, RES_SLOT + 2, SKEW_SLOT]
+        else:
+            slots += [MOTION_SLOT, MOTION_SLOT + 1]
+    index = np.array(slots, dtype=int)
+    out[np.ix_(index, index)] = cov
+    return out
 
 
 def _less(args, excess):

@@ -12,6 +12,7 @@ import numpy as np
 from imunoise import _schema, _summary, _warn
 from imunoise import display as _display
 from imunoise import units as _units
+from imunoise._core import fit as _core_fit
 from imunoise._deprecation import old_call_forms
 from imunoise.errors import ImunoiseDeprecationWarning, ImunoiseValueError
 from imunoise.noise._components import (
@@ -22,6 +23,7 @@ from imunoise.noise._components import (
     finite_list,
 )
 from imunoise.noise._terms import NAMES, SENSOR_NAMES, TERMS
+from imunoise.noise._typed import Term
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -56,7 +58,7 @@ class NoiseModel(PerTerm):
     ====  ==================================================================
 
     A value the data cannot show is NaN with :attr:`upper` its 95 % bound, never
-    0. The fit's own parameters are :attr:`components`. All arrays are read-only.
+    0. The fit's own parameters are :attr:`terms`. All arrays are read-only.
 
     Attributes
     ----------
@@ -90,8 +92,15 @@ class NoiseModel(PerTerm):
         :func:`imunoise.fit` (``in_spectrum`` None where none was given): a tone is
         reported as a line only where the spectrum shows one, at its frequency
         (:mod:`imunoise.spectral_lines`).
+    terms : tuple of tuple of Term
+        Per channel, the fitted terms, typed (``imunoise.noise.White``,
+        ``GaussMarkov``, ``Tone``, …, each with its parameters and their standard
+        uncertainties), in the model's order: the IEEE terms, Gauss–Markov terms by
+        increasing τc, tones by increasing frequency, the resonance, the motion.
+        ``model.terms[0]`` is the first channel's.
     components : Components
-        The fitted components: IEEE coefficients of the fit, Gauss–Markov terms
+        Deprecated (a ``DeprecationWarning``; kept for one release): the same
+        fitted terms as parallel arrays: IEEE coefficients of the fit, Gauss–Markov terms
         (σ, τc), the tone (A, f0) and the resonance (σ, f_r, τr), with their
         uncertainties, covariance and support ranges.
     method : str
@@ -127,7 +136,8 @@ class NoiseModel(PerTerm):
     still work for one release with a ``DeprecationWarning`` naming the new one.
     """
 
-    components: Components
+    _arrays: Components = field(repr=False)
+    terms: tuple[tuple[Term, ...], ...] = field(repr=False)
     method: str
     kind: str
     fs: float
@@ -158,17 +168,15 @@ class NoiseModel(PerTerm):
         ``terms["resonance"]`` for the resonance and ``terms["motion"]`` for a
         bounded motion (when a channel has one).
         """
-        return self.components.predict(self.taus if taus is None else taus)
+        return self._arrays.predict(self.taus if taus is None else taus)
 
     def floor(self, channel: int = 0) -> tuple[float, float] | None:
         """(τ, σ(τ)) of the model's floor over the fitted taus, where ``B`` is read
         (B = σ/√(2 ln2/π)); None where the curve has none (B not resolved)."""
-        from imunoise.noise._datasheet import model_floor, parameters
-
         if self.method != "wls":
             return None
-        p = parameters(self.components, channel)
-        return model_floor(p, np.asarray(self.taus, float), float(self.fs))
+        return _core_fit.model_floor([t.core() for t in self.terms[channel]],
+                                     np.ascontiguousarray(self.taus, dtype=float), float(self.fs))
 
     def plot(self, result: AllanResult, **kwargs) -> Figure:
         """The model over ``result``, the Allan result it was fitted to, with its terms,
@@ -189,25 +197,32 @@ class NoiseModel(PerTerm):
         return self.std(term)
 
     def gauss_markov(self, channel: int = 0) -> list[tuple[float, float]]:
-        """Deprecated: now ``model.components.gauss_markov(channel)``."""
-        _moved("gauss_markov()", "model.components.gauss_markov()")
-        return self.components.gauss_markov(channel)
+        """Deprecated: the :class:`GaussMarkov` terms of ``model.terms[channel]``."""
+        _moved("gauss_markov()", "model.terms")
+        return self._arrays.gauss_markov(channel)
 
     def sine(self, channel: int = 0) -> list[tuple[float, float]]:
-        """Deprecated: now ``model.components.sine(channel)``."""
-        _moved("sine()", "model.components.sine()")
-        return self.components.sine(channel)
+        """Deprecated: the :class:`Tone` terms of ``model.terms[channel]``."""
+        _moved("sine()", "model.terms")
+        return self._arrays.sine(channel)
 
     def resonance(self, channel: int = 0) -> list[tuple[float, float, float]]:
-        """Deprecated: now ``model.components.resonance(channel)``."""
-        _moved("resonance()", "model.components.resonance()")
-        return self.components.resonance(channel)
+        """Deprecated: the :class:`Resonance` term of ``model.terms[channel]``."""
+        _moved("resonance()", "model.terms")
+        return self._arrays.resonance(channel)
+
+    @property
+    def components(self) -> Components:
+        """Deprecated: the fitted terms as parallel arrays (``gm_sigma``, ``sine_freq``,
+        …); :attr:`terms` holds them typed, per axis."""
+        _moved("components", "model.terms (each axis's typed terms)")
+        return self._arrays
 
     def __getattr__(self, name: str):
         # Only reached for names the class does not define: the fields that moved.
         if name in _MOVED_FIELDS:
-            _moved(name, f"model.components.{name}")
-            return getattr(self.components, name)
+            _moved(name, "model.terms")
+            return getattr(self._arrays, name)
         raise AttributeError(f"'NoiseModel' object has no attribute {name!r}")
 
     # -- summaries ----------------------------------------------------------
@@ -217,7 +232,7 @@ class NoiseModel(PerTerm):
         uncertainty, then the components beyond the IEEE terms."""
         terms = [f"{t}={_summary.estimate(self.value(t)[channel], self.std(t)[channel])}"
                  for t in TERMS if self.resolved(t)[channel]]
-        parts = self.components
+        parts = self._arrays
         gm = len(parts.gauss_markov(channel))
         extra = "".join(f", tone {_summary.number(line.frequency)} Hz"
                         for line in self.lines[channel] if line.reported)
@@ -254,7 +269,7 @@ class NoiseModel(PerTerm):
                 v, e = self.value(t)[c], self.std(t)[c]
                 row.append(_summary.estimate(v, e) if self.resolved(t)[c]
                            else _display.upper_bound(np.atleast_1d(self.upper[t])[c]))
-            row.append(self.components.structure(c))
+            row.append(self._arrays.structure(c))
             row.append(f"{100 * float(np.atleast_1d(self.coverage)[c]):.3g} %")
             rows.append(row)
         return _summary.html_table(
@@ -345,7 +360,7 @@ class NoiseModel(PerTerm):
             rows.append(row)
         # σ and A in B's unit (a rate), a motion's σθ in Q's (rate·s)
         like = {None: "B", "Q": "Q"}
-        for term, quantity, unit, values, stds in self.components.other_terms():
+        for term, quantity, unit, values, stds in self._arrays.other_terms():
             as_term = like.get(unit)
             shown = conv[as_term]["unit"] if as_term else unit
 
@@ -436,7 +451,8 @@ class NoiseModel(PerTerm):
     def to_dict(self) -> dict:
         """Plain-Python view of the model (lists and floats), e.g. for JSON: the
         datasheet values under their names (``None`` where not resolved, with
-        ``"upper"`` the bound), the fitted components under ``"components"``."""
+        ``"upper"`` the bound), each axis's fitted terms under ``"terms"`` (and as
+        parallel arrays under ``"components"``, for one release)."""
         d = {"method": self.method, "kind": self.kind, "fs": self.fs,
              "overlapping": self.overlapping, "channels": self.channels,
              "taus": self.taus.tolist(), "units": dict(_INPUT_UNITS)}
@@ -445,7 +461,8 @@ class NoiseModel(PerTerm):
                        "upper": finite_list(np.atleast_1d(self.upper[term])),
                        "supported": self.resolved(term).tolist()}
         d["notes"] = [list(n) for n in self.notes]
-        d["components"] = self.components.to_dict()
+        d["terms"] = [[t.to_dict() for t in terms] for terms in self.terms]
+        d["components"] = self._arrays.to_dict()
         d["coverage"] = np.atleast_1d(self.coverage).tolist()
         d["discrepancy"] = np.atleast_1d(self.discrepancy).tolist()
         d["readoff"] = {term: {k: finite_list(a) for k, a in parts.items()}

@@ -1,5 +1,5 @@
 """The terms of the noise model: names, constants and the one implementation of
-their Allan variance (Rust, :func:`imunoise._core.fit.noise_terms`)."""
+their Allan variance (Rust, :func:`imunoise._core.fit.allan_terms`)."""
 
 from __future__ import annotations
 
@@ -31,7 +31,7 @@ SENSOR_NAMES = {
 # straight line is read (IEEE 952 Annex C).
 SLOPE = {"Q": -1.0, "N": -0.5, "B": 0.0, "K": 0.5, "R": 1.0}
 READ_TAU = {"Q": math.sqrt(3.0), "N": 1.0, "K": 3.0, "R": math.sqrt(2.0)}
-GM_PEAK = 1.8926
+GM_PEAK: float = _core_fit.GM_PEAK
 """τ/τc where a first-order Gauss–Markov term's Allan variance peaks (IEEE 952
 Annex C): its hump. Below it the term rises like a random walk, above it falls
 like white noise."""
@@ -42,18 +42,20 @@ GM_MAX: int = _core_fit.MAX_GAUSS_MARKOV
 TONES_MAX: int = _core_fit.MAX_TONES
 """Most tones a model may have."""
 
-PARAMS: int = _core_fit.PARAMETERS
-"""Parameter slots of the covariance: five IEEE variances, (σ², ln τc) per GM term,
-then (A²/2, ln f0) per tone slot, then the resonance's and the motion's."""
-SINE_SLOT: int = _core_fit.SINE_SLOT
-"""Slot of the first tone's variance A²/2 in the covariance (its ln f0 follows, then
-the next tone's)."""
-RES_SLOT: int = _core_fit.RESONANCE_SLOT
-"""Slot of the resonance's variance σ² in the covariance (ln f_r, ln τr, skew follow)."""
-SKEW_SLOT: int = _core_fit.SKEW_SLOT
-"""Slot of the resonance's skew in the covariance."""
-MOTION_SLOT: int = _core_fit.MOTION_SLOT
-"""Slot of the bounded motion's variance σθ² in the covariance (ln τc follows)."""
+# The deprecated ``Components.cov`` layout (the typed terms carry their own
+# uncertainties): five IEEE variances, (σ², ln τc) per Gauss–Markov slot, (A²/2,
+# ln f0) per tone slot, the resonance's (σ², ln f_r, ln τr, skew), the motion's
+# (σθ², ln τc).
+SINE_SLOT: int = 5 + 2 * GM_MAX
+"""Slot of the first tone's variance A²/2 (its ln f0 follows, then the next tone's)."""
+RES_SLOT: int = SINE_SLOT + 2 * TONES_MAX
+"""Slot of the resonance's variance σ² (ln f_r, ln τr, skew follow)."""
+SKEW_SLOT: int = RES_SLOT + 3
+"""Slot of the resonance's skew."""
+MOTION_SLOT: int = RES_SLOT + 4
+"""Slot of the bounded motion's variance σθ² (ln τc follows)."""
+PARAMS: int = MOTION_SLOT + 2
+"""Slots of the layout."""
 
 
 def gm_white_density(sigma: float, tau_c: float, fs: float) -> float:
@@ -108,18 +110,26 @@ def quadrature_bound(f_r: float, tau_r: float, fs: float) -> float:
     return math.inf if s < 1e-12 else math.sinh(1.0 / (fs * tau_r)) / s
 
 
-def is_log_time(slot: int) -> bool:
-    """Whether covariance slot ``slot`` holds a logarithm (ln τc, ln f0, ln f_r, ln τr)."""
-    return slot in (RES_SLOT + 1, RES_SLOT + 2, MOTION_SLOT + 1) or (
-        5 <= slot < RES_SLOT and (slot - 5) % 2 == 1)
-
-
-FLAT_SLOPE = -0.25
+FLAT_SLOPE: float = _core_fit.FLAT_SLOPE
 """A curve whose log-log slope is above this has flattened: a minimum at its end is
 a bias-instability floor (slope −½ is white noise, 0 the floor)."""
 
 CLOSE = 0.05
 """A model within this relative distance of the measured deviation follows it."""
+
+
+def core_terms(squares, markov=(), tone=(), resonance=(), motion=()) -> list:
+    """The core's (kind, parameters) of a model in variance form: ``squares`` Q²…R²
+    (every one, 0 where absent), ``markov`` (σ², τc), ``tone`` (A²/2, f0),
+    ``resonance`` (σ², f_r, τr, skew), ``motion`` (σθ², τc)."""
+    names = [name for name, _, _ in _core_fit.TERM_KINDS]
+    terms = [(names[j], [float(v)]) for j, v in enumerate(squares)]
+    terms += [("gauss_markov", [float(v), float(t)]) for v, t in markov]
+    terms += [("tone", [float(v), float(f)]) for v, f in tone]
+    terms += [("resonance", [float(v), float(f), float(t), float(k)])
+              for v, f, t, k in resonance]
+    terms += [("motion", [float(v), float(t)]) for v, t in motion]
+    return terms
 
 
 def term_variances(taus, fs: float, coef, markov=(), tone=(), resonance=(),
@@ -132,11 +142,10 @@ def term_variances(taus, fs: float, coef, markov=(), tone=(), resonance=(),
     t = np.ascontiguousarray(np.atleast_1d(np.asarray(taus, dtype=float)))
     with np.errstate(over="ignore"):  # a coefficient near 1e154 squares to inf, not an error
         squares = np.square(np.asarray(coef, dtype=float)).tolist()
-    return _core_fit.noise_terms(t, float(fs), squares,
-                             [(s * s, tc) for s, tc in markov],
-                             [(a * a / 2, f0) for a, f0 in tone],
-                             [(s * s, f, tr, skew) for s, f, tr, skew in resonance],
-                             [(s * s, tc) for s, tc in motion])
+    return _core_fit.allan_terms(t, float(fs), core_terms(
+        squares, [(s * s, tc) for s, tc in markov], [(a * a / 2, f0) for a, f0 in tone],
+        [(s * s, f, tr, skew) for s, f, tr, skew in resonance],
+        [(s * s, tc) for s, tc in motion]))
 
 
 def model_variance(taus, Q=0.0, N=0.0, B=0.0, K=0.0, R=0.0) -> np.ndarray:

@@ -195,8 +195,8 @@ def build(
     if stream not in (None, True, False):
         raise ImunoiseValueError(f"stream must be None, True or False; got {stream!r}")
     if spec is not None:
-        # a wrong --spec is found before the analysis, not after it (17 s on an
-        # hour's log), and before a folder is made
+        # a wrong --spec is found before the analysis, not after it (which takes
+        # seconds to minutes), and before a folder is made
         load_spec(spec)
     out = Path(out_dir)
     inputs = [p for p in (short, long) if isinstance(p, str | os.PathLike)]

@@ -22,17 +22,10 @@ def docs_link(page: str, text: str | None = None) -> str:
     return f"[{text or page} documentation]({DOCS_URL}{page}.html)"
 
 
-#: The report's spelling of units the logs name in ASCII (one spelling per unit
-#: across every table, caption and figure: the symbols the noise tables use).
-_SYMBOLS = (("m/s^2", "m/s²"), ("m/s^3", "m/s³"), ("sqrt(Hz)", "√Hz"), ("sqrt(h)", "√h"),
-            ("sqrt(s)", "√s"), ("deg/s", "°/s"), ("deg/h", "°/h"))
-
-
 def unit_text(unit: str) -> str:
-    """A unit as the report writes it: ``"m/s^2"`` -> ``"m/s²"``."""
-    for ascii_, symbol in _SYMBOLS:
-        unit = unit.replace(ascii_, symbol)
-    return unit
+    """A unit as the report writes it: ``"m/s^2"`` -> ``"m/s²"``
+    (:func:`imunoise.display.unit_symbols`, the one spelling of tables and figures)."""
+    return _display.unit_symbols(unit)
 
 
 def format_number(v: float, std: float | None = None) -> str:

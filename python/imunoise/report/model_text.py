@@ -11,8 +11,9 @@ import numpy as np
 from imunoise import datasheet
 from imunoise import units as _units
 from imunoise._schema import axis_names
+from imunoise.display import format_value, percent
 from imunoise.errors import ImunoiseValueError
-from imunoise.noise import NoiseModel, gm_white_density, resolution_noise
+from imunoise.noise import NoiseModel, _typed, gm_white_density, resolution_noise
 from imunoise.noise._model import table_cell
 from imunoise.report.formatting import format_number
 
@@ -130,12 +131,13 @@ def model_sentences(model: NoiseModel, sensor: str,
     q_unit = _units.unit_info("Q", chosen.get("Q"), sensor)
     out = []
     for c, axis in enumerate(axis_names(model.channels)):
-        parts = [f"{axis}: fitted components {model.components.structure(c)}"]
-        parts_of = model.components
+        terms = model.terms[c]
+        parts = [f"{axis}: fitted components {_typed.structure(terms)}"]
         cover = float(np.atleast_1d(model.coverage)[c])
         delta = float(np.atleast_1d(model.discrepancy)[c])
-        parts.append(f"follows {cover:.0%} of the taus (inside the 95 % interval or within 5 %)"
-                     + (f", residual discrepancy {delta / 2:.1%} in σ" if delta > 0.01 else ""))
+        parts.append(f"follows {percent(cover)} of the taus (inside the 95 % interval or "
+                     "within 5 %)" + (f", residual discrepancy {percent(delta / 2, digits=1)} "
+                                      "in σ" if delta > 0.01 else ""))
         if cover < POOR_COVERAGE:
             parts.append("**the model does not describe this curve: read its coefficients "
                          "as a summary only** (see the data/model panel)")
@@ -144,9 +146,7 @@ def model_sentences(model: NoiseModel, sensor: str,
                                              sensor=sensor)
             parts.append(f"Gauss–Markov bias σ = {format_number(value, value_std)} "
                          f"{b_unit.label}, τc = {format_number(tau_c, tau_std)} s")
-        tone_stds = zip(np.reshape(parts_of.sine_amplitude_std, (parts_of.channels, -1))[c],
-                        np.reshape(parts_of.sine_freq_std, (parts_of.channels, -1))[c],
-                        strict=True)
+        tone_stds = _typed.pairs(terms, _typed.Tone, "amplitude_std", "freq_std")
         for line, (amp_std, f0_std) in zip(model.lines[c], tone_stds, strict=False):
             value, value_std = _units.convert(np.array([line.amplitude, amp_std]), "B",
                                              b_unit.name, sensor=sensor)
@@ -157,15 +157,14 @@ def model_sentences(model: NoiseModel, sensor: str,
             elif line.in_spectrum:
                 parts.append(f"a line of amplitude {format_number(value, value_std)} "
                              f"{b_unit.label} at {line.frequency:.4g} Hz (the spectrum's "
-                             f"peak, {line.ratio:.3g}× its background)")
+                             f"peak, {_g(line.ratio)}× its background)")
             else:
                 parts.append(f"the Allan curve bends like a tone near "
                              f"{line.allan_frequency:.3g} Hz, but the spectrum shows no line "
                              "there: a shape of the sensor's filter or noise, not a vibration")
-        for sigma, f_r, tau_r, skew in parts_of.resonance(c):
-            stds = [float(np.atleast_1d(a)[c]) for a in (
-                parts_of.resonance_sigma_std, parts_of.resonance_freq_std,
-                parts_of.resonance_tau_std, parts_of.resonance_skew_std)]
+        for r in (t for t in terms if isinstance(t, _typed.Resonance)):
+            sigma, f_r, tau_r, skew = r.sigma, r.freq, r.tau, r.skew
+            stds = [r.sigma_std, r.freq_std, r.tau_std, r.skew_std]
             value, value_std = _units.convert(np.array([sigma, stds[0]]), "B", b_unit.name,
                                              sensor=sensor)
             parts.append(f"a resonance (damped oscillation, a band rather than a line) of "
@@ -195,11 +194,9 @@ def _skew_words(skew: float, skew_std: float) -> str:
 def _motion_sentence(model: NoiseModel, c: int, sensor: str, n_unit, q_unit) -> list[str]:
     """What a bounded motion of the mount means for channel ``c``: its size and time,
     and that N leaves it out (an upper bound on N where N is not resolved)."""
-    parts_of = model.components
     out = []
-    for sigma, tau_c in parts_of.motion(c):
-        sigma_std, tau_std = (float(np.atleast_1d(a)[c]) for a in
-                              (parts_of.motion_sigma_std, parts_of.motion_tau_std))
+    for m in (t for t in model.terms[c] if isinstance(t, _typed.Motion)):
+        sigma, tau_c, sigma_std, tau_std = m.sigma, m.tau_c, m.sigma_std, m.tau_c_std
         value, value_std = _units.convert(np.array([sigma, sigma_std]), "Q", q_unit.name,
                                           sensor=sensor)
         white = math.sqrt(2.0 * sigma**2 / tau_c)  # its density below τc
@@ -243,10 +240,10 @@ def _resolution_sentence(model: NoiseModel, c: int, step, sensor: str, units) ->
     if share >= RESOLUTION_SHOWN:
         shown = _units.convert(float(step), "B", b_unit.name, sensor=sensor)
         added = _units.convert(n_round, "N", n_unit.name, sensor=sensor)
-        text = (f"the samples are whole multiples of {float(shown):.3g} "
+        text = (f"the samples are whole multiples of {_g(shown)} "
                 f"{b_unit.label}: rounding to it adds white noise of "
-                f"{float(added):.3g} {n_unit.label}"
-                + (f", {share:.0%} of N" if math.isfinite(share) else ""))
+                f"{_g(added)} {n_unit.label}"
+                + (f", {percent(share)} of N" if math.isfinite(share) else ""))
         if share >= RESOLUTION_LIMITS:
             text += (" — **the log's resolution limits the N measured here** (record with "
                      "more digits, or the sensor's binary output)")
@@ -258,11 +255,17 @@ def _resolution_sentence(model: NoiseModel, c: int, step, sensor: str, units) ->
         times = f"{ratio:.0f}" if ratio >= 10 else f"{ratio:.2g}"
         integral = "velocity" if sensor == "accel" else "angle"
         out.append(f"counts of an integrated {integral} of the samples' resolution "
-                   f"({float(shown):.3g} {b_unit.label}) would give Q = "
-                   f"{float(counted):.3g} {q_unit.label}; the model's Q is {times}× that"
+                   f"({_g(shown)} {b_unit.label}) would give Q = "
+                   f"{_g(counted)} {q_unit.label}; the model's Q is {times}× that"
                    + (": more than the log's resolution explains (the sensor's own "
                       "quantization, or its filter)" if ratio > Q_OWN else ""))
     return out
+
+
+def _g(value) -> str:
+    """Three significant digits as the tables write them ("4.14e-7", "1230"), not
+    Python's "4.14e-07" or "1.23e+03"."""
+    return format_value(float(value), digits=3)
 
 
 #: Share of the datasheet N² above which a term's white tail "carries" N.
@@ -279,11 +282,11 @@ def _correlated_white_sentence(model: NoiseModel, c: int) -> list[str]:
     if not n2 > 0 or len(model.taus) < 3:
         return []
     out = []
-    for sigma, tau_c in model.components.gauss_markov(c):
+    for sigma, tau_c in _typed.pairs(model.terms[c], _typed.GaussMarkov, "sigma", "tau_c"):
         share = gm_white_density(sigma, tau_c, model.fs) / n2
         if tau_c < 1.0 and share > CARRIES_N and 1.9 * tau_c > float(model.taus[1]):
             out.append(
-                f"N is {share:.0%} the white tail of the Gauss–Markov term of τc "
+                f"N is {percent(share)} the white tail of the Gauss–Markov term of τc "
                 f"{tau_c:.2g} s, whose hump the curve shows near {1.9 * tau_c:.2g} s: "
                 "the sensor's own output filter, or a disturbance of the mount (a "
                 "vehicle's or a machine's vibration), which the Allan deviation cannot "
@@ -294,11 +297,8 @@ def _correlated_white_sentence(model: NoiseModel, c: int) -> list[str]:
 
 def _gauss_markov_with_std(model: NoiseModel, c: int) -> list[tuple[float, ...]]:
     """(σ, std of σ, τc, std of τc) of each Gauss–Markov term of channel ``c``."""
-    parts = model.components
-    columns = [np.reshape(a, (model.channels, -1))[c] for a in
-               (parts.gm_sigma, parts.gm_sigma_std, parts.gm_tau, parts.gm_tau_std)]
-    return [tuple(map(float, row)) for row in zip(*columns, strict=True)
-            if np.isfinite(row[0])]
+    return _typed.pairs(model.terms[c], _typed.GaussMarkov, "sigma", "sigma_std", "tau_c",
+                        "tau_c_std")
 
 
 def _readoff_agreement(model: NoiseModel, c: int, term: str, unit, sensor: str) -> list[str]:

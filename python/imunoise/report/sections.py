@@ -17,7 +17,7 @@ import numpy as np
 from imunoise import _stream, _warn, display, noise, plot, stats, units
 from imunoise import allan as _allan
 from imunoise._schema import CHANNELS, SAMPLE_SENSORS, axis_names
-from imunoise.display import format_value
+from imunoise.display import format_value, percent
 from imunoise.planner import fit_line
 from imunoise.report.formatting import (
     docs_link,
@@ -251,8 +251,8 @@ def allan_deviation(ctx: Context, doc: Doc) -> None:
     allan, models = ctx.allan, ctx.models
     doc.p(f"Overlapping Allan deviation of the {'only' if ctx.one_log else 'long'} log, "
           f"{ctx.taus_per_decade} taus per decade, error bars at the "
-          f"{next(iter(allan.values())).confidence:.1%} confidence level (χ² with Greenhall "
-          "EDF)." if allan else "The log has no gyro or accelerometer channel.")
+          f"{percent(next(iter(allan.values())).confidence, digits=1)} confidence level "
+          "(χ² with Greenhall EDF)." if allan else "The log has no gyro or accelerometer channel.")
     for sensor, r in allan.items():
         unit = _unit(sensor)
         model = models.get(sensor)
@@ -338,7 +338,7 @@ def _n_remark(s, j: int, ratio: float) -> str:
     if not np.isfinite(ratio):
         return "the ADEV fit resolves no white noise"
     if abs(ratio - 1) <= N_AGREEMENT:
-        return f"agree within {N_AGREEMENT:.0%}"
+        return f"agree within {percent(N_AGREEMENT)}"
     lines = s.lines[j]
     if ratio < 1 and lines.size:
         where = ", ".join(f"{v:.3g}" for v in lines[:3])
@@ -437,12 +437,12 @@ def dynamic_allan(ctx: Context, doc: Doc) -> None:
         ctx.add_figure(doc, plot.dynamic(d, title=f"{sensor} dynamic Allan deviation"),
                        f"dadev_{sensor}", f"ADEV of {format_duration(d.window)} windows every "
                        f"{format_duration(d.step)} over the whole-record ADEV")
-        share = f"{float(np.max(st.outside)):.0%}"
+        share = percent(float(np.max(st.outside)))
         if st.stationary:
             doc.p(f"The {sensor} noise is stationary along the log: no stretch departs from "
                   f"the typical level (1 % false-alarm rate), and {share} of the window "
                   f"intervals exclude the whole-record ADEV (about "
-                  f"{st.expected_outside:.0%} expected).")
+                  f"{percent(st.expected_outside)} expected).")
             continue
         names = axis_names(d.channels)
         where = "; ".join(
@@ -451,7 +451,7 @@ def dynamic_allan(ctx: Context, doc: Doc) -> None:
         more = f" and {len(st.intervals) - 6} more" if len(st.intervals) > 6 else ""
         doc.p(f"The {sensor} noise is not stationary: it departs from its typical level at "
               f"{where}{more} (from the first sample; {share} of the window intervals exclude "
-              f"the whole-record ADEV, about {st.expected_outside:.0%} expected).")
+              f"the whole-record ADEV, about {percent(st.expected_outside)} expected).")
 
 
 # --- events, warm-up and temperature (issue 13) -------------------------------------
@@ -470,7 +470,8 @@ def events_section(ctx: Context, doc: Doc) -> None:
     found, log = ctx.events, ctx.short
     doc.p(f"Spikes (Hampel test) and bursts (sliding energy, window "
           f"{format_duration(found.window / found.fs)}) per channel of {_short(ctx)}, "
-          f"thresholds set for {found.false_alarm:.0e} false events per sample and channel "
+          f"thresholds set for {format_value(found.false_alarm, digits=1)} false events per "
+          "sample and channel "
           f"(measured on white noise: {docs_link('events')}). "
           f"{len(found)} events cover {100 * found.share:.3g} % of the samples.")
     # with --trim auto on one log the short log starts at the settle point: times

@@ -18,7 +18,7 @@ from imunoise._progress import Progress
 from imunoise.allan import adev
 from imunoise.datasheet import VERDICTS, compare, load_spec
 from imunoise.errors import ImunoiseTypeError, ImunoiseValueError
-from imunoise.noise import GM_MAX, fit
+from imunoise.noise import _typed, fit
 from imunoise.readers.log import ISSUE_KINDS
 from imunoise.readers.read import read
 
@@ -116,7 +116,9 @@ def analyse_log(path: str, spec=None, fs: float | None = None, *,
                 for t in _TERM_ORDER:
                     row[f"verdict_{t}"] = v.get(t)
                 if components:
-                    row["gauss_markov"] = _gauss_markov(m.components, j)
+                    row["gauss_markov"] = tuple(_typed.pairs(
+                        m.terms[j], _typed.GaussMarkov, "sigma", "sigma_std", "tau_c",
+                        "tau_c_std"))
                 rows.append(row)
         return rows
     except Exception as exc:  # noqa: BLE001 - a bad log is a row, not a failed batch
@@ -125,14 +127,6 @@ def analyse_log(path: str, spec=None, fs: float | None = None, *,
             row[f"verdict_{t}"] = None
         row["error"] = f"{type(exc).__name__}: {exc}"
         return [row]
-
-
-def _gauss_markov(c, channel: int) -> tuple[tuple[float, float, float, float], ...]:
-    """``(sigma, sigma_std, tau_c, tau_c_std)`` of each Gauss–Markov term of a channel."""
-    cols = [np.reshape(a, (-1, GM_MAX))[channel]
-            for a in (c.gm_sigma, c.gm_sigma_std, c.gm_tau, c.gm_tau_std)]
-    return tuple(tuple(float(v) for v in term) for term in zip(*cols, strict=True)
-                 if np.isfinite(term[0]))
 
 
 def _frame(rows: list[dict]):

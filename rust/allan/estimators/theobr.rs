@@ -354,8 +354,7 @@ pub fn theobr_work_with(n_phase: usize, ms: &[usize], options: RatioOptions) -> 
 /// (2 shared cores; `benches/bench_theo.py` prints them next to real timings):
 /// direct multiply-adds per second below `theo1::FFT_FROM`, N·log₂(m)² units
 /// per second of the expansion above, and the sweep's pair products per second
-/// (with AVX-512 IFMA, one thread: 720,000 samples, about 3 s for 9.8·10⁹; a CPU
-/// without IFMA is several times slower).
+/// (the IFMA path's; a CPU without it is several times slower).
 /// They only decide whether a warning says a run will be long, so a machine
 /// twice as fast or slow changes nothing else.
 const DIRECT_STEPS_PER_SECOND: f64 = 1.2e9;

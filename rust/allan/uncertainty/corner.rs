@@ -8,8 +8,8 @@
 //! shorter taus identify frequency noise, longer ones phase noise, and the phase
 //! points within τc of each other are one draw, not many. Greenhall's EDF at
 //! α = 2 then counts N where there are N·τ₀/τc draws, and overstates the EDF by
-//! as much as τc/τ₀ (1000-fold and more on a gyro whose mount rocks with
-//! τc = 25 s at 100 Hz; the Monte Carlo spread of the estimates says 20–140).
+//! as much as τc/τ₀, which is thousands for a slow correlation time at a high
+//! sample rate.
 //!
 //! So where a channel's phase noise begins at a tau beyond the first (the
 //! corner), its phase points are counted at that spacing: the EDF is the one

@@ -196,8 +196,7 @@ pub fn theo1_edf(alpha: i32, m: usize, n_phase: usize) -> f64 {
 /// variance of κ), measured here by simulation (300 records of 1000 samples and
 /// 80 of 4000 per noise type; the smaller of the two, rounded to two digits).
 /// κ rests on AVAR at τ up to 10 % of the record, so its scatter does not shrink
-/// as the record grows (white FM: κ's standard deviation is ≈ 11 % at every
-/// length, from 600 to 6000 samples).
+/// as the record grows: one table serves every record length.
 const RATIO_EDF: [f64; 5] = [1.0e4, 400.0, 150.0, 250.0, 340.0];
 
 /// EDF of ThêoBR at averaging factor m: Theo1's (SP 1065, with r = 0.75·m)

@@ -1,0 +1,310 @@
+"""The terms of a fitted noise model, typed: one class per kind, each holding its
+own parameters and their standard uncertainties, in the input's units.
+
+``model.terms[c]`` is channel ``c``'s tuple of terms in the order the model lists
+them (the IEEE terms Q, N, B, K, R, then Gauss–Markov terms by increasing τc, tones
+by increasing frequency, the resonance, the bounded motion). These are the fit's own
+parameters; the datasheet values ``model.N``, ``model.B``, ``model.K`` are read from
+all of them together (:class:`~imunoise.noise.NoiseModel`).
+
+Each kind has its Rust counterpart (``rust/fit/term.rs``, exported as
+``imunoise._core.fit.TERM_KINDS``): the Allan variance of every term comes from
+there, the classes here only name and convert its parameters.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, fields
+from typing import ClassVar
+
+import numpy as np
+
+from imunoise import _summary
+from imunoise._core import fit as _core_fit
+
+
+def _sigma(variance: float, u_variance: float) -> tuple[float, float]:
+    """σ and u(σ) = u(σ²)/(2σ) from a variance and its variance."""
+    sigma = math.sqrt(variance)
+    if not (np.isfinite(u_variance) and sigma > 0):
+        return sigma, math.nan
+    return sigma, math.sqrt(max(u_variance, 0.0)) / (2.0 * sigma)
+
+
+def _from_log(value: float, u_log: float) -> float:
+    """u(x) = x·u(ln x); NaN where ln x is not free."""
+    return value * math.sqrt(max(u_log, 0.0)) if np.isfinite(u_log) else math.nan
+
+
+@dataclass(frozen=True)
+class Term:
+    """One term of a channel's noise model (the base of every kind)."""
+
+    kind: ClassVar[str] = ""
+
+    def core(self) -> tuple[str, list[float]]:
+        """(kind, parameters) in the core's form (variances, times, frequencies)."""
+        raise NotImplementedError
+
+    def allan_variance(self, taus, fs: float) -> np.ndarray:
+        """This term's Allan variance at ``taus`` (s) for data sampled at ``fs`` (Hz)."""
+        t = np.ascontiguousarray(np.atleast_1d(np.asarray(taus, dtype=float)))
+        return _core_fit.allan_terms(t, float(fs), [self.core()])[:, 0]
+
+    def label(self) -> str:
+        """The term in a structure's words: ``"N"``, ``"GM(0.05 s)"``, ``"tone 13.4 Hz"``."""
+        raise NotImplementedError
+
+    def to_dict(self) -> dict:
+        """Plain-Python view: ``kind`` and every parameter and its ``*_std``
+        (None where not finite: JSON has no NaN)."""
+        out: dict = {"kind": self.kind}
+        for f in fields(self):
+            v = float(getattr(self, f.name))
+            out[f.name] = v if math.isfinite(v) else None
+        return out
+
+    def _describe(self) -> str:
+        values = [f"{f.name}={getattr(self, f.name):.4g}" for f in fields(self)
+                  if not f.name.endswith("_std")]
+        return f"{type(self).__name__}({', '.join(values)})"
+
+    def __repr__(self) -> str:
+        return self._describe()
+
+
+@dataclass(frozen=True, repr=False)
+class _Ieee(Term):
+    """An IEEE 952 term: one coefficient and its standard uncertainty."""
+
+    name: ClassVar[str] = ""
+
+    @property
+    def value(self) -> float:
+        """The coefficient (Q, N, B, K or R)."""
+        return getattr(self, self.name)
+
+    def core(self) -> tuple[str, list[float]]:
+        return self.kind, [self.value**2]
+
+    def label(self) -> str:
+        return self.name
+
+    @classmethod
+    def from_core(cls, parameters, cov):
+        value, std = _sigma(parameters[0], cov[0, 0])
+        return cls(value, std)
+
+
+@dataclass(frozen=True, repr=False)
+class Quantization(_Ieee):
+    """Quantization noise: Allan variance 3Q²/τ², ``Q`` in rate·s."""
+
+    kind: ClassVar[str] = "quantization"
+    name: ClassVar[str] = "Q"
+    Q: float
+    Q_std: float = math.nan
+
+
+@dataclass(frozen=True, repr=False)
+class White(_Ieee):
+    """White rate noise (angle or velocity random walk): N²/τ, ``N`` in rate·√s."""
+
+    kind: ClassVar[str] = "white"
+    name: ClassVar[str] = "N"
+    N: float
+    N_std: float = math.nan
+
+
+@dataclass(frozen=True, repr=False)
+class Flicker(_Ieee):
+    """Flicker rate noise (bias instability): (2 ln2/π)·B², ``B`` in rate."""
+
+    kind: ClassVar[str] = "flicker"
+    name: ClassVar[str] = "B"
+    B: float
+    B_std: float = math.nan
+
+
+@dataclass(frozen=True, repr=False)
+class RandomWalk(_Ieee):
+    """Rate random walk: K²τ/3, ``K`` in rate/√s."""
+
+    kind: ClassVar[str] = "random_walk"
+    name: ClassVar[str] = "K"
+    K: float
+    K_std: float = math.nan
+
+
+@dataclass(frozen=True, repr=False)
+class Ramp(_Ieee):
+    """Rate ramp: R²τ²/2, ``R`` in rate/s."""
+
+    kind: ClassVar[str] = "ramp"
+    name: ClassVar[str] = "R"
+    R: float
+    R_std: float = math.nan
+
+
+@dataclass(frozen=True, repr=False)
+class GaussMarkov(Term):
+    """First-order Gauss–Markov bias: standard deviation ``sigma`` (rate) and
+    correlation time ``tau_c`` (s); its Allan variance is the sampled AR1 form of
+    IEEE 952 Annex C (rising as +½ below τc, a hump near 1.89 τc, −½ beyond)."""
+
+    kind: ClassVar[str] = "gauss_markov"
+    sigma: float
+    tau_c: float
+    sigma_std: float = math.nan
+    tau_c_std: float = math.nan
+
+    def core(self) -> tuple[str, list[float]]:
+        return self.kind, [self.sigma**2, self.tau_c]
+
+    def label(self) -> str:
+        return f"GM({_summary.number(self.tau_c)} s)"
+
+    @classmethod
+    def from_core(cls, parameters, cov):
+        sigma, u_sigma = _sigma(parameters[0], cov[0, 0])
+        return cls(sigma, parameters[1], u_sigma, _from_log(parameters[1], cov[1, 1]))
+
+
+@dataclass(frozen=True, repr=False)
+class Tone(Term):
+    """A sinusoid A·sin(2πf₀t + ϕ): peak ``amplitude`` (rate) and ``freq`` f₀ (Hz)."""
+
+    kind: ClassVar[str] = "tone"
+    amplitude: float
+    freq: float
+    amplitude_std: float = math.nan
+    freq_std: float = math.nan
+
+    def core(self) -> tuple[str, list[float]]:
+        return self.kind, [self.amplitude**2 / 2, self.freq]
+
+    def label(self) -> str:
+        return f"tone {_summary.number(self.freq)} Hz"
+
+    @classmethod
+    def from_core(cls, parameters, cov):
+        # s² = A²/2, so u(A) = u(s²)/A.
+        amplitude = math.sqrt(2 * parameters[0])
+        u = math.sqrt(max(cov[0, 0], 0.0)) / amplitude if np.isfinite(cov[0, 0]) else math.nan
+        return cls(amplitude, parameters[1], u, _from_log(parameters[1], cov[1, 1]))
+
+
+@dataclass(frozen=True, repr=False)
+class Resonance(Term):
+    """A damped oscillator (second-order Gauss–Markov process): standard deviation
+    ``sigma`` (rate), frequency ``freq`` f_r (Hz), damping time ``tau`` τr (s;
+    quality factor π·f_r·τr) and ``skew`` in [−1, 1], its quadrature part (0: the
+    plain resonance; a sensor's second-order low-pass filter has skew > 0)."""
+
+    kind: ClassVar[str] = "resonance"
+    sigma: float
+    freq: float
+    tau: float
+    skew: float = 0.0
+    sigma_std: float = math.nan
+    freq_std: float = math.nan
+    tau_std: float = math.nan
+    skew_std: float = math.nan
+
+    def core(self) -> tuple[str, list[float]]:
+        return self.kind, [self.sigma**2, self.freq, self.tau, self.skew]
+
+    def label(self) -> str:
+        skew = f" (skew {self.skew:.2g})" if self.skew else ""
+        return f"resonance {_summary.number(self.freq)} Hz{skew}"
+
+    @classmethod
+    def from_core(cls, parameters, cov):
+        sigma, u_sigma = _sigma(parameters[0], cov[0, 0])
+        u_skew = math.sqrt(max(cov[3, 3], 0.0)) if np.isfinite(cov[3, 3]) else math.nan
+        return cls(sigma, parameters[1], parameters[2], parameters[3], u_sigma,
+                   _from_log(parameters[1], cov[1, 1]), _from_log(parameters[2], cov[2, 2]),
+                   u_skew)
+
+
+@dataclass(frozen=True, repr=False)
+class Motion(Term):
+    """A bounded motion of the mount: its angle (velocity, for an accelerometer)
+    wanders as a Gauss–Markov process of standard deviation ``sigma`` (rate·s) and
+    correlation time ``tau_c`` (s) and comes back; the platform's, not the sensor's."""
+
+    kind: ClassVar[str] = "motion"
+    sigma: float
+    tau_c: float
+    sigma_std: float = math.nan
+    tau_c_std: float = math.nan
+
+    def core(self) -> tuple[str, list[float]]:
+        return self.kind, [self.sigma**2, self.tau_c]
+
+    def label(self) -> str:
+        return f"motion({_summary.number(self.tau_c)} s)"
+
+    @classmethod
+    def from_core(cls, parameters, cov):
+        sigma, u_sigma = _sigma(parameters[0], cov[0, 0])
+        return cls(sigma, parameters[1], u_sigma, _from_log(parameters[1], cov[1, 1]))
+
+
+#: Every kind, by the core's name, in the order a model lists them.
+KINDS: dict[str, type[Term]] = {
+    cls.kind: cls for cls in (Quantization, White, Flicker, RandomWalk, Ramp, GaussMarkov,
+                              Tone, Resonance, Motion)
+}
+
+#: The IEEE kinds by coefficient name (Q, N, B, K, R).
+IEEE: dict[str, type[_Ieee]] = {
+    cls.name: cls for cls in (Quantization, White, Flicker, RandomWalk, Ramp)
+}
+
+_COORDINATES = {name: len(coords) for name, _, coords in _core_fit.TERM_KINDS}
+
+
+def from_core(core_terms, cov: np.ndarray) -> tuple[Term, ...]:
+    """The typed terms of one channel's core fit: ``core_terms`` as (kind,
+    parameters) pairs, ``cov`` the covariance of their coordinates, term after term."""
+    out = []
+    at = 0
+    for kind, parameters in core_terms:
+        width = _COORDINATES[kind]
+        out.append(KINDS[kind].from_core(parameters, cov[at:at + width, at:at + width]))
+        at += width
+    return tuple(out)
+
+
+def allan_variances(terms, taus, fs: float) -> np.ndarray:
+    """(len(taus), len(terms)): each term's Allan variance at ``taus``."""
+    t = np.ascontiguousarray(np.atleast_1d(np.asarray(taus, dtype=float)))
+    if not terms:
+        return np.zeros((t.size, 0))
+    return _core_fit.allan_terms(t, float(fs), [term.core() for term in terms])
+
+
+def ieee_term(terms, name: str) -> _Ieee | None:
+    """The IEEE term of coefficient ``name`` (Q, N, B, K or R) among one channel's
+    terms, or None."""
+    return next((t for t in terms if isinstance(t, _Ieee) and t.name == name), None)
+
+
+def coefficient(terms, name: str) -> float:
+    """The fitted IEEE coefficient ``name`` of one channel's terms; 0 where the
+    structure has none."""
+    term = ieee_term(terms, name)
+    return 0.0 if term is None else term.value
+
+
+def pairs(terms, cls: type[Term], *names: str) -> list[tuple[float, ...]]:
+    """``names``' values of each term of class ``cls``, as tuples, in order."""
+    return [tuple(float(getattr(t, n)) for n in names) for t in terms if isinstance(t, cls)]
+
+
+def structure(terms) -> str:
+    """One channel's fitted structure in words: ``"N + K + GM(0.05 s) + tone 13.4 Hz"``
+    (``"none"`` when empty)."""
+    return " + ".join(t.label() for t in terms) or "none"
