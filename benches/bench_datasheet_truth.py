@@ -68,6 +68,7 @@ from dataclasses import dataclass, field
 import imunoise
 import numpy as np
 from imunoise import _cpu
+from imunoise.noise._typed import structure
 from scipy.signal import butter, freqz, lfilter
 
 FLAT = math.sqrt(2 * math.log(2) / math.pi)  # 0.6643: the flicker floor / B
@@ -354,7 +355,7 @@ def score(name, x, fs, axes, output_filter=True, r=None, spectrum=None):
             line_df=min(found) if found else math.inf,
             check=check,
             filtered=getattr(m, "filter", (None,) * len(axes))[c] is not None,
-            structure=m.components.structure(c),
+            structure=structure(m.terms[c]),
         ))
     return out
 

@@ -31,6 +31,7 @@ import numpy as np
 from bench_fit_real import coverage, recordings
 from imunoise import _cpu
 from imunoise.noise import filtered_prediction
+from imunoise.noise._typed import structure
 
 HERE = Path(__file__).resolve().parent
 
@@ -85,7 +86,7 @@ def plot(name, s, m, out_dir):
     ax.set_xlabel("frequency [Hz]")
     ax.set_ylabel("one-sided PSD [unit²/Hz]")
     ax.set_title(f"{name}: filter {'measured' if found is not None else 'none'}; "
-                 f"{m.components.structure(0)}", fontsize=8)
+                 f"{structure(m.terms[0])}", fontsize=8)
     ax.legend(fontsize=7)
     fig.tight_layout()
     fig.savefig(out_dir / (name.replace(" ", "_") + ".png"), dpi=110)
@@ -116,7 +117,7 @@ def main() -> int:
             r1, _, m1 = fitted(x[:half], fs, v)
             r2 = imunoise.adev(x[half:2 * half], fs, taus=20)
             got[v] = (score(r, m, limit), score(r2, m1, half / fs / 10), float(np.ravel(m.N)[0]),
-                      m.components.structure(0), m)
+                      structure(m.terms[0]), m)
         found = got[True][4].filter[0]
         desc = "none" if found is None else f"{found.white_top:.3g} Hz, {found.gain[-1]:.2g}"
         rows.append((name, got))
