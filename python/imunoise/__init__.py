@@ -9,12 +9,14 @@ plots and reports. Start with ``imunoise.adev(x, fs)``.
 # for the command line's start-up (exit 130 and one line, not a traceback from
 # inside numpy); in any other process it does nothing.
 from imunoise import _interrupt, export, units  # noqa: F401
+from imunoise._align import Aligned, align
 from imunoise._allan_stream import AllanStream
 from imunoise._core import __version__
 from imunoise._cpu import apply_environment as _apply_simd_environment
 from imunoise._events import Events, events
 from imunoise._fleet import Fleet, fleet
 from imunoise._hat import ThreeCorneredHat, gcodev, three_cornered_hat
+from imunoise._mount import OwnNoise, own_noise
 from imunoise._simulate import simulate
 from imunoise._simulate_log import simulate_log
 from imunoise._thermal import Thermal, thermal
@@ -63,6 +65,7 @@ _apply_simd_environment()
 
 __all__ = [
     "__version__",
+    "Aligned",
     "AllanStream",
     "AssumptionWarning",
     "CoverageWarning",
@@ -82,11 +85,13 @@ __all__ = [
     "Gaps",
     "ImuLog",
     "NoiseModel",
+    "OwnNoise",
     "ParseError",
     "ParseIssues",
     "Spectrum",
     "ThreeCorneredHat",
     "adev",
+    "align",
     "batch",
     "compare",
     "describe",
@@ -103,6 +108,7 @@ __all__ = [
     "mtie",
     "mtotdev",
     "ohdev",
+    "own_noise",
     "pdev",
     "plot",
     "plan",

@@ -8,6 +8,13 @@ record's length. The result equals :func:`imunoise.adev` with ``taus="octave"``
 on the samples so far (to rounding: the phase is referred to the first block's
 mean, which cancels in every term, so an offset such as gravity keeps its digits).
 
+Missing samples (NaN) are gaps, as :func:`imunoise.adev` skips them
+(``gaps="skip"``): a missing rate sample breaks the phase interval it spans and
+every term whose span holds a broken interval is left out (``n`` counts the terms
+used, per channel). The phase is held across the gap, so the terms after it are
+exact. A stream whose samples carry timestamps puts a NaN row in each slot a
+dropped sample would have filled; the live view of :func:`imunoise.record` does.
+
 The confidence intervals use the overlapping ADEV's EDF (the statistic's own
 model, as :func:`imunoise.adev`) for the power-law noise type read off the curve's
 local slope (σ² ∝ τ^μ, α = −μ − 1 rounded into the α ≤ 0 of rate noise), not the
@@ -18,6 +25,7 @@ stream does not keep.
 from __future__ import annotations
 
 import math
+import warnings
 
 import numpy as np
 
@@ -76,15 +84,20 @@ class AllanStream:
         self._m = 2 ** np.arange(int(math.floor(math.log2(max_m))) + 1, dtype=np.int64)
         self._keep = 2 * int(self._m[-1]) + 1
         self._history = np.zeros((1, self.channels))  # phase points from index _first on
+        # broken intervals before each phase point of _history (cumulative, per channel)
+        self._broken = np.zeros((1, self.channels), dtype=np.int64)
         self._first = 0
         self._offset: np.ndarray | None = None
         self._sums = np.zeros((self._m.size, self.channels))
         self._errors = np.zeros_like(self._sums)  # Kahan compensation of _sums
-        self._terms = np.zeros(self._m.size, dtype=np.int64)
+        self._terms = np.zeros((self._m.size, self.channels), dtype=np.int64)
         self.n_samples = 0
+        #: Missing samples (NaN) so far, per channel.
+        self.missing = np.zeros(self.channels, dtype=np.int64)
 
     def update(self, samples) -> None:
-        """Add a block of samples: shape (n,) for one channel, else (n, channels)."""
+        """Add a block of samples: shape (n,) for one channel, else (n, channels);
+        NaN marks a missing sample (a gap)."""
         y = np.asarray(samples)
         if not np.issubdtype(y.dtype, np.number) or np.iscomplexobj(y):
             raise ImunoiseTypeError(f"samples must hold real numbers; got dtype {y.dtype}")
@@ -94,13 +107,22 @@ class AllanStream:
                                      f"{np.shape(samples)}")
         if y.shape[0] == 0:
             return
-        if not np.all(np.isfinite(y)):
-            raise ImunoiseValueError("samples must be finite: a stream has no gaps to skip "
-                                     "(analyse a record with missing samples with imunoise.adev)")
-        if self._offset is None:
-            self._offset = y.mean(axis=0)
-        phase = self._history[-1] + np.cumsum(y - self._offset, axis=0)
+        missing = np.isnan(y)
+        if np.isinf(y).any():
+            raise ImunoiseValueError("samples must be finite or NaN (a missing sample); got "
+                                     f"{int(np.isinf(y).sum())} infinite value(s)")
+        if self._offset is None or not np.all(np.isfinite(self._offset)):
+            # the offset cancels in every term; it only keeps a large mean's digits
+            with np.errstate(invalid="ignore"), warnings.catch_warnings():
+                warnings.simplefilter("ignore", RuntimeWarning)  # an all-NaN column
+                first = np.nanmean(y, axis=0)
+            self._offset = first if self._offset is None else np.where(
+                np.isfinite(self._offset), self._offset, first)
+        offset = np.nan_to_num(self._offset)
+        phase = self._history[-1] + np.cumsum(np.where(missing, 0.0, y - offset), axis=0)
         full = np.concatenate([self._history, phase])
+        broken = np.concatenate([self._broken,
+                                 self._broken[-1] + np.cumsum(missing, axis=0, dtype=np.int64)])
         n_old, n_new = self.n_samples, self.n_samples + y.shape[0]
         for k, m in enumerate(self._m):
             # new terms end at phase points t = max(2m, n_old + 1) … n_new
@@ -109,11 +131,14 @@ class AllanStream:
                 continue
             t = np.arange(first, n_new + 1) - self._first
             d = full[t] - 2 * full[t - m] + full[t - 2 * m]
-            self._add(k, np.sum(d * d, axis=0))
-            self._terms[k] += t.size
+            whole = broken[t] == broken[t - 2 * m]  # no missing sample in the term's span
+            self._add(k, np.sum(np.where(whole, d * d, 0.0), axis=0))
+            self._terms[k] += whole.sum(axis=0)
         self.n_samples = n_new
+        self.missing += missing.sum(axis=0)
         cut = max(0, full.shape[0] - self._keep)
         self._history = full[cut:].copy()
+        self._broken = broken[cut:].copy()
         self._first += cut
 
     def _add(self, k: int, value: np.ndarray) -> None:
@@ -126,23 +151,30 @@ class AllanStream:
     def result(self) -> AllanResult:
         """The overlapping Allan deviation of the samples so far at the octave taus
         with at least two terms (as :func:`imunoise.adev` keeps them)."""
-        keep = self._terms >= 2
+        keep = self._terms.min(axis=1) >= 2
         if not keep.any():
-            raise ImunoiseValueError(f"the stream holds {self.n_samples} samples; the "
-                                     "Allan deviation needs at least 3")
+            raise ImunoiseValueError(f"the stream holds {self.n_samples} samples "
+                                     f"({_plural_missing(self.missing)}); the Allan deviation "
+                                     "needs at least 3 in a row")
         m, terms = self._m[keep], self._terms[keep]
-        var = self._sums[keep] / (2.0 * (m * m * terms)[:, None])
+        var = self._sums[keep] / (2.0 * (m * m)[:, None] * terms)
         alpha = _slope_alpha(m, var)
+        # the EDF of a record without gaps that gives each tau its terms (N = terms + 2m)
         edf = np.column_stack([
+            [float(_core_allan.estimator_edf(
+                "oadev", int(terms[i, j] + 2 * m[i]),
+                np.array([alpha[i, j]], dtype=np.int32),
+                np.array([m[i]], dtype=np.uint64))[0]) for i in range(m.size)]
+            if self.missing[j] else
             _core_allan.estimator_edf("oadev", self.n_samples + 1,
                                       np.ascontiguousarray(alpha[:, j], dtype=np.int32),
                                       m.astype(np.uint64))
             for j in range(self.channels)])
         return tau_result(
-            "adev", m, var, np.sqrt(var), np.repeat(terms[:, None], self.channels, axis=1),
+            "adev", m, var, np.sqrt(var), terms,
             edf, alpha, np.zeros(alpha.shape, dtype=bool), fs=self.fs,
             confidence=self.confidence, one_d=self.channels == 1,
-            missing=np.zeros(self.channels, np.int64), gaps="skip",
+            missing=self.missing.copy(), gaps="skip",
             n_points=self.n_samples + 1, data_type="freq")
 
     def __repr__(self) -> str:
@@ -150,6 +182,12 @@ class AllanStream:
         return lines(f"AllanStream({plural(self.channels, 'channel')} at {self.fs:g} Hz",
                      [f"{self.n_samples:,} samples ({seconds:.6g} s)",
                       f"octave taus up to {self._m[-1] / self.fs:g} s"])
+
+
+def _plural_missing(missing: np.ndarray) -> str:
+    """``"none missing"`` or ``"12 missing"`` (the most of any channel)."""
+    most = int(np.max(missing)) if missing.size else 0
+    return f"{most} missing" if most else "none missing"
 
 
 def _slope_alpha(m: np.ndarray, var: np.ndarray) -> np.ndarray:

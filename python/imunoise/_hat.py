@@ -43,7 +43,8 @@ from imunoise._validate import confidence_level, samples
 from imunoise.allan import ONE_SIGMA, AllanResult, TauSpec, chi2_interval
 from imunoise.errors import ImunoiseValueError
 
-__all__ = ["gcodev", "three_cornered_hat", "ThreeCorneredHat", "HAT_KINDS"]
+__all__ = ["HAT_KINDS", "ThreeCorneredHat", "at_m", "gcodev", "own_variance",
+           "three_cornered_hat"]
 
 #: Statistics the hat can combine: each a quadratic form of the data, whose
 #: expectation for independent noises adds (ThêoBR and ThêoH scale Theo1 by a
@@ -294,32 +295,23 @@ def three_cornered_hat(a: npt.ArrayLike, b: npt.ArrayLike, c: npt.ArrayLike, fs:
     }
     # gaps can leave the pairs different taus: the hat needs all three at each
     common = np.intersect1d(np.intersect1d(pairs["ab"].m, pairs["ac"].m), pairs["bc"].m)
-    pairs = {k: _at_m(r, common) for k, r in pairs.items()}
+    pairs = {k: at_m(r, common) for k, r in pairs.items()}
     var = {k: np.asarray(r.var, dtype=np.float64) for k, r in pairs.items()}
     spread = {k: var[k] * np.sqrt(2.0 / np.asarray(r.edf, dtype=np.float64))
               for k, r in pairs.items()}
     s = 0.5 * (spread["ab"] + spread["ac"] + spread["bc"])
-    z = _stats.norm.ppf(0.5 + confidence / 2.0)
     # sensor -> (the two pairs holding it, the pair without it)
     layout = {"a": ("ab", "ac", "bc"), "b": ("ab", "bc", "ac"), "c": ("ac", "bc", "ab")}
     own, negative = {}, []
     for sensor, (p, q, other) in layout.items():
         v = 0.5 * (var[p] + var[q] - var[other])
-        below = v < 0
-        negative.append(below)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            edf = np.where(below, np.nan, 2.0 * v**2 / s**2)
-            dev = np.where(below, np.nan, np.sqrt(np.abs(v)))
-        low, high = chi2_interval(dev, edf, confidence)
-        low = np.where(below, 0.0, low)
-        high = np.where(below, np.sqrt(np.maximum(v + z * s, 0.0)), high)
         smaller = var[p] <= var[q]
-        own[sensor] = _replace(
-            pairs[p], var=v, dev=dev, edf=edf, ci_low=low, ci_high=high,
-            n=_fewer(pairs[p].n, pairs[q].n),
+        own[sensor], below = own_variance(
+            pairs[p], v, s, confidence, n=_fewer(pairs[p].n, pairs[q].n),
             alpha=np.where(smaller, pairs[p].alpha, pairs[q].alpha),
             alpha_identified=np.where(smaller, pairs[p].alpha_identified,
                                       pairs[q].alpha_identified))
+        negative.append(below)
         if below.any():
             taus_below = common[below.reshape(len(common), -1).any(axis=1)] / fs
             shown = ", ".join(f"{t:g}" for t in taus_below[:8])
@@ -333,6 +325,30 @@ def three_cornered_hat(a: npt.ArrayLike, b: npt.ArrayLike, c: npt.ArrayLike, fs:
                             ac=pairs["ac"], bc=pairs["bc"], negative=np.array(negative))
 
 
+def own_variance(base: AllanResult, var: np.ndarray, spread: np.ndarray, confidence: float,
+                 **fields) -> tuple[AllanResult, np.ndarray]:
+    """``base`` carrying a sensor's own variance ``var`` (a difference of variances,
+    so possibly negative) of standard deviation ``spread``, and where it is negative.
+
+    ``edf`` is that of a χ² of this mean and spread, ν = 2·var²/spread², and the
+    interval the χ² one; where ``var`` < 0, ``dev`` and ``edf`` are NaN, ``ci_low``
+    0 and ``ci_high`` the upper bound √max(0, var + z·spread), z the normal
+    quantile of the interval's upper end. ``fields`` replace more of ``base``."""
+    below = var < 0
+    z = _stats.norm.ppf(0.5 + confidence / 2.0)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        edf = np.where(below, np.nan, 2.0 * var**2 / spread**2)
+        dev = np.where(below, np.nan, np.sqrt(np.abs(var)))
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        low, high = chi2_interval(dev, edf, confidence)
+    # an EDF far below 1 (a variance near 0 against its spread) puts both χ² quantiles
+    # at 0 in floating point: the interval's lower end is then 0, not inf
+    low = np.where(below | ~np.isfinite(low), 0.0, low)
+    high = np.where(below, np.sqrt(np.maximum(var + z * spread, 0.0)), high)
+    return _replace(base, var=var, dev=dev, edf=edf, ci_low=low, ci_high=high,
+                    **fields), below
+
+
 def _fewer(n_p: np.ndarray, n_q: np.ndarray) -> np.ndarray:
     """The smaller term count of two pairs, (T,) or (T, channels) as either is."""
     n_p, n_q = np.asarray(n_p), np.asarray(n_q)
@@ -341,7 +357,7 @@ def _fewer(n_p: np.ndarray, n_q: np.ndarray) -> np.ndarray:
     return np.minimum(n_p, n_q)
 
 
-def _at_m(result: AllanResult, m: np.ndarray) -> AllanResult:
+def at_m(result: AllanResult, m: np.ndarray) -> AllanResult:
     """``result`` at the averaging factors ``m`` (a subset of its own)."""
     if np.array_equal(result.m, m):
         return result

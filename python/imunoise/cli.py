@@ -82,6 +82,16 @@ def _build_parser() -> argparse.ArgumentParser:
                    "(the report states what was cut)")
     _report_units_option(r)
     _stream_options(r)
+    r.add_argument("--mount", nargs="+", default=None, metavar="LOG",
+                   help="one or two logs of other sensors on the long log's mount, recorded "
+                   "over the same time: adds the section 'Sensors on one mount', each "
+                   "sensor's own Allan deviation beside its plain one (three-cornered hat "
+                   "with two, Groslambert covariance with one); without it the report has "
+                   "no such section")
+    r.add_argument("--mount-clock", choices=["timestamps", "motion"], default="timestamps",
+                   help="how the --mount logs' times relate to the long log's: "
+                   "'timestamps' on one clock (default), or 'motion': each log's clock has "
+                   "its own zero and the logs are lined up on the gyro's motion")
 
     a = sub.add_parser("adev", help="print an Allan-family deviation table",
                        description="Print tau, deviation, confidence interval and number of "
@@ -502,7 +512,8 @@ def _cmd_report(args) -> int:
     args.units = [u for u in args.units if u != _TABLE_UNITS]
     rep = report.build(args.short_log, args.long_log, args.output, spec=spec, fs=args.fs,
                        progress=args.progress, read_options=_read_options(args), trim=args.trim,
-                       force=args.force, units=table_units, stream=args.stream)
+                       force=args.force, units=table_units, stream=args.stream,
+                       mount=args.mount, mount_clock=args.mount_clock)
     for log in rep.logs:
         _note_gaps(log.source, log)
     print(f"report written to {rep.html}")

@@ -39,6 +39,7 @@ from imunoise.stats import Distribution
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
+    from imunoise._mount import OwnNoise
     from imunoise.dynamic import DynamicAllan
     from imunoise.spectrum import Spectrum
 
@@ -50,6 +51,7 @@ __all__ = [
     "dynamic",
     "events",
     "histograms",
+    "own_noise",
     "plain_ticks",
     "save",
     "spectrum",
@@ -1112,4 +1114,67 @@ def compensation(before: AllanResult, after: AllanResult, *, title: str = "",
         ax.legend(ncol=2)
         fig.suptitle(title or "Allan deviation before and after compensation")
         _margins(fig, left=0.9, bottom=0.5, title=True)
+    return plain_ticks(fig)
+
+
+#: Colours of the logs in :func:`own_noise` (one per sensor).
+LOG_COLORS = ("#1f77b4", "#d62728", "#2ca02c")
+
+
+def own_noise(result: OwnNoise, *, title: str = "", unit: str = "",
+              names: Sequence[str] | None = None) -> Figure:
+    """Each sensor's own deviation (markers, error bars) beside its plain one (line),
+    one panel per axis, a colour per log (:func:`imunoise.own_noise`).
+
+    Where a sensor's own variance is negative the upper end of its interval is
+    drawn as an open downward triangle (an upper bound), never left out.
+    """
+    new_figure = _plt()
+    if not hasattr(result, "own") or not hasattr(result, "plain"):
+        raise ImunoiseTypeError(f"result must be an OwnNoise (imunoise.own_noise); got "
+                                f"{type(result).__name__}")
+    taus = np.asarray(result.taus, dtype=np.float64)
+    k = result.own[0].channels
+    names = list(names) if names is not None else [
+        _summary.source_name(log.source) for log in result.aligned]
+    with style():
+        fig = new_figure(figsize=(3.6 * k, 4.2))
+        axes = list(fig.subplots(1, k, squeeze=False, sharey=True)[0])
+        for i, (own, plain) in enumerate(zip(result.own, result.plain, strict=True)):
+            color = LOG_COLORS[i % len(LOG_COLORS)]
+            dev = np.asarray(own.dev, dtype=np.float64).reshape(len(taus), -1)
+            lo = np.asarray(own.ci_low, dtype=np.float64).reshape(dev.shape)
+            hi = np.asarray(own.ci_high, dtype=np.float64).reshape(dev.shape)
+            base = np.asarray(plain.dev, dtype=np.float64).reshape(dev.shape)
+            below = np.asarray(result.negative[i]).reshape(dev.shape)
+            for j, ax in enumerate(axes):
+                ax.loglog(taus, base[:, j], color=color, linewidth=1.0, alpha=0.7,
+                          label=f"{names[i]} plain")
+                ok = ~below[:, j]
+                yerr = np.vstack([dev[ok, j] - lo[ok, j], hi[ok, j] - dev[ok, j]])
+                # an unbounded end (EDF far below 1) draws no bar rather than failing
+                yerr = np.where(np.isfinite(yerr), np.maximum(yerr, 0.0), 0.0)
+                ax.errorbar(taus[ok], dev[ok, j], yerr=yerr, fmt="o", ms=3, color=color,
+                            elinewidth=0.8, capsize=1.5, label=f"{names[i]} own")
+                if below[:, j].any():
+                    ax.plot(taus[~ok], hi[~ok, j], linestyle="none", marker="v", mfc="none",
+                            color=color, ms=6, label=f"{names[i]} own < (negative variance)")
+        # the curves set the range: an interval of an EDF far below 1 runs to 1e100
+        values = np.concatenate([np.ravel(r.dev) for r in (*result.own, *result.plain)])
+        values = values[np.isfinite(values) & (values > 0)]
+        if values.size:
+            axes[0].set_ylim(values.min() / 3.0, values.max() * 3.0)
+        for ax, axis in zip(axes, axis_names(k), strict=True):
+            ax.set_title(axis)
+            ax.set_xlabel("τ [s]")
+            ax.grid(True, which="both", alpha=0.3)
+        axes[0].set_ylabel(_label("σ(τ)", unit))
+        seen: dict[str, object] = {}  # one entry per label over all panels
+        for ax in axes:
+            for handle, label in zip(*ax.get_legend_handles_labels(), strict=True):
+                seen.setdefault(label, handle)
+        fig.legend(list(seen.values()), list(seen), loc="lower center",
+                   ncol=min(len(seen), 3), fontsize="small", frameon=False)
+        fig.suptitle(title or f"{result.sensor}: own ({result.method}) and plain deviation")
+        _margins(fig, left=0.8, bottom=0.6 + 0.22 * ((len(seen) + 2) // 3), title=True)
     return plain_ticks(fig)

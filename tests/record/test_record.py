@@ -34,10 +34,11 @@ def test_ten_minutes_recorded_byte_identical_and_settings_restored(emulator, tmp
     assert log.issues.total == 0 and len(log.gaps) == 0
     assert log.messages["VNYMR"] * 4 == pytest.approx(len(log), abs=8)  # 200 Hz beside 800 Hz
     assert log.duration >= 600
-    # the live view parsed a copy of the same stream: same samples, same ADEV
+    # the live view parsed a copy of the same stream: same samples, same ADEV (its
+    # AllanStream, fed a second at a time, against the whole record's)
     snap = rec.snapshot
     np.testing.assert_array_equal(snap.gyro, log.gyro)
-    np.testing.assert_array_equal(snap.adev.dev, imunoise.adev(log.gyro, log.fs).dev)
+    _same_adev(snap.adev, imunoise.adev(log.gyro, log.fs))
     assert snap.dropped == 0
     # the host receive times: one line per chunk, offsets increasing from 0 within the log
     offsets, seconds = host_times(out)
@@ -90,6 +91,20 @@ def test_vanishing_port_is_one_gap_of_its_length(emulator, tmp_path):
     assert log.gaps.samples[0] == pytest.approx(expected, abs=1)
     assert log.gaps.samples[0] >= 2 * 200
     assert rec.snapshot.outages == 1 and rec.snapshot.dropped == log.gaps.total
+    # the dropped samples are a gap of the live ADEV, skipped as adev skips the log's
+    assert rec.snapshot.adev.missing[0] == log.gaps.total
+    _same_adev(rec.snapshot.adev, imunoise.adev(log.gyro, log.fs, gaps="skip"))
+
+
+def _same_adev(live, whole):
+    """The live view's curve is the whole record's, at every tau it has (the stream
+    keeps octave taus with two terms: it may lack the last)."""
+    k = len(live.taus)
+    assert k >= len(whole.taus) - 1
+    np.testing.assert_array_equal(live.m, whole.m[:k])
+    np.testing.assert_array_equal(live.n, whole.n[:k])
+    np.testing.assert_allclose(live.dev, whole.dev[:k], rtol=1e-9)
+    np.testing.assert_allclose(live.taus, whole.taus[:k], rtol=1e-6)
 
 
 def test_outage_of_an_ascii_log_without_timestamps_comes_from_the_side_file(tmp_path):

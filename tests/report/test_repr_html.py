@@ -15,6 +15,7 @@ from pathlib import Path
 import imunoise
 import numpy as np
 import pytest
+from helpers.mount import mount_logs
 from imunoise.recording.recorder import Recording
 from imunoise.report.build import Report
 
@@ -98,6 +99,8 @@ def objects(tmp_path_factory):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         fleet = imunoise.fleet(paths, client=False, progress=False)
+    mount = imunoise.align(mount_logs(20_000, 40.0, (0.01, 0.02, 0.03), starts=(0, 100, 50),
+                                      ends=(19_000, 20_000, 19_500), jitter=0.2))
     return {
         "Fleet": fleet,
         "ImuLog": log, "damaged ImuLog": damaged, "ParseIssues": damaged.issues,
@@ -114,13 +117,14 @@ def objects(tmp_path_factory):
                                identity={}, settings={}, previous={}, restored=True),
         "ThreeCorneredHat": imunoise.three_cornered_hat(
             *(x[:20_000, 0] + x[:20_000, k] for k in range(3)), 40.0),
+        "Aligned": mount, "OwnNoise": imunoise.own_noise(mount),
     }
 
 
 NAMES = ("ImuLog", "damaged ImuLog", "ParseIssues", "Gaps", "AllanResult", "NoiseModel",
          "Components", "Prediction", "Description", "Distribution", "Comparison", "Spectrum",
          "DynamicAllan", "Stationarity", "Events", "Warmup", "Thermal", "Conversion", "Report",
-         "Plan", "Recording", "ThreeCorneredHat", "Fleet")
+         "Plan", "Recording", "ThreeCorneredHat", "Fleet", "Aligned", "OwnNoise")
 
 
 @pytest.mark.parametrize("name", NAMES)

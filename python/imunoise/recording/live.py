@@ -6,8 +6,16 @@ the recorder's buffers); a thread of its own parses the queue with the streaming
 VN parser and keeps the gyro samples of the main message type. Once a second it
 shows elapsed and target time, samples and rate, damaged records, port outages,
 per-axis mean and std, the overlapping ADEV's N and B read-offs with their
-uncertainties and the planner's answer for K. The Allan computations release
-the GIL, and the view is off when the output is not a terminal.
+uncertainties and the planner's answer for K. The view is off when the output is
+not a terminal.
+
+The ADEV is an :class:`imunoise.AllanStream` fed only the samples that arrived
+since the last refresh, so a refresh costs the same after ten hours as after ten
+seconds. With timestamps, a dropped sample (a step of the stamps longer than one
+period) is fed as a NaN row, a gap the stream skips as :func:`imunoise.adev` does.
+The rate is the configured output rate until timestamps give one; when the rate
+or the main message type changes, the stream starts again from the samples kept
+(the rate labels every tau and places every gap).
 """
 
 from __future__ import annotations
@@ -20,9 +28,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from imunoise._allan_stream import AllanStream
 from imunoise._core import vn as _core_vn
 from imunoise._simulate_log import DEFAULT_K
-from imunoise.allan import AllanResult, adev
+from imunoise.allan import AllanResult
 from imunoise.display import duration
 from imunoise.noise._terms import FLICKER
 from imunoise.planner import plan as make_plan
@@ -33,6 +42,14 @@ __all__ = ["LiveView", "Snapshot"]
 
 #: Seconds between two refreshes.
 REFRESH = 1.0
+#: Samples before the live view shows an ADEV.
+MIN_SAMPLES = 16
+#: Relative change of the rate that restarts the ADEV stream (its taus and gaps
+#: follow the rate; the timestamps' median step settles within this early on).
+RATE_CHANGE = 1e-3
+#: Longest step of the timestamps (s) read as dropped samples; a longer jump forward
+#: is the clock's (set, or reset to a later value) and leaves no gap rows.
+MAX_GAP = 600.0
 
 
 @dataclass(frozen=True)
@@ -77,6 +94,10 @@ class LiveView:
         self._tables: dict[str, _Table] = {}
         self._lock = threading.Lock()
         self._lines = 0
+        # the ADEV stream: its table, rate, samples fed, last stamp fed
+        self._stream: AllanStream | None = None
+        self._fed: tuple[str | None, float, int, float | None] = (None, 0.0, 0, None)
+        self._stream_lock = threading.Lock()
         self._thread = threading.Thread(target=self._run, name="imunoise-live", daemon=True)
         self._thread.start()
 
@@ -137,9 +158,31 @@ class LiveView:
                 fs = 1.0 / step
                 # samples missing between stamps (a clock reset's backward step counts none)
                 dropped = int(np.sum(np.maximum(np.round(steps / step) - 1, 0)))
-        result = adev(gyro, fs) if len(gyro) >= 16 else None
+        result = self._adev(name, gyro, stamps, fs)
         return Snapshot(gyro=gyro, fs=fs, adev=result, damaged=damaged, outages=self.outages,
                         dropped=dropped)
+
+    def _adev(self, name: str | None, gyro: np.ndarray, stamps: np.ndarray | None,
+              fs: float) -> AllanResult | None:
+        """The ADEV of the main table's gyro so far: the stream fed the samples since
+        the last call (NaN rows for the samples its timestamps say were dropped)."""
+        with self._stream_lock:
+            table, rate, fed, last = self._fed
+            if self._stream is None or table != name or abs(fs / rate - 1.0) > RATE_CHANGE:
+                self._stream = AllanStream(fs, channels=3)
+                table, rate, fed, last = name, fs, 0, None
+            new = gyro[fed:]
+            if stamps is not None and len(stamps) == len(gyro) and len(new):
+                new, last = _with_dropped(new, stamps[fed:], last, rate)
+            if len(new):
+                self._stream.update(new)
+            self._fed = (table, rate, len(gyro), last)
+            if len(gyro) < MIN_SAMPLES:
+                return None
+            try:
+                return self._stream.result()
+            except ValueError:  # fewer than 3 samples in a row so far
+                return None
 
     def _render(self, snap: Snapshot) -> None:
         elapsed = time.monotonic() - self.started
@@ -196,3 +239,20 @@ class LiveView:
         if self.show:
             self._render(snap)
         return snap
+
+
+def _with_dropped(samples: np.ndarray, stamps: np.ndarray, last: float | None,
+                  fs: float) -> tuple[np.ndarray, float]:
+    """``samples`` with a NaN row for every sample dropped before each (a step of the
+    stamps of k periods leaves k − 1 missing; a step back, a clock reset, none),
+    ``last`` the stamp of the sample before them; and the last stamp."""
+    steps = np.diff(stamps, prepend=stamps[0] if last is None else last)
+    # a NaN stamp or a jump forward beyond MAX_GAP is a clock's fault, not dropped samples
+    steps = np.where(np.isfinite(steps) & (steps <= MAX_GAP), steps, 0.0)
+    gaps = np.maximum(np.rint(steps * fs) - 1, 0).astype(np.int64)
+    if not gaps.any():
+        return samples, float(stamps[-1])
+    rows = np.arange(len(samples)) + np.cumsum(gaps)
+    out = np.full((int(rows[-1]) + 1, samples.shape[1]), np.nan)
+    out[rows] = samples
+    return out, float(stamps[-1])

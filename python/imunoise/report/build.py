@@ -11,11 +11,12 @@ import datetime as _dt
 import os
 import shutil
 import time
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from imunoise import _atomic, _interrupt, _stream, _summary, export, stats
+from imunoise._align import CLOCKS, align
 from imunoise._core import __version__
 from imunoise._progress import Progress, wanted
 from imunoise._schema import ALLAN_SENSORS
@@ -62,6 +63,8 @@ SECTIONS: tuple[Section, ...] = (
             applies=lambda ctx: ctx.thermal is not None),
     Section("Allan deviation", sections.allan_deviation),
     Section("Noise coefficients", sections.noise_coefficients),
+    Section("Sensors on one mount", sections.one_mount,
+            applies=lambda ctx: ctx.aligned is not None),
     Section("Events and the Allan deviation", sections.long_log_events,
             applies=lambda ctx: ctx.long_events is not None and len(ctx.long_events) > 0),
     Section("Datasheet comparison", sections.datasheet_comparison),
@@ -96,7 +99,11 @@ class Report:
     models : dict
         ``{"gyro": NoiseModel, "accel": NoiseModel}`` (empty without gyro and accel).
     logs : tuple of ImuLog
-        The logs analysed (short, then long when it is another log).
+        The logs analysed (short, then long when it is another log, then the
+        ``mount`` logs).
+    own_noise : dict
+        ``{"gyro": OwnNoise, …}`` of the long log and the ``mount`` logs (empty
+        without them).
     """
 
     out_dir: Path
@@ -110,6 +117,7 @@ class Report:
     models: dict
     logs: tuple = ()
     attitude: dict = field(default_factory=dict)
+    own_noise: dict = field(default_factory=dict)
 
     def _facts(self) -> list[str]:
         return [_summary.plural(len(self.logs), "log"),
@@ -141,6 +149,8 @@ def build(
     force: bool = False,
     units: str | None = None,
     stream: bool | None = None,
+    mount: Sequence[str | os.PathLike | ImuLog] | None = None,
+    mount_clock: str = "timestamps",
 ) -> Report:
     """Analyse the logs and write the report directory.
 
@@ -187,6 +197,17 @@ def build(
         channel at a time. None (default): for VN logs larger than
         ``imunoise._stream.STREAM_BYTES`` (256 MiB). The numbers are those of the
         in-memory path (to rounding; the report's digits agree).
+    mount : sequence of path or ImuLog, optional
+        One or two logs of other sensors on the long log's mount, recorded over the
+        same time (the same motion): adds the section "Sensors on one mount", each
+        sensor's own Allan deviation beside its plain one (the three-cornered hat
+        with two, the Groslambert covariance with one; :func:`imunoise.own_noise`).
+        The logs are aligned on the long log's grid (:func:`imunoise.align`) before
+        any analysis, so a log that cannot be aligned fails the report at once;
+        the aligned copies are in memory, whatever ``stream``.
+    mount_clock : {"timestamps", "motion"}
+        How the ``mount`` logs' times relate to the long log's (``clock`` of
+        :func:`imunoise.align`).
     """
     if trim not in (None, "auto"):
         raise ImunoiseValueError(f"trim must be None or 'auto'; got {trim!r}")
@@ -194,12 +215,16 @@ def build(
         raise ImunoiseValueError(f"units must be None or 'datasheet'; got {units!r}")
     if stream not in (None, True, False):
         raise ImunoiseValueError(f"stream must be None, True or False; got {stream!r}")
+    mount = _mount_sources(mount)
+    if mount_clock not in CLOCKS:
+        raise ImunoiseValueError(f"mount_clock must be one of {', '.join(CLOCKS)}; got "
+                                 f"{mount_clock!r}")
     if spec is not None:
         # a wrong --spec is found before the analysis, not after it (which takes
         # seconds to minutes), and before a folder is made
         load_spec(spec)
     out = Path(out_dir)
-    inputs = [p for p in (short, long) if isinstance(p, str | os.PathLike)]
+    inputs = [p for p in (short, long, *mount) if isinstance(p, str | os.PathLike)]
     previous = folder.claim(out, force=force, inputs=inputs)
     options = dict(read_options or {})
     streamed = stream if stream is not None else any(
@@ -217,7 +242,8 @@ def build(
         # should the command line's watchdog end a stuck process, it cleans up too
         with _interrupt.undo_on_exit(lambda: clean(True)):
             rep = _build(short, long, out, previous, inputs, options, workdirs, spec=spec,
-                         fs=fs, progress=progress, trim=trim, streamed=streamed, units=units)
+                         fs=fs, progress=progress, trim=trim, streamed=streamed, units=units,
+                         mount=mount, mount_clock=mount_clock)
     except BaseException:
         clean(True)
         raise
@@ -225,8 +251,22 @@ def build(
     return rep
 
 
+def _mount_sources(mount) -> list:
+    """The ``mount`` logs as a list of one or two (none for None)."""
+    if mount is None:
+        return []
+    if isinstance(mount, str | os.PathLike | ImuLog):
+        mount = [mount]
+    mount = list(mount)
+    if not 1 <= len(mount) <= 2:
+        raise ImunoiseValueError(f"mount must hold one or two logs (with the long log, two "
+                                 f"or three sensors on one mount); got {len(mount)}")
+    return mount
+
+
 def _build(short, long, out: Path, previous, inputs, options, workdirs: list[Path], *,
-           spec, fs, progress, trim, streamed: bool, units: str | None) -> Report:
+           spec, fs, progress, trim, streamed: bool, units: str | None, mount: list,
+           mount_clock: str) -> Report:
     """:func:`build` once the folder is claimed; ``workdirs`` collects the folders of
     the streamed path's memory maps (the caller removes them)."""
     timings: list[tuple[str, float, float]] = []
@@ -243,7 +283,7 @@ def _build(short, long, out: Path, previous, inputs, options, workdirs: list[Pat
                        **options)
         if streamed:
             _stream.release_log(log)  # the reader's checks touched every page
-        name = "the log" if long is None else f"the {label} log"
+        name = "the log" if long is None and label == "short" else f"the {label} log"
         if (fs is None and not isinstance(source, ImuLog) and log.time is None
                 and log.fs == DEFAULT_FS):
             assumed.append(name)  # the reader assumed the rate (it warned)
@@ -262,6 +302,14 @@ def _build(short, long, out: Path, previous, inputs, options, workdirs: list[Pat
         start = time.perf_counter()
         _trim_warmup(ctx)
         ctx.stage(f"warm-up of the {'' if ctx.one_log else 'long '}log (--trim auto)", start)
+    others: list[ImuLog] = []  # the mount logs as read (the report's logs)
+    if mount:
+        # before any analysis: a log that cannot be aligned fails the report at once
+        others = [source if isinstance(source, ImuLog) else read(source, f"mount {i}")
+                  for i, source in enumerate(mount, start=1)]
+        start = time.perf_counter()
+        ctx.aligned = align([ctx.long, *others], clock=mount_clock)
+        ctx.stage("aligning the logs of the mount", start)
     doc = Doc()
     doc.h(1, TITLE)
     stamp = _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
@@ -307,8 +355,9 @@ def _build(short, long, out: Path, previous, inputs, options, workdirs: list[Pat
         distributions=ctx.distributions,
         allan=ctx.allan,
         models=ctx.models,
-        logs=tuple(log for _label, log in ctx.logs),
+        logs=tuple(log for _label, log in ctx.logs) + tuple(others),
         attitude=ctx.attitude_distributions,
+        own_noise=ctx.own_noise,
     )
 
 

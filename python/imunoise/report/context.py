@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import gc
 import time
+import warnings
 from dataclasses import dataclass, field
 from functools import cached_property
 from pathlib import Path
@@ -14,10 +15,13 @@ import numpy as np
 
 from imunoise import _schema, _stream, noise, plot, stats
 from imunoise import allan as _allan
+from imunoise._align import Aligned
 from imunoise._events import Events, events
+from imunoise._mount import OwnNoise, own_noise
 from imunoise._schema import ALLAN_SENSORS, SAMPLE_SENSORS, sensor_label
 from imunoise._thermal import Thermal, thermal
 from imunoise._warmup import Warmup, warmup
+from imunoise.errors import ImunoiseWarning
 from imunoise.readers.log import ImuLog
 from imunoise.report import sections
 from imunoise.report.document import Doc
@@ -55,6 +59,9 @@ class Context:
     #: Units of the noise coefficients in every table (None: the defaults, or
     #: "datasheet"; :meth:`imunoise.noise.NoiseModel.table`).
     units: str | None = None
+    #: The long log and the logs of the other sensors on its mount on one grid
+    #: (``--mount``); None without them.
+    aligned: Aligned | None = None
 
     @property
     def logs(self) -> list[tuple[str, ImuLog]]:
@@ -145,6 +152,22 @@ class Context:
                 out[sensor] = _stream.adev(y, self.long.fs, self.taus_per_decade,
                                            self.streamed, self.block)
                 _stream.release(y)  # a memory map's pages, before the next sensor's
+        return out
+
+    @cached_property
+    def own_noise(self) -> dict[str, OwnNoise]:
+        """Per sensor every aligned log has, each sensor's own Allan deviation beside
+        its plain one on the report's grid (empty without ``aligned``). The negative
+        variances are said by the section, not warned about."""
+        if self.aligned is None:
+            return {}
+        out = {}
+        for sensor in ALLAN_SENSORS:
+            if all(getattr(log, sensor) is not None for log in self.aligned):
+                with warnings.catch_warnings():
+                    warnings.simplefilter("ignore", ImunoiseWarning)
+                    out[sensor] = own_noise(self.aligned, sensor=sensor,
+                                            taus=self.taus_per_decade)
         return out
 
     @cached_property

@@ -51,6 +51,7 @@ __all__ = [
     "events_section",
     "long_log_events",
     "noise_coefficients",
+    "one_mount",
     "power_spectral_density",
     "recording_summary",
     "sample_statistics",
@@ -751,3 +752,99 @@ def thermal_section(ctx: Context, doc: Doc) -> None:
                                 unit=_unit(sensor))
         ctx.add_figure(doc, fig, f"thermal_adev_{sensor}",
                        f"Allan deviation of {sensor} before and after compensation")
+
+
+def one_mount(ctx: Context, doc: Doc) -> None:
+    """The long log and the logs of the other sensors on its mount: how they were put
+    on one grid, then per sensor each one's own Allan deviation beside its plain one,
+    the taus where an own variance is negative said in words."""
+    al = ctx.aligned
+    names = [f"{label} ({_source(log)})" for label, log in
+             zip(_mount_labels(len(al)), al, strict=True)]
+    method = ("three-cornered hat: σ²_a = ½(σ²_ab + σ²_ac − σ²_bc) from the Allan "
+              "variances of the differences" if len(al) == 3 else
+              "Groslambert covariance: σ²_own,a = σ²_a − GCOV(a, b)")
+    doc.p(f"{len(al)} sensors on one mount, recorded over the same time: the mount's motion "
+          "is common to them and cancels, so each sensor's own noise is told from the "
+          f"motion ({method}; {docs_link('mount', 'sensors on one mount')}). A sensor's "
+          "plain Allan deviation holds the motion and its own noise; where the two curves "
+          "agree the sensor's noise dominates, where the plain one is higher the motion does.")
+    clock = ("their timestamps, taken to be on one clock" if al.clock == "timestamps" else
+             "the motion: the lag of best correlation of the gyro (each log's clock has its "
+             "own zero)")
+    doc.p(f"The logs were put on the long log's grid, lined up by {clock}. Each log keeps "
+          "its own samples, each at the nearest row of the grid; none is interpolated "
+          "(interpolation would filter the white noise being measured). Common span: "
+          f"{al.n_samples} samples = {format_duration(al.duration)} at {al.fs:.6g} Hz.")
+    rows = [[name, *row[1:]] for name, row in zip(names, al.rows(), strict=True)]
+    doc.table(list(al.HEADER), rows,
+              caption="The logs on one grid: offset of each log's first sample on the long "
+              "log's clock, mean timing error of its samples against the grid (phase), the "
+              "motion's peak correlation with the long log's (clock 'motion'), and the "
+              "samples each lost: cut before and after the common span, dropped as doubled "
+              "(a clock faster than the long log's: two samples for one row, the farther "
+              "dropped), missing in the span (its own gaps, and rows a slower clock does not "
+              "reach)")
+    if not ctx.own_noise:
+        doc.p("No gyro or accelerometer channel is in every log: nothing to compare.")
+        return
+    if len(al) == 2:
+        doc.p("With two sensors the product of the motion and each sensor's noise does "
+              "not cancel: a motion far above the noise leaves the own deviation wide or "
+              "negative. A third sensor (the three-cornered hat, differences only) cancels "
+              "the motion whatever its size.")
+    for sensor, result in ctx.own_noise.items():
+        unit = _unit(sensor)
+        doc.h(3, sensor)
+        fig = plot.own_noise(result, title=f"{sensor}: own and plain Allan deviation",
+                             unit=unit, names=_mount_labels(len(al)))
+        ctx.add_figure(doc, fig, f"mount_{sensor}",
+                       f"Own (markers, {result.own[0].confidence:.1%} interval) and plain "
+                       f"(line) Allan deviation of {sensor} [{unit}] per sensor; an open "
+                       "triangle is the upper bound where the own variance is negative")
+        axes = axis_names(result.own[0].channels)
+        said = False
+        for i, name in enumerate(names):
+            below = np.asarray(result.negative[i]).reshape(len(result.taus), -1)
+            if not below.any():
+                continue
+            said = True
+            where = "; ".join(
+                f"{a} at τ = {', '.join(format_number(t) for t in result.taus[below[:, j]])} s"
+                for j, a in enumerate(axes) if below[:, j].any())
+            doc.p(f"**Negative own variance**, {name}: {where}. There the sensor's noise is "
+                  "below what the other sensors' resolve; the table gives the upper bound "
+                  "(< value), the figure an open triangle.")
+        if not said:
+            doc.p(f"No own variance of {sensor} is negative: every τ resolves each sensor's "
+                  "own noise.")
+        header = ["τ [s]"]
+        for label in _mount_labels(len(al)):
+            for a in axes:
+                header += [f"{label} {a} plain", f"{label} {a} own"]
+        table = []
+        for t, tau in enumerate(result.taus):
+            row = [format_number(tau)]
+            for own, plain, neg in zip(result.own, result.plain, result.negative, strict=True):
+                dev = np.reshape(own.dev, (len(result.taus), -1))[t]
+                high = np.reshape(own.ci_high, (len(result.taus), -1))[t]
+                base = np.reshape(plain.dev, (len(result.taus), -1))[t]
+                below = np.reshape(neg, (len(result.taus), -1))[t]
+                for j in range(len(axes)):
+                    row += [format_number(base[j]),
+                            f"< {format_number(high[j])}" if below[j] else
+                            format_number(dev[j])]
+            table.append(row)
+        doc.table(header, table, caption=f"Plain and own Allan deviation of {sensor} "
+                  f"[{unit}] per sensor ({result.method}); \"< x\": negative own variance, "
+                  "x the upper bound", collapsed=True)
+
+
+def _mount_labels(count: int) -> list[str]:
+    """How the section names the sensors: the long log, then the others."""
+    return ["long", *(f"mount {i}" for i in range(1, count))]
+
+
+def _source(log) -> str:
+    """A log's file name (``"<arrays>"``-style sources unchanged)."""
+    return log.source if log.source.startswith("<") else Path(log.source).name
