@@ -68,6 +68,7 @@ from dataclasses import dataclass, field
 import imunoise
 import numpy as np
 from imunoise import _cpu
+from imunoise.noise._typed import structure
 from scipy.signal import butter, freqz, lfilter
 
 FLAT = math.sqrt(2 * math.log(2) / math.pi)  # 0.6643: the flicker floor / B
@@ -319,12 +320,12 @@ def rel(value, truth):
     return abs(value / truth - 1) if np.isfinite(value) else math.inf
 
 
-def score(name, x, fs, axes):
-    r = imunoise.adev(x, fs, taus=20)
-    spectrum = imunoise.psd(x, fs)
+def score(name, x, fs, axes, output_filter=True, r=None, spectrum=None):
+    r = imunoise.adev(x, fs, taus=20) if r is None else r
+    spectrum = imunoise.psd(x, fs) if spectrum is None else spectrum
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        m = imunoise.fit(r, spectrum=spectrum)
+        m = imunoise.fit(r, spectrum=spectrum, output_filter=output_filter)
     T = len(x) / fs
     taus = np.asarray(m.taus)
     out = []
@@ -353,6 +354,8 @@ def score(name, x, fs, axes):
             tones=len(reported), has_line=bool(ax.lines),
             line_df=min(found) if found else math.inf,
             check=check,
+            filtered=getattr(m, "filter", (None,) * len(axes))[c] is not None,
+            structure=structure(m.terms[c]),
         ))
     return out
 
@@ -392,37 +395,53 @@ def main() -> int:
     ap.add_argument("--quick", action="store_true", help="1 seed per class instead of 3")
     ap.add_argument("--only", help="one class")
     ap.add_argument("-v", "--verbose", action="store_true", help="print every record")
+    ap.add_argument("--filter", choices=("on", "off", "both"), default="both",
+                    help="fit with the output filter measured from the spectrum, without "
+                         "it (the fit before it), or both on the same records (default)")
     args = ap.parse_args()
+    variants = {"on": [True], "off": [False], "both": [False, True]}[args.filter]
     seeds = 1 if args.quick else 3
     start = time.perf_counter()
     print(_cpu.describe())
-    rows, every = [], {}
+    every = {v: {} for v in variants}
     for name, (group, make) in CLASSES.items():
         if args.only and name != args.only:
             continue
-        axes = []
+        for v in variants:
+            every[v][name] = (group, [])
         for seed in range(seeds):
             x, fs, truth, desc = make(seed)
-            got = score(name, x, fs, truth)
-            axes += got
-            if args.verbose:
-                for c, a in enumerate(got):
-                    print(f"  {name} seed {seed} ({desc}) axis {c}: N {pct(a['N'])}, "
-                          f"B {pct(a['B'])}, K {a['K']:.3g} (upper {a['K_up']:.3g}, truth "
-                          f"{a['K_true']:.3g}, visible {a['K_vis']}), coverage "
-                          f"{100 * a['cov']:.0f} %, tones {a['tones']}, line Δf "
-                          f"{pct(a['line_df'])}, meas/theory {a['check']:.2f}", flush=True)
-        every[name] = (group, axes)
-        rows.append(row(name, group, axes))
+            r, spectrum = imunoise.adev(x, fs, taus=20), imunoise.psd(x, fs)
+            for v in variants:
+                got = score(name, x, fs, truth, v, r, spectrum)
+                every[v][name][1].extend(got)
+                for c, a in enumerate(got) if args.verbose else ():
+                    print(f"  {name} seed {seed} ({desc}) axis {c} filter {v}: N "
+                          f"{pct(a['N'])}, B {pct(a['B'])}, K {a['K']:.3g} (upper "
+                          f"{a['K_up']:.3g}, truth {a['K_true']:.3g}, visible {a['K_vis']}), "
+                          f"coverage {100 * a['cov']:.0f} %, tones {a['tones']}, line Δf "
+                          f"{pct(a['line_df'])}, meas/theory {a['check']:.2f}, filter "
+                          f"measured {a['filtered']}, {a['structure']}", flush=True)
         print(f"  {name}: done at {time.perf_counter() - start:.0f} s", flush=True)
-    wall = time.perf_counter() - start
-    print(f"\n{seeds} seed(s) × 3 axes per class; N, B error median / worst; K: visible by "
+    for v in variants:
+        summary(every[v], seeds, v)
+    print(f"\nwall {time.perf_counter() - start:.0f} s")
+    return 0
+
+
+def summary(every, seeds, output_filter) -> None:
+    print(f"\n== output filter {'on' if output_filter else 'off'}: {seeds} seed(s) × 3 axes "
+          f"per class; N, B error median / worst; K: visible by "
           f"T/10, resolved (count: median / worst ratio to truth), NaN (count: bound ≥ "
           f"truth), met; coverage median / worst; tones; measured / theoretical Allan "
-          f"variance, τ ≤ T/10 (median, range over axes)\n")
+          f"variance, τ ≤ T/10 (median, range over axes); axes with a measured filter; axes "
+          f"whose model has a resonance\n")
     print("| class | N error | B error | K visible | K resolved | K NaN | K met | coverage "
-          "| tones | meas/theory |\n|---|---|---|---|---|---|---|---|---|---|")
-    print("\n".join(rows))
+          "| tones | meas/theory | filter | resonance |\n"
+          "|---|---|---|---|---|---|---|---|---|---|---|---|")
+    for name, (group, axes) in every.items():
+        print(row(name, group, axes) + f" {sum(a['filtered'] for a in axes)}/{len(axes)} "
+              f"| {sum('resonance' in a['structure'] for a in axes)} |")
     sensor = [a for g, axes in every.values() if g == "sensor" for a in axes]
     if sensor:
         n_e = np.array([a["N"] for a in sensor])
@@ -432,10 +451,9 @@ def main() -> int:
               f"worst {pct(n_e.max())}; B error median {pct(np.median(b_e))}, worst "
               f"{pct(b_e.max())}; K met on {sum(a['K_ok'] for a in sensor)}/{len(sensor)}; "
               f"coverage worst {100 * cov.min():.1f} %, below 95 % on "
-              f"{np.sum(cov < 0.95)}")
-    print(f"\nwall {wall:.0f} s")
-    return 0
-
+              f"{np.sum(cov < 0.95)}; invented tones on "
+              f"{sum(a['tones'] > 0 for a in sensor if not a['has_line'])} axes, a resonance on "
+              f"{sum('resonance' in a['structure'] for a in sensor)}")
 
 if __name__ == "__main__":
     raise SystemExit(main())

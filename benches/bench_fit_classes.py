@@ -41,6 +41,7 @@ import warnings
 import imunoise
 import numpy as np
 from imunoise import _cpu
+from imunoise.noise import filtered_prediction
 from imunoise.noise._typed import structure
 from scipy.signal import butter, lfilter
 
@@ -146,29 +147,33 @@ def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--only", help="one class")
     ap.add_argument("--seeds", type=int, default=2, help="records per class")
+    ap.add_argument("--filter", action="store_true",
+                    help="fit with the record's Welch PSD: the output filter measured")
     args = ap.parse_args()
     rows = []
     print("| class | seed | coverage X / Y / Z | structure (X) | datasheet N error (median) "
-          "| fit |\n|---|---|---|---|---|---|")
+          "| filter | fit |\n|---|---|---|---|---|---|---|")
     for name, make in classes().items():
         if args.only and name != args.only:
             continue
         for seed in range(args.seeds):
             x, fs, n_true = make(seed)
             r = imunoise.adev(x, fs, taus=20)
+            spectrum = imunoise.psd(x, fs) if args.filter else None
             start = time.perf_counter()
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
-                m = imunoise.fit(r)
+                m = imunoise.fit(r, spectrum=spectrum)
             took = time.perf_counter() - start
-            p = m.predict(r.taus).dev
+            p = filtered_prediction(m, r.taus).dev
             limit = len(x) / fs / 10
             cov = [coverage(r.taus, r.dev[:, c], r.edf[:, c], p[:, c], limit) for c in range(3)]
             n_err = np.abs(np.ravel(m.N) / n_true - 1)
+            measured = sum(f is not None for f in m.filter)
             rows.append((name, seed, cov, structure(m.terms[0]), n_err, took))
             print(f"| {name} | {seed} | {' / '.join(f'{c:.0%}' for c in cov)} | "
-                  f"{structure(m.terms[0])} | {np.median(n_err):.1%} | {took:.2f} s |",
-                  flush=True)
+                  f"{structure(m.terms[0])} | {np.median(n_err):.1%} | {measured}/3 | "
+                  f"{took:.2f} s |", flush=True)
     every = [c for row in rows for c in row[2]]
     if every:
         print(f"\n{len(rows)} records, {len(every)} axes: coverage median {np.median(every):.0%}, "

@@ -464,6 +464,10 @@ def model_psd_terms(model: NoiseModel, f: npt.ArrayLike) -> dict[str, np.ndarray
         c = np.array([_typed.coefficient(terms, term) for terms in model.terms])
         if np.any(c > 0):
             out[term] = term_psd(term, c[None, :], f[:, None], fs=fs)
+    if "N" in out:  # the white term through each channel's measured output filter
+        for j, found in enumerate(getattr(model, "filter", ())):
+            if found is not None:
+                out["N"][:, j] = out["N"][:, j] * np.interp(f, found.f, found.gain)
     for j in range(channels):
         terms = model.terms[j]
         for k, (sigma, tau_c) in enumerate(_typed.pairs(terms, _typed.GaussMarkov, "sigma",

@@ -27,6 +27,12 @@ autocovariance σ²ρ^|h|·cos(θh) with ρ = exp(−1/(fs·τr)), θ = 2πf_r/f
 sensor's filter top or a mechanical mode: a band, not a line), whose Allan
 variance is the real part of the AR1 form continued to z = ρe^(iθ).
 
+The sensor's own output filter (a low-pass of any order, a CIC decimator, an FIR)
+is no term: given a spectrum (or a log), :func:`fit` measures its gain
+G(f) = |H(f)|² from the spectrum's shape above its white region
+(:func:`estimate_filter`) and passes the white noise through it, σ²_N(τ) =
+(N²/τ)·c(τ) (:func:`filter_factor`), so that no other term draws its roll-off.
+
 :func:`fit` offers two estimators:
 
 ``"wls"`` (default)
@@ -73,7 +79,8 @@ MathWorks, "Inertial Sensor Noise Analysis Using Allan Variance" (example).
 from __future__ import annotations
 
 from imunoise.noise._components import Components, Prediction
-from imunoise.noise._fit import fit
+from imunoise.noise._filter import OutputFilter, estimate_filter, filter_factor
+from imunoise.noise._fit import filtered_prediction, fit
 from imunoise.noise._model import NoiseModel, format_table
 from imunoise.noise._terms import (
     FLICKER,
@@ -98,7 +105,8 @@ from imunoise.noise._typed import (
     White,
 )
 
-__all__ = ["TERMS", "FLICKER", "GM_MAX", "TONES_MAX", "Components", "NoiseModel", "Prediction",
-           "fit", "format_table", "gm_white_density", "model_variance", "resolution_noise",
+__all__ = ["TERMS", "FLICKER", "GM_MAX", "TONES_MAX", "Components", "NoiseModel", "OutputFilter",
+           "Prediction", "estimate_filter", "filter_factor", "filtered_prediction", "fit",
+           "format_table", "gm_white_density", "model_variance", "resolution_noise",
            "resonance_white_density", "Term", "Quantization", "White", "Flicker", "RandomWalk",
            "Ramp", "GaussMarkov", "Tone", "Resonance", "Motion"]

@@ -20,6 +20,7 @@ from imunoise.errors import CoverageWarning, ImunoiseTypeError, ImunoiseValueErr
 from imunoise.noise import _typed
 from imunoise.noise._components import Components
 from imunoise.noise._datasheet import datasheet_notes, datasheet_values, upper_bounds
+from imunoise.noise._filter import OutputFilter, estimate_filter
 from imunoise.noise._model import NoiseModel
 from imunoise.noise._readoff import coverage, fit_slopes, measured, readoffs
 from imunoise.noise._terms import (
@@ -144,15 +145,18 @@ def _parse_terms(terms) -> tuple[np.ndarray, int, tuple[int, bool, bool], bool]:
 def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
         tau_range: tuple[float, float] | None = None, uncertainty: str = "independent",
         replicates: int = 30, seed=None, warn_coverage: bool = True,
-        spectrum=None) -> NoiseModel:
+        spectrum=None, sensor: str = "gyro", output_filter: bool = True) -> NoiseModel:
     """Fit the noise model to an Allan deviation.
 
     Parameters
     ----------
-    result : AllanResult
+    result : AllanResult or ImuLog
         From :func:`imunoise.adev` (overlapping or not); ``kind`` must be
         ``"adev"``. Taus with a non-finite or non-positive variance or EDF are
-        ignored.
+        ignored. A log (:func:`imunoise.read`) is analysed here: the Allan
+        deviation of its ``sensor`` at 10 taus per decade and, unless
+        ``spectrum`` is given, its Welch PSD (:func:`imunoise.psd`), from which
+        the output filter is measured.
     method : {"wls", "slopes"}
         Log-space weighted least squares (default) or the IEEE 952 / MATLAB
         slope read-off (see the module docstring).
@@ -191,6 +195,17 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
         (:attr:`NoiseModel.lines`) only where the spectrum shows one, at the
         spectrum's frequency. Without it the tones are reported unchecked: the
         Allan curve alone cannot tell a line from a filter's roll-off.
+        The sensor's output filter is measured from it too (``output_filter``).
+    sensor : {"gyro", "accel"}
+        Which channel group of a log ``result`` is; ignored for an Allan result.
+    output_filter : bool
+        With a spectrum (or a log), take the sensor's output filter G(f) = |H(f)|²
+        from the spectrum's shape above its white region
+        (:func:`imunoise.noise.estimate_filter`) and fit the white noise through it
+        (:attr:`NoiseModel.filter`), so that no tone, resonance or Gauss–Markov
+        term draws the filter's roll-off. False fits as without a spectrum (the
+        tones are still checked against it). Without a spectrum there is no
+        filter, and ``model.notes`` says so.
 
     Returns
     -------
@@ -217,6 +232,7 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
         raise ImunoiseValueError(
             f"uncertainty must be 'independent' or 'bootstrap'; got {uncertainty!r}"
         )
+    result, spectrum = _from_log(result, spectrum, sensor)
     if uncertainty == "bootstrap":
         if isinstance(replicates, bool) or not isinstance(replicates, numbers.Integral):
             raise ImunoiseTypeError(f"replicates must be an integer; got {replicates!r}")
@@ -238,6 +254,7 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
     taus, var, edf, one = _extract(result, tau_range)
     dev_all, edf_raw = measured(result, taus)
     channels = var.shape[1]
+    filters = _filters(spectrum, channels, output_filter and method == "wls")
     coef = np.zeros((channels, 5))
     std = np.full((channels, 5), np.nan)
     sup = np.zeros((channels, 5), dtype=bool)
@@ -271,7 +288,7 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
         def fit_channel(c):
             ok = usable[c]
             return _fit_wls(taus[ok], var[ok, c], edf[ok, c], float(result.fs), mask,
-                            gm_count, oscillators, select)
+                            gm_count, oscillators, select, filters[c])
 
         with ThreadPoolExecutor(max_workers=min(channels, os.cpu_count() or 1)) as pool:
             fits = list(pool.map(fit_channel, range(channels)))
@@ -284,6 +301,8 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
             motions = [tuple(moving[c])] if np.isfinite(moving[c, 0]) else []
             parts = term_variances(taus[usable[c]], result.fs, coef[c], markov, tones, oscs,
                                    motions)
+            if filters[c] is not None:  # the white term through the filter
+                parts[:, 1] *= filters[c].factor(taus[usable[c]])
             rng[c] = _support_range(parts, taus[usable[c]], sup[c])
     else:
         for c in range(channels):
@@ -361,8 +380,9 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
         **{k + "_std": shaped(np.where(resolved[k], e, np.nan)) for k, (_, e) in sheet.items()},
         supported={k: shaped(v) for k, v in resolved.items()},
         upper={k: shaped(np.where(resolved[k], np.nan, bounds[k])) for k in TERMS},
-        notes=tuple(datasheet_notes(components, taus, c, method)
-                    + _unplaced_note(unplaced[c]) for c in range(channels)),
+        notes=tuple((*datasheet_notes(components, taus, c, method), *_unplaced_note(unplaced[c]),
+                     *_filter_notes(filters[c], spectrum, output_filter, method))
+                    for c in range(channels)),
         lines=tuple(_lines(components, spectrum, c) for c in range(channels)),
         _arrays=components,
         terms=typed,
@@ -377,7 +397,9 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
         n_eff=shaped(stats[:, 2]),
         readoff=readoffs(taus, dev_all, edf_raw, shaped),
     )
-    cover = coverage(model, taus, dev_all, edf_raw)
+    # The filter travels with the model: its prediction at any tau needs it.
+    object.__setattr__(model, "filter", filters)
+    cover = coverage(_Filtered(model), taus, dev_all, edf_raw)
     object.__setattr__(model, "coverage", shaped(cover))
     if method == "wls" and any(
             components.gauss_markov(c) or components.sine(c) or components.resonance(c)
@@ -393,6 +415,83 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
             CoverageWarning,
         )
     return model
+
+
+def _from_log(result, spectrum, sensor):
+    """A log becomes its ``sensor``'s Allan deviation (10 taus per decade) and, unless
+    given, its Welch PSD; an Allan result passes through."""
+    from imunoise.readers.log import ImuLog
+
+    if not isinstance(result, ImuLog):
+        return result, spectrum
+    from imunoise import _schema
+    from imunoise.allan import adev
+    from imunoise.spectrum import psd
+
+    if sensor not in ("gyro", "accel"):
+        raise ImunoiseValueError(f"sensor must be 'gyro' or 'accel'; got {sensor!r}")
+    y = getattr(result, sensor)
+    if y is None:
+        raise ImunoiseValueError(f"the log {result.source} has no {sensor} channel; pass "
+                                 f"sensor={'accel' if sensor == 'gyro' else 'gyro'!r}")
+    allan = adev(y, result.fs, taus=_schema.TAUS_PER_DECADE)
+    return allan, spectrum if spectrum is not None else psd(y, result.fs)
+
+
+def _filters(spectrum, channels: int, wanted: bool) -> tuple[OutputFilter | None, ...]:
+    """Each channel's output filter measured from ``spectrum`` (None: none found, or
+    not asked for)."""
+    if spectrum is None or not wanted:
+        return (None,) * channels
+    return tuple(estimate_filter(spectrum, c) for c in range(channels))
+
+
+def _filter_notes(found, spectrum, wanted: bool, method: str) -> tuple[str, ...]:
+    """What a reader of one channel's values must know about its output filter."""
+    if method != "wls" or not wanted:
+        return ()
+    if spectrum is None:
+        return ("the output filter was not taken from a spectrum (fitted from the Allan "
+                "deviation alone): a filter's roll-off at the short taus is drawn by the "
+                "other terms; pass spectrum=imunoise.psd(x, fs) or fit the log",)
+    if found is None:
+        return ()
+    return (f"the white noise passes the output filter measured from the spectrum: white "
+            f"to {found.white_top:.3g} Hz, gain {found.gain[-1]:.2g} at "
+            f"{found.fs / 2:g} Hz (model.filter)",)
+
+
+class _Filtered:
+    """``model`` whose prediction passes the white term through its output filter
+    (until :meth:`NoiseModel.predict` does so itself)."""
+
+    def __init__(self, model):
+        self.model = model
+
+    def predict(self, taus):
+        return filtered_prediction(self.model, taus)
+
+
+def filtered_prediction(model, taus):
+    """``model.predict(taus)`` with each channel's white term through its output filter
+    (``model.filter``): terms["N"] times √c(τ), the total recomputed."""
+    from dataclasses import replace
+
+    pred = model.predict(taus)
+    filters = getattr(model, "filter", ())
+    if not any(f is not None for f in filters):
+        return pred
+    t = np.asarray(pred.taus, dtype=float)
+    dev = np.array(pred.dev, dtype=float, ndmin=2).reshape(t.size, -1)
+    white = np.array(pred.terms["N"], dtype=float).reshape(t.size, -1)
+    for c, found in enumerate(filters):
+        if found is not None:
+            extra = white[:, c] ** 2 * (found.factor(t) - 1.0) + found.excess(t)
+            dev[:, c] = np.sqrt(np.maximum(dev[:, c] ** 2 + extra, 0.0))
+            white[:, c] *= np.sqrt(found.factor(t))
+    shape = np.shape(pred.dev)
+    return replace(pred, dev=dev.reshape(shape),
+                   terms={**pred.terms, "N": white.reshape(shape)})
 
 
 def _check_spectrum(spectrum, result) -> None:
@@ -513,13 +612,16 @@ def _readonly(a):
     return out
 
 
-def _fit_wls(t, v, e, fs, mask, gm_count, oscillators, select):
+def _fit_wls(t, v, e, fs, mask, gm_count, oscillators, select, found=None):
     tone, resonance, motion = oscillators
+    args = [np.ascontiguousarray(t), np.ascontiguousarray(v), np.ascontiguousarray(e), fs,
+            [bool(m) for m in mask], gm_count, select, tone, resonance, motion]
     try:
-        r = _core_fit.fit_noise(
-            np.ascontiguousarray(t), np.ascontiguousarray(v), np.ascontiguousarray(e), fs,
-            [bool(m) for m in mask], gm_count, select, tone, resonance, motion,
-        )
+        if found is None:
+            r = _core_fit.fit_noise(*args)
+        else:
+            r = _core_fit.fit_noise(*_less(args, found.excess(t)),
+                                    filter=np.ascontiguousarray(found.gain))
     except ValueError as exc:
         raise ImunoiseValueError(f"cannot fit the noise model to result: {exc}") from None
     terms = _typed.from_core(r.terms, np.asarray(r.cov))
@@ -623,6 +725,22 @@ def _slot_covariance(core_terms, cov):
     index = np.array(slots, dtype=int)
     out[np.ix_(index, index)] = cov
     return out
+
+
+def _less(args, excess):
+    """The fit's arguments with ``excess`` taken from the measured Allan variance, its
+    EDF scaled to the same absolute sampling error (a tau left with nothing dropped).
+
+    The filter's share of the flicker and walk (:meth:`OutputFilter.excess`, from the
+    spectrum's own levels) is taken off this way: the core passes only the white term
+    through the filter, and where the filter leaves little of it (an 11-tap Bartlett
+    FIR keeps 0.4 % of the white variance at one sample) the flicker's unfiltered
+    (2 ln2/π)B² would be 9 % of the curve there."""
+    t, v, e = args[:3]
+    less = v - excess
+    keep = less > 0
+    return [np.ascontiguousarray(t[keep]), np.ascontiguousarray(less[keep]),
+            np.ascontiguousarray((e * (less / v) ** 2)[keep]), *args[3:]]
 
 
 def _support_range(parts, t, sup, min_share=0.25):
