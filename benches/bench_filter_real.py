@@ -30,7 +30,6 @@ import imunoise
 import numpy as np
 from bench_fit_real import coverage, recordings
 from imunoise import _cpu
-from imunoise.noise import filtered_prediction
 from imunoise.noise._typed import structure
 
 HERE = Path(__file__).resolve().parent
@@ -63,7 +62,7 @@ def fitted(x, fs, output_filter):
 
 
 def score(r, m, limit):
-    p = np.ravel(filtered_prediction(m, r.taus).dev)
+    p = np.ravel(m.predict(r.taus).dev)
     return coverage(r.taus, np.ravel(r.dev), np.ravel(r.edf), p, limit)
 
 

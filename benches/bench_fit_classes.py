@@ -41,7 +41,6 @@ import warnings
 import imunoise
 import numpy as np
 from imunoise import _cpu
-from imunoise.noise import filtered_prediction
 from imunoise.noise._typed import structure
 from scipy.signal import butter, lfilter
 
@@ -165,7 +164,7 @@ def main() -> int:
                 warnings.simplefilter("ignore")
                 m = imunoise.fit(r, spectrum=spectrum)
             took = time.perf_counter() - start
-            p = filtered_prediction(m, r.taus).dev
+            p = m.predict(r.taus).dev
             limit = len(x) / fs / 10
             cov = [coverage(r.taus, r.dev[:, c], r.edf[:, c], p[:, c], limit) for c in range(3)]
             n_err = np.abs(np.ravel(m.N) / n_true - 1)

@@ -31,7 +31,7 @@ from imunoise._schema import ATTITUDE_NAMES, CHANNELS, axis_names
 from imunoise.allan import AllanResult
 from imunoise.display import cell, format_value, percent, rounded
 from imunoise.errors import ImunoiseTypeError, ImunoiseValueError
-from imunoise.noise import FLICKER, TERMS, NoiseModel, _typed, filtered_prediction, model_variance
+from imunoise.noise import FLICKER, TERMS, NoiseModel, _typed, model_variance
 from imunoise.noise._terms import term_variances
 from imunoise.readers.log import ImuLog
 from imunoise.stats import Distribution
@@ -522,7 +522,7 @@ def _coefficient_curves(coeffs: Mapping[str, float], grid: np.ndarray) -> dict[s
 def _model_curves(model: NoiseModel, grid: np.ndarray, channel: int) -> dict[str, np.ndarray]:
     """Deviation of each term of a fitted model and its total at ``grid`` (the white
     term through the model's output filter)."""
-    pred = filtered_prediction(model, grid)
+    pred = model.predict(grid)
     out = {name: np.reshape(v, (grid.size, -1))[:, channel] for name, v in pred.terms.items()}
     out["total"] = np.reshape(pred.dev, (grid.size, -1))[:, channel]
     return out
@@ -722,7 +722,7 @@ def allan(
             lims.append((ymin, ymax))
         spans: list[float] = []
         for j, ax in enumerate(res_axes):
-            pred = np.reshape(filtered_prediction(model, taus).dev, dev.shape)[:, j]
+            pred = np.reshape(model.predict(taus).dev, dev.shape)[:, j]
             ratio = dev[:, j] / pred
             ax.axhspan(0.95, 1.05, color="0.88", zorder=0, label="±5 %")
             ax.axhline(1.0, color="k", linewidth=0.8)

@@ -11,7 +11,8 @@ import imunoise
 import numpy as np
 import pytest
 from imunoise.errors import ImunoiseValueError
-from imunoise.noise import OutputFilter, estimate_filter, filter_factor
+from imunoise.noise import OutputFilter, estimate_filter
+from imunoise.noise._filter import filter_factor  # the numpy oracle of the core's c(τ)
 from scipy import stats
 from scipy.signal import butter, freqz, lfilter
 
@@ -220,4 +221,4 @@ def test_output_filter_repr_and_factor():
                          white_top=12.5, white=2e-6)
     assert "white to 12.5 Hz" in repr(found)
     np.testing.assert_allclose(found.factor([0.01, 100.0]),
-                               filter_factor([0.01, 100.0], FS, found.gain))
+                               filter_factor([0.01, 100.0], FS, found.gain), rtol=3e-4)  # the core

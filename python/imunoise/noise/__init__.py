@@ -31,7 +31,7 @@ The sensor's own output filter (a low-pass of any order, a CIC decimator, an FIR
 is no term: given a spectrum (or a log), :func:`fit` measures its gain
 G(f) = |H(f)|² from the spectrum's shape above its white region
 (:func:`estimate_filter`) and passes the white noise through it, σ²_N(τ) =
-(N²/τ)·c(τ) (:func:`filter_factor`), so that no other term draws its roll-off.
+(N²/τ)·c(τ) (:meth:`OutputFilter.factor`), so that no other term draws its roll-off.
 
 :func:`fit` offers two estimators:
 
@@ -79,8 +79,8 @@ MathWorks, "Inertial Sensor Noise Analysis Using Allan Variance" (example).
 from __future__ import annotations
 
 from imunoise.noise._components import Components, Prediction
-from imunoise.noise._filter import OutputFilter, estimate_filter, filter_factor
-from imunoise.noise._fit import filtered_prediction, fit
+from imunoise.noise._filter import OutputFilter, estimate_filter
+from imunoise.noise._fit import fit
 from imunoise.noise._model import NoiseModel, format_table
 from imunoise.noise._terms import (
     FLICKER,
@@ -106,7 +106,7 @@ from imunoise.noise._typed import (
 )
 
 __all__ = ["TERMS", "FLICKER", "GM_MAX", "TONES_MAX", "Components", "NoiseModel", "OutputFilter",
-           "Prediction", "estimate_filter", "filter_factor", "filtered_prediction", "fit",
+           "Prediction", "estimate_filter", "fit",
            "format_table", "gm_white_density", "model_variance", "resolution_noise",
            "resonance_white_density", "Term", "Quantization", "White", "Flicker", "RandomWalk",
            "Ramp", "GaussMarkov", "Tone", "Resonance", "Motion"]

@@ -62,9 +62,9 @@ The white term's Allan variance with the filter is (N²/τ)·c(τ),
 
 ν = f/fs, m = τ·fs: the Allan variance of a sampled process with two-sided spectrum
 S(ν) is ∫ S(ν)·2 sin⁴(πνm)/(m² sin²πν) dν over [−½, ½], 1/m for unit white noise.
-:func:`filter_factor` evaluates it exactly for G linear between the grid's points, from
-the Fourier coefficients of G − 1 (the kernel is a Fejér kernel times sin²(πνm), a
-finite cosine sum), in O(L log L + taus).
+``filter_factor`` (the tests' oracle of the core's c(τ)) evaluates it exactly for G
+linear between the grid's points, from the Fourier coefficients of G − 1 (the kernel
+is a Fejér kernel times sin²(πνm), a finite cosine sum), in O(L log L + taus).
 """
 
 from __future__ import annotations
@@ -77,6 +77,7 @@ from scipy import optimize as _optimize
 from scipy import signal as _signal
 from scipy import stats as _stats
 
+from imunoise._core import fit as _core_fit
 from imunoise.errors import ImunoiseTypeError, ImunoiseValueError
 
 __all__ = ["OutputFilter", "estimate_filter", "filter_factor"]
@@ -152,8 +153,10 @@ class OutputFilter:
         return _allan_of(taus, self.fs, d)
 
     def factor(self, taus) -> np.ndarray:
-        """c(τ): the white term's Allan variance with the filter over N²/τ."""
-        return filter_factor(taus, self.fs, self.gain)
+        """c(τ): the white term's Allan variance with the filter over N²/τ, from the
+        core (the same c(τ) the fit used)."""
+        t = np.ascontiguousarray(np.atleast_1d(np.asarray(taus, dtype=float)))
+        return _core_fit.filter_factor(t, float(self.fs), np.ascontiguousarray(self.gain))
 
     def __repr__(self) -> str:
         low = float(self.gain.min())

@@ -396,10 +396,9 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
         chi2=shaped(stats[:, 1]),
         n_eff=shaped(stats[:, 2]),
         readoff=readoffs(taus, dev_all, edf_raw, shaped),
+        filter=filters,
     )
-    # The filter travels with the model: its prediction at any tau needs it.
-    object.__setattr__(model, "filter", filters)
-    cover = coverage(_Filtered(model), taus, dev_all, edf_raw)
+    cover = coverage(model, taus, dev_all, edf_raw)
     object.__setattr__(model, "coverage", shaped(cover))
     if method == "wls" and any(
             components.gauss_markov(c) or components.sine(c) or components.resonance(c)
@@ -459,39 +458,6 @@ def _filter_notes(found, spectrum, wanted: bool, method: str) -> tuple[str, ...]
     return (f"the white noise passes the output filter measured from the spectrum: white "
             f"to {found.white_top:.3g} Hz, gain {found.gain[-1]:.2g} at "
             f"{found.fs / 2:g} Hz (model.filter)",)
-
-
-class _Filtered:
-    """``model`` whose prediction passes the white term through its output filter
-    (until :meth:`NoiseModel.predict` does so itself)."""
-
-    def __init__(self, model):
-        self.model = model
-
-    def predict(self, taus):
-        return filtered_prediction(self.model, taus)
-
-
-def filtered_prediction(model, taus):
-    """``model.predict(taus)`` with each channel's white term through its output filter
-    (``model.filter``): terms["N"] times √c(τ), the total recomputed."""
-    from dataclasses import replace
-
-    pred = model.predict(taus)
-    filters = getattr(model, "filter", ())
-    if not any(f is not None for f in filters):
-        return pred
-    t = np.asarray(pred.taus, dtype=float)
-    dev = np.array(pred.dev, dtype=float, ndmin=2).reshape(t.size, -1)
-    white = np.array(pred.terms["N"], dtype=float).reshape(t.size, -1)
-    for c, found in enumerate(filters):
-        if found is not None:
-            extra = white[:, c] ** 2 * (found.factor(t) - 1.0) + found.excess(t)
-            dev[:, c] = np.sqrt(np.maximum(dev[:, c] ** 2 + extra, 0.0))
-            white[:, c] *= np.sqrt(found.factor(t))
-    shape = np.shape(pred.dev)
-    return replace(pred, dev=dev.reshape(shape),
-                   terms={**pred.terms, "N": white.reshape(shape)})
 
 
 def _check_spectrum(spectrum, result) -> None:

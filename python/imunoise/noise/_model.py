@@ -4,7 +4,7 @@ exports, with the fitted components behind them under one name."""
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -22,6 +22,7 @@ from imunoise.noise._components import (
     check_term,
     finite_list,
 )
+from imunoise.noise._filter import OutputFilter
 from imunoise.noise._terms import NAMES, SENSOR_NAMES, TERMS
 from imunoise.noise._typed import Term
 
@@ -151,6 +152,7 @@ class NoiseModel(PerTerm):
     upper: dict[str, np.ndarray] = field(repr=False)
     notes: tuple[tuple[str, ...], ...] = field(repr=False)
     lines: tuple[tuple[SpectralLine, ...], ...] = field(repr=False)
+    filter: tuple[OutputFilter | None, ...] = field(default=(), repr=False)
 
     # -- per term (channels, one_channel, value, std: PerTerm) ---------------
     def resolved(self, term: str) -> np.ndarray:
@@ -168,7 +170,22 @@ class NoiseModel(PerTerm):
         ``terms["resonance"]`` for the resonance and ``terms["motion"]`` for a
         bounded motion (when a channel has one).
         """
-        return self._arrays.predict(self.taus if taus is None else taus)
+        pred = self._arrays.predict(self.taus if taus is None else taus)
+        if not any(f is not None for f in self.filter):
+            return pred
+        # The white term through each channel's output filter, and the filter's
+        # share of the spectrum's flicker and walk, which pass it too.
+        t = np.asarray(pred.taus, dtype=float)
+        dev = np.array(pred.dev, dtype=float, ndmin=2).reshape(t.size, -1)
+        white = np.array(pred.terms["N"], dtype=float).reshape(t.size, -1)
+        for c, found in enumerate(self.filter):
+            if found is not None:
+                extra = white[:, c] ** 2 * (found.factor(t) - 1.0) + found.excess(t)
+                dev[:, c] = np.sqrt(np.maximum(dev[:, c] ** 2 + extra, 0.0))
+                white[:, c] *= np.sqrt(found.factor(t))
+        shape = np.shape(pred.dev)
+        return replace(pred, dev=dev.reshape(shape),
+                       terms={**pred.terms, "N": white.reshape(shape)})
 
     def floor(self, channel: int = 0) -> tuple[float, float] | None:
         """(τ, σ(τ)) of the model's floor over the fitted taus, where ``B`` is read
