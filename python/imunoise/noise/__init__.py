@@ -29,7 +29,7 @@ variance is the real part of the AR1 form continued to z = ρe^(iθ).
 
 The sensor's own output filter (a low-pass of any order, a CIC decimator, an FIR)
 is no term: given a spectrum (or a log), :func:`fit` measures its gain
-G(f) = |H(f)|² from the spectrum's shape above its white region
+G(f) = ``|H(f)|²`` from the spectrum's shape above its white region
 (:func:`estimate_filter`) and passes the white noise through it, σ²_N(τ) =
 (N²/τ)·c(τ) (:meth:`OutputFilter.factor`), so that no other term draws its roll-off.
 

@@ -1,7 +1,7 @@
 r"""The sensor's output filter, measured from the spectrum of its rate.
 
 Real sensors pass their rate through an output filter (a Butterworth low-pass, a CIC
-decimator, an FIR, a MEMS's own low-pass). Its gain G(f) = |H(f)|² bends the white
+decimator, an FIR, a MEMS's own low-pass). Its gain G(f) = ``|H(f)|²`` bends the white
 noise's spectrum above the white region, and the Allan deviation at short τ with it.
 No term of the noise model has that shape; without it the fit draws the filter with a
 resonance, Gauss–Markov terms or tones, and N comes out wrong. This module estimates G
@@ -115,7 +115,7 @@ class OutputFilter:
     f : ndarray, (L,)
         Frequencies, Hz: k·(fs/2)/(L−1), k = 0…L−1.
     gain : ndarray, (L,)
-        G(f) = |H(f)|², the output's power over the white level; 1 up to
+        G(f) = ``|H(f)|²``, the output's power over the white level; 1 up to
         ``white_top``.
     fs : float
         Sample rate, Hz.

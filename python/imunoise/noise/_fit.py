@@ -199,7 +199,7 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
     sensor : {"gyro", "accel"}
         Which channel group of a log ``result`` is; ignored for an Allan result.
     output_filter : bool
-        With a spectrum (or a log), take the sensor's output filter G(f) = |H(f)|²
+        With a spectrum (or a log), take the sensor's output filter G(f) = ``|H(f)|²``
         from the spectrum's shape above its white region
         (:func:`imunoise.noise.estimate_filter`) and fit the white noise through it
         (:attr:`NoiseModel.filter`), so that no tone, resonance or Gauss–Markov
