@@ -799,7 +799,8 @@ def one_mount(ctx: Context, doc: Doc) -> None:
         fig = plot.own_noise(result, title=f"{sensor}: own and plain Allan deviation",
                              unit=unit, names=_mount_labels(len(al)))
         ctx.add_figure(doc, fig, f"mount_{sensor}",
-                       f"Own (markers, {result.own[0].confidence:.1%} interval) and plain "
+                       f"Own (markers, {percent(result.own[0].confidence, digits=1)} interval) "
+                       "and plain "
                        f"(line) Allan deviation of {sensor} [{unit}] per sensor; an open "
                        "triangle is the upper bound where the own variance is negative")
         axes = axis_names(result.own[0].channels)
