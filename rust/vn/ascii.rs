@@ -6,11 +6,12 @@
 //! [`crate::vn::messages`] and the number parser of [`crate::vn::number`].
 //! Cost: one pass over the body; no allocation for good sentences.
 
+use crate::simd::Level;
 use crate::vn::checksum;
 use crate::vn::messages::{
     command_by_id, is_defined_error, spec_by_id, spec_by_register, MsgSpec, MAX_FIELDS,
 };
-use crate::vn::number::{fast_number, parse_f64};
+use crate::vn::number::{fast_digits, parse_f64, Quotients};
 
 /// The 2024 SDK rejects ASCII packets longer than this (spec §2.1).
 pub const MAX_SENTENCE: usize = 320;
@@ -49,6 +50,7 @@ pub enum Decoded {
 pub fn fast_sentence(
     b: &[u8],
     hint: Option<&'static MsgSpec>,
+    level: Level,
 ) -> Option<(&'static MsgSpec, [f64; MAX_FIELDS], usize)> {
     let head = b.get(..7)?;
     if head[1] != b'V' || head[2] != b'N' || head[6] != b',' {
@@ -61,11 +63,11 @@ pub fn fast_sentence(
     };
     // The general decoder's header rule (three upper-case letters) holds for
     // every id of MESSAGES, so a match above implies it.
-    let mut values = [0.0f64; MAX_FIELDS];
+    let mut values = Quotients::new();
     let n = spec.fields.len();
     let mut j = 7usize;
-    for (k, v) in values.iter_mut().enumerate().take(n) {
-        *v = fast_number(b, &mut j)?;
+    for k in 0..n {
+        values.set(k, fast_digits(b, &mut j)?);
         let sep = *b.get(j)?;
         let want = if k + 1 == n { b'*' } else { b',' };
         if sep != want {
@@ -87,7 +89,7 @@ pub fn fast_sentence(
     if field[2].is_ascii_hexdigit() || field[2] == b'X' || check != x as u16 {
         return None;
     }
-    Some((spec, values, star))
+    Some((spec, values.divide(level), star))
 }
 
 fn parse_uint(s: &[u8]) -> Option<u16> {
@@ -264,7 +266,7 @@ mod tests {
     #[test]
     fn fast_sentence_takes_the_common_case() {
         let a1 = b"$VNYMR,+100.949,-007.330,+000.715,-00.0049,-00.2449,+00.5397,-01.258,-00.100,-09.701,-00.000018,+00.001122,-00.000551*69\r\n";
-        let (spec, v, star) = fast_sentence(a1, None).unwrap();
+        let (spec, v, star) = fast_sentence(a1, None, Level::Scalar).unwrap();
         assert_eq!((spec.id, star), ("VNYMR", a1.len() - 5));
         assert_eq!((v[0], v[1], v[9]), (100.949, -7.33, -0.000018));
         // Each of these leaves it to the general path.
@@ -278,12 +280,12 @@ mod tests {
             b"$VNRRG,08,-114.314,+000.058,-001.773*4F\r\n",
         ] {
             assert!(
-                fast_sentence(s, None).is_none(),
+                fast_sentence(s, None, Level::Scalar).is_none(),
                 "{}",
                 String::from_utf8_lossy(s)
             );
         }
         let ok = b"$VNYPR,+010.071,+000.278,-002.026*60\r\n";
-        assert!(fast_sentence(ok, None).is_some());
+        assert!(fast_sentence(ok, None, Level::Scalar).is_some());
     }
 }

@@ -316,12 +316,14 @@ impl Parser {
     pub fn feed(&mut self, buf: &[u8], fin: bool) -> usize {
         let n = buf.len();
         let mut i = 0usize;
+        // Once per block: the level cannot change the values, only their speed.
+        let level = crate::simd::level();
         while i < n {
             if self.fail.is_some() {
                 return n;
             }
             match buf[i] {
-                b'$' if self.fast && self.fast_ascii(buf, &mut i) => {}
+                b'$' if self.fast && self.fast_ascii(buf, &mut i, level) => {}
                 b'$' => match scan_ascii(buf, i, fin) {
                     Ascii::Need => break,
                     Ascii::Noise => {
@@ -371,8 +373,9 @@ impl Parser {
     /// The common sentence ([`ascii::fast_sentence`]) at `buf[*i] == b'$'`:
     /// decoded and `*i` moved past it, or `false` with nothing changed.
     #[inline]
-    fn fast_ascii(&mut self, buf: &[u8], i: &mut usize) -> bool {
-        let Some((spec, values, star)) = ascii::fast_sentence(&buf[*i..], self.last_spec) else {
+    fn fast_ascii(&mut self, buf: &[u8], i: &mut usize, level: crate::simd::Level) -> bool {
+        let Some((spec, values, star)) = ascii::fast_sentence(&buf[*i..], self.last_spec, level)
+        else {
             return false;
         };
         self.last_spec = Some(spec);
