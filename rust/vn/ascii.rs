@@ -68,7 +68,7 @@ pub fn fast_sentence(
     // separators say, not where the one before it ended, so the numbers of a
     // sentence are parsed side by side instead of one after another.
     let mut sep = [0usize; MAX_FIELDS + 1];
-    separators(b, &mut sep[..n + 1])?;
+    separators(b, &mut sep[..n + 1], level)?;
     let mut values = Quotients::new();
     let mut ok = sep[0] == 6;
     for k in 0..n {
@@ -97,39 +97,116 @@ pub fn fast_sentence(
 }
 
 /// Fills `out` with the offsets of the first `out.len()` bytes of `b` that are `,`
-/// or `*`, looked for 64 bytes at a time (a compare per byte into a bit mask,
-/// which the compiler vectorises; byte by byte in the last, shorter window);
+/// or `*`, looked for 64 bytes at a time (vector compares into a bit mask, at
+/// the instruction-set `level`; byte by byte in the last, shorter window);
 /// `None` when they are not all in `b` within its first [`MAX_SENTENCE`] bytes.
 #[inline(always)]
-fn separators(b: &[u8], out: &mut [usize]) -> Option<()> {
-    let mut found = 0;
-    let mut base = 0;
-    while found < out.len() {
-        if base >= MAX_SENTENCE {
-            return None;
-        }
-        let mut mask = 0u64;
-        if let Some(window) = b.get(base..base + 64) {
-            let window: &[u8; 64] = window.try_into().ok()?;
-            for (k, &c) in window.iter().enumerate() {
-                mask |= (((c == b',') | (c == b'*')) as u64) << k;
-            }
-        } else {
-            for (k, &c) in b.get(base..)?.iter().enumerate() {
-                mask |= (((c == b',') | (c == b'*')) as u64) << k;
-            }
-            if mask.count_ones() < (out.len() - found) as u32 {
+fn separators(b: &[u8], out: &mut [usize], level: Level) -> Option<()> {
+    #[cfg(target_arch = "x86_64")]
+    if level >= Level::Avx2 {
+        // SAFETY: the level is at most the CPU's (simd::level), which has AVX2.
+        return unsafe { x86::separators_avx2(b, out) };
+    }
+    let _ = level;
+    separators_with!(b, out, window_mask)
+}
+
+/// The loop of [`separators`] with `$mask(&[u8; 64]) -> u64` (bit k: byte k is a
+/// separator): one body for every level, compiled with each level's features.
+macro_rules! separators_with {
+    ($b:expr, $out:expr, $mask:path) => {{
+        let (b, out): (&[u8], &mut [usize]) = ($b, $out);
+        let mut found = 0;
+        let mut base = 0;
+        while found < out.len() {
+            if base >= MAX_SENTENCE {
                 return None;
             }
+            let mask = match b.get(base..base + 64) {
+                Some(window) => $mask(window.try_into().ok()?),
+                None => {
+                    let tail = b.get(base..)?;
+                    let m = tail.iter().enumerate().fold(0u64, |m, (k, &c)| {
+                        m | (((c == b',') | (c == b'*')) as u64) << k
+                    });
+                    if m.count_ones() < (out.len() - found) as u32 {
+                        return None;
+                    }
+                    m
+                }
+            };
+            let mut mask = mask;
+            while mask != 0 && found < out.len() {
+                out[found] = base + mask.trailing_zeros() as usize;
+                found += 1;
+                mask &= mask - 1;
+            }
+            base += 64;
         }
-        while mask != 0 && found < out.len() {
-            out[found] = base + mask.trailing_zeros() as usize;
-            found += 1;
-            mask &= mask - 1;
+        Some(())
+    }};
+}
+use separators_with;
+
+/// Bit k set where `w[k]` is `,` or `*`: SSE2 compares on x86-64 (part of its
+/// baseline, the scalar level), a byte loop elsewhere.
+#[inline(always)]
+fn window_mask(w: &[u8; 64]) -> u64 {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::*;
+        let mut mask = 0u64;
+        for k in 0..4 {
+            // SAFETY: SSE2 is part of every x86-64 CPU; the load reads bytes
+            // 16k..16k+16 of the 64-byte window.
+            let bits = unsafe {
+                let v = _mm_loadu_si128(w.as_ptr().add(16 * k).cast());
+                let hit = _mm_or_si128(
+                    _mm_cmpeq_epi8(v, _mm_set1_epi8(b',' as i8)),
+                    _mm_cmpeq_epi8(v, _mm_set1_epi8(b'*' as i8)),
+                );
+                _mm_movemask_epi8(hit) as u32 as u64
+            };
+            mask |= bits << (16 * k);
         }
-        base += 64;
+        mask
     }
-    Some(())
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        w.iter().enumerate().fold(0u64, |m, (k, &c)| {
+            m | (((c == b',') | (c == b'*')) as u64) << k
+        })
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+mod x86 {
+    use std::arch::x86_64::*;
+
+    use super::MAX_SENTENCE;
+
+    /// [`super::window_mask`] with two 32-byte compares.
+    #[inline(always)]
+    unsafe fn window_mask_avx2(w: &[u8; 64]) -> u64 {
+        let mut mask = 0u64;
+        for k in 0..2 {
+            // SAFETY: bytes 32k..32k+32 of the 64-byte window; AVX2 is enabled
+            // in the only caller.
+            let v = _mm256_loadu_si256(w.as_ptr().add(32 * k).cast());
+            let hit = _mm256_or_si256(
+                _mm256_cmpeq_epi8(v, _mm256_set1_epi8(b',' as i8)),
+                _mm256_cmpeq_epi8(v, _mm256_set1_epi8(b'*' as i8)),
+            );
+            mask |= (_mm256_movemask_epi8(hit) as u32 as u64) << (32 * k);
+        }
+        mask
+    }
+
+    #[target_feature(enable = "avx2")]
+    pub(super) unsafe fn separators_avx2(b: &[u8], out: &mut [usize]) -> Option<()> {
+        let mask = |w: &[u8; 64]| unsafe { window_mask_avx2(w) };
+        separators_with!(b, out, mask)
+    }
 }
 
 fn parse_uint(s: &[u8]) -> Option<u16> {
