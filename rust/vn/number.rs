@@ -250,7 +250,10 @@ mod x86 {
     }
 }
 
-const _: () = assert!(LANES % 8 == 0, "the vector paths divide 8 lanes at a time");
+const _: () = assert!(
+    LANES.is_multiple_of(8),
+    "the vector paths divide 8 lanes at a time"
+);
 
 #[cfg(test)]
 mod tests {

@@ -13,6 +13,11 @@ use crate::vn::binary::{self, HeaderScan};
 use crate::vn::stream::parser::{Failure, Parser, MAX_LAYOUTS};
 use crate::vn::{IssueKind, Location, Table, VnData, FIRST_KEEP};
 
+/// What a piece parser of [`Parser::feed_block`] leaves: its data, a strict-mode
+/// failure, its newlines, the end of its last run of skipped bytes and its
+/// unused spare buffers.
+type PieceResult = (VnData, Option<Failure>, u64, u64, Vec<Vec<f64>>);
+
 /// Tables of several pieces by message name, to append in one parallel copy.
 #[derive(Default)]
 struct TableParts(Vec<(String, Vec<Table>)>);
@@ -110,7 +115,7 @@ impl Parser {
         let strict = self.strict;
         let fast = self.fast;
         let lent = self.lend_spare(inner.len());
-        let results: Vec<(VnData, Option<Failure>, u64, u64, Vec<Vec<f64>>)> = inner
+        let results: Vec<PieceResult> = inner
             .par_iter()
             .zip(lent)
             .map(|(&(a, b), spare)| {
