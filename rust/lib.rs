@@ -9,6 +9,7 @@ pub mod error;
 pub mod fit;
 pub mod interrupt;
 mod memory;
+pub mod records;
 pub mod simd;
 pub mod vn;
 

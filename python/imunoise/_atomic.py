@@ -46,6 +46,7 @@ __all__ = [
     "refuse_input",
     "remove_stale",
     "same_content",
+    "synced_fingerprint",
     "publish",
     "replacing",
     "staged",
@@ -251,11 +252,25 @@ def fingerprint(path) -> dict:
     """What identifies the content of the file at ``path``: ``{"bytes", "mtime_ns",
     "sha256"}`` (JSON-able). A rename keeps all three; a copy keeps bytes and digest."""
     digest = hashlib.sha256()
-    with open(path, "rb") as f:
+    block = bytearray(_HASH_BLOCK)  # one buffer read into: fresh bytes per read page-fault
+    with open(path, "rb") as f, memoryview(block) as view:
         st = os.fstat(f.fileno())
-        while block := f.read(_HASH_BLOCK):
-            digest.update(block)
+        while got := f.readinto(block):
+            digest.update(view[:got])
     return {"bytes": st.st_size, "mtime_ns": st.st_mtime_ns, "sha256": digest.hexdigest()}
+
+
+def synced_fingerprint(path) -> dict:
+    """:func:`sync` the file at ``path`` and return its :func:`fingerprint`; the flush
+    to disk runs in a thread while the hash reads the page cache (neither changes
+    the file, so the order does not matter)."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    with ThreadPoolExecutor(1, thread_name_prefix="imunoise-sync") as pool:
+        flushed = pool.submit(sync, path)
+        mark = fingerprint(path)
+        flushed.result()
+    return mark
 
 
 def same_content(path, mark: dict) -> bool:
@@ -296,9 +311,9 @@ def publish_pair(tmp, target, meta_of, meta_target) -> tuple[Path, Path]:
     tmp, target, meta_target = Path(tmp), Path(target), Path(meta_target)
     meta_tmp = None
     try:
-        sync(tmp)
+        mark = synced_fingerprint(tmp)
         _keep_mode(tmp, target)
-        text = meta_of(fingerprint(tmp))
+        text = meta_of(mark)
         meta_tmp = temporary_beside(meta_target)
         with open(meta_tmp, "xb") as fh:
             fh.write(text.encode("utf-8"))

@@ -1,7 +1,7 @@
 //! The pyo3 binding layer: borrows numpy arrays, releases the GIL around every
 //! O(n) kernel, calls the pure core and converts `CoreError` into Python
 //! exceptions. One file per concern, each a submodule of `_core` with the same
-//! name (`_core.allan`, `_core.vn`, `_core.fit`), so the Python side mirrors this
+//! name (`_core.allan`, `_core.vn`, `_core.fit`, `_core.records`), so the Python side mirrors this
 //! folder.
 
 use pyo3::exceptions::{
@@ -16,6 +16,7 @@ use crate::error::CoreError;
 mod allan;
 mod fit;
 mod interrupt;
+mod records;
 mod simd;
 mod vn;
 
@@ -139,5 +140,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     add_submodule(m, "vn", vn::register)?;
     add_submodule(m, "fit", fit::register)?;
     add_submodule(m, "simd", simd::register)?;
+    add_submodule(m, "records", records::register)?;
     Ok(())
 }

@@ -6,11 +6,12 @@
 //! [`crate::vn::messages`] and the number parser of [`crate::vn::number`].
 //! Cost: one pass over the body; no allocation for good sentences.
 
+use crate::simd::Level;
 use crate::vn::checksum;
 use crate::vn::messages::{
     command_by_id, is_defined_error, spec_by_id, spec_by_register, MsgSpec, MAX_FIELDS,
 };
-use crate::vn::number::{fast_number, parse_f64};
+use crate::vn::number::{fast_digits, parse_f64, Quotients};
 
 /// The 2024 SDK rejects ASCII packets longer than this (spec §2.1).
 pub const MAX_SENTENCE: usize = 320;
@@ -49,6 +50,7 @@ pub enum Decoded {
 pub fn fast_sentence(
     b: &[u8],
     hint: Option<&'static MsgSpec>,
+    level: Level,
 ) -> Option<(&'static MsgSpec, [f64; MAX_FIELDS], usize)> {
     let head = b.get(..7)?;
     if head[1] != b'V' || head[2] != b'N' || head[6] != b',' {
@@ -61,19 +63,23 @@ pub fn fast_sentence(
     };
     // The general decoder's header rule (three upper-case letters) holds for
     // every id of MESSAGES, so a match above implies it.
-    let mut values = [0.0f64; MAX_FIELDS];
     let n = spec.fields.len();
-    let mut j = 7usize;
-    for (k, v) in values.iter_mut().enumerate().take(n) {
-        *v = fast_number(b, &mut j)?;
-        let sep = *b.get(j)?;
-        let want = if k + 1 == n { b'*' } else { b',' };
-        if sep != want {
-            return None;
-        }
-        j += 1;
+    // Every field's bounds first, then the fields: each number starts where the
+    // separators say, not where the one before it ended, so the numbers of a
+    // sentence are parsed side by side instead of one after another.
+    let mut sep = [0usize; MAX_FIELDS + 1];
+    separators(b, &mut sep[..n + 1], level)?;
+    let mut values = Quotients::new();
+    let mut ok = sep[0] == 6;
+    for k in 0..n {
+        let mut j = sep[k] + 1;
+        values.set(k, fast_digits(b, &mut j)?);
+        ok &= (j == sep[k + 1]) & (b[sep[k]] == b',');
     }
-    let star = j - 1;
+    let star = sep[n];
+    if !ok || b[star] != b'*' {
+        return None;
+    }
     // The scanner looks for '*' within MAX_SENTENCE bytes of '$'.
     if star >= MAX_SENTENCE {
         return None;
@@ -87,7 +93,120 @@ pub fn fast_sentence(
     if field[2].is_ascii_hexdigit() || field[2] == b'X' || check != x as u16 {
         return None;
     }
-    Some((spec, values, star))
+    Some((spec, values.divide(level), star))
+}
+
+/// Fills `out` with the offsets of the first `out.len()` bytes of `b` that are `,`
+/// or `*`, looked for 64 bytes at a time (vector compares into a bit mask, at
+/// the instruction-set `level`; byte by byte in the last, shorter window);
+/// `None` when they are not all in `b` within its first [`MAX_SENTENCE`] bytes.
+#[inline(always)]
+fn separators(b: &[u8], out: &mut [usize], level: Level) -> Option<()> {
+    #[cfg(target_arch = "x86_64")]
+    if level >= Level::Avx2 {
+        // SAFETY: the level is at most the CPU's (simd::level), which has AVX2.
+        return unsafe { x86::separators_avx2(b, out) };
+    }
+    let _ = level;
+    separators_with!(b, out, window_mask)
+}
+
+/// The loop of [`separators`] with `$mask(&[u8; 64]) -> u64` (bit k: byte k is a
+/// separator): one body for every level, compiled with each level's features.
+macro_rules! separators_with {
+    ($b:expr, $out:expr, $mask:path) => {{
+        let (b, out): (&[u8], &mut [usize]) = ($b, $out);
+        let mut found = 0;
+        let mut base = 0;
+        while found < out.len() {
+            if base >= MAX_SENTENCE {
+                return None;
+            }
+            let mask = match b.get(base..base + 64) {
+                Some(window) => $mask(window.try_into().ok()?),
+                None => {
+                    let tail = b.get(base..)?;
+                    let m = tail.iter().enumerate().fold(0u64, |m, (k, &c)| {
+                        m | (((c == b',') | (c == b'*')) as u64) << k
+                    });
+                    if m.count_ones() < (out.len() - found) as u32 {
+                        return None;
+                    }
+                    m
+                }
+            };
+            let mut mask = mask;
+            while mask != 0 && found < out.len() {
+                out[found] = base + mask.trailing_zeros() as usize;
+                found += 1;
+                mask &= mask - 1;
+            }
+            base += 64;
+        }
+        Some(())
+    }};
+}
+use separators_with;
+
+/// Bit k set where `w[k]` is `,` or `*`: SSE2 compares on x86-64 (part of its
+/// baseline, the scalar level), a byte loop elsewhere.
+#[inline(always)]
+fn window_mask(w: &[u8; 64]) -> u64 {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::*;
+        let mut mask = 0u64;
+        for k in 0..4 {
+            // SAFETY: SSE2 is part of every x86-64 CPU; the load reads bytes
+            // 16k..16k+16 of the 64-byte window.
+            let bits = unsafe {
+                let v = _mm_loadu_si128(w.as_ptr().add(16 * k).cast());
+                let hit = _mm_or_si128(
+                    _mm_cmpeq_epi8(v, _mm_set1_epi8(b',' as i8)),
+                    _mm_cmpeq_epi8(v, _mm_set1_epi8(b'*' as i8)),
+                );
+                _mm_movemask_epi8(hit) as u32 as u64
+            };
+            mask |= bits << (16 * k);
+        }
+        mask
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        w.iter().enumerate().fold(0u64, |m, (k, &c)| {
+            m | (((c == b',') | (c == b'*')) as u64) << k
+        })
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+mod x86 {
+    use std::arch::x86_64::*;
+
+    use super::MAX_SENTENCE;
+
+    /// [`super::window_mask`] with two 32-byte compares.
+    #[inline(always)]
+    unsafe fn window_mask_avx2(w: &[u8; 64]) -> u64 {
+        let mut mask = 0u64;
+        for k in 0..2 {
+            // SAFETY: bytes 32k..32k+32 of the 64-byte window; AVX2 is enabled
+            // in the only caller.
+            let v = _mm256_loadu_si256(w.as_ptr().add(32 * k).cast());
+            let hit = _mm256_or_si256(
+                _mm256_cmpeq_epi8(v, _mm256_set1_epi8(b',' as i8)),
+                _mm256_cmpeq_epi8(v, _mm256_set1_epi8(b'*' as i8)),
+            );
+            mask |= (_mm256_movemask_epi8(hit) as u32 as u64) << (32 * k);
+        }
+        mask
+    }
+
+    #[target_feature(enable = "avx2")]
+    pub(super) unsafe fn separators_avx2(b: &[u8], out: &mut [usize]) -> Option<()> {
+        let mask = |w: &[u8; 64]| unsafe { window_mask_avx2(w) };
+        separators_with!(b, out, mask)
+    }
 }
 
 fn parse_uint(s: &[u8]) -> Option<u16> {
@@ -264,7 +383,7 @@ mod tests {
     #[test]
     fn fast_sentence_takes_the_common_case() {
         let a1 = b"$VNYMR,+100.949,-007.330,+000.715,-00.0049,-00.2449,+00.5397,-01.258,-00.100,-09.701,-00.000018,+00.001122,-00.000551*69\r\n";
-        let (spec, v, star) = fast_sentence(a1, None).unwrap();
+        let (spec, v, star) = fast_sentence(a1, None, Level::Scalar).unwrap();
         assert_eq!((spec.id, star), ("VNYMR", a1.len() - 5));
         assert_eq!((v[0], v[1], v[9]), (100.949, -7.33, -0.000018));
         // Each of these leaves it to the general path.
@@ -278,12 +397,12 @@ mod tests {
             b"$VNRRG,08,-114.314,+000.058,-001.773*4F\r\n",
         ] {
             assert!(
-                fast_sentence(s, None).is_none(),
+                fast_sentence(s, None, Level::Scalar).is_none(),
                 "{}",
                 String::from_utf8_lossy(s)
             );
         }
         let ok = b"$VNYPR,+010.071,+000.278,-002.026*60\r\n";
-        assert!(fast_sentence(ok, None).is_some());
+        assert!(fast_sentence(ok, None, Level::Scalar).is_some());
     }
 }

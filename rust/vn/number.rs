@@ -110,8 +110,19 @@ const POW10_U64: [u64; 8] = [1, 10, 100, 1_000, 10_000, 100_000, 1_000_000, 10_0
 /// value is one correctly rounded division, bit-identical to [`parse_f64`]
 /// (whose fast path takes this grammar) and to Python's `float()`. `None`
 /// for anything else, and near the end of `b` (8-byte loads).
+#[cfg(test)]
 #[inline(always)]
 pub(crate) fn fast_number(b: &[u8], j: &mut usize) -> Option<f64> {
+    let (mant, frac, neg) = fast_digits(b, j)?;
+    let v = mant as i64 as f64 / POW10[frac];
+    Some(f64::from_bits(v.to_bits() | (neg as u64) << 63))
+}
+
+/// The pieces of [`fast_number`]'s value, `(mantissa, decimals, negative)`: the
+/// value is `mantissa / 10^decimals` with the sign bit set when `negative`, so
+/// that the divisions of a whole sentence can be made together ([`Quotients`]).
+#[inline(always)]
+pub(crate) fn fast_digits(b: &[u8], j: &mut usize) -> Option<(u64, usize, bool)> {
     // Signs are random in sensor data: no branch on them (a mispredicted
     // branch per field cost more than the rest of the field).
     let c = *b.get(*j)?;
@@ -140,11 +151,109 @@ pub(crate) fn fast_number(b: &[u8], j: &mut usize) -> Option<f64> {
     }
     debug_assert!(mant <= EXACT_MANT && frac < POW10.len());
     *j = k;
-    // Below 2^53 the signed conversion is the same exact value, and one
-    // instruction where the unsigned one takes several on x86-64.
-    let v = mant as i64 as f64 / POW10[frac];
-    Some(f64::from_bits(v.to_bits() | (neg as u64) << 63))
+    Some((mant, frac, neg))
 }
+
+/// Up to [`LANES`] values `mantissa / 10^decimals`, sign bit or-ed in, divided
+/// all at once (`divide`): a sentence's twelve divisions one after the other
+/// were the parser's largest cost, and vector division is correctly rounded
+/// like the scalar one, so every level gives the same bits.
+pub(crate) struct Quotients {
+    num: [f64; LANES],
+    den: [f64; LANES],
+    sign: [u64; LANES],
+}
+
+/// Values a [`Quotients`] holds (the most fields of a message).
+pub(crate) const LANES: usize = crate::vn::messages::MAX_FIELDS;
+
+impl Quotients {
+    #[inline(always)]
+    pub(crate) fn new() -> Quotients {
+        Quotients {
+            num: [0.0; LANES],
+            den: [1.0; LANES],
+            sign: [0; LANES],
+        }
+    }
+
+    /// Lane `k` holds the value of [`fast_digits`]'s `(mant, frac, neg)`.
+    #[inline(always)]
+    pub(crate) fn set(&mut self, k: usize, (mant, frac, neg): (u64, usize, bool)) {
+        // Below 2^53 the signed conversion is the same exact value, and one
+        // instruction where the unsigned one takes several on x86-64.
+        self.num[k] = mant as i64 as f64;
+        self.den[k] = POW10[frac];
+        self.sign[k] = (neg as u64) << 63;
+    }
+
+    /// Every lane's value (lanes never set are 0), at the instruction-set `level`.
+    #[inline(always)]
+    pub(crate) fn divide(&self, level: crate::simd::Level) -> [f64; LANES] {
+        use crate::simd::Level;
+        match level {
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: the level is at most the CPU's (simd::level), which has AVX-512 F.
+            Level::Avx512 | Level::Ifma => unsafe { x86::divide_avx512(self) },
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: as above, with AVX2.
+            Level::Avx2 => unsafe { x86::divide_avx2(self) },
+            _ => self.divide_scalar(),
+        }
+    }
+
+    /// The portable path, one lane at a time (SSE2 pairs them).
+    #[inline(always)]
+    pub(crate) fn divide_scalar(&self) -> [f64; LANES] {
+        std::array::from_fn(|k| {
+            f64::from_bits((self.num[k] / self.den[k]).to_bits() | self.sign[k])
+        })
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+mod x86 {
+    use std::arch::x86_64::*;
+
+    use super::{Quotients, LANES};
+
+    #[target_feature(enable = "avx512f")]
+    pub(super) unsafe fn divide_avx512(q: &Quotients) -> [f64; LANES] {
+        let mut out = [0.0f64; LANES];
+        for k in (0..LANES).step_by(8) {
+            // SAFETY: k + 8 <= LANES for every k of the loop (LANES is 16).
+            let v = _mm512_div_pd(
+                _mm512_loadu_pd(q.num.as_ptr().add(k)),
+                _mm512_loadu_pd(q.den.as_ptr().add(k)),
+            );
+            let s = _mm512_loadu_si512(q.sign.as_ptr().add(k).cast());
+            let v = _mm512_castsi512_pd(_mm512_or_si512(_mm512_castpd_si512(v), s));
+            _mm512_storeu_pd(out.as_mut_ptr().add(k), v);
+        }
+        out
+    }
+
+    #[target_feature(enable = "avx2")]
+    pub(super) unsafe fn divide_avx2(q: &Quotients) -> [f64; LANES] {
+        let mut out = [0.0f64; LANES];
+        for k in (0..LANES).step_by(4) {
+            // SAFETY: k + 4 <= LANES for every k of the loop.
+            let v = _mm256_div_pd(
+                _mm256_loadu_pd(q.num.as_ptr().add(k)),
+                _mm256_loadu_pd(q.den.as_ptr().add(k)),
+            );
+            let s = _mm256_loadu_si256(q.sign.as_ptr().add(k).cast());
+            let v = _mm256_castsi256_pd(_mm256_or_si256(_mm256_castpd_si256(v), s));
+            _mm256_storeu_pd(out.as_mut_ptr().add(k), v);
+        }
+        out
+    }
+}
+
+const _: () = assert!(
+    LANES.is_multiple_of(8),
+    "the vector paths divide 8 lanes at a time"
+);
 
 #[cfg(test)]
 mod tests {
@@ -194,6 +303,42 @@ mod tests {
             }
         }
         assert!(taken > 10_000);
+    }
+
+    #[test]
+    fn quotients_are_the_same_bits_at_every_level() {
+        let mut seed = 0x2545_F491_4F6C_DD1Du64;
+        let mut next = || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            seed
+        };
+        let mut cases = Vec::new();
+        for _ in 0..2000 {
+            let mut q = Quotients::new();
+            let mut want = [0.0f64; LANES];
+            for (k, w) in want.iter_mut().enumerate().take((next() % 17) as usize) {
+                // Up to 14 digits, 0..=7 of them decimals, either sign, zero too.
+                let frac = (next() % 8) as usize;
+                let digits = 1 + (next() % 14) as u32;
+                let mant = next() % 10u64.pow(digits);
+                let neg = next() % 2 == 1;
+                q.set(k, (mant, frac, neg));
+                let text = format!("{}{}e-{frac}", if neg { "-" } else { "" }, mant);
+                *w = text.parse::<f64>().unwrap();
+            }
+            cases.push((q, want));
+        }
+        crate::simd::at_every_level(|level| {
+            for (q, want) in &cases {
+                let got = q.divide(level);
+                for k in 0..LANES {
+                    assert_eq!(got[k].to_bits(), want[k].to_bits(), "{level:?} lane {k}");
+                }
+                assert_eq!(got.map(f64::to_bits), q.divide_scalar().map(f64::to_bits));
+            }
+        });
     }
 
     #[test]

@@ -53,6 +53,17 @@ impl Table {
         self.values.iter().skip(k).step_by(nc).copied().collect()
     }
 
+    /// An empty table whose values go into `buffer` (cleared; its capacity kept):
+    /// a buffer recycled from an earlier piece of a parallel parse is memory
+    /// already mapped, where a fresh one is zeroed page by page by the kernel.
+    pub(crate) fn with_buffer(names: Vec<String>, mut buffer: Vec<f64>) -> Table {
+        buffer.clear();
+        Table {
+            values: buffer,
+            ..Table::new(names)
+        }
+    }
+
     /// Make room for `rows` more rows.
     pub fn reserve(&mut self, rows: usize) {
         let want = (self.len + rows).saturating_mul(self.ncols());
@@ -108,8 +119,9 @@ impl Table {
     /// pages of a fresh destination are then also first touched (and zeroed by
     /// the kernel) on all cores, which is most of the cost of a large table.
     /// If the table must grow, it makes room for `rows_hint` more rows (at
-    /// least the rows appended).
-    pub(crate) fn append_all(&mut self, mut parts: Vec<Table>, rows_hint: usize) {
+    /// least the rows appended). Returns the parts' emptied value buffers, for
+    /// reuse.
+    pub(crate) fn append_all(&mut self, mut parts: Vec<Table>, rows_hint: usize) -> Vec<Vec<f64>> {
         use rayon::prelude::*;
         let add: usize = parts.iter().map(|p| p.values.len()).sum();
         if self.values.capacity() - self.values.len() < add {
@@ -117,6 +129,7 @@ impl Table {
             self.reserve(rows_hint.max(rows));
         }
         let old = self.values.len();
+        let mut emptied = Vec::with_capacity(parts.len());
         if let Some(spare) = self.values.spare_capacity_mut().get_mut(..add) {
             let mut rest = spare;
             let mut slots = Vec::with_capacity(parts.len());
@@ -137,7 +150,9 @@ impl Table {
             // `old`, and each was filled from a part of its own length above.
             unsafe { self.values.set_len(old + add) };
             for p in &mut parts {
-                p.values = Vec::new();
+                let mut buffer = std::mem::take(&mut p.values);
+                buffer.clear();
+                emptied.push(buffer);
             }
         }
         // Extra columns and the row count (and the values, had the room above
@@ -145,6 +160,7 @@ impl Table {
         for p in parts {
             self.append(p);
         }
+        emptied
     }
 
     pub(crate) fn append(&mut self, mut other: Table) {

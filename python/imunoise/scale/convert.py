@@ -49,6 +49,7 @@ from pathlib import Path
 import numpy as np
 
 from imunoise import _atomic, _summary
+from imunoise._core import records as _core_records
 from imunoise._core import vn as _core_vn
 from imunoise._schema import CHANNELS, column_names
 from imunoise.errors import ImunoiseTypeError, ImunoiseValueError
@@ -137,71 +138,59 @@ def _order(channels: Iterable[str]) -> list[str]:
     return [c for c in ("time", *CHANNELS) if c in have]
 
 
-#: Bytes of the buffer that rows are gathered through before they are written.
-GATHER_BYTES = 1 << 20
-
-
-def _gather_buffer(owner, dtype: np.dtype, row_shape: tuple[int, ...]) -> np.ndarray:
-    """``owner``'s reusable buffer of about :data:`GATHER_BYTES` rows."""
-    buf = getattr(owner, "_gather", None)
-    if buf is None:
-        row_bytes = np.dtype(dtype).itemsize * int(np.prod(row_shape, dtype=np.int64))
-        buf = np.empty((max(1, GATHER_BYTES // row_bytes), *row_shape), dtype=dtype)
-        owner._gather = buf
-    return buf
-
-
 class _NpyAppender:
-    """A 1-D or 2-D float64 ``.npy`` file grown by appending rows.
+    """A float64 ``.npy`` file (plain, or structured of float64 fields) grown by
+    appending rows.
 
     The header is written first for zero rows and rewritten in place at the end
     (numpy reserves room in the header for any row count, so its length does
-    not change).
+    not change). The rows go from the arrays given (views of the parser's
+    tables) straight into the file, gathered and written by the core with the
+    GIL released (:class:`imunoise._core.records.RecordFile`).
     """
 
     def __init__(self, path: Path, dtype: np.dtype, row_shape: tuple[int, ...]):
         self.path = path
         self.dtype = np.dtype(dtype)
         self.row_shape = row_shape
-        self.rows = 0
-        self.f = open(path, "xb")  # noqa: SIM115 - closed in close()
-        self._header()
-        self.data_start = self.f.tell()
+        with open(path, "xb") as f:
+            self._header(f, 0)
+            self.data_start = f.tell()
+        width = self.dtype.itemsize // 8 * int(np.prod(row_shape, dtype=np.int64))
+        self.records = _core_records.RecordFile(str(path), width)
 
-    def _header(self) -> None:
+    def _header(self, f, rows: int) -> None:
         np.lib.format.write_array_header_1_0(
-            self.f,
+            f,
             {"descr": np.lib.format.dtype_to_descr(self.dtype), "fortran_order": False,
-             "shape": (self.rows, *self.row_shape)},
+             "shape": (rows, *self.row_shape)},
         )
 
-    def append(self, rows: np.ndarray) -> None:
-        rows = np.asarray(rows)
-        if rows.dtype == self.dtype and rows.flags.c_contiguous:
-            self.f.write(memoryview(rows).cast("B"))
-        else:
-            # Columns of the parser's row-major table: gathered block by block into
-            # one buffer that stays in cache (a whole-piece copy would be a fresh
-            # allocation per piece: page faults and a pass over memory).
-            block = _gather_buffer(self, self.dtype, self.row_shape)
-            for i in range(0, len(rows), len(block)):
-                part = rows[i:i + len(block)]
-                out = block[:len(part)]
-                out[...] = part
-                self.f.write(memoryview(out).cast("B"))
-        self.rows += len(rows)
+    @property
+    def rows(self) -> int:
+        return self.records.rows
+
+    def append(self, *blocks: np.ndarray) -> None:
+        """Append one row per row of the blocks (1-D: one value, 2-D: its columns),
+        row r of each block in turn."""
+        arrays = []
+        for a in blocks:
+            a = np.asarray(a, dtype=np.float64)
+            if any(st < 0 or st % 8 for st in a.strides) or not a.flags.aligned:
+                a = np.ascontiguousarray(a)  # the core reads non-negative 8-byte strides
+            arrays.append(a)
+        self.records.append(arrays)
 
     def close(self) -> None:
-        if self.f.closed:
+        if self.records is None:
             return
-        end = self.f.tell()
-        self.f.seek(0)
-        self._header()
-        if self.f.tell() != self.data_start:  # pragma: no cover - numpy guarantees room
-            self.f.close()
-            raise OSError(f"{self.path}: the .npy header grew when rewritten")
-        self.f.seek(end)
-        self.f.close()
+        rows = self.records.rows
+        self.records.close()
+        self.records = None
+        with open(self.path, "r+b") as f:
+            self._header(f, rows)
+            if f.tell() != self.data_start:  # pragma: no cover - numpy guarantees room
+                raise OSError(f"{self.path}: the .npy header grew when rewritten")
 
 
 class _Sink:
@@ -251,7 +240,7 @@ class _DirSink(_Sink):
     def publish(self, out, meta):
         # each channel file's fingerprint: a directory whose files were replaced one
         # by one (below) and interrupted is refused by the reader, not mixed
-        ties = {f"{ch}.npy": _atomic.fingerprint(self.staging / f"{ch}.npy")
+        ties = {f"{ch}.npy": _atomic.synced_fingerprint(self.staging / f"{ch}.npy")
                 for ch in self.channels}
         _atomic.write_text(self.staging / "meta.json",
                            json.dumps({**meta, "data": ties}, indent=1))
@@ -294,14 +283,8 @@ class _NpySink(_Sink):
         self.file = _NpyAppender(staging, self.dtype, ())
 
     def append(self, cols):
-        m = len(cols[self.channels[0]])
-        block = _gather_buffer(self, self.dtype, ())
-        for i in range(0, m, len(block)):
-            out = block[:min(len(block), m - i)]
-            for ch in self.channels:
-                out[ch] = cols[ch][i:i + len(out)]
-            self.file.append(out)
-        self.rows += m
+        self.file.append(*(cols[ch] for ch in self.channels))
+        self.rows += len(cols[self.channels[0]])
 
     def close(self, meta):
         self.file.close()

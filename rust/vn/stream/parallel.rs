@@ -13,6 +13,11 @@ use crate::vn::binary::{self, HeaderScan};
 use crate::vn::stream::parser::{Failure, Parser, MAX_LAYOUTS};
 use crate::vn::{IssueKind, Location, Table, VnData, FIRST_KEEP};
 
+/// What a piece parser of [`Parser::feed_block`] leaves: its data, a strict-mode
+/// failure, its newlines, the end of its last run of skipped bytes and its
+/// unused spare buffers.
+type PieceResult = (VnData, Option<Failure>, u64, u64, Vec<Vec<f64>>);
+
 /// Tables of several pieces by message name, to append in one parallel copy.
 #[derive(Default)]
 struct TableParts(Vec<(String, Vec<Table>)>);
@@ -29,13 +34,14 @@ impl TableParts {
     }
 
     /// Append them, in piece order, to the tables of `data`, reserving
-    /// `scale` rows per row appended when a table has to grow.
-    fn flush(&mut self, data: &mut VnData, scale: f64) {
+    /// `scale` rows per row appended when a table has to grow; the parts' emptied
+    /// buffers go to `spare`.
+    fn flush(&mut self, data: &mut VnData, scale: f64, spare: &mut Vec<Vec<f64>>) {
         for (name, parts) in self.0.drain(..) {
             let rows: usize = parts.iter().map(|t| t.len).sum();
             let names = parts.first().map(|t| t.names.clone()).unwrap_or_default();
             let mine = data.tables.entry(name).or_insert_with(|| Table::new(names));
-            mine.append_all(parts, (rows as f64 * scale) as usize);
+            spare.extend(mine.append_all(parts, (rows as f64 * scale) as usize));
         }
     }
 }
@@ -68,6 +74,15 @@ fn has_byte(buf: &[u8], byte: u8) -> bool {
 }
 
 impl Parser {
+    /// The spare buffers split among `pieces` piece parsers (at most one each;
+    /// more than a block's worth are not kept).
+    fn lend_spare(&mut self, pieces: usize) -> Vec<Vec<Vec<f64>>> {
+        self.spare.truncate(pieces);
+        (0..pieces)
+            .map(|_| self.spare.pop().into_iter().collect())
+            .collect()
+    }
+
     /// Parse a block, using all cores when it is large and pure ASCII.
     pub fn feed_block(&mut self, buf: &[u8], fin: bool) -> usize {
         if buf.len() < self.parallel_min || self.fail.is_some() {
@@ -99,12 +114,15 @@ impl Parser {
         let inner: Vec<(usize, usize)> = cuts.windows(2).map(|w| (w[0], w[1])).collect();
         let strict = self.strict;
         let fast = self.fast;
-        let results: Vec<(VnData, Option<Failure>, u64, u64)> = inner
+        let lent = self.lend_spare(inner.len());
+        let results: Vec<PieceResult> = inner
             .par_iter()
-            .map(|&(a, b)| {
+            .zip(lent)
+            .map(|(&(a, b), spare)| {
                 let piece = &buf[a..b];
                 let mut p = Parser::with_size_hint(strict, piece.len() as u64);
                 p.fast = fast;
+                p.spare = spare;
                 // One spare location, for a run of skipped bytes that turns out
                 // to continue one from the previous piece.
                 p.skip_keep = FIRST_KEEP + 1;
@@ -112,13 +130,14 @@ impl Parser {
                 // `feed` consumed the whole piece and counted its newlines
                 // (unless strict mode stopped it, when the count is not used).
                 let nl = p.lines;
-                (p.data, p.fail, nl, p.skip_end)
+                (p.data, p.fail, nl, p.skip_end, p.spare)
             })
             .collect();
         // Lines before the block (kept current by `feed`).
         let mut line_shift = self.lines;
         let mut parts = TableParts::default();
-        for ((a, b), (mut data, fail, nl, skip_end)) in inner.iter().zip(results) {
+        for ((a, b), (mut data, fail, nl, skip_end, unused)) in inner.iter().zip(results) {
+            self.spare.extend(unused);
             let shift_offset = self.base + *a as u64;
             let skipped = &mut data.issues.first[IssueKind::BytesSkipped as usize];
             if self.skip_end == shift_offset && skipped.first().is_some_and(|l| l.offset == 0) {
@@ -145,14 +164,14 @@ impl Parser {
                 };
                 self.fail = Some(failure);
                 let scale = self.rows_scale(self.base, *b, buf.len());
-                parts.flush(&mut self.data, scale);
+                parts.flush(&mut self.data, scale, &mut self.spare);
                 return buf.len();
             }
             line_shift += nl;
         }
         // The tables of all pieces, appended in one parallel copy.
         let scale = self.rows_scale(self.base, last, buf.len());
-        parts.flush(&mut self.data, scale);
+        parts.flush(&mut self.data, scale, &mut self.spare);
         // Continue sequentially from `last`.
         self.lines = line_shift;
         self.line_pos = self.base + last as u64;
@@ -202,12 +221,15 @@ impl Parser {
             .collect();
         let last = bounds.len() - 1;
         let (strict, fast) = (self.strict, self.fast);
+        let lent = self.lend_spare(bounds.len());
         let results: Vec<(Parser, usize)> = bounds
             .par_iter()
+            .zip(lent)
             .enumerate()
-            .map(|(k, &(a, b))| {
+            .map(|(k, (&(a, b), spare))| {
                 let mut p = Parser::with_size_hint(strict, (b - a) as u64);
                 p.fast = fast;
+                p.spare = spare;
                 let used = p.feed(&buf[a..b], fin && k == last);
                 (p, used)
             })
@@ -261,6 +283,7 @@ impl Parser {
         let mut ascii_parts = TableParts::default();
         let mut consumed = 0usize;
         for (mut p, used) in pieces {
+            self.spare.append(&mut p.spare);
             for (k_piece, (layout, name, table)) in p.layouts.drain(..).enumerate() {
                 let k = match self
                     .layouts
@@ -300,9 +323,10 @@ impl Parser {
                 *mine = Table::new(parts[0].names.clone());
             }
             let rows: usize = parts.iter().map(|t| t.len).sum();
-            mine.append_all(parts, (rows as f64 * scale) as usize);
+            self.spare
+                .extend(mine.append_all(parts, (rows as f64 * scale) as usize));
         }
-        ascii_parts.flush(&mut self.data, scale);
+        ascii_parts.flush(&mut self.data, scale, &mut self.spare);
         consumed
     }
 

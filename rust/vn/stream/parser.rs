@@ -90,6 +90,9 @@ pub struct Parser {
     /// Locations kept for runs of skipped bytes (one more in a piece of a
     /// parallel parse, see [`Parser::feed_block`]).
     pub(super) skip_keep: usize,
+    /// Emptied value buffers of merged pieces, lent to the next block's pieces:
+    /// memory already mapped is filled at once, a fresh buffer page-faults.
+    pub(super) spare: Vec<Vec<f64>>,
 }
 
 impl Parser {
@@ -117,6 +120,7 @@ impl Parser {
             parallel_min: PARALLEL_MIN,
             merged_pieces: 0,
             skip_keep: FIRST_KEEP,
+            spare: Vec::new(),
         }
     }
 
@@ -139,6 +143,12 @@ impl Parser {
     fn rows_hint(&self, len: usize) -> usize {
         let left = self.size_hint.saturating_sub(self.base);
         (left / len.max(1) as u64).min(1 << 32) as usize
+    }
+
+    /// An empty table for message `spec`, in a spare buffer when there is one.
+    fn new_table(&mut self, spec: &MsgSpec) -> Table {
+        let names = spec.fields.iter().map(|s| s.to_string()).collect();
+        Table::with_buffer(names, self.spare.pop().unwrap_or_default())
     }
 
     fn location(&mut self, buf: &[u8], i: usize) -> Location {
@@ -197,7 +207,7 @@ impl Parser {
                 status,
             } => {
                 if !self.data.tables.contains_key(spec.id) {
-                    let mut table = Table::new(spec.fields.iter().map(|s| s.to_string()).collect());
+                    let mut table = self.new_table(spec);
                     table.reserve(self.rows_hint(len));
                     self.data.tables.insert(spec.id.to_string(), table);
                 }
@@ -306,12 +316,14 @@ impl Parser {
     pub fn feed(&mut self, buf: &[u8], fin: bool) -> usize {
         let n = buf.len();
         let mut i = 0usize;
+        // Once per block: the level cannot change the values, only their speed.
+        let level = crate::simd::level();
         while i < n {
             if self.fail.is_some() {
                 return n;
             }
             match buf[i] {
-                b'$' if self.fast && self.fast_ascii(buf, &mut i) => {}
+                b'$' if self.fast && self.fast_ascii(buf, &mut i, level) => {}
                 b'$' => match scan_ascii(buf, i, fin) {
                     Ascii::Need => break,
                     Ascii::Noise => {
@@ -361,8 +373,9 @@ impl Parser {
     /// The common sentence ([`ascii::fast_sentence`]) at `buf[*i] == b'$'`:
     /// decoded and `*i` moved past it, or `false` with nothing changed.
     #[inline]
-    fn fast_ascii(&mut self, buf: &[u8], i: &mut usize) -> bool {
-        let Some((spec, values, star)) = ascii::fast_sentence(&buf[*i..], self.last_spec) else {
+    fn fast_ascii(&mut self, buf: &[u8], i: &mut usize, level: crate::simd::Level) -> bool {
+        let Some((spec, values, star)) = ascii::fast_sentence(&buf[*i..], self.last_spec, level)
+        else {
             return false;
         };
         self.last_spec = Some(spec);
@@ -371,7 +384,7 @@ impl Parser {
         let table = match self.data.tables.get_mut(spec.id) {
             Some(t) => t,
             None => {
-                let mut table = Table::new(spec.fields.iter().map(|s| s.to_string()).collect());
+                let mut table = self.new_table(spec);
                 table.reserve(self.rows_hint(len));
                 self.data.tables.entry(spec.id.to_string()).or_insert(table)
             }
@@ -453,9 +466,13 @@ impl Parser {
             }
             self.pending.retain(|(p, _)| *p != k);
         }
+        let buffer = match self.layouts[k].2.names.is_empty() {
+            true => self.spare.pop().unwrap_or_default(),
+            false => Vec::new(),
+        };
         let (layout, _, table) = &mut self.layouts[k];
         if table.names.is_empty() {
-            *table = Table::new(layout.column_names());
+            *table = Table::with_buffer(layout.column_names(), buffer);
             let rows = (self.size_hint.saturating_sub(self.base + i as u64) / (end - i) as u64)
                 .min(1 << 32) as usize;
             table.reserve(rows);

@@ -377,6 +377,30 @@ proptest! {
     }
 
     #[test]
+    fn fast_path_agrees_at_every_level(
+        s in sentences(),
+        flips in proptest::collection::vec((any::<u16>(), 0u8..8), 0..4),
+    ) {
+        // The vector divisions of the fast path against the general path, on
+        // sentences with corrupt bytes too, at every instruction-set level.
+        let mut s = s;
+        for (at, bit) in flips {
+            let at = at as usize % s.len();
+            s[at] ^= 1 << bit;
+        }
+        let text = |d: CoreResult<VnData>| match d {
+            Ok(d) => format!("{d:?}"),
+            Err(e) => e.to_string(),
+        };
+        let want = text(reference(&s, false));
+        crate::simd::at_every_level(|level| {
+            assert_eq!(text(parse_bytes(&s, false)), want, "{level:?}");
+            let p = Parser::with_size_hint(false, s.len() as u64).with_parallel_min(64);
+            assert_eq!(text(parse_bytes_with(p, &s)), want, "{level:?} parallel");
+        });
+    }
+
+    #[test]
     fn parallel_binary_equals_sequential(
         kinds in proptest::collection::vec(0u8..5, 20..200),
         edits in proptest::collection::vec((any::<u16>(), any::<u8>(), 0u8..3), 0..8),
