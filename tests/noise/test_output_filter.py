@@ -222,3 +222,15 @@ def test_output_filter_repr_and_factor():
     assert "white to 12.5 Hz" in repr(found)
     np.testing.assert_allclose(found.factor([0.01, 100.0]),
                                filter_factor([0.01, 100.0], FS, found.gain), rtol=3e-4)  # the core
+
+
+def test_the_filter_travels_in_the_models_dict():
+    import json
+
+    fs, n = 200.0, 400_000
+    b, a = butter(4, fs / 10, fs=fs)
+    x = lfilter(b, a, imunoise.simulate(n, fs, N=1e-3, B=1e-5, seed=21))
+    model = imunoise.fit(imunoise.adev(x, fs, taus=10), spectrum=imunoise.psd(x, fs))
+    d = json.loads(json.dumps(model.to_dict()))
+    assert d["filter"][0]["white_top"] == pytest.approx(model.filter[0].white_top)
+    assert d["filter"][0]["gain"][-1] < 0.1  # a 4th-order low-pass at fs/10: nothing at fs/2

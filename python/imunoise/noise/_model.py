@@ -469,7 +469,9 @@ class NoiseModel(PerTerm):
         """Plain-Python view of the model (lists and floats), e.g. for JSON: the
         datasheet values under their names (``None`` where not resolved, with
         ``"upper"`` the bound), each axis's fitted terms under ``"terms"`` (and as
-        parallel arrays under ``"components"``, for one release)."""
+        parallel arrays under ``"components"``, for one release), each axis's output
+        filter under ``"filter"`` (white band's top, Hz; frequencies and gains; None
+        where none was measured)."""
         d = {"method": self.method, "kind": self.kind, "fs": self.fs,
              "overlapping": self.overlapping, "channels": self.channels,
              "taus": self.taus.tolist(), "units": dict(_INPUT_UNITS)}
@@ -479,6 +481,9 @@ class NoiseModel(PerTerm):
                        "supported": self.resolved(term).tolist()}
         d["notes"] = [list(n) for n in self.notes]
         d["terms"] = [[t.to_dict() for t in terms] for terms in self.terms]
+        d["filter"] = [None if f is None else
+                       {"white_top": float(f.white_top), "frequency": f.f.tolist(),
+                        "gain": f.gain.tolist()} for f in self.filter]
         d["components"] = self._arrays.to_dict()
         d["coverage"] = np.atleast_1d(self.coverage).tolist()
         d["discrepancy"] = np.atleast_1d(self.discrepancy).tolist()
