@@ -152,22 +152,38 @@ fn check_model(taus: &[f64], fs: f64) -> PyResult<()> {
     Ok(())
 }
 
-/// datasheet(terms, cov, taus, fs, filter=None) -> {"N"|"B"|"K": (value, std)}:
+/// A record's duration: `record` (finite, at least the longest tau) or the longest tau.
+fn record_length(record: Option<f64>, taus: &[f64]) -> PyResult<f64> {
+    let longest = taus[taus.len() - 1];
+    match record {
+        None => Ok(longest),
+        Some(r) if r.is_finite() && r >= longest => Ok(r),
+        Some(r) => Err(super::value_error(format!(
+            "record must be finite and at least the longest tau ({longest} s); got {r}"
+        ))),
+    }
+}
+
+/// datasheet(terms, cov, taus, fs, record=None, filter=None) -> {"N"|"B"|"K": (value, std)}:
 /// the datasheet values of a model (NaN where not resolved) with their
-/// uncertainty propagated from `cov`, the covariance of the terms' coordinates.
+/// uncertainty propagated from `cov`, the covariance of the terms' coordinates;
+/// `record` the record's duration (s; default the longest tau).
 #[pyfunction]
-#[pyo3(signature = (terms, cov, taus, fs, filter=None))]
+#[pyo3(signature = (terms, cov, taus, fs, record=None, filter=None))]
+#[allow(clippy::too_many_arguments)] // mirrors the Python keyword arguments
 fn datasheet<'py>(
     py: Python<'py>,
     terms: Vec<(String, Vec<f64>)>,
     cov: PyReadonlyArray2<'py, f64>,
     taus: PyReadonlyArray1<'py, f64>,
     fs: f64,
+    record: Option<f64>,
     filter: Option<PyReadonlyArray1<'py, f64>>,
 ) -> PyResult<Vec<(&'static str, (f64, f64))>> {
     let typed = typed_terms(&terms)?;
     let taus = taus.as_array().to_vec();
     check_model(&taus, fs)?;
+    let record = record_length(record, &taus)?;
     let filter = output_filter(filter)?;
     let size: usize = typed
         .iter()
@@ -184,6 +200,7 @@ fn datasheet<'py>(
     let model = fit::datasheet::Model {
         terms: &typed,
         taus: &taus,
+        record,
         fs,
         filter: filter.as_ref(),
     };
@@ -211,9 +228,11 @@ fn model_floor<'py>(
     let taus = taus.as_array().to_vec();
     check_model(&taus, fs)?;
     let filter = output_filter(filter)?;
+    let record = taus[taus.len() - 1];
     Ok(fit::datasheet::floor(&fit::datasheet::Model {
         terms: &typed,
         taus: &taus,
+        record,
         fs,
         filter: filter.as_ref(),
     }))

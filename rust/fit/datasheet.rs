@@ -55,10 +55,12 @@ pub struct Value {
 }
 
 /// What a datasheet value is read from: the model's terms, the fitted taus, the
-/// sample rate and the output filter.
+/// record's duration (s; a Gauss–Markov term stands in for K only if its hump lies
+/// beyond it), the sample rate and the output filter.
 pub struct Model<'a> {
     pub terms: &'a [Term],
     pub taus: &'a [f64],
+    pub record: f64,
     pub fs: f64,
     pub filter: Option<&'a OutputFilter>,
 }
@@ -138,13 +140,12 @@ pub fn floor(model: &Model) -> Option<(f64, f64)> {
 
 /// The value of `which` for `model`; NaN where not resolved.
 pub fn value(which: Datasheet, model: &Model) -> f64 {
-    let longest = model.taus[model.taus.len() - 1];
     let total: f64 = match which {
         Datasheet::B => {
             return floor(model).map_or(f64::NAN, |(_, dev)| dev / FLICKER_FACTOR.sqrt());
         }
         Datasheet::N => model.terms.iter().map(|t| t.white_share(model.fs)).sum(),
-        Datasheet::K => model.terms.iter().map(|t| t.walk_share(longest)).sum(),
+        Datasheet::K => model.terms.iter().map(|t| t.walk_share(model.record)).sum(),
     };
     if total > 0.0 {
         total.sqrt()
@@ -222,6 +223,7 @@ mod tests {
         Model {
             terms,
             taus,
+            record: 10.0 * taus[taus.len() - 1],
             fs: 100.0,
             filter: None,
         }
@@ -238,6 +240,7 @@ mod tests {
             },
         ];
         assert!(value(Datasheet::K, &model(&bump, &taus)).is_nan());
+        // its hump (3.8e3 s) beyond the longest tau but within the record (10⁴ s)
         let slow = [
             Term::White { variance: 1e-6 },
             Term::GaussMarkov {
@@ -245,9 +248,17 @@ mod tests {
                 tau_c: 2000.0,
             },
         ];
+        assert!(value(Datasheet::K, &model(&slow, &taus)).is_nan());
+        let slow = [
+            Term::White { variance: 1e-6 },
+            Term::GaussMarkov {
+                variance: 1e-8,
+                tau_c: 6000.0,
+            },
+        ];
         let k = value(Datasheet::K, &model(&slow, &taus));
         assert!(
-            (k / (2.0 * 1e-8 / 2000.0f64).sqrt() - 1.0).abs() < 1e-12,
+            (k / (2.0 * 1e-8 / 6000.0f64).sqrt() - 1.0).abs() < 1e-12,
             "{k}"
         );
     }

@@ -444,16 +444,16 @@ impl Term {
         }
     }
 
-    /// What the term adds to the datasheet's K² over a record whose longest
-    /// fitted tau is `longest`: the random walk itself, and the short-τ walk rate
+    /// What the term adds to the datasheet's K² over a record of `record`
+    /// seconds: the random walk itself, and the short-τ walk rate
     /// 2σ²/τc of a Gauss–Markov term whose hump lies beyond the record (over the
     /// record it rises like a walk). A bump within the record is a bias state of
     /// its own and adds nothing: taken as K it would inflate an EKF's bias
     /// process noise by the bump's height over the walk's.
-    pub fn walk_share(&self, longest: f64) -> f64 {
+    pub fn walk_share(&self, record: f64) -> f64 {
         match *self {
             Term::RandomWalk { variance } => variance,
-            Term::GaussMarkov { variance, tau_c } if tau_c > 1.0 && GM_PEAK * tau_c > longest => {
+            Term::GaussMarkov { variance, tau_c } if tau_c > 1.0 && GM_PEAK * tau_c > record => {
                 2.0 * variance / tau_c
             }
             _ => 0.0,

@@ -90,10 +90,12 @@ def datasheet(
     cov: npt.NDArray[np.float64],
     taus: npt.NDArray[np.float64],
     fs: float,
+    record: float | None = None,
     filter: npt.NDArray[np.float64] | None = None,
 ) -> list[tuple[str, tuple[float, float]]]:
     """(name, (value, std)) of N, B, K of a model given as (kind, parameters) terms
-    with ``cov`` the covariance of their coordinates; NaN where not resolved."""
+    with ``cov`` the covariance of their coordinates; NaN where not resolved.
+    ``record``: the record's duration, s (default the longest tau)."""
 
 def model_floor(
     terms: list[tuple[str, list[float]]],

@@ -12,11 +12,11 @@ A datasheet quotes what the curve shows, not which components made it:
 - ``K``, the rate random walk: a walk that keeps rising to the end of the record.
   The fitted K, together with the short-τ random-walk rate √(2σ²/τc) of a
   Gauss–Markov term whose hump (its Allan variance's peak, τ ≈ 1.89 τc) lies
-  beyond the longest fitted tau: over the record it rises like a walk, and an
-  estimator's walk over that span is its rate. A Gauss–Markov term whose hump lies
-  within the fitted taus is a bump, a bias state of its own: it shapes B and is
-  never added to K (taken as K it would inflate an EKF's bias process noise by
-  the bump's height over the walk's).
+  beyond the record (its duration, not only its longest fitted tau): over the record
+  it rises like a walk, and an estimator's walk over that span is its rate. A
+  Gauss–Markov term whose hump lies within the record is a bump, a bias state of
+  its own: it shapes B and is never added to K (taken as K it would inflate an
+  EKF's bias process noise by the bump's height over the walk's).
 - ``B``, the bias instability: the floor of the model's deviation over the
   fitted taus divided by √(2 ln2/π) ≈ 0.6643 (:func:`model_floor`: the minimum,
   or, where the curve falls again past a slow bump, the valley before it); not
@@ -54,12 +54,13 @@ from imunoise.noise._terms import (
 _B_GRID = 200
 
 
-def datasheet_values(components, core, taus,
-                     method: str) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+def datasheet_values(components, core, taus, method: str,
+                     record: float) -> dict[str, tuple[np.ndarray, np.ndarray]]:
     """``{term: (values, stds)}``, each of shape (channels,), for Q, N, B, K, R.
     ``core``: per channel, the core fit's (kind, parameters) terms and the
     covariance of their coordinates (``"wls"``), from which N, B, K and their
-    uncertainties come (Rust: ``rust/fit/datasheet.rs``)."""
+    uncertainties come (Rust: ``rust/fit/datasheet.rs``); ``record`` the record's
+    duration (s)."""
     out = {term: (components.value(term).astype(float), components.std(term).astype(float))
            for term in TERMS}
     if method != "wls":
@@ -68,16 +69,17 @@ def datasheet_values(components, core, taus,
     values = {t: np.full(components.channels, np.nan) for t in ("N", "B", "K")}
     stds = {t: np.full(components.channels, np.nan) for t in ("N", "B", "K")}
     for c, (terms, cov) in enumerate(core):
-        for name, (v, e) in _core_fit.datasheet(terms, cov, taus, float(components.fs)):
+        for name, (v, e) in _core_fit.datasheet(terms, cov, taus, float(components.fs),
+                                                record=float(record)):
             values[name][c], stds[name][c] = v, e
     out.update({t: (values[t], stds[t]) for t in values})
     return out
 
 
-def walks_beyond(tau_c: float, taus: np.ndarray) -> bool:
-    """Whether a Gauss–Markov term of correlation time ``tau_c`` still rises at the
-    longest fitted tau (its hump lies beyond the record), and so may stand in for K."""
-    return GM_PEAK * tau_c > float(taus[-1])
+def walks_beyond(tau_c: float, record: float) -> bool:
+    """Whether a Gauss–Markov term of correlation time ``tau_c`` rises to the end of a
+    record of ``record`` seconds (its hump lies beyond it), and so may stand in for K."""
+    return GM_PEAK * tau_c > record
 
 
 #: Confidence of the bound on a value the data do not resolve.
@@ -116,21 +118,20 @@ def upper_bounds(taus, var, edf) -> dict[str, np.ndarray]:
     return out
 
 
-def datasheet_notes(components, taus, channel: int, method: str) -> tuple[str, ...]:
+def datasheet_notes(components, record: float, channel: int, method: str) -> tuple[str, ...]:
     """What a reader of channel ``channel``'s K needs to know: which slow
     Gauss–Markov terms stand in for it (hump beyond the record) and which are bumps
     within the record, bias states of their own left out of it."""
     if method != "wls":
         return ()
-    taus = np.asarray(taus, float)
     notes = []
     for _, tau_c in components.gauss_markov(channel):
         if GM_PEAK * tau_c <= 1.0:  # in N: its hump lies before the 1 s read-off
             continue
-        if walks_beyond(tau_c, taus):
+        if walks_beyond(tau_c, record):
             notes.append(f"K includes a Gauss–Markov term of τc {tau_c:.3g} s whose hump "
-                         f"(τ ≈ {GM_PEAK * tau_c:.3g} s) lies beyond the longest tau "
-                         f"({taus[-1]:.3g} s): over the record it rises like a random walk")
+                         f"(τ ≈ {GM_PEAK * tau_c:.3g} s) lies beyond the record "
+                         f"({record:.3g} s): over the record it rises like a random walk")
         else:
             notes.append(f"a Gauss–Markov bump of τc {tau_c:.3g} s lies within the record: "
                          "a bias state of its own (the EKF export keeps it), not part of K")

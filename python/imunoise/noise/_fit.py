@@ -370,7 +370,8 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
         cov=shaped(cov),
         fs=float(result.fs),
     )
-    sheet = datasheet_values(components, core, taus, method)
+    record = _record_seconds(result, taus)
+    sheet = datasheet_values(components, core, taus, method, record)
     if uncertainty == "bootstrap":
         sheet = {k: (v, sheet_std[:, i]) for i, (k, (v, _)) in enumerate(sheet.items())}
     resolved = {k: (v > 0) & np.isfinite(v) for k, (v, _) in sheet.items()}
@@ -380,7 +381,7 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
         **{k + "_std": shaped(np.where(resolved[k], e, np.nan)) for k, (_, e) in sheet.items()},
         supported={k: shaped(v) for k, v in resolved.items()},
         upper={k: shaped(np.where(resolved[k], np.nan, bounds[k])) for k in TERMS},
-        notes=tuple((*datasheet_notes(components, taus, c, method), *_unplaced_note(unplaced[c]),
+        notes=tuple((*datasheet_notes(components, record, c, method), *_unplaced_note(unplaced[c]),
                      *_filter_notes(filters[c], spectrum, output_filter, method))
                     for c in range(channels)),
         lines=tuple(_lines(components, spectrum, c) for c in range(channels)),
@@ -513,6 +514,16 @@ def _warn_sparse_grid(taus) -> None:
             "fit adev(..., taus=10) or denser",
             CoverageWarning,
         )
+
+
+def _record_seconds(result, taus) -> float:
+    """The record's duration behind an Allan result (s): its samples over its rate,
+    or, where it does not say, its longest tau."""
+    n_samples = getattr(result, "n_samples", None)
+    longest = float(taus[-1])
+    if not n_samples:
+        return longest
+    return max(float(n_samples) / float(result.fs), longest)
 
 
 def _record_length(result) -> int:

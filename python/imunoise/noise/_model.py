@@ -53,7 +53,7 @@ class NoiseModel(PerTerm):
     B     the model curve's flat minimum / 0.6643 over the fitted taus
     K     a random walk that keeps rising to the end of the record: the fitted K
           with any Gauss–Markov term whose hump (τ ≈ 1.89 τc) lies beyond the
-          longest tau (:attr:`notes` says so); a bump within the record is a
+          record's duration (:attr:`notes` says so); a bump within it is a
           bias state of its own, never added to K
     Q, R  the fitted coefficients
     ====  ==================================================================
