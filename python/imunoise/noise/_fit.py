@@ -328,8 +328,13 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
                 _bootstrap_std(result, n_record, coef[c], markov, (tones, oscs, motions),
                                int(replicates), generator, options)
     std[~sup] = np.nan
-    typed = tuple(_typed_terms(coef[c], std[c], gm[c], gm_std[c], sine[c], sine_std[c], osc[c],
-                               osc_std[c], moving[c], moving_std[c]) for c in range(channels))
+    # The typed terms come from the core; only a bootstrap, which replaced their
+    # uncertainties in the arrays, rebuilds them from there.
+    typed = tuple(
+        _typed.from_core(*core[c]) if core[c] is not None and uncertainty != "bootstrap"
+        else _typed_terms(coef[c], std[c], gm[c], gm_std[c], sine[c], sine_std[c], osc[c],
+                          osc_std[c], moving[c], moving_std[c])
+        for c in range(channels))
     requested = () if select or method != "wls" else tuple(terms)
     unplaced = [_unplaced(requested, typed[c]) for c in range(channels)]
     if any(unplaced):
@@ -640,19 +645,13 @@ def _legacy_arrays(terms):
             moving_std)
 
 
-#: The name ``fit(terms=...)`` gives each kind of term.
-_REQUESTED = {_typed.GaussMarkov: "GM", _typed.Tone: "sine", _typed.Resonance: "resonance",
-              _typed.Motion: "motion"}
-
-
 def _unplaced(requested, terms) -> list[str]:
     """The requested terms (``fit(terms=...)`` names) that one channel's fit has not:
     the data put their variance at 0."""
     left = list(requested)
     for term in terms:
-        name = term.name if isinstance(term, _typed._Ieee) else _REQUESTED[type(term)]
-        if name in left:
-            left.remove(name)
+        if term.requested in left:
+            left.remove(term.requested)
     return left
 
 

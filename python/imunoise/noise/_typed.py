@@ -42,6 +42,8 @@ class Term:
     """One term of a channel's noise model (the base of every kind)."""
 
     kind: ClassVar[str] = ""
+    #: The name ``fit(terms=[...])`` asks for this kind by.
+    requested: ClassVar[str] = ""
 
     def core(self) -> tuple[str, list[float]]:
         """(kind, parameters) in the core's form (variances, times, frequencies)."""
@@ -103,6 +105,7 @@ class Quantization(_Ieee):
 
     kind: ClassVar[str] = "quantization"
     name: ClassVar[str] = "Q"
+    requested: ClassVar[str] = "Q"
     Q: float
     Q_std: float = math.nan
 
@@ -113,6 +116,7 @@ class White(_Ieee):
 
     kind: ClassVar[str] = "white"
     name: ClassVar[str] = "N"
+    requested: ClassVar[str] = "N"
     N: float
     N_std: float = math.nan
 
@@ -123,6 +127,7 @@ class Flicker(_Ieee):
 
     kind: ClassVar[str] = "flicker"
     name: ClassVar[str] = "B"
+    requested: ClassVar[str] = "B"
     B: float
     B_std: float = math.nan
 
@@ -133,6 +138,7 @@ class RandomWalk(_Ieee):
 
     kind: ClassVar[str] = "random_walk"
     name: ClassVar[str] = "K"
+    requested: ClassVar[str] = "K"
     K: float
     K_std: float = math.nan
 
@@ -143,6 +149,7 @@ class Ramp(_Ieee):
 
     kind: ClassVar[str] = "ramp"
     name: ClassVar[str] = "R"
+    requested: ClassVar[str] = "R"
     R: float
     R_std: float = math.nan
 
@@ -154,6 +161,7 @@ class GaussMarkov(Term):
     IEEE 952 Annex C (rising as +½ below τc, a hump near 1.89 τc, −½ beyond)."""
 
     kind: ClassVar[str] = "gauss_markov"
+    requested: ClassVar[str] = "GM"
     sigma: float
     tau_c: float
     sigma_std: float = math.nan
@@ -176,6 +184,7 @@ class Tone(Term):
     """A sinusoid A·sin(2πf₀t + ϕ): peak ``amplitude`` (rate) and ``freq`` f₀ (Hz)."""
 
     kind: ClassVar[str] = "tone"
+    requested: ClassVar[str] = "sine"
     amplitude: float
     freq: float
     amplitude_std: float = math.nan
@@ -203,6 +212,7 @@ class Resonance(Term):
     plain resonance; a sensor's second-order low-pass filter has skew > 0)."""
 
     kind: ClassVar[str] = "resonance"
+    requested: ClassVar[str] = "resonance"
     sigma: float
     freq: float
     tau: float
@@ -235,6 +245,7 @@ class Motion(Term):
     correlation time ``tau_c`` (s) and comes back; the platform's, not the sensor's."""
 
     kind: ClassVar[str] = "motion"
+    requested: ClassVar[str] = "motion"
     sigma: float
     tau_c: float
     sigma_std: float = math.nan
