@@ -36,6 +36,7 @@ from collections.abc import Iterable, Iterator
 from pathlib import Path
 from typing import BinaryIO
 
+from imunoise import _interrupt
 from imunoise.errors import DataWarning, ImunoiseValueError
 
 __all__ = [
@@ -234,14 +235,17 @@ def staged(target, *, inputs: Iterable = ()) -> Iterator[tuple[BinaryIO, Path]]:
     refuse_input(target, inputs)
     tmp = temporary_beside(target)
     fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_BINARY", 0), 0o666)
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            yield fh, tmp
-            fh.flush()
-            os.fsync(fh.fileno())
-    except BaseException:
-        _discard(tmp)
-        raise
+    # Ctrl-C's watchdog may end the process before the unwinding reaches the except
+    # below (a long fsync): it removes the temporary then.
+    with _interrupt.undo_on_exit(lambda: _discard(tmp)):
+        try:
+            with os.fdopen(fd, "wb") as fh:
+                yield fh, tmp
+                fh.flush()
+                os.fsync(fh.fileno())
+        except BaseException:
+            _discard(tmp)
+            raise
 
 
 #: Bytes hashed at a time by :func:`fingerprint` (bounds the memory it needs).
@@ -309,25 +313,32 @@ def publish_pair(tmp, target, meta_of, meta_target) -> tuple[Path, Path]:
     its own temporary first, then both are renamed, data first, holding the
     directory's lock. On an exception both temporaries are removed."""
     tmp, target, meta_target = Path(tmp), Path(target), Path(meta_target)
-    meta_tmp = None
-    try:
-        mark = synced_fingerprint(tmp)
-        _keep_mode(tmp, target)
-        text = meta_of(mark)
-        meta_tmp = temporary_beside(meta_target)
-        with open(meta_tmp, "xb") as fh:
-            fh.write(text.encode("utf-8"))
-            fh.flush()
-            os.fsync(fh.fileno())
-        _keep_mode(meta_tmp, meta_target)
-        with _directory_lock(target.parent):
-            os.replace(tmp, target)
-            os.replace(meta_tmp, meta_target)
-    except BaseException:
-        _discard(tmp)
-        if meta_tmp is not None:
-            _discard(meta_tmp)
-        raise
+    temporaries = [tmp]
+
+    def discard() -> None:
+        for path in temporaries:
+            _discard(path)
+
+    # Ctrl-C's watchdog may end the process before the unwinding reaches the except
+    # below (the fsync beside the hash can be slow): it removes the temporaries then.
+    with _interrupt.undo_on_exit(discard):
+        try:
+            mark = synced_fingerprint(tmp)
+            _keep_mode(tmp, target)
+            text = meta_of(mark)
+            meta_tmp = temporary_beside(meta_target)
+            temporaries.append(meta_tmp)
+            with open(meta_tmp, "xb") as fh:
+                fh.write(text.encode("utf-8"))
+                fh.flush()
+                os.fsync(fh.fileno())
+            _keep_mode(meta_tmp, meta_target)
+            with _directory_lock(target.parent):
+                os.replace(tmp, target)
+                os.replace(meta_tmp, meta_target)
+        except BaseException:
+            discard()
+            raise
     _fsync_dir(target.parent)
     return target, meta_target
 
