@@ -27,10 +27,15 @@ def faults():
     return module
 
 
+#: An outcome of the output, not of the process: a run killed between the data's and
+#: its metadata's renames also has its process outcome ("SIGKILL: killed").
+OUTPUT_STATES = ("new data, old metadata: refused by the reader",)
+
+
 def _check(summary, runs):
     assert summary.runs == runs
     assert not summary.failures, summary.text()
-    assert sum(summary.outcomes.values()) == runs
+    assert sum(v for k, v in summary.outcomes.items() if k not in OUTPUT_STATES) == runs
 
 
 def test_signals_during_convert(faults, tmp_path):
