@@ -32,6 +32,9 @@ struct PyNoiseFit {
     parameters: usize,
     /// Its Bayesian information criterion.
     bic: f64,
+    /// (kind, alternative kind, ΔBIC) of each term of a selected structure that
+    /// the alternative fits as well: not resolved by the data.
+    ambiguous: Vec<(&'static str, &'static str, f64)>,
 }
 
 fn ieee_flags(terms: &[bool]) -> PyResult<[bool; IEEE_TERMS]> {
@@ -101,6 +104,9 @@ fn fit_noise<'py>(
         n_eff: r.n_eff,
         parameters: r.parameters,
         bic: r.bic,
+        ambiguous: (r.ambiguous.iter())
+            .map(|a| (a.kind.name(), a.alternative.name(), a.delta_bic))
+            .collect(),
     })
 }
 

@@ -26,6 +26,7 @@
 //! independent); Paule & Mandel (1982) for a fitted between-"study" variance;
 //! Lawson & Hanson (1974) for NNLS.
 
+pub mod ambiguity;
 pub mod basis;
 pub mod datasheet;
 pub mod estimate;
@@ -104,6 +105,10 @@ pub struct NoiseFit {
     pub parameters: usize,
     /// Bayesian information criterion of the chosen structure.
     pub bic: f64,
+    /// Terms of a selected structure that an alternative fits as well
+    /// ([`ambiguity::ambiguities`]): not resolved by the data. Empty for a
+    /// structure fitted as requested.
+    pub ambiguous: Vec<ambiguity::Ambiguity>,
 }
 
 impl NoiseFit {
@@ -180,7 +185,11 @@ pub fn fit_noise(
     } else {
         fixed_structure(&data, fs, opts)?
     };
-    Ok(summarise(&data, fs, &chosen))
+    let mut fit = summarise(&data, fs, &chosen);
+    if opts.select {
+        fit.ambiguous = ambiguity::ambiguities(&data, fs, opts.ieee, opts.gm, &chosen);
+    }
+    Ok(fit)
 }
 
 /// The structure `opts` names, fitted as it is (no selection): the IEEE terms and
@@ -361,6 +370,7 @@ fn summarise(data: &Data, fs: f64, c: &Candidate) -> NoiseFit {
         n_eff: data.n_eff(),
         parameters: search::parameters(&c.solution.theta, c.resonance, c.motion.is_some()),
         bic: c.bic,
+        ambiguous: Vec::new(),
     }
 }
 

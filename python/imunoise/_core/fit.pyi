@@ -47,6 +47,10 @@ class NoiseFit:
     @property
     def bic(self) -> float:
         """Its Bayesian information criterion."""
+    @property
+    def ambiguous(self) -> list[tuple[str, str, float]]:
+        """(kind, alternative kind, ΔBIC) of each term of a selected structure that
+        the alternative fits as well: not resolved by the data."""
 
 def fit_noise(
     taus: npt.NDArray[np.float64],

@@ -270,6 +270,7 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
     stats = np.full((channels, 3), np.nan)  # discrepancy, chi2, n_eff
     cov = np.full((channels, PARAMS, PARAMS), np.nan)
     core: list = [None] * channels  # per channel: the core's terms and their covariance
+    ambiguous: list = [[] for _ in range(channels)]  # per channel: the core's ties
     usable = []
     for c in range(channels):
         ok = np.isfinite(var[:, c]) & (var[:, c] > 0) & np.isfinite(edf[:, c]) & (edf[:, c] > 0)
@@ -294,7 +295,8 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
             fits = list(pool.map(fit_channel, range(channels)))
         for c, out in enumerate(fits):
             coef[c], std[c], sup[c], gm[c], gm_std[c], sine[c], sine_std[c], osc[c], \
-                osc_std[c], moving[c], moving_std[c], stats[c], cov[c], core[c] = out
+                osc_std[c], moving[c], moving_std[c], stats[c], cov[c], core[c], \
+                ambiguous[c] = out
             markov = [(a, b) for a, b in gm[c] if np.isfinite(a)]
             tones = [tuple(p) for p in sine[c] if np.isfinite(p[0])]
             oscs = [tuple(osc[c])] if np.isfinite(osc[c, 0]) else []
@@ -380,13 +382,18 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
     if uncertainty == "bootstrap":
         sheet = {k: (v, sheet_std[:, i]) for i, (k, (v, _)) in enumerate(sheet.items())}
     resolved = {k: (v > 0) & np.isfinite(v) for k, (v, _) in sheet.items()}
+    for c, ties in enumerate(ambiguous):
+        for kind, _, _ in ties:
+            resolved[_typed.KINDS[kind].name][c] = False
     bounds = upper_bounds(taus, np.square(dev_all), edf_raw)
     model = NoiseModel(
         **{k: shaped(np.where(resolved[k], v, np.nan)) for k, (v, _) in sheet.items()},
         **{k + "_std": shaped(np.where(resolved[k], e, np.nan)) for k, (_, e) in sheet.items()},
         supported={k: shaped(v) for k, v in resolved.items()},
         upper={k: shaped(np.where(resolved[k], np.nan, bounds[k])) for k in TERMS},
-        notes=tuple((*datasheet_notes(components, record, c, method), *_unplaced_note(unplaced[c]),
+        notes=tuple((*datasheet_notes(components, record, c, method),
+                     *_ambiguity_notes(ambiguous[c], {k: v[c] for k, (v, _) in sheet.items()}),
+                     *_unplaced_note(unplaced[c]),
                      *_filter_notes(filters[c], spectrum, output_filter, method))
                     for c in range(channels)),
         lines=tuple(_lines(components, spectrum, c) for c in range(channels)),
@@ -609,7 +616,7 @@ def _fit_wls(t, v, e, fs, mask, gm_count, oscillators, select, found=None):
     terms = _typed.from_core(r.terms, np.asarray(r.cov))
     return _legacy_arrays(terms) + (
         (r.discrepancy, r.chi2, r.n_eff), _slot_covariance(r.terms, np.asarray(r.cov)),
-        (r.terms, np.asarray(r.cov)))
+        (r.terms, np.asarray(r.cov)), r.ambiguous)
 
 
 def _legacy_arrays(terms):
@@ -643,6 +650,24 @@ def _legacy_arrays(terms):
     supported = coef > 0
     return (coef, std, supported, markov, markov_std, sine, sine_std, osc, osc_std, moving,
             moving_std)
+
+
+def _ambiguity_notes(ties, fitted) -> tuple[str, ...]:
+    """What a reader of a datasheet value the data do not resolve needs to know: which
+    other kind of term fits the same part of the curve as well (``ties``: the core's
+    (kind, alternative kind, ΔBIC)), and the value the chosen structure gave it
+    (``fitted``: {term: value}), which the model does not report."""
+    out = []
+    for kind, alternative, delta in ties:
+        term = _typed.KINDS[kind]
+        other = _typed.KINDS[alternative]
+        value = float(fitted[term.name])
+        out.append(
+            f"{term.name} is not resolved: a {other.noun} in place of the {term.noun} "
+            f"fits the curve as well (BIC {delta:+.2g}, under the 2 that positive evidence "
+            f"asks), so the record cannot tell them apart; as a {term.noun} it would be "
+            f"{value:.3g}, and model.upper['{term.name}'] bounds it")
+    return tuple(out)
 
 
 def _unplaced(requested, terms) -> list[str]:

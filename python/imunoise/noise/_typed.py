@@ -42,6 +42,8 @@ class Term:
     """One term of a channel's noise model (the base of every kind)."""
 
     kind: ClassVar[str] = ""
+    #: The kind in words, as a sentence names it: ``"rate random walk"``.
+    noun: ClassVar[str] = ""
     #: The name ``fit(terms=[...])`` asks for this kind by.
     requested: ClassVar[str] = ""
 
@@ -104,6 +106,7 @@ class Quantization(_Ieee):
     """Quantization noise: Allan variance 3Q²/τ², ``Q`` in rate·s."""
 
     kind: ClassVar[str] = "quantization"
+    noun: ClassVar[str] = "quantization noise"
     name: ClassVar[str] = "Q"
     requested: ClassVar[str] = "Q"
     Q: float
@@ -115,6 +118,7 @@ class White(_Ieee):
     """White rate noise (angle or velocity random walk): N²/τ, ``N`` in rate·√s."""
 
     kind: ClassVar[str] = "white"
+    noun: ClassVar[str] = "white noise"
     name: ClassVar[str] = "N"
     requested: ClassVar[str] = "N"
     N: float
@@ -126,6 +130,7 @@ class Flicker(_Ieee):
     """Flicker rate noise (bias instability): (2 ln2/π)·B², ``B`` in rate."""
 
     kind: ClassVar[str] = "flicker"
+    noun: ClassVar[str] = "flicker (bias instability)"
     name: ClassVar[str] = "B"
     requested: ClassVar[str] = "B"
     B: float
@@ -137,6 +142,7 @@ class RandomWalk(_Ieee):
     """Rate random walk: K²τ/3, ``K`` in rate/√s."""
 
     kind: ClassVar[str] = "random_walk"
+    noun: ClassVar[str] = "rate random walk"
     name: ClassVar[str] = "K"
     requested: ClassVar[str] = "K"
     K: float
@@ -148,6 +154,7 @@ class Ramp(_Ieee):
     """Rate ramp: R²τ²/2, ``R`` in rate/s."""
 
     kind: ClassVar[str] = "ramp"
+    noun: ClassVar[str] = "rate ramp"
     name: ClassVar[str] = "R"
     requested: ClassVar[str] = "R"
     R: float
@@ -161,6 +168,7 @@ class GaussMarkov(Term):
     IEEE 952 Annex C (rising as +½ below τc, a hump near 1.89 τc, −½ beyond)."""
 
     kind: ClassVar[str] = "gauss_markov"
+    noun: ClassVar[str] = "Gauss–Markov bump"
     requested: ClassVar[str] = "GM"
     sigma: float
     tau_c: float
@@ -184,6 +192,7 @@ class Tone(Term):
     """A sinusoid A·sin(2πf₀t + ϕ): peak ``amplitude`` (rate) and ``freq`` f₀ (Hz)."""
 
     kind: ClassVar[str] = "tone"
+    noun: ClassVar[str] = "tone"
     requested: ClassVar[str] = "sine"
     amplitude: float
     freq: float
@@ -212,6 +221,7 @@ class Resonance(Term):
     plain resonance; a sensor's second-order low-pass filter has skew > 0)."""
 
     kind: ClassVar[str] = "resonance"
+    noun: ClassVar[str] = "resonance"
     requested: ClassVar[str] = "resonance"
     sigma: float
     freq: float
@@ -245,6 +255,7 @@ class Motion(Term):
     correlation time ``tau_c`` (s) and comes back; the platform's, not the sensor's."""
 
     kind: ClassVar[str] = "motion"
+    noun: ClassVar[str] = "bounded motion"
     requested: ClassVar[str] = "motion"
     sigma: float
     tau_c: float
