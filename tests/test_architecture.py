@@ -142,9 +142,9 @@ def test_no_use_cycle_between_rust_modules():
     assert not related, f"Rust modules that use each other: {sorted(set(related))}"
 
 
-#: Modules that may write a file other than through imunoise._atomic, and why.
+#: Modules that may write a file other than through imunoise._support.atomic, and why.
 _OWN_WRITES = {
-    "imunoise._atomic": "the helper itself",
+    "imunoise._support.atomic": "the helper itself",
     "imunoise.scale.convert": "appends to its staging files, themselves _atomic temporaries",
     "imunoise.readers.rosbag_reader": "bytes given as a bag go to a scratch TemporaryDirectory",
     "imunoise.recording.writer": "a recording is an append stream fsync-ed every second: it must "
@@ -179,7 +179,7 @@ def test_every_write_goes_through_the_atomic_helper(name):
         if isinstance(func, ast.Name) and func.id == "open" and len(node.args) > 1:
             mode = node.args[1]
             assert not (isinstance(mode, ast.Constant) and set(str(mode.value)) & set("wax+")), \
-                f"{name}:{node.lineno} opens a file for writing; use imunoise._atomic"
+                f"{name}:{node.lineno} opens a file for writing; use imunoise._support.atomic"
         if not isinstance(func, ast.Attribute) or func.attr not in _WRITERS:
             continue
         owner = func.value
@@ -191,4 +191,4 @@ def test_every_write_goes_through_the_atomic_helper(name):
                                                        and owner.id == "os"):
             continue  # str.replace, dataclasses.replace ...
         assert into_handle, (f"{name}:{node.lineno} writes with .{func.attr}() outside "
-                             "imunoise._atomic")
+                             "imunoise._support.atomic")
