@@ -90,6 +90,30 @@ def test_no_import_cycle_between_modules():
             visit(node)
 
 
+#: What the plumbing package may import at module level: itself and what lies below it
+#: (stream reads a log through readers.log; it calls scale, allan, stats inside functions).
+_SUPPORT_BELOW = ("imunoise._support", "imunoise._core", "imunoise.errors", "imunoise.display",
+                  "imunoise.readers")
+
+
+@pytest.mark.parametrize("name", sorted(n for n in MODULES if n.startswith("imunoise._support.")))
+def test_support_imports_nothing_above_it(name):
+    for module, names in _imports(MODULES[name], top_level_only=True):
+        for target in _resolve(module, names) if module.startswith("imunoise") else ():
+            assert target.startswith(_SUPPORT_BELOW), f"{name} imports {target}"
+
+
+def test_compute_modules_load_no_presentation():
+    """plot and report (matplotlib) load on use: no other module imports them at its top."""
+    presentation = ("imunoise.plot", "imunoise.report", "imunoise.cli")
+    for name, path in MODULES.items():
+        if name == "imunoise" or name.startswith(presentation):
+            continue
+        for module, names in _imports(path, top_level_only=True):
+            for target in _resolve(module, names):
+                assert not target.startswith(presentation[:2]), f"{name} imports {target}"
+
+
 RUST = Path(__file__).resolve().parents[1] / "rust"
 
 
