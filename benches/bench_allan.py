@@ -22,7 +22,7 @@ import time
 import allantools
 import imunoise
 import numpy as np
-from imunoise import _cpu
+from imunoise._support import cpu as _cpu
 
 
 def median_time(fn, repeats: int, *args, **kwargs) -> float:

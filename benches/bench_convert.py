@@ -26,7 +26,7 @@ import sys
 import textwrap
 from pathlib import Path
 
-from imunoise import _cpu
+from imunoise._support import cpu as _cpu
 
 PARSE = """
 import json, resource, sys, time

@@ -67,7 +67,7 @@ from dataclasses import dataclass, field
 
 import imunoise
 import numpy as np
-from imunoise import _cpu
+from imunoise._support import cpu as _cpu
 from imunoise.noise._typed import structure
 from scipy.signal import butter, freqz, lfilter
 

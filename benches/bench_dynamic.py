@@ -13,7 +13,7 @@ import time
 
 import imunoise
 import numpy as np
-from imunoise import _cpu
+from imunoise._support import cpu as _cpu
 
 
 def best_of(repeat: int, call):

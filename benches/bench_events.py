@@ -33,7 +33,7 @@ from pathlib import Path
 
 import imunoise
 import numpy as np
-from imunoise import _cpu
+from imunoise._support import cpu as _cpu
 from scipy import ndimage
 
 DATA = Path(__file__).resolve().parents[2] / "shared" / "data"
@@ -154,9 +154,9 @@ def false_warmups(logs: int = 10) -> None:
     and the same channels judged against an oracle null (the true coefficients)."""
     import importlib
 
-    from imunoise._simulate_log import noise_of_spec, still_log
+    from imunoise._simulation.log import noise_of_spec, still_log
 
-    wu = importlib.import_module("imunoise._warmup")
+    wu = importlib.import_module("imunoise._analysis.warmup")
     truth = noise_of_spec("vn100")
     print(f"3b. false warm-ups: {logs} simulated still VN-100 logs (5 h, 40 Hz, datasheet N, B, "
           "K; no transient), 6 channels each")

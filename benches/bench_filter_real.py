@@ -29,7 +29,7 @@ from pathlib import Path
 import imunoise
 import numpy as np
 from bench_fit_real import coverage, recordings
-from imunoise import _cpu
+from imunoise._support import cpu as _cpu
 from imunoise.noise._typed import structure
 
 HERE = Path(__file__).resolve().parent

@@ -34,7 +34,7 @@ import warnings
 import allan_variance
 import imunoise
 import numpy as np
-from imunoise import _cpu
+from imunoise._support import cpu as _cpu
 from imunoise.noise import FLICKER, GaussMarkov, Resonance, Tone, model_variance
 from imunoise.noise._typed import coefficient
 

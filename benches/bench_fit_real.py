@@ -35,7 +35,7 @@ import allan_variance
 import imunoise
 import imunoise.plot
 import numpy as np
-from imunoise import _cpu
+from imunoise._support import cpu as _cpu
 
 HERE = Path(__file__).resolve().parent
 DATA = HERE.parent.parent / "shared" / "data"

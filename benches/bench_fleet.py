@@ -21,8 +21,8 @@ import tempfile
 import time
 from pathlib import Path
 
-from imunoise import _cpu
-from imunoise._simulate_log import noise_of_spec, simulate_log
+from imunoise._simulation.log import noise_of_spec, simulate_log
+from imunoise._support import cpu as _cpu
 
 
 def write_logs(folder: Path, units: int, hours: float, fs: float) -> list[Path]:

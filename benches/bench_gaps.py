@@ -16,7 +16,7 @@ import os
 import imunoise
 import numpy as np
 from bench_allan import median_time
-from imunoise import _cpu
+from imunoise._support import cpu as _cpu
 
 
 def with_gaps(y: np.ndarray, gaps: int, share: float, rng) -> np.ndarray:

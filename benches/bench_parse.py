@@ -28,7 +28,7 @@ from pathlib import Path
 import imunoise
 import numpy as np
 import pandas as pd
-from imunoise import _cpu
+from imunoise._support import cpu as _cpu
 
 
 def median_time(fn, repeats: int) -> tuple[float, float]:

@@ -16,7 +16,7 @@ from pathlib import Path
 
 import imunoise
 import numpy as np
-from imunoise import _cpu
+from imunoise._support import cpu as _cpu
 
 HERE = Path(__file__).resolve().parent
 DATA = HERE.parent.parent / "shared" / "data"

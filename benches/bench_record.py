@@ -22,7 +22,7 @@ import sys
 import tempfile
 from pathlib import Path
 
-from imunoise import _cpu
+from imunoise._support import cpu as _cpu
 from imunoise.emulate import Emulator
 
 FIELDS = "common=TimeStartup+YawPitchRoll+Quaternion+AngularRate+Accel+MagPres+Imu"

@@ -20,7 +20,7 @@ import time
 from pathlib import Path
 
 import numpy as np
-from imunoise import _cpu
+from imunoise._support import cpu as _cpu
 
 
 def write_vnymr(path: Path, hours: float, fs: float, seed: int = 0) -> int:

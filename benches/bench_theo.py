@@ -39,8 +39,8 @@ import warnings
 import allantools
 import imunoise
 import numpy as np
-from imunoise import _cpu
 from imunoise._core import allan as _core_allan
+from imunoise._support import cpu as _cpu
 
 
 def quiet(fn, *args, **kwargs):

@@ -24,7 +24,7 @@ import warnings
 import allantools
 import imunoise
 import numpy as np
-from imunoise import _cpu
+from imunoise._support import cpu as _cpu
 
 #: (name, imunoise function, allantools function): both libraries use the same names.
 CASES = [

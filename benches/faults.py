@@ -45,7 +45,7 @@ from collections import Counter
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from imunoise import _cpu
+from imunoise._support import cpu as _cpu
 
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent

@@ -25,7 +25,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from imunoise import _cpu
+from imunoise._support import cpu as _cpu
 
 CLI = [sys.executable, "-m", "imunoise.cli"]
 #: Hours per piece when the log is longer than ``imunoise simulate`` makes at once
@@ -37,7 +37,7 @@ def write_long_log(path: Path, hours: float, fs: float) -> None:
     """A still VN-100 binary log of any length, simulated piece by piece (each piece
     its own noise realisation; TimeStartup runs on across the pieces)."""
     import numpy as np
-    from imunoise._simulate_log import still_log
+    from imunoise._simulation.log import still_log
     from imunoise.writers.vn import write_vn_binary
 
     done = 0

@@ -20,7 +20,7 @@ import textwrap
 import time
 from pathlib import Path
 
-from imunoise import _cpu
+from imunoise._support import cpu as _cpu
 
 FS = 800.0
 
@@ -37,7 +37,7 @@ print(json.dumps({{"wall_s": wall, "peak_rss": resource.getrusage(resource.RUSAG
 ANALYSE = """
 import json, resource, sys, time
 import imunoise
-from imunoise import _cpu
+from imunoise._support import cpu as _cpu
 from imunoise import scale
 t = time.perf_counter()
 log = scale.load(sys.argv[1])
@@ -54,7 +54,7 @@ print(json.dumps(out))
 
 def generate(path: Path, size: int) -> tuple[int, float]:
     import imunoise
-    from imunoise._simulate_log import still_log
+    from imunoise._simulation.log import still_log
 
     t = time.perf_counter()
     seed = 0

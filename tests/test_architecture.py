@@ -90,6 +90,30 @@ def test_no_import_cycle_between_modules():
             visit(node)
 
 
+#: What the plumbing package may import at module level: itself and what lies below it
+#: (stream reads a log through readers.log; it calls scale, allan, stats inside functions).
+_SUPPORT_BELOW = ("imunoise._support", "imunoise._core", "imunoise.errors", "imunoise.display",
+                  "imunoise.readers")
+
+
+@pytest.mark.parametrize("name", sorted(n for n in MODULES if n.startswith("imunoise._support.")))
+def test_support_imports_nothing_above_it(name):
+    for module, names in _imports(MODULES[name], top_level_only=True):
+        for target in _resolve(module, names) if module.startswith("imunoise") else ():
+            assert target.startswith(_SUPPORT_BELOW), f"{name} imports {target}"
+
+
+def test_compute_modules_load_no_presentation():
+    """plot and report (matplotlib) load on use: no other module imports them at its top."""
+    presentation = ("imunoise.plot", "imunoise.report", "imunoise.cli")
+    for name, path in MODULES.items():
+        if name == "imunoise" or name.startswith(presentation):
+            continue
+        for module, names in _imports(path, top_level_only=True):
+            for target in _resolve(module, names):
+                assert not target.startswith(presentation[:2]), f"{name} imports {target}"
+
+
 RUST = Path(__file__).resolve().parents[1] / "rust"
 
 
@@ -142,9 +166,9 @@ def test_no_use_cycle_between_rust_modules():
     assert not related, f"Rust modules that use each other: {sorted(set(related))}"
 
 
-#: Modules that may write a file other than through imunoise._atomic, and why.
+#: Modules that may write a file other than through imunoise._support.atomic, and why.
 _OWN_WRITES = {
-    "imunoise._atomic": "the helper itself",
+    "imunoise._support.atomic": "the helper itself",
     "imunoise.scale.convert": "appends to its staging files, themselves _atomic temporaries",
     "imunoise.readers.rosbag_reader": "bytes given as a bag go to a scratch TemporaryDirectory",
     "imunoise.recording.writer": "a recording is an append stream fsync-ed every second: it must "
@@ -179,7 +203,7 @@ def test_every_write_goes_through_the_atomic_helper(name):
         if isinstance(func, ast.Name) and func.id == "open" and len(node.args) > 1:
             mode = node.args[1]
             assert not (isinstance(mode, ast.Constant) and set(str(mode.value)) & set("wax+")), \
-                f"{name}:{node.lineno} opens a file for writing; use imunoise._atomic"
+                f"{name}:{node.lineno} opens a file for writing; use imunoise._support.atomic"
         if not isinstance(func, ast.Attribute) or func.attr not in _WRITERS:
             continue
         owner = func.value
@@ -191,4 +215,4 @@ def test_every_write_goes_through_the_atomic_helper(name):
                                                        and owner.id == "os"):
             continue  # str.replace, dataclasses.replace ...
         assert into_handle, (f"{name}:{node.lineno} writes with .{func.attr}() outside "
-                             "imunoise._atomic")
+                             "imunoise._support.atomic")

@@ -8,13 +8,13 @@ import subprocess
 import sys
 
 import pytest
-from imunoise import _cpu
 from imunoise._core import simd
+from imunoise._support import cpu as _cpu
 
 
 def _level_in_child(value: str) -> subprocess.CompletedProcess:
     env = {**os.environ, _cpu.ENVIRONMENT: value}
-    code = "import imunoise._cpu as c; print(c.level())"
+    code = "import imunoise._support.cpu as c; print(c.level())"
     return subprocess.run([sys.executable, "-c", f"import imunoise; {code}"],
                           env=env, capture_output=True, text=True, timeout=120)
 

@@ -14,7 +14,7 @@ from pathlib import Path
 import imunoise
 import numpy as np
 import pytest
-from imunoise import _cpu
+from imunoise._support import cpu as _cpu
 
 pytestmark = pytest.mark.filterwarnings("ignore::UserWarning")
 

@@ -6,8 +6,9 @@ import math
 import imunoise
 import numpy as np
 import pytest
-from imunoise import _schema, noise, units
+from imunoise import noise, units
 from imunoise._core import fit as core_fit
+from imunoise._support import schema as _schema
 from imunoise.readers import log as readers_log
 
 

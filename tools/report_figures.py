@@ -38,7 +38,7 @@ def build_reports(work: Path) -> dict[str, Path]:
     sys.path.insert(0, str(ROOT / "python"))
     import imunoise
     from imunoise import report
-    from imunoise._simulate_log import still_log
+    from imunoise._simulation.log import still_log
     from imunoise.cli import bundled_log
 
     out = {}

@@ -5,23 +5,26 @@ fitting, log readers for VectorNav VN-100 (ASCII and binary), CSV and ROS bags,
 plots and reports. Start with ``imunoise.adev(x, fs)``.
 """
 
-# _interrupt is imported first, before the heavy imports: importing it arms Ctrl-C
-# for the command line's start-up (exit 130 and one line, not a traceback from
+# _support.interrupt is imported first, before the heavy imports: importing it arms
+# Ctrl-C for the command line's start-up (exit 130 and one line, not a traceback from
 # inside numpy); in any other process it does nothing.
-from imunoise import _interrupt, export, units  # noqa: F401
-from imunoise._align import Aligned, align
-from imunoise._allan_stream import AllanStream
+from imunoise._support import interrupt as _interrupt  # noqa: F401
+
+# isort: split
+from imunoise import export, units
+from imunoise._analysis.align import Aligned, align
+from imunoise._analysis.allan_stream import AllanStream
+from imunoise._analysis.events import Events, events
+from imunoise._analysis.fleet import Fleet, fleet
+from imunoise._analysis.hat import ThreeCorneredHat, gcodev, three_cornered_hat
+from imunoise._analysis.mount import OwnNoise, own_noise
+from imunoise._analysis.thermal import Thermal, thermal
+from imunoise._analysis.timefreq import mtie, pdev, tierms
+from imunoise._analysis.warmup import Warmup, warmup
 from imunoise._core import __version__
-from imunoise._cpu import apply_environment as _apply_simd_environment
-from imunoise._events import Events, events
-from imunoise._fleet import Fleet, fleet
-from imunoise._hat import ThreeCorneredHat, gcodev, three_cornered_hat
-from imunoise._mount import OwnNoise, own_noise
-from imunoise._simulate import simulate
-from imunoise._simulate_log import simulate_log
-from imunoise._thermal import Thermal, thermal
-from imunoise._timefreq import mtie, pdev, tierms
-from imunoise._warmup import Warmup, warmup
+from imunoise._simulation.log import simulate_log
+from imunoise._simulation.simulate import simulate
+from imunoise._support.cpu import apply_environment as _apply_simd_environment
 from imunoise.allan import (
     AllanResult,
     adev,

@@ -99,10 +99,12 @@ import numpy as np
 import numpy.typing as npt
 from scipy import stats as _stats
 
-from imunoise import _schema, _summary, _warn
 from imunoise._core import allan as _core_allan
-from imunoise._runs import true_runs
-from imunoise._validate import (
+from imunoise._support import schema as _schema
+from imunoise._support import summary as _summary
+from imunoise._support import warn as _warn
+from imunoise._support.runs import true_runs
+from imunoise._support.validate import (
     confidence_level,
     integer,
     no_infinity,

@@ -15,8 +15,9 @@ from pathlib import Path
 
 import numpy as np
 
-from imunoise import _atomic, _interrupt
-from imunoise._schema import (
+from imunoise._support import atomic as _atomic
+from imunoise._support import interrupt as _interrupt
+from imunoise._support.schema import (
     ALLAN_SENSORS,
     CHANNELS,
     SAMPLE_SENSORS,
@@ -464,7 +465,7 @@ def _stream_workdir():
     import shutil
     import tempfile
 
-    from imunoise._stream import fresh_workdir
+    from imunoise._support.stream import fresh_workdir
 
     path = fresh_workdir(tempfile.gettempdir(), "imunoise-stream-")
     atexit.register(shutil.rmtree, path, ignore_errors=True)
@@ -608,7 +609,8 @@ def _plan_line(model, log, sensor: str) -> str:
 
 
 def _cmd_stats(args) -> int:
-    from imunoise import _stream, display, stats
+    from imunoise import display, stats
+    from imunoise._support import stream as _stream
 
     log = _read(args)
     desc = _stream.describe(log) if _stream.is_mapped(log.gyro) else stats.describe(log)
@@ -767,7 +769,7 @@ def _cmd_convert(args) -> int:
 
 def _convert_streaming(args, out: Path) -> int:
     from imunoise import scale
-    from imunoise._progress import byte_bar, wanted
+    from imunoise._support.progress import byte_bar, wanted
 
     source = sys.stdin.buffer if args.log == "-" else args.log
     bar = byte_bar(f"converting {Path(args.log).name}") if wanted(args.progress) else None
@@ -815,7 +817,7 @@ def _cmd_batch(args) -> int:
 
 
 def _cmd_fleet(args) -> int:
-    from imunoise._fleet import fleet
+    from imunoise._analysis.fleet import fleet
 
     if args.serial and args.scheduler:
         _fail("--serial and --scheduler exclude each other")
@@ -841,7 +843,7 @@ def _cmd_fleet(args) -> int:
 
 
 def _cmd_simulate(args) -> int:
-    from imunoise._simulate_log import simulate_log
+    from imunoise._simulation.log import simulate_log
 
     out = simulate_log(args.output, args.hours, args.fs, format=args.format, seed=args.seed)
     print(f"wrote {args.hours:g} h at {args.fs:g} Hz ({args.format}) to {out}")
@@ -857,7 +859,7 @@ def bundled_log() -> Path:
 
 def _cmd_demo(args) -> int:
     from imunoise import report
-    from imunoise._simulate_log import still_log
+    from imunoise._simulation.log import still_log
 
     short = bundled_log()
     long = still_log(args.hours, 40.0, spec="vn100", seed=args.seed)
@@ -870,7 +872,7 @@ def _cmd_demo(args) -> int:
 
 
 def _cmd_events(args) -> int:
-    from imunoise._events import events
+    from imunoise._analysis.events import events
 
     log = _read(args)
     found = events(log, false_alarm=args.false_alarm)
@@ -884,8 +886,8 @@ def _cmd_events(args) -> int:
 
 
 def _cmd_thermal(args) -> int:
-    from imunoise._thermal import thermal
-    from imunoise._warmup import warmup
+    from imunoise._analysis.thermal import thermal
+    from imunoise._analysis.warmup import warmup
     from imunoise.display import format_value
 
     log = _read(args)

@@ -26,10 +26,10 @@ from pathlib import Path
 
 import numpy as np
 
-from imunoise import _summary
 from imunoise import display as _display
 from imunoise import units as _units
-from imunoise._schema import axis_names
+from imunoise._support import summary as _summary
+from imunoise._support.schema import axis_names
 from imunoise.errors import ImunoiseTypeError, ImunoiseValueError
 
 if sys.version_info >= (3, 11):

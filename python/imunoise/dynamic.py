@@ -64,11 +64,14 @@ import numpy as np
 import numpy.typing as npt
 from scipy import stats as _stats
 
-from imunoise import _schema, _stream, _summary, _warn
 from imunoise import display as _display
 from imunoise._core import allan as _core_allan
-from imunoise._runs import true_runs
-from imunoise._validate import no_infinity, positive_finite, sample_rate, samples
+from imunoise._support import schema as _schema
+from imunoise._support import stream as _stream
+from imunoise._support import summary as _summary
+from imunoise._support import warn as _warn
+from imunoise._support.runs import true_runs
+from imunoise._support.validate import no_infinity, positive_finite, sample_rate, samples
 from imunoise.allan import ONE_SIGMA, AllanResult, adev, adev_by_column, chi2_interval
 from imunoise.errors import CoverageWarning, ImunoiseTypeError, ImunoiseValueError
 from imunoise.taus import averaging_factors
@@ -161,7 +164,7 @@ class Stationarity:
         ], sep=", ")
 
     def _repr_html_(self) -> str:
-        """The departures (the first :data:`~imunoise._summary.HTML_ROWS`), ratio
+        """The departures (the first :data:`~imunoise._support.summary.HTML_ROWS`), ratio
         rounded to its uncertainty as in the repr."""
         rows = [[_summary.number(d.start), _summary.number(d.end), d.channel,
                  _display.rounded(d.ratio, d.ratio_std)]

@@ -27,7 +27,7 @@ doubt) or ``"rms"`` (√ of the mean square over axes). Kalibr's documentation
 also suggests inflating the values of a still-bench characterisation for a
 moving platform; do that with ``inflate`` (default 1: the measured values).
 
-All files are written atomically (:mod:`imunoise._atomic`): a unique temporary
+All files are written atomically (:mod:`imunoise._support.atomic`): a unique temporary
 beside the target is written, fsync-ed and renamed onto it.
 
 References
@@ -44,8 +44,9 @@ from pathlib import Path
 
 import numpy as np
 
-from imunoise import _atomic, _warn
 from imunoise import units as _units
+from imunoise._support import atomic as _atomic
+from imunoise._support import warn as _warn
 from imunoise.errors import CoverageWarning, ImunoiseDeprecationWarning, ImunoiseValueError
 from imunoise.noise import _typed, gm_white_density, resonance_white_density
 

@@ -28,7 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from imunoise._core import allan as _core_allan
-from imunoise._validate import sample_rate
+from imunoise._support.validate import sample_rate
 from imunoise.errors import ImunoiseValueError
 from imunoise.noise._terms import FLICKER, model_variance
 
@@ -135,7 +135,7 @@ class Plan:
 
     def _repr_html_(self) -> str:
         """Per term: its value, the τ it is read at and the record it needs."""
-        from imunoise import _summary
+        from imunoise._support import summary as _summary
 
         rows = [(k, _summary.number(t.value), _summary.number(t.tau), _length(t.seconds))
                 for k, t in self.terms.items()]
@@ -207,7 +207,7 @@ def _coefficients(source, sensor: str) -> tuple[dict[str, float], str, tuple[str
             values = values[np.isfinite(values)]
             out[k] = float(np.median(values)) if values.size else 0.0
         return out, "", ()
-    from imunoise._simulate_log import noise_of_spec
+    from imunoise._simulation.log import noise_of_spec
     from imunoise.datasheet import load_spec
 
     noise = noise_of_spec(source)

@@ -26,8 +26,9 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from imunoise import _atomic, _summary
-from imunoise._schema import ATTITUDE_NAMES, CHANNELS, axis_names
+from imunoise._support import atomic as _atomic
+from imunoise._support import summary as _summary
+from imunoise._support.schema import ATTITUDE_NAMES, CHANNELS, axis_names
 from imunoise.allan import AllanResult
 from imunoise.display import cell, format_value, percent, rounded
 from imunoise.errors import ImunoiseTypeError, ImunoiseValueError
@@ -39,7 +40,7 @@ from imunoise.stats import Distribution
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
-    from imunoise._mount import OwnNoise
+    from imunoise._analysis.mount import OwnNoise
     from imunoise.dynamic import DynamicAllan
     from imunoise.spectrum import Spectrum
 

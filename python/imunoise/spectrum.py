@@ -68,9 +68,11 @@ from scipy import optimize as _optimize
 from scipy import signal as _signal
 from scipy import stats as _stats
 
-from imunoise import _schema, _stream, _summary
-from imunoise._runs import true_runs
-from imunoise._validate import (
+from imunoise._support import schema as _schema
+from imunoise._support import stream as _stream
+from imunoise._support import summary as _summary
+from imunoise._support.runs import true_runs
+from imunoise._support.validate import (
     confidence_level,
     integer,
     no_infinity,

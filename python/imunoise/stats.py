@@ -58,9 +58,10 @@ import numpy as np
 from scipy import special as _special
 from scipy import stats as _sstats
 
-from imunoise import _schema, _summary
-from imunoise._deprecation import old_call_forms
-from imunoise._validate import sample_rate
+from imunoise._support import schema as _schema
+from imunoise._support import summary as _summary
+from imunoise._support.deprecation import old_call_forms
+from imunoise._support.validate import sample_rate
 from imunoise.errors import ImunoiseTypeError, ImunoiseValueError
 from imunoise.readers.log import ImuLog
 

@@ -6,7 +6,7 @@ import numbers
 
 import numpy as np
 
-from imunoise import _warn
+from imunoise._support import warn as _warn
 from imunoise.errors import CoverageWarning, ImunoiseTypeError, ImunoiseValueError
 
 #: Named grids. Their largest m follows allantools: every m below the number of

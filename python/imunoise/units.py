@@ -30,7 +30,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from imunoise import _schema
+from imunoise._support import schema as _schema
 from imunoise.errors import ImunoiseTypeError, ImunoiseValueError
 
 __all__ = [

@@ -7,7 +7,7 @@ from importlib import resources
 import imunoise
 import numpy as np
 import pytest
-from imunoise._events import FALSE_ALARM, Events
+from imunoise._analysis.events import FALSE_ALARM, Events
 
 FS = 100.0
 LOG = resources.files("imunoise") / "data" / "vn100_stationary_5min.txt"
@@ -164,7 +164,7 @@ def test_valid_pairs_count_every_pair_of_valid_samples(runs, monkeypatch):
     """The pairs of valid samples k apart behind the energy law's autocorrelation,
     counted from the runs of missing samples (or by FFT beyond PAIR_RUNS runs), are
     the brute-force counts."""
-    from imunoise import _events
+    from imunoise._analysis import events as _events
 
     rng = np.random.default_rng(runs)
     n, lags = 3000, 250

@@ -1,11 +1,12 @@
-"""The event search read a block at a time (imunoise._blocks): the same events and the
+"""The event search read a block at a time (imunoise._support.blocks): the same events and the
 same numbers, bit for bit, whatever the block size, for events that straddle a block's
 edge, and the block-wise reductions equal their whole-array definitions."""
 
 import imunoise
 import numpy as np
 import pytest
-from imunoise import _blocks, _events
+from imunoise._analysis import events as _events
+from imunoise._support import blocks as _blocks
 
 FS = 100.0
 EDGE = 3 * 997  # a block edge when blocks are 997 rows

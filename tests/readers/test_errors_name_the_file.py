@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 from helpers.data import DATA
 from imunoise import scale
-from imunoise._atomic import fingerprint
+from imunoise._support.atomic import fingerprint
 from imunoise.cli import main
 from imunoise.errors import ParseError
 

@@ -6,7 +6,7 @@ import imunoise
 import numpy as np
 import pytest
 from imunoise._core import vn as _core_vn
-from imunoise._simulate_log import still_log
+from imunoise._simulation.log import still_log
 from imunoise.errors import ParseError
 
 

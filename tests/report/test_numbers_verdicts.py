@@ -2,7 +2,7 @@
 import math
 
 import pytest
-from imunoise import _summary
+from imunoise._support import summary as _summary
 from imunoise.datasheet import COVERAGE_K, verdict
 from imunoise.display import cell, duration, format_value, rounded
 from imunoise.report.formatting import format_duration

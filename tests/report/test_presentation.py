@@ -19,7 +19,7 @@ from importlib import resources
 import numpy as np
 import pytest
 from imunoise import plot, report
-from imunoise._simulate_log import still_log
+from imunoise._simulation.log import still_log
 from imunoise.plot import _renderer, _tick_labels_overlap
 from imunoise.readers.read import read
 from matplotlib.patches import StepPatch

@@ -3,7 +3,7 @@
 import sys
 import warnings
 
-from imunoise._progress import Progress, byte_bar, wanted
+from imunoise._support.progress import Progress, byte_bar, wanted
 
 
 def test_step_bar_only_when_asked(capsys):

@@ -11,8 +11,9 @@ import sys
 import imunoise
 import numpy as np
 import pytest
-from imunoise import _stream, report, stats
-from imunoise._simulate_log import simulate_log
+from imunoise import report, stats
+from imunoise._simulation.log import simulate_log
+from imunoise._support import stream as _stream
 from imunoise.cli import main
 
 FS = 40.0

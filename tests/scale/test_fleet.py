@@ -11,9 +11,9 @@ import warnings
 import imunoise
 import numpy as np
 import pytest
-from imunoise import _fleet as fleet_module
-from imunoise._fleet import MIN_UNITS, Z_CUT, cut, robust_z
-from imunoise._simulate_log import noise_of_spec
+from imunoise._analysis import fleet as fleet_module
+from imunoise._analysis.fleet import MIN_UNITS, Z_CUT, cut, robust_z
+from imunoise._simulation.log import noise_of_spec
 from imunoise.cli import main
 from imunoise.scale.batch import _base_row
 
@@ -267,12 +267,12 @@ def test_dask_gives_the_serial_numbers(units, result):
 
 
 def test_computing_a_fleet_loads_no_plotting():
-    code = ("import sys, imunoise._fleet; "
+    code = ("import sys, imunoise._analysis.fleet; "
             "sys.exit(any(m in sys.modules for m in ('matplotlib', 'imunoise.plot', "
             "'imunoise.report')))")
     assert subprocess.run([sys.executable, "-c", code]).returncode == 0
 
 
 def test_public_name():
-    assert "fleet" in imunoise.__all__ and imunoise.fleet.__module__ == "imunoise._fleet"
+    assert "fleet" in imunoise.__all__ and imunoise.fleet.__module__ == "imunoise._analysis.fleet"
     assert re.search(r"Parameters\n\s+-+", imunoise.fleet.__doc__)

@@ -11,7 +11,7 @@ import imunoise
 import numpy as np
 import pytest
 from imunoise import scale
-from imunoise._simulate_log import still_log
+from imunoise._simulation.log import still_log
 from imunoise.cli import main
 from imunoise.scale.convert import _Steps
 

@@ -53,7 +53,7 @@ def test_shapes_and_seed():
 
 def test_long_flicker_is_chunked_consistently():
     """Blocks of the overlap-save flicker join without a seam (small block size)."""
-    from imunoise._simulate import flicker
+    from imunoise._simulation.simulate import flicker
 
     rng = np.random.default_rng(0)
     y = flicker(1 << 14, 1.0, rng, taps=1 << 10)

@@ -3,7 +3,7 @@
 import imunoise
 import numpy as np
 import pytest
-from imunoise._simulate_log import flicker_for_floor, noise_of_spec, simulate_log, still_log
+from imunoise._simulation.log import flicker_for_floor, noise_of_spec, simulate_log, still_log
 from imunoise.noise import FLICKER, model_variance
 
 

@@ -110,7 +110,7 @@ def test_still_vn100_noise_with_rate_random_walk_has_no_transient(seed):
     """Rate random walk and flicker wander fit exponentials well by chance: the
     bootstrap null of the sensor's own noise must not call that a warm-up (an F-test
     gave p < 1e-10 on these logs and a settle point past their end)."""
-    from imunoise._simulate_log import still_log
+    from imunoise._simulation.log import still_log
 
     log = still_log(5.0, 40.0, seed=seed)
     found = imunoise.warmup(log)
@@ -127,7 +127,7 @@ def test_a_quiet_second_half_does_not_make_the_null_too_quiet(seed):
     of the too-quiet null and below what one of six uniform p-values reaches by
     chance on a few per cent of logs (seed 1019's Z gyro: 0.0045 since the rate
     ramp needs BIC evidence in the half log's model)."""
-    from imunoise._simulate_log import still_log
+    from imunoise._simulation.log import still_log
 
     found = imunoise.warmup(still_log(5.0, 40.0, seed=seed))
     assert not found.significant.any()

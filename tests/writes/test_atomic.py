@@ -6,7 +6,7 @@ import sys
 
 import numpy as np
 import pytest
-from imunoise import _atomic
+from imunoise._support import atomic as _atomic
 from imunoise.cli import main
 
 

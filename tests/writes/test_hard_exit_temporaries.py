@@ -16,7 +16,7 @@ def _run(code: str) -> subprocess.CompletedProcess:
 def test_a_hard_exit_while_writing_leaves_no_temporary(tmp_path):
     target = tmp_path / "out.bin"
     done = _run(f"""
-import imunoise._atomic as atomic, imunoise._interrupt as interrupt
+import imunoise._support.atomic as atomic, imunoise._support.interrupt as interrupt
 with atomic.staged({str(target)!r}) as (fh, tmp):
     fh.write(b"partial")
     interrupt._end(2)  # what the watchdog does at its deadline
@@ -29,7 +29,7 @@ def test_a_hard_exit_while_publishing_leaves_neither_temporary(tmp_path):
     target = tmp_path / "out.npy"
     meta = tmp_path / "out.npy.meta.json"
     done = _run(f"""
-import imunoise._atomic as atomic, imunoise._interrupt as interrupt
+import imunoise._support.atomic as atomic, imunoise._support.interrupt as interrupt
 with atomic.staged({str(target)!r}) as (fh, tmp):
     fh.write(b"data")
 

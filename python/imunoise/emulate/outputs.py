@@ -1,6 +1,6 @@
 """What an emulated still VN-100 sends: simulated samples encoded as its outputs.
 
-The IMU samples are those of :func:`imunoise._simulate_log.still_log` (the
+The IMU samples are those of :func:`imunoise._simulation.log.still_log` (the
 datasheet's noise on gyro and accelerometer, gravity on −Z) at the IMU rate,
 generated in blocks of :data:`BLOCK` samples with seeds of their own (the flicker
 term therefore restarts every block: fine for a stream, not for an Allan analysis
@@ -29,8 +29,8 @@ from __future__ import annotations
 import numpy as np
 from scipy.signal import lfilter
 
-from imunoise._simulate import simulate
-from imunoise._simulate_log import STILL_MAG, STILL_YPR, still_log
+from imunoise._simulation.log import STILL_MAG, STILL_YPR, still_log
+from imunoise._simulation.simulate import simulate
 from imunoise.emulate.registers import ADOR_MESSAGES, IMU_RATE, Registers
 from imunoise.writers.vn import write_vn_ascii, write_vn_binary
 

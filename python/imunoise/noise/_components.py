@@ -14,7 +14,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from imunoise import _schema, _summary
+from imunoise._support import schema as _schema
+from imunoise._support import summary as _summary
 from imunoise.errors import ImunoiseValueError
 from imunoise.noise._terms import GM_MAX, TERMS, TONES_MAX, term_variances
 

@@ -13,9 +13,10 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
-from imunoise import _warn, display
+from imunoise import display
 from imunoise._core import fit as _core_fit
-from imunoise._deprecation import old_call_forms
+from imunoise._support import warn as _warn
+from imunoise._support.deprecation import old_call_forms
 from imunoise.errors import CoverageWarning, ImunoiseTypeError, ImunoiseValueError
 from imunoise.noise import _typed
 from imunoise.noise._components import Components
@@ -436,7 +437,7 @@ def _from_log(result, spectrum, sensor):
 
     if not isinstance(result, ImuLog):
         return result, spectrum
-    from imunoise import _schema
+    from imunoise._support import schema as _schema
     from imunoise.allan import adev
     from imunoise.spectrum import psd
 
@@ -563,7 +564,7 @@ def _bootstrap_std(result, n, coef, markov, oscillators, replicates, rng, option
     resonance σ, f_r, τr, skew, motion σθ, τc, and the datasheet values Q…R) over fits to
     records simulated from the model with the rate and taus of ``result`` and its
     length ``n``; ``oscillators`` is (tones, resonances, motions)."""
-    from imunoise._simulate import simulate
+    from imunoise._simulation.simulate import simulate
     from imunoise.allan import adev
 
     tones, oscs, motions = oscillators

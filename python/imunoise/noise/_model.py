@@ -9,11 +9,13 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from imunoise import _schema, _summary, _warn
 from imunoise import display as _display
 from imunoise import units as _units
 from imunoise._core import fit as _core_fit
-from imunoise._deprecation import old_call_forms
+from imunoise._support import schema as _schema
+from imunoise._support import summary as _summary
+from imunoise._support import warn as _warn
+from imunoise._support.deprecation import old_call_forms
 from imunoise.errors import ImunoiseDeprecationWarning, ImunoiseValueError
 from imunoise.noise._components import (
     Components,
@@ -458,7 +460,8 @@ class NoiseModel(PerTerm):
         See :func:`imunoise.export.kalibr_yaml` for the options; with ``path``
         the file is also written atomically.
         """
-        from imunoise import _atomic, export
+        from imunoise import export
+        from imunoise._support import atomic as _atomic
 
         text = export.kalibr_yaml(gyro=self, accel=accel, **kwargs)
         if path is not None:

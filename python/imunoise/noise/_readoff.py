@@ -8,7 +8,7 @@ import math
 
 import numpy as np
 
-from imunoise import _warn
+from imunoise._support import warn as _warn
 from imunoise.errors import CoverageWarning
 from imunoise.noise._terms import CLOSE, FLAT_SLOPE, FLICKER, READ_TAU, SLOPE, TERMS
 

@@ -20,8 +20,8 @@ from typing import ClassVar
 
 import numpy as np
 
-from imunoise import _summary
 from imunoise._core import fit as _core_fit
+from imunoise._support import summary as _summary
 
 
 def _sigma(variance: float, u_variance: float) -> tuple[float, float]:

@@ -23,7 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
-from imunoise._schema import CHANNELS, column_names
+from imunoise._support.schema import CHANNELS, column_names
 from imunoise.errors import ImunoiseTypeError, ImunoiseValueError, ParseError
 from imunoise.readers import metafile
 from imunoise.readers.grid import Gaps

@@ -21,8 +21,8 @@ from pathlib import Path
 
 import numpy as np
 
-from imunoise import _warn
-from imunoise._schema import CHANNELS, COLUMN_SUFFIXES, G
+from imunoise._support import warn as _warn
+from imunoise._support.schema import CHANNELS, COLUMN_SUFFIXES, G
 from imunoise.errors import (
     AssumptionWarning,
     DataWarning,

@@ -52,8 +52,8 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from imunoise import _summary
-from imunoise._runs import true_runs
+from imunoise._support import summary as _summary
+from imunoise._support.runs import true_runs
 from imunoise.errors import ImunoiseValueError
 
 __all__ = ["MAX_GRID_RATIO", "Gaps", "TimeGrid", "outlier_stamps"]

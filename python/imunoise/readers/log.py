@@ -9,9 +9,11 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from imunoise import _schema, _summary, _warn
 from imunoise._core import vn as _core_vn
-from imunoise._validate import sample_rate
+from imunoise._support import schema as _schema
+from imunoise._support import summary as _summary
+from imunoise._support import warn as _warn
+from imunoise._support.validate import sample_rate
 from imunoise.errors import (
     AssumptionWarning,
     DataWarning,

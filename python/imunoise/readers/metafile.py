@@ -19,7 +19,7 @@ the field (:func:`bad_field`).
 
 Tied to the data: what ``convert`` writes beside a file carries the file's
 fingerprint (``"data"``: bytes, modification time, SHA-256; see
-:func:`imunoise._atomic.publish_pair`); :func:`check_tie` refuses metadata whose
+:func:`imunoise._support.atomic.publish_pair`); :func:`check_tie` refuses metadata whose
 fingerprint is not that of the file beside it.
 """
 
@@ -31,7 +31,7 @@ import os
 import stat
 from pathlib import Path
 
-from imunoise import _atomic
+from imunoise._support import atomic as _atomic
 from imunoise.errors import ImunoiseValueError, ParseError
 
 __all__ = ["MAX_BYTES", "MAX_COUNT", "MAX_DEPTH", "MAX_FS", "SUFFIX", "bad_field", "check_tie",

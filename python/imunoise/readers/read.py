@@ -9,8 +9,8 @@ import stat
 import warnings
 from collections.abc import Callable, Mapping, Sequence
 
-from imunoise import _warn
-from imunoise._deprecation import old_call_forms
+from imunoise._support import warn as _warn
+from imunoise._support.deprecation import old_call_forms
 from imunoise.errors import ImunoiseTypeError, ImunoiseValueError, ParseError
 from imunoise.readers import registry
 from imunoise.readers.log import ImuLog

@@ -27,7 +27,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from imunoise import _warn
+from imunoise._support import warn as _warn
 from imunoise.errors import DataWarning, ImunoiseValueError, ParseError
 from imunoise.readers import metafile
 

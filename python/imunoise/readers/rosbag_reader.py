@@ -39,7 +39,7 @@ from pathlib import Path
 
 import numpy as np
 
-from imunoise import _warn
+from imunoise._support import warn as _warn
 from imunoise.errors import AssumptionWarning, ImunoiseTypeError, ImunoiseValueError, ParseError
 from imunoise.readers._sentences import IssueTally, sentence_rows
 from imunoise.readers.log import ImuLog, log_on_grid

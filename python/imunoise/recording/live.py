@@ -28,9 +28,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from imunoise._allan_stream import AllanStream
+from imunoise._analysis.allan_stream import AllanStream
 from imunoise._core import vn as _core_vn
-from imunoise._simulate_log import DEFAULT_K
+from imunoise._simulation.log import DEFAULT_K
 from imunoise.allan import AllanResult
 from imunoise.display import duration
 from imunoise.noise._terms import FLICKER

@@ -33,7 +33,7 @@ import time
 import warnings
 from dataclasses import dataclass, field
 
-from imunoise import _atomic
+from imunoise._support import atomic as _atomic
 from imunoise.errors import DataWarning, ImunoiseValueError
 from imunoise.readers.recording import GAPS, META, TIMES, Outage
 from imunoise.recording import config
@@ -84,7 +84,7 @@ class Recording:
     notes: tuple[str, ...] = ()
 
     def __repr__(self) -> str:
-        from imunoise import _summary
+        from imunoise._support import summary as _summary
 
         return (f"Recording({self.path}: {self.bytes:,} bytes in "
                 f"{_summary.duration(self.seconds)}, {len(self.outages)} port outages, "
@@ -92,7 +92,7 @@ class Recording:
 
     def _repr_html_(self) -> str:
         """The log, its size and length, the outages and whether the settings came back."""
-        from imunoise import _summary
+        from imunoise._support import summary as _summary
 
         rows = [("log", self.path), ("bytes", f"{self.bytes:,}"),
                 ("wall time", _summary.duration(self.seconds)),

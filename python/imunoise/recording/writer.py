@@ -1,7 +1,7 @@
 """The lossless writer: the raw log and its side files, as append streams.
 
 Why not the atomic write every other imunoise file goes through
-(:mod:`imunoise._atomic`: a temporary renamed onto the target when complete)?
+(:mod:`imunoise._support.atomic`: a temporary renamed onto the target when complete)?
 A recording is hours long and must survive ``kill -9``, a crash or a power cut
 with at most the last second lost: a temporary that is renamed only at the end
 would lose all of it. So the raw bytes are appended to the log as they arrive
@@ -10,7 +10,7 @@ would lose all of it. So the raw bytes are appended to the log as they arrive
 outages) are appended and synced with it. A killed process loses nothing the
 kernel already has; a power cut at most the last second. The reader handles a
 record cut at the end. The metadata, rewritten whole, goes through
-:mod:`imunoise._atomic`.
+:mod:`imunoise._support.atomic`.
 """
 
 from __future__ import annotations
@@ -20,7 +20,7 @@ import json
 import os
 import time
 
-from imunoise import _atomic
+from imunoise._support import atomic as _atomic
 from imunoise.readers.recording import GAPS, META, TIMES
 
 __all__ = ["SYNC_EVERY", "RawWriter"]

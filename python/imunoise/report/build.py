@@ -15,11 +15,15 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from imunoise import _atomic, _interrupt, _stream, _summary, export, stats
-from imunoise._align import CLOCKS, align
+from imunoise import export, stats
+from imunoise._analysis.align import CLOCKS, align
 from imunoise._core import __version__
-from imunoise._progress import Progress, wanted
-from imunoise._schema import ALLAN_SENSORS
+from imunoise._support import atomic as _atomic
+from imunoise._support import interrupt as _interrupt
+from imunoise._support import stream as _stream
+from imunoise._support import summary as _summary
+from imunoise._support.progress import Progress, wanted
+from imunoise._support.schema import ALLAN_SENSORS
 from imunoise.datasheet import load_spec
 from imunoise.errors import ImunoiseValueError
 from imunoise.readers.log import DEFAULT_FS, ImuLog
@@ -191,11 +195,11 @@ def build(
         other terms in the family of its B), without ``spec``
         :data:`imunoise.units.DATASHEET_UNITS`.
     stream : bool or None
-        Bounded memory for logs larger than memory (:mod:`imunoise._stream`): each
+        Bounded memory for logs larger than memory (:mod:`imunoise._support.stream`): each
         log file is parsed once into memory maps (a temporary folder beside
         ``out_dir``, removed at the end) and every analysis reads them a block or a
         channel at a time. None (default): for VN logs larger than
-        ``imunoise._stream.STREAM_BYTES`` (256 MiB). The numbers are those of the
+        ``imunoise._support.stream.STREAM_BYTES`` (256 MiB). The numbers are those of the
         in-memory path (to rounding; the report's digits agree).
     mount : sequence of path or ImuLog, optional
         One or two logs of other sensors on the long log's mount, recorded over the

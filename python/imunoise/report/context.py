@@ -13,14 +13,16 @@ from pathlib import Path
 
 import numpy as np
 
-from imunoise import _schema, _stream, noise, plot, stats
 from imunoise import allan as _allan
-from imunoise._align import Aligned
-from imunoise._events import Events, events
-from imunoise._mount import OwnNoise, own_noise
-from imunoise._schema import ALLAN_SENSORS, SAMPLE_SENSORS, sensor_label
-from imunoise._thermal import Thermal, thermal
-from imunoise._warmup import Warmup, warmup
+from imunoise import noise, plot, stats
+from imunoise._analysis.align import Aligned
+from imunoise._analysis.events import Events, events
+from imunoise._analysis.mount import OwnNoise, own_noise
+from imunoise._analysis.thermal import Thermal, thermal
+from imunoise._analysis.warmup import Warmup, warmup
+from imunoise._support import schema as _schema
+from imunoise._support import stream as _stream
+from imunoise._support.schema import ALLAN_SENSORS, SAMPLE_SENSORS, sensor_label
 from imunoise.errors import ImunoiseWarning
 from imunoise.readers.log import ImuLog
 from imunoise.report import sections
@@ -50,7 +52,7 @@ class Context:
     #: What ``--trim auto`` cut, in words ("" when nothing was cut).
     trim_note: str = ""
     #: True when the logs are memory maps read a block or a channel at a time
-    #: (:mod:`imunoise._stream`): the analyses then hold one channel, not the log.
+    #: (:mod:`imunoise._support.stream`): the analyses then hold one channel, not the log.
     streamed: bool = False
     #: Rows per block of the streamed path.
     block: int = _stream.BLOCK_ROWS

@@ -23,11 +23,13 @@ from pathlib import Path
 
 import numpy as np
 
-from imunoise import _atomic, _summary, plot
 from imunoise import display as _display
+from imunoise import plot
+from imunoise._analysis.fleet import MIN_UNITS, TERMS, Fleet, outlier_rule
 from imunoise._core import __version__
-from imunoise._fleet import MIN_UNITS, TERMS, Fleet, outlier_rule
-from imunoise._schema import ALLAN_SENSORS
+from imunoise._support import atomic as _atomic
+from imunoise._support import summary as _summary
+from imunoise._support.schema import ALLAN_SENSORS
 from imunoise.report import folder
 from imunoise.report.document import Doc
 

@@ -5,7 +5,7 @@ there. :func:`claim` refuses to write into an existing folder that holds other
 things and no manifest unless ``force`` is given (the report would mix its files
 with someone else's); :func:`settle` removes what the previous report wrote and
 this one did not (figures of sections that no longer apply) and records the new
-list. Every file is written atomically (:mod:`imunoise._atomic`), so an
+list. Every file is written atomically (:mod:`imunoise._support.atomic`), so an
 interrupted report leaves each file either old or new, never partial, and the
 manifest still names the folder a report: :func:`mark` writes it before the first
 file. A report that fails or is interrupted takes back what it added
@@ -21,7 +21,7 @@ import shutil
 from collections.abc import Iterable
 from pathlib import Path
 
-from imunoise import _atomic
+from imunoise._support import atomic as _atomic
 from imunoise.errors import ImunoiseValueError
 
 __all__ = ["MANIFEST", "Undo", "claim", "mark", "settle"]

@@ -7,8 +7,8 @@ import sys
 import warnings
 from pathlib import Path
 
-from imunoise import _warn
-from imunoise._progress import byte_bar, wanted
+from imunoise._support import warn as _warn
+from imunoise._support.progress import byte_bar, wanted
 from imunoise.errors import ImunoiseValueError
 from imunoise.readers.log import ImuLog
 from imunoise.readers.read import read
@@ -19,9 +19,9 @@ __all__ = ["read_log", "streams"]
 def streams(source, read_options=None, *, forced: bool = False) -> bool:
     """Whether the report parses ``source`` into memory maps first: a log file that
     :func:`imunoise.scale.convert` can write as ``.npy`` (no text-layout options),
-    and, unless ``forced``, a VN log larger than ``imunoise._stream.STREAM_BYTES``.
+    and, unless ``forced``, a VN log larger than ``imunoise._support.stream.STREAM_BYTES``.
     Folders ``convert`` wrote are memory maps already: never."""
-    from imunoise import _stream
+    from imunoise._support import stream as _stream
     from imunoise.readers import registry
     from imunoise.readers.read import detect_format
 
@@ -61,7 +61,7 @@ def read_log(source, label: str = "input", *, fs: float | None = None,
     workdir : Path, optional
         Parse the log once into this (empty) folder with
         :func:`imunoise.scale.convert` and return memory maps of it (the streamed
-        path: :mod:`imunoise._stream`); the same arrays as :func:`imunoise.read`.
+        path: :mod:`imunoise._support.stream`); the same arrays as :func:`imunoise.read`.
     **read_options
         Passed to :func:`imunoise.read`: ``columns``, ``units``, ``delimiter``,
         ``time_column`` for text logs whose header does not say their layout.
@@ -90,7 +90,7 @@ def read_log(source, label: str = "input", *, fs: float | None = None,
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         if workdir is not None:
-            from imunoise import _stream
+            from imunoise._support import stream as _stream
 
             log = _stream.open_mapped(path, workdir, fs=fs, progress=callback)
         else:

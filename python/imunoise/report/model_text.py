@@ -10,7 +10,7 @@ import numpy as np
 
 from imunoise import datasheet
 from imunoise import units as _units
-from imunoise._schema import axis_names
+from imunoise._support.schema import axis_names
 from imunoise.display import format_value, percent
 from imunoise.errors import ImunoiseValueError
 from imunoise.noise import NoiseModel, _typed, gm_white_density, resolution_noise

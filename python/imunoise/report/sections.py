@@ -14,9 +14,11 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from imunoise import _stream, _warn, display, noise, plot, stats, units
 from imunoise import allan as _allan
-from imunoise._schema import CHANNELS, SAMPLE_SENSORS, axis_names
+from imunoise import display, noise, plot, stats, units
+from imunoise._support import stream as _stream
+from imunoise._support import warn as _warn
+from imunoise._support.schema import CHANNELS, SAMPLE_SENSORS, axis_names
 from imunoise.display import format_value, percent
 from imunoise.planner import fit_line
 from imunoise.report.formatting import (

@@ -13,8 +13,8 @@ import warnings
 
 import numpy as np
 
-from imunoise import _schema
-from imunoise._progress import Progress
+from imunoise._support import schema as _schema
+from imunoise._support.progress import Progress
 from imunoise.allan import adev
 from imunoise.datasheet import VERDICTS, compare, load_spec
 from imunoise.errors import ImunoiseTypeError, ImunoiseValueError

@@ -22,7 +22,7 @@ Output layouts (chosen by ``out``):
 ``OUT.npy``
     one structured array, a field per channel (``a["gyro"]`` is (n, 3)), plus
     ``OUT.npy.meta.json`` (with the array file's fingerprint: the two are published
-    together, see :func:`imunoise._atomic.publish_pair`).
+    together, see :func:`imunoise._support.atomic.publish_pair`).
 ``OUT.parquet``
     a column per axis (``gyro_x`` ...) written row group by row group (needs
     pyarrow); the metadata are the file's key-value metadata (``fs``, ``source``,
@@ -48,10 +48,11 @@ from pathlib import Path
 
 import numpy as np
 
-from imunoise import _atomic, _summary
 from imunoise._core import records as _core_records
 from imunoise._core import vn as _core_vn
-from imunoise._schema import CHANNELS, column_names
+from imunoise._support import atomic as _atomic
+from imunoise._support import summary as _summary
+from imunoise._support.schema import CHANNELS, column_names
 from imunoise.errors import ImunoiseTypeError, ImunoiseValueError
 from imunoise.readers import metafile, registry
 from imunoise.readers.columnar import META_KEY, log_meta, read_columnar

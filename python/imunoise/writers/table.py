@@ -5,7 +5,7 @@ source, format, issues, messages, gaps), so that :func:`imunoise.read` gives
 back the log that was written: the ``.npz`` as an entry ``imunoise`` (a JSON
 string), the CSV in ``OUT.csv.meta.json`` beside it (the CSV itself stays a plain
 header and rows for any other tool), with the CSV's fingerprint so that a reader
-never pairs it with another CSV (:func:`imunoise._atomic.publish_pair`). Every
+never pairs it with another CSV (:func:`imunoise._support.atomic.publish_pair`). Every
 value is written with the shortest text that parses back to the same float64
 (numpy's round-trip repr): epoch times keep their nanoseconds, samples are
 bit-identical.
@@ -20,8 +20,8 @@ from pathlib import Path
 
 import numpy as np
 
-from imunoise import _atomic
-from imunoise._schema import column_names
+from imunoise._support import atomic as _atomic
+from imunoise._support.schema import column_names
 from imunoise.readers import metafile
 from imunoise.readers.columnar import META_KEY, log_meta
 from imunoise.readers.log import ImuLog

@@ -12,8 +12,8 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 
-from imunoise import _atomic
 from imunoise._core import vn as _core_vn
+from imunoise._support import atomic as _atomic
 from imunoise.errors import ImunoiseValueError
 from imunoise.readers.log import ImuLog
 

@@ -20,10 +20,11 @@ from pathlib import Path
 
 import numpy as np
 
-from imunoise import _schema, _warn
-from imunoise._deprecation import old_call_forms
-from imunoise._simulate import simulate
-from imunoise._validate import positive_finite, sample_rate
+from imunoise._simulation.simulate import simulate
+from imunoise._support import schema as _schema
+from imunoise._support import warn as _warn
+from imunoise._support.deprecation import old_call_forms
+from imunoise._support.validate import positive_finite, sample_rate
 from imunoise.datasheet import load_spec
 from imunoise.errors import AssumptionWarning, ImunoiseValueError
 from imunoise.noise import FLICKER, model_variance

@@ -5,8 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from imunoise import _schema
-from imunoise._validate import sample_rate
+from imunoise._support import schema as _schema
+from imunoise._support.validate import sample_rate
 from imunoise.errors import ImunoiseTypeError, ImunoiseValueError
 from imunoise.readers.log import ImuLog
 
@@ -15,7 +15,7 @@ class Columns:
     """The rate channels of a log one column at a time: ``len(cols)`` channels of
     ``cols.n`` samples, ``cols[j]`` a contiguous float64 copy of channel ``j`` (read a
     block at a time from a memory-mapped log, so one channel is in memory, never the
-    whole log: :mod:`imunoise._stream`)."""
+    whole log: :mod:`imunoise._support.stream`)."""
 
     def __init__(self, parts: list[tuple[np.ndarray, int | None]], n: int) -> None:
         self._parts = parts
@@ -25,7 +25,7 @@ class Columns:
         return len(self._parts)
 
     def __getitem__(self, j: int) -> np.ndarray:
-        from imunoise import _stream
+        from imunoise._support import stream as _stream
 
         arr, col = self._parts[j]
         return _stream.column(arr, col)
@@ -46,7 +46,7 @@ class Columns:
         """Rows ``a`` … ``b − 1`` of the channels ``which`` side by side, (b − a, k)
         float64 (``np.column_stack`` of them), read a block of rows at a time (a memory
         map's pages given back behind each block)."""
-        from imunoise import _stream
+        from imunoise._support import stream as _stream
 
         out = np.empty((b - a, len(which)))
         for c, j in enumerate(which):

@@ -19,7 +19,7 @@ from imunoise.errors import CoverageWarning, ImunoiseDeprecationWarning, Imunois
 __all__ = ["warn"]
 
 #: Files under this folder are imunoise's own.
-_PACKAGE = str(Path(__file__).resolve().parent)
+_PACKAGE = str(Path(__file__).resolve().parents[1])
 
 
 def _inside(filename: str) -> bool:

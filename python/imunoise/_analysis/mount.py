@@ -19,12 +19,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from imunoise import _summary, _warn, allan
-from imunoise._align import Aligned, align
-from imunoise._hat import HAT_KINDS, at_m, gcodev, own_variance, three_cornered_hat
-from imunoise._schema import ALLAN_SENSORS, axis_names
-from imunoise._timefreq import pdev
-from imunoise._validate import confidence_level
+from imunoise import allan
+from imunoise._analysis.align import Aligned, align
+from imunoise._analysis.hat import HAT_KINDS, at_m, gcodev, own_variance, three_cornered_hat
+from imunoise._analysis.timefreq import pdev
+from imunoise._support import summary as _summary
+from imunoise._support import warn as _warn
+from imunoise._support.schema import ALLAN_SENSORS, axis_names
+from imunoise._support.validate import confidence_level
 from imunoise.allan import ONE_SIGMA, AllanResult, TauSpec
 from imunoise.errors import (
     CoverageWarning,
@@ -139,7 +141,7 @@ def own_noise(logs: Aligned | Sequence[ImuLog | str | os.PathLike], *, sensor: s
     taus, confidence
         As for :func:`imunoise.adev`.
     kind : str
-        The statistic, one of ``imunoise._hat.HAT_KINDS`` for three logs; two
+        The statistic, one of ``imunoise._analysis.hat.HAT_KINDS`` for three logs; two
         logs take ``"adev"`` only.
     clock : {"timestamps", "motion"}
         How to align logs that are not aligned yet (:func:`imunoise.align`).

@@ -1,6 +1,6 @@
 """Whole-channel quantities from passes over blocks, with the whole array's numbers.
 
-The event search (:mod:`imunoise._events`) needs quantities of a whole channel (its
+The event search (:mod:`imunoise._analysis.events`) needs quantities of a whole channel (its
 noise law: a mean, lag products, a median of window energies; running sums of
 squares) but should hold only a block of the arrays derived from it at a time. A
 *series* is a function ``f(a, b)`` giving its rows ``a`` … ``b − 1`` as float64 (a

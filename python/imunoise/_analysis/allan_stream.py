@@ -29,10 +29,10 @@ import warnings
 
 import numpy as np
 
+from imunoise._analysis.timefreq import tau_result
 from imunoise._core import allan as _core_allan
-from imunoise._summary import lines, plural
-from imunoise._timefreq import tau_result
-from imunoise._validate import integer, positive_finite, sample_rate
+from imunoise._support.summary import lines, plural
+from imunoise._support.validate import integer, positive_finite, sample_rate
 from imunoise.allan import ONE_SIGMA, AllanResult
 from imunoise.errors import ImunoiseTypeError, ImunoiseValueError
 

@@ -36,7 +36,7 @@ from collections.abc import Iterable, Iterator
 from pathlib import Path
 from typing import BinaryIO
 
-from imunoise import _interrupt
+from imunoise._support import interrupt as _interrupt
 from imunoise.errors import DataWarning, ImunoiseValueError
 
 __all__ = [

@@ -12,7 +12,7 @@ import inspect
 from collections.abc import Callable, Mapping, Sequence
 from typing import TypeVar
 
-from imunoise import _warn
+from imunoise._support import warn as _warn
 from imunoise.errors import ImunoiseDeprecationWarning, ImunoiseTypeError
 
 F = TypeVar("F", bound=Callable)

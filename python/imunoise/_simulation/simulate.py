@@ -45,8 +45,8 @@ from collections.abc import Sequence
 import numpy as np
 from scipy import fft as _fft
 
-from imunoise._deprecation import old_call_forms
-from imunoise._validate import integer, sample_rate
+from imunoise._support.deprecation import old_call_forms
+from imunoise._support.validate import integer, sample_rate
 from imunoise.errors import ImunoiseTypeError, ImunoiseValueError
 
 __all__ = ["simulate", "flicker"]
@@ -161,7 +161,7 @@ def simulate(n_samples: int, fs: float, Q: float = 0.0, N: float = 0.0, B: float
         coefficients and components above must then be left out; ``fs`` must be the
         source's own rate (or None for a model, result or Spectrum); the channels are
         the source's (``channels`` repeats a one-channel source). See
-        ``imunoise._simulate_like``.
+        ``imunoise._simulation.like``.
 
     Returns
     -------
@@ -184,7 +184,7 @@ def simulate(n_samples: int, fs: float, Q: float = 0.0, N: float = 0.0, B: float
         if given:
             raise ImunoiseValueError(
                 f"like= replaces the coefficients; leave out {', '.join(given)}")
-        from imunoise._simulate_like import simulate_like
+        from imunoise._simulation.like import simulate_like
 
         return simulate_like(like, n_samples, fs, channels=None if channels == 1 else channels,
                              seed=seed)

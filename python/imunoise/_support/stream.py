@@ -24,7 +24,7 @@ from typing import TypeVar
 
 import numpy as np
 
-from imunoise import _schema
+from imunoise._support import schema as _schema
 from imunoise.errors import DataWarning
 from imunoise.readers.log import ImuLog
 
@@ -297,7 +297,7 @@ def fresh_workdir(parent: Path, prefix: str) -> Path:
     import shutil
     import tempfile
 
-    from imunoise import _warn
+    from imunoise._support import warn as _warn
 
     for old in Path(parent).glob(f"{prefix}*"):
         pid = old.name[len(prefix):].split("-", 1)[0]

@@ -59,10 +59,11 @@ from scipy import linalg as _linalg
 from scipy import signal as _signal
 from scipy import stats as _sstats
 
-from imunoise import _blocks, _summary
-from imunoise._channels import rate_columns
-from imunoise._runs import true_runs
-from imunoise._validate import positive_finite
+from imunoise._analysis.channels import rate_columns
+from imunoise._support import blocks as _blocks
+from imunoise._support import summary as _summary
+from imunoise._support.runs import true_runs
+from imunoise._support.validate import positive_finite
 from imunoise.errors import ImunoiseValueError
 from imunoise.readers.log import ImuLog
 
@@ -396,7 +397,7 @@ def events(
     sigma = np.empty(len(cols))
     for j in range(len(cols)):
         # the one array of the channel's length kept: its standardised samples; what
-        # is derived from them is read a block at a time (imunoise._blocks)
+        # is derived from them is read a block at a time (imunoise._support.blocks)
         r, mad_sigma, knots = _standardise(cols.owned(j), block)
         valid = np.isfinite(r)
         if valid.all():
@@ -841,7 +842,7 @@ def _dof(rho: np.ndarray, w: int) -> float:
 
 def _tail_dof(z: np.ndarray) -> float:
     """Degrees of freedom ν of the Student-t with the excess kurtosis of the finite
-    samples ``z`` (:func:`imunoise._blocks.gather`'s: an array of our own, overwritten)
+    samples ``z`` (:func:`imunoise._support.blocks.gather`'s: an array of our own, overwritten)
     (6/(ν − 4)), at least :data:`CHANGE_POINT_DOF`: Gaussian-like noise keeps the
     Gaussian likelihood's precision, heavy-tailed noise gets bounded influence."""
     if z.size < 8:

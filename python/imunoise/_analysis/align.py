@@ -47,9 +47,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from imunoise import _summary
-from imunoise._schema import ALLAN_SENSORS
-from imunoise._validate import positive_finite
+from imunoise._support import summary as _summary
+from imunoise._support.schema import ALLAN_SENSORS
+from imunoise._support.validate import positive_finite
 from imunoise.errors import ImunoiseTypeError, ImunoiseValueError
 from imunoise.readers.log import ImuLog
 from imunoise.readers.read import read
@@ -178,7 +178,7 @@ def align(logs: Sequence[ImuLog | str | os.PathLike], *, clock: str = "timestamp
 
     The first log is the reference: the common grid is its own, cut to the span
     every log covers. Each other log's rows go to the nearest common row; see
-    :mod:`imunoise._align` (docs: "Sensors on one mount") for the method and its
+    :mod:`imunoise._analysis.align` (docs: "Sensors on one mount") for the method and its
     limits.
 
     Parameters

@@ -55,9 +55,10 @@ import numpy as np
 from scipy import optimize as _opt
 from scipy import stats as _stats
 
-from imunoise import _stream, _summary
-from imunoise._channels import rate_columns
-from imunoise._simulate import simulate
+from imunoise._analysis.channels import rate_columns
+from imunoise._simulation.simulate import simulate
+from imunoise._support import stream as _stream
+from imunoise._support import summary as _summary
 from imunoise.allan import adev, adev_by_column
 from imunoise.errors import ImunoiseValueError
 from imunoise.noise import _typed, fit, model_variance

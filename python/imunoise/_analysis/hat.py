@@ -36,10 +36,18 @@ import numpy as np
 import numpy.typing as npt
 from scipy import stats as _stats
 
-from imunoise import _summary, _warn, allan
+from imunoise import allan
+from imunoise._analysis.timefreq import (
+    averaging_grid,
+    pdev,
+    phase_points,
+    tau_result,
+    valid_windows,
+)
 from imunoise._core import allan as _core_allan
-from imunoise._timefreq import averaging_grid, pdev, phase_points, tau_result, valid_windows
-from imunoise._validate import confidence_level, samples
+from imunoise._support import summary as _summary
+from imunoise._support import warn as _warn
+from imunoise._support.validate import confidence_level, samples
 from imunoise.allan import ONE_SIGMA, AllanResult, TauSpec, chi2_interval
 from imunoise.errors import ImunoiseValueError
 

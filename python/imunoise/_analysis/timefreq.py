@@ -42,10 +42,10 @@ import numpy as np
 import numpy.typing as npt
 from scipy import signal as _signal
 
-from imunoise import _warn
 from imunoise._core import allan as _core_allan
-from imunoise._runs import true_runs
-from imunoise._validate import confidence_level, no_infinity, sample_rate, samples
+from imunoise._support import warn as _warn
+from imunoise._support.runs import true_runs
+from imunoise._support.validate import confidence_level, no_infinity, sample_rate, samples
 from imunoise.allan import (
     DATA_TYPES,
     GAPS,

@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from imunoise._validate import integer, sample_rate
+from imunoise._support.validate import integer, sample_rate
 from imunoise.errors import ImunoiseTypeError, ImunoiseValueError
 from imunoise.noise import _typed
 
@@ -81,7 +81,7 @@ def _channels(channels, available: int) -> list[int]:
 
 
 def _from_model(model, n: int, fs: float, channels, rng) -> np.ndarray:
-    from imunoise._simulate import simulate
+    from imunoise._simulation.simulate import simulate
 
     picked = _channels(channels, model.channels)
     columns = []

@@ -32,8 +32,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from imunoise import _schema, _summary
-from imunoise._channels import rate_channels
+from imunoise._analysis.channels import rate_channels
+from imunoise._support import schema as _schema
+from imunoise._support import summary as _summary
 from imunoise.display import format_value
 from imunoise.errors import ImunoiseValueError
 from imunoise.readers.log import ImuLog

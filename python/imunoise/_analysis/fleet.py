@@ -46,9 +46,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from imunoise import _summary
 from imunoise import display as _display
 from imunoise import units as _units
+from imunoise._support import summary as _summary
 from imunoise.datasheet import VERDICTS, Spec, load_spec
 from imunoise.errors import ImunoiseValueError
 from imunoise.scale.batch import BATCH_SENSORS, analyse_logs, expand
