@@ -61,7 +61,10 @@ class NoiseModel(PerTerm):
     ====  ==================================================================
 
     A value the data cannot show is NaN with :attr:`upper` its 95 % bound, never
-    0. The fit's own parameters are :attr:`terms`. All arrays are read-only.
+    0; so is a K (or R) where a ramp (a walk) or a Gauss–Markov bump the taus show
+    fits the rise of the longest taus as well (BIC within 2: the record cannot tell
+    them apart; :attr:`notes` names the alternative). The fit's own parameters are
+    :attr:`terms`. All arrays are read-only.
 
     Attributes
     ----------
