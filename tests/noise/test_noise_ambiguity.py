@@ -69,3 +69,30 @@ def test_a_walk_over_decades_is_resolved():
         model = imunoise.fit(imunoise.adev(x, FS, taus=10))
     assert float(model.K) == pytest.approx(1e-4, rel=0.2)
     assert not any("not resolved" in n for n in model.notes[0])
+
+
+def test_the_model_types_each_tie_and_the_report_says_it(walks):
+    from imunoise.report import model_sentences
+
+    tied = [m for _, m in walks if m.ties[0]]
+    assert tied
+    for model in tied:
+        (tie,) = model.ties[0]
+        assert isinstance(tie, imunoise.noise.Tie)
+        assert tie.term == "K" and tie.noun == "rate random walk"
+        assert tie.alternative in ("rate ramp", "Gauss–Markov bump")
+        assert tie.delta_bic < 2 and tie.value > 0
+        assert tie.note() in model.notes[0]
+        (sentence,) = model_sentences(model, "gyro")
+        assert f"K not resolved: a {tie.alternative} fits the rise" in sentence
+    resolved = [m for _, m in walks if not m.ties[0]]
+    assert all("not resolved: a" not in model_sentences(m, "gyro")[0] for m in resolved)
+
+
+def test_ties_go_to_json(walks):
+    import json
+
+    for _, model in walks:
+        d = json.loads(json.dumps(model.to_dict()))
+        assert len(d["ties"]) == 1
+        assert [t["term"] for t in d["ties"][0]] == [t.term for t in model.ties[0]]

@@ -78,6 +78,7 @@ MathWorks, "Inertial Sensor Noise Analysis Using Allan Variance" (example).
 
 from __future__ import annotations
 
+from imunoise.noise._ambiguity import Tie
 from imunoise.noise._components import Components, Prediction
 from imunoise.noise._filter import OutputFilter, estimate_filter
 from imunoise.noise._fit import fit
@@ -109,4 +110,4 @@ __all__ = ["TERMS", "FLICKER", "GM_MAX", "TONES_MAX", "Components", "NoiseModel"
            "Prediction", "estimate_filter", "fit",
            "format_table", "gm_white_density", "model_variance", "resolution_noise",
            "resonance_white_density", "Term", "Quantization", "White", "Flicker", "RandomWalk",
-           "Ramp", "GaussMarkov", "Tone", "Resonance", "Motion"]
+           "Ramp", "GaussMarkov", "Tone", "Resonance", "Motion", "Tie"]

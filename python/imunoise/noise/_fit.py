@@ -18,7 +18,7 @@ from imunoise._core import fit as _core_fit
 from imunoise._support import warn as _warn
 from imunoise._support.deprecation import old_call_forms
 from imunoise.errors import CoverageWarning, ImunoiseTypeError, ImunoiseValueError
-from imunoise.noise import _typed
+from imunoise.noise import _ambiguity, _typed
 from imunoise.noise._components import Components
 from imunoise.noise._datasheet import datasheet_notes, datasheet_values, upper_bounds
 from imunoise.noise._filter import OutputFilter, estimate_filter
@@ -383,9 +383,11 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
     if uncertainty == "bootstrap":
         sheet = {k: (v, sheet_std[:, i]) for i, (k, (v, _)) in enumerate(sheet.items())}
     resolved = {k: (v > 0) & np.isfinite(v) for k, (v, _) in sheet.items()}
-    for c, ties in enumerate(ambiguous):
-        for kind, _, _ in ties:
-            resolved[_typed.KINDS[kind].name][c] = False
+    fitted = [{k: v[c] for k, (v, _) in sheet.items()} for c in range(channels)]
+    tied = tuple(_ambiguity.ties(ambiguous[c], fitted[c]) for c in range(channels))
+    for c, channel_ties in enumerate(tied):
+        for tie in channel_ties:
+            resolved[tie.term][c] = False
     bounds = upper_bounds(taus, np.square(dev_all), edf_raw)
     model = NoiseModel(
         **{k: shaped(np.where(resolved[k], v, np.nan)) for k, (v, _) in sheet.items()},
@@ -393,11 +395,12 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
         supported={k: shaped(v) for k, v in resolved.items()},
         upper={k: shaped(np.where(resolved[k], np.nan, bounds[k])) for k in TERMS},
         notes=tuple((*datasheet_notes(components, record, c, method),
-                     *_ambiguity_notes(ambiguous[c], {k: v[c] for k, (v, _) in sheet.items()}),
+                     *(tie.note() for tie in tied[c]),
                      *_unplaced_note(unplaced[c]),
                      *_filter_notes(filters[c], spectrum, output_filter, method))
                     for c in range(channels)),
         lines=tuple(_lines(components, spectrum, c) for c in range(channels)),
+        ties=tied,
         _arrays=components,
         terms=typed,
         method=method,
@@ -651,24 +654,6 @@ def _legacy_arrays(terms):
     supported = coef > 0
     return (coef, std, supported, markov, markov_std, sine, sine_std, osc, osc_std, moving,
             moving_std)
-
-
-def _ambiguity_notes(ties, fitted) -> tuple[str, ...]:
-    """What a reader of a datasheet value the data do not resolve needs to know: which
-    other kind of term fits the same part of the curve as well (``ties``: the core's
-    (kind, alternative kind, ΔBIC)), and the value the chosen structure gave it
-    (``fitted``: {term: value}), which the model does not report."""
-    out = []
-    for kind, alternative, delta in ties:
-        term = _typed.KINDS[kind]
-        other = _typed.KINDS[alternative]
-        value = float(fitted[term.name])
-        out.append(
-            f"{term.name} is not resolved: a {other.noun} in place of the {term.noun} "
-            f"fits the curve as well (BIC {delta:+.2g}, under the 2 that positive evidence "
-            f"asks), so the record cannot tell them apart; as a {term.noun} it would be "
-            f"{value:.3g}, and model.upper['{term.name}'] bounds it")
-    return tuple(out)
 
 
 def _unplaced(requested, terms) -> list[str]:

@@ -4,7 +4,7 @@ exports, with the fitted components behind them under one name."""
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass, field, replace
+from dataclasses import asdict, dataclass, field, replace
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -17,6 +17,7 @@ from imunoise._support import summary as _summary
 from imunoise._support import warn as _warn
 from imunoise._support.deprecation import old_call_forms
 from imunoise.errors import ImunoiseDeprecationWarning, ImunoiseValueError
+from imunoise.noise._ambiguity import Tie
 from imunoise.noise._components import (
     Components,
     PerTerm,
@@ -93,6 +94,10 @@ class NoiseModel(PerTerm):
         Per channel, what a reader of the datasheet values needs to know: a slow
         Gauss–Markov term standing in for K (its hump lies beyond the record), or a
         bump within the record kept out of K.
+    ties : tuple of tuple of Tie
+        Per channel, the datasheet values (K, R) the record does not tell from an
+        alternative term (:class:`imunoise.noise.Tie`: the alternative, the BIC
+        difference, the value the chosen structure gave): not resolved.
     lines : tuple of tuple of SpectralLine
         Per channel, each fitted tone checked against the spectrum given to
         :func:`imunoise.fit` (``in_spectrum`` None where none was given): a tone is
@@ -158,6 +163,7 @@ class NoiseModel(PerTerm):
     notes: tuple[tuple[str, ...], ...] = field(repr=False)
     lines: tuple[tuple[SpectralLine, ...], ...] = field(repr=False)
     filter: tuple[OutputFilter | None, ...] = field(default=(), repr=False)
+    ties: tuple[tuple[Tie, ...], ...] = field(default=(), repr=False)
 
     # -- per term (channels, one_channel, value, std: PerTerm) ---------------
     def resolved(self, term: str) -> np.ndarray:
@@ -477,7 +483,8 @@ class NoiseModel(PerTerm):
         ``"upper"`` the bound), each axis's fitted terms under ``"terms"`` (and as
         parallel arrays under ``"components"``, for one release), each axis's output
         filter under ``"filter"`` (white band's top, Hz; frequencies and gains; None
-        where none was measured)."""
+        where none was measured), and each axis's ties under ``"ties"`` (the values
+        not resolved because an alternative term fits as well)."""
         d = {"method": self.method, "kind": self.kind, "fs": self.fs,
              "overlapping": self.overlapping, "channels": self.channels,
              "taus": self.taus.tolist(), "units": dict(_INPUT_UNITS)}
@@ -487,6 +494,7 @@ class NoiseModel(PerTerm):
                        "supported": self.resolved(term).tolist()}
         d["notes"] = [list(n) for n in self.notes]
         d["terms"] = [[t.to_dict() for t in terms] for terms in self.terms]
+        d["ties"] = [[asdict(t) for t in ties] for ties in self.ties]
         d["filter"] = [None if f is None else
                        {"white_top": float(f.white_top), "frequency": f.f.tolist(),
                         "gain": f.gain.tolist()} for f in self.filter]
