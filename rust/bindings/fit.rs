@@ -259,12 +259,26 @@ fn filter_factor<'py>(
             "taus must be finite and > 0; got {t}"
         )));
     }
-    let factors = py.detach(|| {
-        taus.iter()
-            .map(|t| filter.white_factor(t * fs))
-            .collect::<Vec<f64>>()
-    });
+    let ms: Vec<f64> = taus.iter().map(|t| t * fs).collect();
+    let factors = py.detach(|| filter.white_factors(&ms));
     Ok(factors.into_pyarray(py))
+}
+
+/// density_allan(taus, fs, density) -> the Allan variance at `taus` of a process
+/// whose one-sided density (units²/Hz, any sign) is `density` on the output
+/// filter's grid, from 0 Hz to fs/2, linear between its points.
+#[pyfunction]
+fn density_allan<'py>(
+    py: Python<'py>,
+    taus: PyReadonlyArray1<'py, f64>,
+    fs: f64,
+    density: PyReadonlyArray1<'py, f64>,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let taus = taus.as_array().to_vec();
+    check_model(&taus, fs)?;
+    let density = density.as_array().to_vec();
+    let out = py.detach(|| fit::filter::density_allan(&density, &taus, fs))?;
+    Ok(out.into_pyarray(py))
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -288,6 +302,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(fit_noise, m)?)?;
     m.add_function(wrap_pyfunction!(allan_terms, m)?)?;
     m.add_function(wrap_pyfunction!(filter_factor, m)?)?;
+    m.add_function(wrap_pyfunction!(density_allan, m)?)?;
     m.add_function(wrap_pyfunction!(datasheet, m)?)?;
     m.add_function(wrap_pyfunction!(model_floor, m)?)?;
     Ok(())

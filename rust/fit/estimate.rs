@@ -44,7 +44,7 @@ pub struct Data {
     pub v: Vec<f64>,
     pub omega: Vec<f64>,
     /// Per tau, the white term's factor through the sensor's output filter
-    /// (`filter::OutputFilter::white_factor`; 1 without one).
+    /// (`filter::OutputFilter::white_factors`; 1 without one).
     pub white: Vec<f64>,
 }
 
@@ -112,7 +112,7 @@ impl Data {
     /// The same data with the white term seen through `filter`.
     pub fn with_filter(mut self, filter: Option<&OutputFilter>) -> Data {
         if let Some(f) = filter {
-            self.white = self.m.iter().map(|&m| f.white_factor(m)).collect();
+            self.white = f.white_factors(&self.m);
         }
         self
     }

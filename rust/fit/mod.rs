@@ -372,9 +372,10 @@ pub fn allan_terms(
     terms: &[Term],
     filter: Option<&OutputFilter>,
 ) -> Vec<Vec<f64>> {
-    taus.iter()
-        .map(|&t| {
-            let white = filter.map_or(1.0, |f| f.white_factor(t * fs));
+    let ms: Vec<f64> = taus.iter().map(|t| t * fs).collect();
+    let white = filter.map_or_else(|| vec![1.0; taus.len()], |f| f.white_factors(&ms));
+    (taus.iter().zip(&white))
+        .map(|(&t, &white)| {
             (terms.iter())
                 .map(|term| term.allan_variance(t, t * fs, fs, white))
                 .collect()

@@ -1,5 +1,6 @@
 """The sensor's output filter measured from the spectrum (`imunoise.noise._filter`)
-and used by `imunoise.fit`: c(τ) against an independent quadrature and the core,
+and used by `imunoise.fit`: the core's c(τ) against an independent quadrature and the
+tests' numpy oracle,
 the gain of simulated filters recovered, no filter on white noise, N through a
 filter, a log fitted directly."""
 
@@ -10,9 +11,10 @@ import warnings
 import imunoise
 import numpy as np
 import pytest
+from helpers.filter_oracle import density_allan, filter_factor  # the core's numpy oracle
+from imunoise._core import fit as core_fit
 from imunoise.errors import ImunoiseValueError
 from imunoise.noise import OutputFilter, estimate_filter
-from imunoise.noise._filter import filter_factor  # the numpy oracle of the core's c(τ)
 from scipy import stats
 from scipy.signal import butter, freqz, lfilter
 
@@ -38,43 +40,57 @@ def butterworth_gain(order, cutoff, points):
     return np.abs(h) ** 2
 
 
-@pytest.mark.parametrize("gain", [butterworth_gain(4, FS / 10, 513),
-                                  butterworth_gain(2, FS / 4, 257),
-                                  np.r_[1.0, np.full(64, 0.5)],  # a step: G's corners
-                                  np.linspace(1.0, 3.0, 33)])    # a rising gain
+GAINS = [butterworth_gain(4, FS / 10, 513), butterworth_gain(2, FS / 4, 257),
+         np.r_[1.0, np.full(64, 0.5)],  # a step: G's corners
+         np.linspace(1.0, 3.0, 33)]     # a rising gain
+
+
+@pytest.mark.parametrize("gain", GAINS)
 def test_filter_factor_is_the_quadrature(gain):
+    """The core's c(τ) and the oracle's against brute-force trapezoids. Measured: both
+    within 4·10⁻¹² of them, 3·10⁻⁹ on the step gain (the trapezoids' own error at its
+    corner)."""
     taus = np.array([1, 2, 3, 5, 10, 31, 100, 400]) / FS
-    np.testing.assert_allclose(filter_factor(taus, FS, gain),
-                               quadrature_factor(taus, FS, gain), rtol=2e-6, atol=1e-9)
+    want = quadrature_factor(taus, FS, gain)
+    np.testing.assert_allclose(core_fit.filter_factor(taus, FS, gain), want, rtol=2e-6,
+                               atol=1e-9)
+    np.testing.assert_allclose(filter_factor(taus, FS, gain), want, rtol=2e-6, atol=1e-9)
 
 
 def test_filter_factor_is_one_without_a_filter_and_at_long_taus():
     taus = np.geomspace(0.01, 1000.0, 25)
-    np.testing.assert_allclose(filter_factor(taus, FS, np.ones(129)), 1.0, atol=1e-12)
-    c = filter_factor(taus, FS, butterworth_gain(4, FS / 10, 1025))
+    np.testing.assert_array_equal(core_fit.filter_factor(taus, FS, np.ones(129)), 1.0)
+    c = core_fit.filter_factor(taus, FS, butterworth_gain(4, FS / 10, 1025))
     assert c[0] < 0.1 and abs(c[-1] - 1) < 1e-4 and np.all(np.diff(c) > 0)
 
 
-@pytest.mark.parametrize("gain", [butterworth_gain(3, FS / 6, 1025),
-                                  np.r_[1.0, np.full(64, 0.5)], np.linspace(1.0, 3.0, 33)])
-def test_core_filter_factor_agrees_with_the_numpy_one(gain):
-    """The core's c(τ) (Simpson per grid segment, sin⁴ averaged where a segment holds
-    many periods) against this module's (exact for the piecewise-linear G, from its
-    Fourier coefficients): two ways to one integral. Measured: within 1.3·10⁻⁴ (a
-    step gain at m = 40), far below any Allan estimate's scatter."""
-    core = pytest.importorskip("imunoise._core.fit")
-    if not hasattr(core, "filter_factor"):
-        pytest.skip("the compiled core has no filter_factor")
+@pytest.mark.parametrize("gain", [butterworth_gain(3, FS / 6, 1025), *GAINS[2:],
+                                  butterworth_gain(4, FS / 10, 32769)])
+def test_core_filter_factor_agrees_with_the_numpy_oracle(gain):
+    """The core's c(τ) against the oracle's: one exact formula (the piecewise-linear
+    G's Fourier coefficients), two codes (rustfft and compensated running sums; numpy's
+    FFT and cumsum), to the rounding of the sums up to m = 3·10⁵ (the longest tau of a
+    5 h record at 40 Hz at a Welch grid of 32769 points)."""
     taus = np.r_[np.arange(1, 40), np.geomspace(40, 3e5, 40).round()] / FS
-    np.testing.assert_allclose(core.filter_factor(taus, FS, gain),
-                               filter_factor(taus, FS, gain), rtol=3e-4, atol=1e-7)
+    np.testing.assert_allclose(core_fit.filter_factor(taus, FS, gain),
+                               filter_factor(taus, FS, gain), rtol=1e-9, atol=1e-12)
 
 
-def test_filter_factor_names_a_bad_gain():
-    with pytest.raises(ImunoiseValueError, match="gain must hold finite values >= 0"):
-        filter_factor([1.0], FS, np.array([1.0, -0.1]))
-    with pytest.raises(ImunoiseValueError, match=re.escape("got shape (1,)")):
-        filter_factor([1.0], FS, np.array([1.0]))
+def test_core_density_allan_agrees_with_the_numpy_oracle():
+    """The filter's share of a flicker and walk level (any sign), as ``excess`` asks it."""
+    f = np.linspace(0, FS / 2, 2049)
+    low = np.r_[0.0, 1e-6 / f[1:] + 1e-8 / f[1:] ** 2]
+    density = (butterworth_gain(4, FS / 10, f.size) - 1.0) * low
+    taus = np.r_[np.arange(1, 20), np.geomspace(20, 1e5, 30).round()] / FS
+    np.testing.assert_allclose(core_fit.density_allan(taus, FS, density),
+                               density_allan(taus, FS, density), rtol=1e-9, atol=1e-20)
+
+
+def test_density_allan_names_a_bad_density():
+    with pytest.raises(ImunoiseValueError, match=re.escape("density[1] = NaN")):
+        core_fit.density_allan(np.array([1.0]), FS, np.array([1.0, np.nan]))
+    with pytest.raises(ImunoiseValueError, match="at least 2 values"):
+        core_fit.density_allan(np.array([1.0]), FS, np.array([1.0]))
 
 
 def filtered_noise(b, a, seed, n=360_000, channels=1):
@@ -221,7 +237,7 @@ def test_output_filter_repr_and_factor():
                          white_top=12.5, white=2e-6)
     assert "white to 12.5 Hz" in repr(found)
     np.testing.assert_allclose(found.factor([0.01, 100.0]),
-                               filter_factor([0.01, 100.0], FS, found.gain), rtol=3e-4)  # the core
+                               filter_factor([0.01, 100.0], FS, found.gain), rtol=1e-9)
 
 
 def test_the_filter_travels_in_the_models_dict():

@@ -83,7 +83,17 @@ def filter_factor(
     filter: npt.NDArray[np.float64],
 ) -> npt.NDArray[np.float64]:
     """c(τ): the white term's Allan variance through the output filter ``filter``
-    (power gain from 0 Hz to fs/2, G(0) = 1) over the one without."""
+    (power gain from 0 Hz to fs/2, G(0) = 1) over the one without; exact for a gain
+    linear between its points at whole cluster sizes τ·fs, read linearly between."""
+
+def density_allan(
+    taus: npt.NDArray[np.float64],
+    fs: float,
+    density: npt.NDArray[np.float64],
+) -> npt.NDArray[np.float64]:
+    """Allan variance at ``taus`` of a process whose one-sided density (units²/Hz,
+    any sign) is ``density`` at L ≥ 2 frequencies evenly spaced from 0 Hz to fs/2,
+    linear between them."""
 
 def datasheet(
     terms: list[tuple[str, list[float]]],
