@@ -214,6 +214,28 @@ fn datasheet<'py>(
     }))
 }
 
+/// datasheet_shares(terms, fs, record) -> [(white, walk)]: what each term adds to
+/// the datasheet's N² (`Term::white_share`) and to its K² over a record of `record`
+/// seconds (`Term::walk_share`), the rules `datasheet` sums.
+#[pyfunction]
+fn datasheet_shares(
+    terms: Vec<(String, Vec<f64>)>,
+    fs: f64,
+    record: f64,
+) -> PyResult<Vec<(f64, f64)>> {
+    let typed = typed_terms(&terms)?;
+    for (name, v) in [("fs", fs), ("record", record)] {
+        if !(v.is_finite() && v > 0.0) {
+            return Err(super::value_error(format!(
+                "{name} must be finite and > 0; got {v}"
+            )));
+        }
+    }
+    Ok((typed.iter())
+        .map(|t| (t.white_share(fs), t.walk_share(record)))
+        .collect())
+}
+
 /// model_floor(terms, taus, fs, filter=None) -> (τ, σ) or None: the floor of the
 /// model's deviation over `taus`, where B is read.
 #[pyfunction]
@@ -305,5 +327,6 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(density_allan, m)?)?;
     m.add_function(wrap_pyfunction!(datasheet, m)?)?;
     m.add_function(wrap_pyfunction!(model_floor, m)?)?;
+    m.add_function(wrap_pyfunction!(datasheet_shares, m)?)?;
     Ok(())
 }

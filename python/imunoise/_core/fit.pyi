@@ -115,3 +115,12 @@ def model_floor(
 ) -> tuple[float, float] | None:
     """(τ, σ) of the floor of the model's deviation over ``taus`` (where B is read),
     or None where the curve has none."""
+
+def datasheet_shares(
+    terms: list[tuple[str, list[float]]],
+    fs: float,
+    record: float,
+) -> list[tuple[float, float]]:
+    """(white, walk) per term: what it adds to the datasheet's N² and to its K² over a
+    record of ``record`` seconds (0 where it counts in neither), the rules of
+    ``datasheet``."""
