@@ -250,3 +250,58 @@ def test_the_filter_travels_in_the_models_dict():
     d = json.loads(json.dumps(model.to_dict()))
     assert d["filter"][0]["white_top"] == pytest.approx(model.filter[0].white_top)
     assert d["filter"][0]["gain"][-1] < 0.1  # a 4th-order low-pass at fs/10: nothing at fs/2
+
+
+def test_apply_gives_white_noise_the_filters_allan_variance():
+    """``OutputFilter.apply`` (a bootstrap's replicates through the sensor's filter):
+    white noise through it has the Allan variance (N²/τ)·c(τ) the core fits."""
+    gain = butterworth_gain(4, FS / 10, 513)
+    found = OutputFilter(f=np.linspace(0, FS / 2, gain.size), gain=gain, fs=FS,
+                         white_top=1.0, white=2e-6)
+    x = imunoise.simulate(400_000, FS, N=1e-3, channels=2, seed=4)
+    y = found.apply(x)
+    assert y.shape == x.shape
+    np.testing.assert_array_equal(found.apply(x[:, 0]), y[:, 0])
+    r = imunoise.adev(y, FS, taus=np.array([0.01, 0.02, 0.05, 0.1, 1.0]))
+    want = 1e-6 / r.taus * found.factor(r.taus)
+    # each within 4 of its own standard errors (EDF of the overlapping estimates)
+    z = (r.var / want[:, None] - 1) / np.sqrt(2 / r.edf)
+    assert np.all(np.abs(z) < 4), z
+
+
+def test_a_bootstrap_simulates_and_refits_through_the_point_fits_filter(monkeypatch):
+    from imunoise.noise import _fit as fit_module
+
+    b, a = butter(4, 0.2)
+    x = filtered_noise(b, a, seed=8, n=100_000)
+    r, s = imunoise.adev(x, FS, taus=10), imunoise.psd(x, FS)
+    applied, refits = [], []
+    real_apply, real_fit = OutputFilter.apply, fit_module._fit
+
+    def spy_apply(self, y):
+        applied.append(self)
+        return real_apply(self, y)
+
+    def spy_fit(result, **kwargs):
+        if result is not r:  # a replicates' refit
+            refits.append(kwargs.get("filters"))
+        return real_fit(result, **kwargs)
+
+    monkeypatch.setattr(OutputFilter, "apply", spy_apply)
+    monkeypatch.setattr(fit_module, "_fit", spy_fit)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        model = imunoise.fit(r, spectrum=s, uncertainty="bootstrap", replicates=5, seed=0)
+    found = model.filter[0]
+    assert found is not None
+    assert applied == [found]
+    assert len(refits) == 1 and refits[0] == (found,) * 5
+    # the core's terms, their uncertainties the bootstrap's
+    plain = imunoise.fit(r, spectrum=s)
+    assert len(model.terms[0]) == len(plain.terms[0])
+    for boot, core in zip(model.terms[0], plain.terms[0], strict=True):
+        values = {k: v for k, v in boot.to_dict().items() if not k.endswith("_std")}
+        assert values == {k: v for k, v in core.to_dict().items() if not k.endswith("_std")}
+    white = [next(t for t in m.terms[0] if isinstance(t, imunoise.noise.White))
+             for m in (model, plain)]
+    assert np.isfinite(white[0].N_std) and white[0].N_std != white[1].N_std
