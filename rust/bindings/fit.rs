@@ -59,10 +59,11 @@ fn to_matrix(rows: Vec<Vec<f64>>, cols: usize) -> PyResult<Array2<f64>> {
         .map_err(|e| super::value_error(e.to_string()))
 }
 
-/// fit_noise(taus, var, edf, fs, terms, gm, select, tones, resonance, motion, filter) -> NoiseFit
+/// fit_noise(taus, var, edf, fs, terms, gm, select, tones, resonance, motion, filter,
+/// filter_level_std) -> NoiseFit
 #[pyfunction]
 #[allow(clippy::too_many_arguments)] // mirrors the Python keyword arguments
-#[pyo3(signature = (taus, var, edf, fs, terms, gm=3, select=true, tones=2, resonance=true, motion=true, filter=None))]
+#[pyo3(signature = (taus, var, edf, fs, terms, gm=3, select=true, tones=2, resonance=true, motion=true, filter=None, filter_level_std=0.0))]
 fn fit_noise<'py>(
     py: Python<'py>,
     taus: PyReadonlyArray1<'py, f64>,
@@ -76,8 +77,11 @@ fn fit_noise<'py>(
     resonance: bool,
     motion: bool,
     filter: Option<PyReadonlyArray1<'py, f64>>,
+    filter_level_std: f64,
 ) -> PyResult<PyNoiseFit> {
-    let filter = output_filter(filter)?;
+    let filter = output_filter(filter)?
+        .map(|f| f.with_level_std(filter_level_std))
+        .transpose()?;
     let opts = Options {
         ieee: ieee_flags(&terms)?,
         gm,

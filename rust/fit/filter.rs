@@ -44,6 +44,9 @@ pub struct OutputFilter {
     gain: Vec<f64>,
     /// G − 1, which is what the white term's Allan variance meets.
     excess: PiecewiseLinear,
+    /// The relative standard uncertainty of the white level G was measured against
+    /// ([`OutputFilter::with_level_std`]; 0: none).
+    level_std: f64,
 }
 
 impl OutputFilter {
@@ -70,7 +73,46 @@ impl OutputFilter {
             )));
         }
         let excess = PiecewiseLinear::new(&gain.iter().map(|g| g - 1.0).collect::<Vec<f64>>())?;
-        Ok(OutputFilter { gain, excess })
+        Ok(OutputFilter {
+            gain,
+            excess,
+            level_std: 0.0,
+        })
+    }
+
+    /// The same filter, measured against a white level of relative standard
+    /// uncertainty `std` (finite, ≥ 0): from its first point that is not 1 on, G is a
+    /// spectrum over that level, so it scales as 1/level there, and the fit's
+    /// covariance carries the level's uncertainty ([`OutputFilter::level_factors`]).
+    pub fn with_level_std(mut self, std: f64) -> CoreResult<OutputFilter> {
+        if !(std.is_finite() && std >= 0.0) {
+            return Err(CoreError::InvalidArgument(format!(
+                "the white level's relative uncertainty must be finite and >= 0; got {std}"
+            )));
+        }
+        self.level_std = std;
+        Ok(self)
+    }
+
+    /// The relative standard uncertainty of the white level G is measured against.
+    pub fn level_std(&self) -> f64 {
+        self.level_std
+    }
+
+    /// ∂c(m)/∂ln(level) at each cluster size of `ms`: G's measured part (from its
+    /// first point that is not 1) scales as 1/level.
+    pub fn level_factors(&self, ms: &[f64]) -> CoreResult<Vec<f64>> {
+        let first = (self.gain.iter()).position(|&g| g != 1.0);
+        let slope: Vec<f64> = (self.gain.iter().enumerate())
+            .map(|(k, &g)| {
+                if first.is_some_and(|f| k >= f) {
+                    -g
+                } else {
+                    0.0
+                }
+            })
+            .collect();
+        Ok(PiecewiseLinear::new(&slope)?.kernel_sums(ms))
     }
 
     /// The gains, from 0 Hz to fs/2.
@@ -326,6 +368,76 @@ mod tests {
         for (g, t) in got.iter().zip([0.02, 0.5, 40.0]) {
             assert!((g / (3.0 / (2.0 * t)) - 1.0).abs() < 1e-12, "{got:?}");
         }
+    }
+
+    #[test]
+    fn the_white_levels_uncertainty_is_the_fits_slope_in_it() {
+        // N + B + K through a 4-tap moving average, fitted exactly; the covariance a
+        // level uncertainty u adds to the white variance is u²·(dN²/dε)², with the
+        // slope from refits whose measured gain is scaled by e^(∓δ).
+        use crate::fit::{fit_noise, Kind, Options, Term};
+        let fs = 100.0;
+        let gain: Vec<f64> = (0..257)
+            .map(|k| {
+                let s = (std::f64::consts::PI * 0.5 * k as f64 / 256.0).sin();
+                if s == 0.0 {
+                    1.0
+                } else {
+                    ((4.0 * std::f64::consts::PI * 0.5 * k as f64 / 256.0).sin() / (4.0 * s))
+                        .powi(2)
+                }
+            })
+            .collect();
+        let taus: Vec<f64> = (0..40).map(|i| 0.01 * 1.25f64.powi(i)).collect();
+        let truth = [
+            Term::White { variance: 4e-6 },
+            Term::Flicker { variance: 1e-8 },
+            Term::RandomWalk { variance: 1e-10 },
+        ];
+        let filter = OutputFilter::new(gain.clone()).unwrap();
+        let var: Vec<f64> = (crate::fit::allan_terms(&taus, fs, &truth, Some(&filter)).iter())
+            .map(|r| r.iter().sum())
+            .collect();
+        let edf: Vec<f64> = taus.iter().map(|t| 1e5 / (t * fs)).collect();
+        let opts = Options {
+            ieee: [false, true, true, true, false],
+            gm: 0,
+            tones: 0,
+            resonance: false,
+            motion: false,
+            select: false,
+        };
+        let white = |f: &OutputFilter| {
+            let fit = fit_noise(&taus, &var, &edf, fs, &opts, Some(f)).unwrap();
+            let k = fit
+                .terms
+                .iter()
+                .position(|t| t.kind() == Kind::White)
+                .unwrap();
+            (fit.terms[k].variance(), fit.cov[k][k])
+        };
+        let delta = 1e-4;
+        let scaled = |e: f64| {
+            let g = gain
+                .iter()
+                .enumerate()
+                .map(|(k, g)| if k == 0 { 1.0 } else { g * (-e).exp() });
+            OutputFilter::new(g.collect()).unwrap()
+        };
+        let slope = (white(&scaled(delta)).0 - white(&scaled(-delta)).0) / (2.0 * delta);
+        let u = 0.01;
+        let (_, plain) = white(&filter);
+        let (_, with) = white(&filter.clone().with_level_std(u).unwrap());
+        let predicted = ((with - plain).max(0.0)).sqrt() / u;
+        assert!(slope.abs() > 1e-7, "{slope}");
+        assert!(
+            (predicted / slope.abs() - 1.0).abs() < 1e-3,
+            "{predicted} vs {slope}"
+        );
+        assert!(OutputFilter::new(gain)
+            .unwrap()
+            .with_level_std(f64::NAN)
+            .is_err());
     }
 
     #[test]

@@ -60,13 +60,17 @@ def fit_noise(
     resonance: bool = True,
     motion: bool = True,
     filter: npt.NDArray[np.float64] | None = None,
+    filter_level_std: float = 0.0,
 ) -> NoiseFit:
     """Log-space, octave-weighted fit of the noise model (IEEE terms, up to
     ``gm`` Gauss–Markov terms, up to ``tones`` tones, with ``resonance`` a
     damped oscillator and with ``motion`` a bounded motion of the mount) to one
     channel; structure chosen by BIC when ``select``. ``filter``: the sensor's
     output-filter power gain G at L ≥ 2 frequencies evenly spaced from 0 Hz
-    (G = 1) to fs/2; the white term is seen through it."""
+    (G = 1) to fs/2; the white term is seen through it. ``filter_level_std``: the
+    relative standard uncertainty of the white level G was measured against (G
+    scales as its inverse from its first point that is not 1); the covariance
+    carries it."""
 
 def allan_terms(
     taus: npt.NDArray[np.float64],

@@ -127,6 +127,10 @@ class OutputFilter:
     psd, low : ndarray, (L,)
         The running median of the PSD on ``f`` and the flicker and walk part of the
         level, h₋₁/f + h₋₂/f² (:meth:`excess`).
+    white_std : float
+        Relative standard uncertainty of ``white`` (of its fit to the log-binned
+        spectrum): G above ``white_top`` scales as its inverse, and the fit's
+        uncertainties carry it (0: not known).
     """
 
     f: np.ndarray
@@ -136,6 +140,7 @@ class OutputFilter:
     white: float
     psd: np.ndarray = field(repr=False, default=None)
     low: np.ndarray = field(repr=False, default=None)
+    white_std: float = 0.0
 
     def __post_init__(self) -> None:
         for name in ("f", "gain", "psd", "low"):
@@ -237,7 +242,8 @@ def estimate_filter(spectrum, channel: int = 0) -> OutputFilter | None:
     low = np.zeros(size)
     low[1:] = h1 / grid[1:] + h2 / grid[1:] ** 2
     return OutputFilter(f=grid, gain=_gain(grid, numerator, low, h0, start), fs=fs,
-                        white_top=float(start), white=float(h0), psd=numerator, low=low)
+                        white_top=float(start), white=float(h0), psd=numerator, low=low,
+                        white_std=float(u_h0))
 
 
 def _crossover(h0, h1, h2, lowest):
