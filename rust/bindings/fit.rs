@@ -62,10 +62,11 @@ fn to_matrix(rows: Vec<Vec<f64>>, cols: usize) -> PyResult<Array2<f64>> {
         .map_err(|e| super::value_error(e.to_string()))
 }
 
-/// fit_noise(taus, var, edf, fs, terms, gm, select, tones, resonance, motion, filter) -> NoiseFit
+/// fit_noise(taus, var, edf, fs, terms, gm, select, tones, resonance, motion, filter,
+/// filter_level_std) -> NoiseFit
 #[pyfunction]
 #[allow(clippy::too_many_arguments)] // mirrors the Python keyword arguments
-#[pyo3(signature = (taus, var, edf, fs, terms, gm=3, select=true, tones=2, resonance=true, motion=true, filter=None))]
+#[pyo3(signature = (taus, var, edf, fs, terms, gm=3, select=true, tones=2, resonance=true, motion=true, filter=None, filter_level_std=0.0))]
 fn fit_noise<'py>(
     py: Python<'py>,
     taus: PyReadonlyArray1<'py, f64>,
@@ -79,8 +80,11 @@ fn fit_noise<'py>(
     resonance: bool,
     motion: bool,
     filter: Option<PyReadonlyArray1<'py, f64>>,
+    filter_level_std: f64,
 ) -> PyResult<PyNoiseFit> {
-    let filter = output_filter(filter)?;
+    let filter = output_filter(filter)?
+        .map(|f| f.with_level_std(filter_level_std))
+        .transpose()?;
     let opts = Options {
         ieee: ieee_flags(&terms)?,
         gm,
@@ -220,6 +224,28 @@ fn datasheet<'py>(
     }))
 }
 
+/// datasheet_shares(terms, fs, record) -> [(white, walk)]: what each term adds to
+/// the datasheet's N² (`Term::white_share`) and to its K² over a record of `record`
+/// seconds (`Term::walk_share`), the rules `datasheet` sums.
+#[pyfunction]
+fn datasheet_shares(
+    terms: Vec<(String, Vec<f64>)>,
+    fs: f64,
+    record: f64,
+) -> PyResult<Vec<(f64, f64)>> {
+    let typed = typed_terms(&terms)?;
+    for (name, v) in [("fs", fs), ("record", record)] {
+        if !(v.is_finite() && v > 0.0) {
+            return Err(super::value_error(format!(
+                "{name} must be finite and > 0; got {v}"
+            )));
+        }
+    }
+    Ok((typed.iter())
+        .map(|t| (t.white_share(fs), t.walk_share(record)))
+        .collect())
+}
+
 /// model_floor(terms, taus, fs, filter=None) -> (τ, σ) or None: the floor of the
 /// model's deviation over `taus`, where B is read.
 #[pyfunction]
@@ -265,12 +291,26 @@ fn filter_factor<'py>(
             "taus must be finite and > 0; got {t}"
         )));
     }
-    let factors = py.detach(|| {
-        taus.iter()
-            .map(|t| filter.white_factor(t * fs))
-            .collect::<Vec<f64>>()
-    });
+    let ms: Vec<f64> = taus.iter().map(|t| t * fs).collect();
+    let factors = py.detach(|| filter.white_factors(&ms));
     Ok(factors.into_pyarray(py))
+}
+
+/// density_allan(taus, fs, density) -> the Allan variance at `taus` of a process
+/// whose one-sided density (units²/Hz, any sign) is `density` on the output
+/// filter's grid, from 0 Hz to fs/2, linear between its points.
+#[pyfunction]
+fn density_allan<'py>(
+    py: Python<'py>,
+    taus: PyReadonlyArray1<'py, f64>,
+    fs: f64,
+    density: PyReadonlyArray1<'py, f64>,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let taus = taus.as_array().to_vec();
+    check_model(&taus, fs)?;
+    let density = density.as_array().to_vec();
+    let out = py.detach(|| fit::filter::density_allan(&density, &taus, fs))?;
+    Ok(out.into_pyarray(py))
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -294,7 +334,9 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(fit_noise, m)?)?;
     m.add_function(wrap_pyfunction!(allan_terms, m)?)?;
     m.add_function(wrap_pyfunction!(filter_factor, m)?)?;
+    m.add_function(wrap_pyfunction!(density_allan, m)?)?;
     m.add_function(wrap_pyfunction!(datasheet, m)?)?;
     m.add_function(wrap_pyfunction!(model_floor, m)?)?;
+    m.add_function(wrap_pyfunction!(datasheet_shares, m)?)?;
     Ok(())
 }

@@ -44,8 +44,13 @@ pub struct Data {
     pub v: Vec<f64>,
     pub omega: Vec<f64>,
     /// Per tau, the white term's factor through the sensor's output filter
-    /// (`filter::OutputFilter::white_factor`; 1 without one).
+    /// (`filter::OutputFilter::white_factors`; 1 without one).
     pub white: Vec<f64>,
+    /// Per tau, ∂(that factor)/∂ln(white level the filter was measured against)
+    /// (`filter::OutputFilter::level_factors`), and the level's relative variance:
+    /// what the covariance adds for the level's uncertainty (0 without a filter).
+    pub white_level: Vec<f64>,
+    pub level_var: f64,
 }
 
 fn invalid(msg: String) -> CoreError {
@@ -106,13 +111,21 @@ impl Data {
             v,
             omega: octave_shares(taus),
             white: vec![1.0; n],
+            white_level: vec![0.0; n],
+            level_var: 0.0,
         })
     }
 
     /// The same data with the white term seen through `filter`.
     pub fn with_filter(mut self, filter: Option<&OutputFilter>) -> Data {
         if let Some(f) = filter {
-            self.white = self.m.iter().map(|&m| f.white_factor(m)).collect();
+            self.white = f.white_factors(&self.m);
+            if f.level_std() > 0.0 {
+                if let Ok(slope) = f.level_factors(&self.m) {
+                    self.white_level = slope;
+                    self.level_var = f.level_std().powi(2);
+                }
+            }
         }
         self
     }

@@ -159,7 +159,14 @@ pub fn fit_noise(
             opts.gm
         )));
     }
-    let data = Data::new(taus, var, edf, fs)?.with_filter(filter);
+    let reported = Data::new(taus, var, edf, fs)?.with_filter(filter);
+    // The search and its pruning judge terms by what the data constrain; the white
+    // level the filter was measured against, one number for every tau, enters the
+    // reported covariance only.
+    let data = Data {
+        level_var: 0.0,
+        ..reported.clone()
+    };
     let chosen = if opts.select {
         let selected = |motion: bool| -> CoreResult<Candidate> {
             let kinds = (opts.tones, opts.resonance, motion);
@@ -185,7 +192,7 @@ pub fn fit_noise(
     } else {
         fixed_structure(&data, fs, opts)?
     };
-    let mut fit = summarise(&data, fs, &chosen);
+    let mut fit = summarise(&reported, fs, &chosen);
     if opts.select {
         fit.ambiguous = ambiguity::ambiguities(&data, fs, opts.ieee, opts.gm, &chosen);
     }
@@ -382,9 +389,10 @@ pub fn allan_terms(
     terms: &[Term],
     filter: Option<&OutputFilter>,
 ) -> Vec<Vec<f64>> {
-    taus.iter()
-        .map(|&t| {
-            let white = filter.map_or(1.0, |f| f.white_factor(t * fs));
+    let ms: Vec<f64> = taus.iter().map(|t| t * fs).collect();
+    let white = filter.map_or_else(|| vec![1.0; taus.len()], |f| f.white_factors(&ms));
+    (taus.iter().zip(&white))
+        .map(|(&t, &white)| {
             (terms.iter())
                 .map(|term| term.allan_variance(t, t * fs, fs, white))
                 .collect()
@@ -468,11 +476,38 @@ fn covariance(data: &Data, fs: f64, terms: &[Term], d2: f64) -> Vec<Vec<f64>> {
             }
         }
     }
+    // The output filter's white level, measured with a relative variance: the fitted
+    // coordinates move with it by dx/dε = −F⁻¹ Σ wᵢ gᵢ hᵢ, hᵢ = ∂ln Mᵢ/∂ε (the white
+    // term's share through the level's slope of c), and carry that variance too.
+    let level: Vec<f64> = (0..data.len())
+        .filter(|_| data.level_var > 0.0)
+        .map(|i| {
+            let white: f64 = (terms.iter())
+                .filter(|t| t.kind() == Kind::White)
+                .map(|t| t.allan_variance(data.taus[i], data.m[i], fs, data.white_level[i]))
+                .sum();
+            white / model_at(data, fs, terms, i)
+        })
+        .collect();
     for keep in [all, without_oscillator] {
         if let Some(inv) = nnls::invert_spd(&fisher(&keep)) {
+            let pull: Vec<f64> = (keep.iter())
+                .filter(|_| data.level_var > 0.0)
+                .map(|&a| {
+                    (rows.iter().zip(&level))
+                        .map(|((w, g), h)| w * g[a] * h)
+                        .sum()
+                })
+                .collect();
+            let moved: Vec<f64> = (0..pull.len())
+                .map(|a| -(0..keep.len()).map(|b| inv[a][b] * pull[b]).sum::<f64>())
+                .collect();
             for (a, &ka) in keep.iter().enumerate() {
                 for (b, &kb) in keep.iter().enumerate() {
                     cov[slots[ka]][slots[kb]] = inv[a][b];
+                    if data.level_var > 0.0 {
+                        cov[slots[ka]][slots[kb]] += data.level_var * moved[a] * moved[b];
+                    }
                 }
             }
             break;

@@ -257,3 +257,32 @@ def test_model_json_carries_gauss_markov(white_plus_gm):
     assert len(parts["gauss_markov"]) == 2 and parts["gauss_markov"][0][0]["tau_c"] > 0
     assert 0 < d["coverage"][0] <= 1
     assert set(d["readoff"]) == {"N", "K", "B"}
+
+
+def test_the_notes_follow_the_cores_datasheet_rule():
+    """Which Gauss–Markov term counts in N, stands in for K or is a bump: one rule, the
+    core's (Term::white_share, walk_share), read by the values and the notes alike."""
+    from imunoise._core import fit as core_fit
+    from imunoise.noise._datasheet import datasheet_notes
+    from imunoise.noise._typed import from_core
+
+    fs, record = 100.0, 1e4
+    core = [("white", [1e-6]), ("gauss_markov", [1e-8, 0.1]),  # hump before 1 s: in N
+            ("gauss_markov", [1e-8, 20.0]),                     # hump within the record
+            ("gauss_markov", [1e-8, 6000.0])]                   # hump beyond it: K
+    shares = core_fit.datasheet_shares(core, fs, record)
+    assert [w > 0 for w, _ in shares] == [True, True, False, False]
+    assert [k > 0 for _, k in shares] == [False, False, False, True]
+    cov = np.zeros((7, 7))
+    values = dict(core_fit.datasheet(core, cov, np.array([0.01, 1000.0]), fs, record=record))
+    assert values["N"][0] == pytest.approx(np.sqrt(sum(w for w, _ in shares)), rel=1e-12)
+    assert values["K"][0] == pytest.approx(np.sqrt(sum(k for _, k in shares)), rel=1e-12)
+    notes = datasheet_notes(from_core(core, cov), fs, record, "wls")
+    assert len(notes) == 2
+    assert "bump of τc 20 s" in notes[0]
+    assert "K includes a Gauss–Markov term of τc 6e+03 s" in notes[1]
+    # a record beyond the slow term's hump makes it a bump too
+    longer = datasheet_notes(from_core(core, cov), fs, 2e4, "wls")
+    assert len(longer) == 2 and all("bump" in note for note in longer)
+    with pytest.raises(ValueError, match="record must be finite and > 0"):
+        core_fit.datasheet_shares(core, fs, 0.0)

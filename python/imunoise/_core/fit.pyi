@@ -64,13 +64,17 @@ def fit_noise(
     resonance: bool = True,
     motion: bool = True,
     filter: npt.NDArray[np.float64] | None = None,
+    filter_level_std: float = 0.0,
 ) -> NoiseFit:
     """Log-space, octave-weighted fit of the noise model (IEEE terms, up to
     ``gm`` Gauss–Markov terms, up to ``tones`` tones, with ``resonance`` a
     damped oscillator and with ``motion`` a bounded motion of the mount) to one
     channel; structure chosen by BIC when ``select``. ``filter``: the sensor's
     output-filter power gain G at L ≥ 2 frequencies evenly spaced from 0 Hz
-    (G = 1) to fs/2; the white term is seen through it."""
+    (G = 1) to fs/2; the white term is seen through it. ``filter_level_std``: the
+    relative standard uncertainty of the white level G was measured against (G
+    scales as its inverse from its first point that is not 1); the covariance
+    carries it."""
 
 def allan_terms(
     taus: npt.NDArray[np.float64],
@@ -87,7 +91,17 @@ def filter_factor(
     filter: npt.NDArray[np.float64],
 ) -> npt.NDArray[np.float64]:
     """c(τ): the white term's Allan variance through the output filter ``filter``
-    (power gain from 0 Hz to fs/2, G(0) = 1) over the one without."""
+    (power gain from 0 Hz to fs/2, G(0) = 1) over the one without; exact for a gain
+    linear between its points at whole cluster sizes τ·fs, read linearly between."""
+
+def density_allan(
+    taus: npt.NDArray[np.float64],
+    fs: float,
+    density: npt.NDArray[np.float64],
+) -> npt.NDArray[np.float64]:
+    """Allan variance at ``taus`` of a process whose one-sided density (units²/Hz,
+    any sign) is ``density`` at L ≥ 2 frequencies evenly spaced from 0 Hz to fs/2,
+    linear between them."""
 
 def datasheet(
     terms: list[tuple[str, list[float]]],
@@ -109,3 +123,12 @@ def model_floor(
 ) -> tuple[float, float] | None:
     """(τ, σ) of the floor of the model's deviation over ``taus`` (where B is read),
     or None where the curve has none."""
+
+def datasheet_shares(
+    terms: list[tuple[str, list[float]]],
+    fs: float,
+    record: float,
+) -> list[tuple[float, float]]:
+    """(white, walk) per term: what it adds to the datasheet's N² and to its K² over a
+    record of ``record`` seconds (0 where it counts in neither), the rules of
+    ``datasheet``."""

@@ -49,6 +49,7 @@ from imunoise.noise._terms import (
     TERMS,
     term_variances,
 )
+from imunoise.noise._typed import GaussMarkov
 
 #: Points of the log-spaced grid over the fitted taus on which B's minimum is sought.
 _B_GRID = 200
@@ -74,12 +75,6 @@ def datasheet_values(components, core, taus, method: str,
             values[name][c], stds[name][c] = v, e
     out.update({t: (values[t], stds[t]) for t in values})
     return out
-
-
-def walks_beyond(tau_c: float, record: float) -> bool:
-    """Whether a Gauss–Markov term of correlation time ``tau_c`` rises to the end of a
-    record of ``record`` seconds (its hump lies beyond it), and so may stand in for K."""
-    return GM_PEAK * tau_c > record
 
 
 #: Confidence of the bound on a value the data do not resolve.
@@ -118,17 +113,23 @@ def upper_bounds(taus, var, edf) -> dict[str, np.ndarray]:
     return out
 
 
-def datasheet_notes(components, record: float, channel: int, method: str) -> tuple[str, ...]:
-    """What a reader of channel ``channel``'s K needs to know: which slow
-    Gauss–Markov terms stand in for it (hump beyond the record) and which are bumps
-    within the record, bias states of their own left out of it."""
+def datasheet_notes(terms, fs: float, record: float, method: str) -> tuple[str, ...]:
+    """What a reader of one channel's K needs to know (``terms``: its typed terms):
+    which slow Gauss–Markov terms stand in for it (hump beyond the record) and which
+    are bumps within the record, bias states of their own left out of it. Which term
+    counts where is the core's rule (``Term::white_share``, ``walk_share``)."""
     if method != "wls":
         return ()
+    markov = [t for t in terms if isinstance(t, GaussMarkov)]
+    if not markov:
+        return ()
+    shares = _core_fit.datasheet_shares([t.core() for t in markov], float(fs), float(record))
     notes = []
-    for _, tau_c in components.gauss_markov(channel):
-        if GM_PEAK * tau_c <= 1.0:  # in N: its hump lies before the 1 s read-off
+    for term, (white, walk) in zip(markov, shares, strict=True):
+        tau_c = term.tau_c
+        if white > 0:  # in N: its hump lies before the 1 s read-off
             continue
-        if walks_beyond(tau_c, record):
+        if walk > 0:
             notes.append(f"K includes a Gauss–Markov term of τc {tau_c:.3g} s whose hump "
                          f"(τ ≈ {GM_PEAK * tau_c:.3g} s) lies beyond the record "
                          f"({record:.3g} s): over the record it rises like a random walk")

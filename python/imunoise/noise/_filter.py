@@ -62,9 +62,10 @@ The white term's Allan variance with the filter is (N²/τ)·c(τ),
 
 ν = f/fs, m = τ·fs: the Allan variance of a sampled process with two-sided spectrum
 S(ν) is ∫ S(ν)·2 sin⁴(πνm)/(m² sin²πν) dν over [−½, ½], 1/m for unit white noise.
-``filter_factor`` (the tests' oracle of the core's c(τ)) evaluates it exactly for G
-linear between the grid's points, from the Fourier coefficients of G − 1 (the kernel
-is a Fejér kernel times sin²(πνm), a finite cosine sum), in O(L log L + taus).
+The core evaluates it (and the Allan variance of the flicker and walk's share, the
+same integral over another piecewise-linear density) exactly for G linear between the
+grid's points, from the Fourier coefficients of G − 1 (``rust/fit/filter.rs``):
+:meth:`OutputFilter.factor` and :meth:`OutputFilter.excess` read it from there.
 """
 
 from __future__ import annotations
@@ -80,7 +81,7 @@ from scipy import stats as _stats
 from imunoise._core import fit as _core_fit
 from imunoise.errors import ImunoiseTypeError, ImunoiseValueError
 
-__all__ = ["OutputFilter", "estimate_filter", "filter_factor"]
+__all__ = ["OutputFilter", "estimate_filter"]
 
 #: Bins of the running median on either side of its centre: a line's Hann leakage
 #: stays above a white floor 60 dB below it for ±8 bins, and a median ignores a
@@ -126,6 +127,10 @@ class OutputFilter:
     psd, low : ndarray, (L,)
         The running median of the PSD on ``f`` and the flicker and walk part of the
         level, h₋₁/f + h₋₂/f² (:meth:`excess`).
+    white_std : float
+        Relative standard uncertainty of ``white`` (of its fit to the log-binned
+        spectrum): G above ``white_top`` scales as its inverse, and the fit's
+        uncertainties carry it (0: not known).
     """
 
     f: np.ndarray
@@ -135,6 +140,7 @@ class OutputFilter:
     white: float
     psd: np.ndarray = field(repr=False, default=None)
     low: np.ndarray = field(repr=False, default=None)
+    white_std: float = 0.0
 
     def __post_init__(self) -> None:
         for name in ("f", "gain", "psd", "low"):
@@ -150,7 +156,8 @@ class OutputFilter:
         if self.low is None:
             return np.zeros(np.size(taus))
         d = (self.gain - 1.0) * np.where(self.f > 0, self.low, 0.0)
-        return _allan_of(taus, self.fs, d)
+        t = np.ascontiguousarray(np.atleast_1d(np.asarray(taus, dtype=float)))
+        return _core_fit.density_allan(t, float(self.fs), np.ascontiguousarray(d))
 
     def factor(self, taus) -> np.ndarray:
         """c(τ): the white term's Allan variance with the filter over N²/τ, from the
@@ -158,59 +165,28 @@ class OutputFilter:
         t = np.ascontiguousarray(np.atleast_1d(np.asarray(taus, dtype=float)))
         return _core_fit.filter_factor(t, float(self.fs), np.ascontiguousarray(self.gain))
 
+    def apply(self, x) -> np.ndarray:
+        """``x``, (n,) or (n, k) sampled at ``fs``, through this filter: each rFFT bin
+        times √G at its frequency (G linear between the grid's points), with the line
+        from the first to the last sample taken off before and put back after (a
+        record is no period of itself). A zero-phase filter whose output has the
+        spectrum of ``x`` times G: how a bootstrap's replicates get the sensor's
+        filter."""
+        x = np.asarray(x, dtype=float)
+        flat = x.reshape(x.shape[0], -1)
+        n = flat.shape[0]
+        amplitude = np.sqrt(np.interp(np.fft.rfftfreq(n, 1.0 / self.fs), self.f, self.gain))
+        ramp = np.linspace(0.0, 1.0, n)
+        out = np.empty_like(flat)
+        for k in range(flat.shape[1]):  # a column at a time: the spectra stay small
+            line = flat[0, k] + (flat[-1, k] - flat[0, k]) * ramp
+            out[:, k] = np.fft.irfft(np.fft.rfft(flat[:, k] - line) * amplitude, n) + line
+        return out.reshape(x.shape)
+
     def __repr__(self) -> str:
         low = float(self.gain.min())
         return (f"OutputFilter({self.gain.size} freqs to {self.fs / 2:g} Hz, white to "
                 f"{self.white_top:.3g} Hz, gain down to {low:.3g})")
-
-
-def _allan_of(taus, fs: float, density) -> np.ndarray:
-    """Allan variance at ``taus`` of a process whose one-sided spectrum is ``density``
-    (units²/Hz on k·(fs/2)/(L−1), linear between the points; any sign):
-    (1/2τ)·2m∫₀^½ X(ν)·2 sin⁴(πνm)/(m² sin²πν) dν."""
-    t = np.atleast_1d(np.asarray(taus, dtype=float))
-    return (_kernel_sum(t, fs, np.asarray(density, dtype=float)) - 1.0) / (2 * t)
-
-
-def filter_factor(taus, fs: float, gain) -> np.ndarray:
-    """c(τ) of the white term through the filter ``gain`` (G on k·(fs/2)/(L−1),
-    k = 0…L−1, linear between the points), m = τ·fs rounded to a whole sample.
-
-    With D = G − 1 and d_j its Fourier coefficients on the circle (ν in cycles per
-    sample, D even about 0 and ½), the kernel's cosine sum gives
-
-    c(m) − 1 = (A − B)/m,  A = Σ_{|j|<m} (m − |j|) d_j,  B = Σ_{0<j<2m} (m − |j − m|) d_j,
-
-    each from prefix sums of d_j and j·d_j. The coefficients of the piecewise-linear
-    D are its samples' DFT times sinc²(πj/M), M = 2(L − 1).
-    """
-    g = np.asarray(gain, dtype=float)
-    if g.ndim != 1 or g.size < 2:
-        raise ImunoiseValueError(f"gain must be a 1-D array of at least 2 values; got shape "
-                                 f"{g.shape}")
-    if not np.all(np.isfinite(g)) or np.any(g < 0):
-        raise ImunoiseValueError("gain must hold finite values >= 0")
-    t = np.atleast_1d(np.asarray(taus, dtype=float))
-    if not np.all(np.isfinite(t)) or np.any(t <= 0):
-        raise ImunoiseValueError(f"taus must be finite and > 0; got {t!r}")
-    return _kernel_sum(t, fs, g - 1.0)
-
-
-def _kernel_sum(t, fs, d):
-    """1 + 2m∫₀^½ d(ν)·2 sin⁴(πνm)/(m² sin²πν) dν for d linear between its points."""
-    g = d
-    m = np.maximum(np.rint(t * float(fs)), 1).astype(np.int64)
-    big = 2 * (g.size - 1)  # samples of D on the whole circle
-    circle = np.r_[d, d[-2:0:-1]]
-    dft = np.fft.fft(circle).real / big  # even sequence: real coefficients
-    top = int(2 * m.max())
-    j = np.arange(top + 1)
-    coef = dft[j % big] * np.sinc(j / big) ** 2  # np.sinc(x) = sin(πx)/(πx)
-    p0 = np.cumsum(np.r_[0.0, coef[1:]])  # P0(n) = Σ_{1..n} d_j
-    p1 = np.cumsum(np.r_[0.0, j[1:] * coef[1:]])  # P1(n) = Σ_{1..n} j·d_j
-    a = m * coef[0] + 2 * (m * p0[m - 1] - p1[m - 1])
-    b = p1[m] + 2 * m * (p0[2 * m - 1] - p0[m]) - (p1[2 * m - 1] - p1[m])
-    return 1.0 + (a - b) / m
 
 
 def estimate_filter(spectrum, channel: int = 0) -> OutputFilter | None:
@@ -266,7 +242,8 @@ def estimate_filter(spectrum, channel: int = 0) -> OutputFilter | None:
     low = np.zeros(size)
     low[1:] = h1 / grid[1:] + h2 / grid[1:] ** 2
     return OutputFilter(f=grid, gain=_gain(grid, numerator, low, h0, start), fs=fs,
-                        white_top=float(start), white=float(h0), psd=numerator, low=low)
+                        white_top=float(start), white=float(h0), psd=numerator, low=low,
+                        white_std=float(u_h0))
 
 
 def _crossover(h0, h1, h2, lowest):

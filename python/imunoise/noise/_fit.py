@@ -10,6 +10,7 @@ import os
 import warnings
 from collections.abc import Sequence
 from concurrent.futures import ThreadPoolExecutor
+from dataclasses import fields, replace
 
 import numpy as np
 
@@ -179,9 +180,10 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
         as one independent piece of evidence and the model discrepancy δ
         included. ``"bootstrap"``: parametric bootstrap — ``replicates`` records
         of the same length and rate are simulated from the fitted model
-        (:func:`imunoise.simulate`), analysed with the same taus and refitted
-        with the same structure; each ``*_std`` is the standard deviation over
-        the replicates (≈ 0.6 s per replicate and channel for 5 h at 40 Hz).
+        (:func:`imunoise.simulate`; through the channel's output filter where
+        one was measured), analysed with the same taus and refitted with the
+        same structure (and filter); each ``*_std`` is the standard deviation
+        over the replicates (≈ 0.6 s per replicate and channel for 5 h at 40 Hz).
     replicates : int
         ``"bootstrap"`` only: number of simulated records (≥ 5; default 30).
     seed : int, numpy.random.Generator or None
@@ -227,6 +229,17 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
     Standard uncertainties of the coefficients follow from those of their
     squares: u(N) = u(N²)/(2N); of a correlation time from that of ln τc.
     """
+    return _fit(result, method=method, terms=terms, tau_range=tau_range,
+                uncertainty=uncertainty, replicates=replicates, seed=seed,
+                warn_coverage=warn_coverage, spectrum=spectrum, sensor=sensor,
+                output_filter=output_filter)
+
+
+def _fit(result, *, method, terms, tau_range, uncertainty, replicates, seed, warn_coverage,
+         spectrum, sensor, output_filter, filters=None) -> NoiseModel:
+    """:func:`fit`; ``filters``, when given, are the channels' output filters (None:
+    none) in place of those the spectrum shows: a bootstrap refits its replicates,
+    simulated through the point fit's filter, with that same filter."""
     if method not in ("wls", "slopes"):
         raise ImunoiseValueError(f"method must be 'wls' or 'slopes'; got {method!r}")
     if uncertainty not in ("independent", "bootstrap"):
@@ -255,7 +268,8 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
     taus, var, edf, one = _extract(result, tau_range)
     dev_all, edf_raw = measured(result, taus)
     channels = var.shape[1]
-    filters = _filters(spectrum, channels, output_filter and method == "wls")
+    if filters is None:
+        filters = _filters(spectrum, channels, output_filter and method == "wls")
     coef = np.zeros((channels, 5))
     std = np.full((channels, 5), np.nan)
     sup = np.zeros((channels, 5), dtype=bool)
@@ -311,6 +325,14 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
         for c in range(channels):
             ok = usable[c]
             coef[c], std[c], sup[c], rng[c] = fit_slopes(taus[ok], var[ok, c], edf[ok, c], mask)
+    def terms_of(c):
+        """Channel ``c``'s typed terms: the core's fit, or the read-off's coefficients."""
+        if core[c] is not None:
+            return _typed.from_core(*core[c])
+        return tuple(_typed.IEEE[name](float(coef[c, j]), float(std[c, j]))
+                     for j, name in enumerate(TERMS) if coef[c, j] > 0)
+
+    typed = [terms_of(c) for c in range(channels)]
     sheet_std = np.full((channels, 5), np.nan)  # bootstrap: of the datasheet values
     if uncertainty == "bootstrap":
         generator = np.random.default_rng(seed)
@@ -327,17 +349,16 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
                                                  *["resonance"] * len(oscs),
                                                  *["motion"] * len(motions)],
                            tau_range=tau_range)
-            std[c], gm_std[c], sine_std[c], osc_std[c], moving_std[c], sheet_std[c] = \
-                _bootstrap_std(result, n_record, coef[c], markov, (tones, oscs, motions),
-                               int(replicates), generator, options)
+            typed[c], sheet_std[c] = _bootstrap_std(
+                result, n_record, typed[c], coef[c], markov, (tones, oscs, motions),
+                int(replicates), generator, options, filters[c])
+            # the deprecated arrays' uncertainties from the terms'
+            (_, std[c], _, _, gm_std[c], _, sine_std[c], _, osc_std[c], _,
+             moving_std[c]) = _legacy_arrays(typed[c])
     std[~sup] = np.nan
-    # The typed terms come from the core; only a bootstrap, which replaced their
-    # uncertainties in the arrays, rebuilds them from there.
-    typed = tuple(
-        _typed.from_core(*core[c]) if core[c] is not None and uncertainty != "bootstrap"
-        else _typed_terms(coef[c], std[c], gm[c], gm_std[c], sine[c], sine_std[c], osc[c],
-                          osc_std[c], moving[c], moving_std[c])
-        for c in range(channels))
+    if method != "wls":  # the read-off's flags: a coefficient it did not place has no std
+        typed = [terms_of(c) for c in range(channels)]
+    typed = tuple(typed)
     requested = () if select or method != "wls" else tuple(terms)
     unplaced = [_unplaced(requested, typed[c]) for c in range(channels)]
     if any(unplaced):
@@ -394,7 +415,7 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
         **{k + "_std": shaped(np.where(resolved[k], e, np.nan)) for k, (_, e) in sheet.items()},
         supported={k: shaped(v) for k, v in resolved.items()},
         upper={k: shaped(np.where(resolved[k], np.nan, bounds[k])) for k in TERMS},
-        notes=tuple((*datasheet_notes(components, record, c, method),
+        notes=tuple((*datasheet_notes(typed[c], result.fs, record, method),
                      *(tie.note() for tie in tied[c]),
                      *_unplaced_note(unplaced[c]),
                      *_filter_notes(filters[c], spectrum, output_filter, method))
@@ -466,7 +487,7 @@ def _filter_notes(found, spectrum, wanted: bool, method: str) -> tuple[str, ...]
     """What a reader of one channel's values must know about its output filter."""
     if method != "wls" or not wanted:
         return ()
-    if spectrum is None:
+    if found is None and spectrum is None:
         return ("the output filter was not taken from a spectrum (fitted from the Allan "
                 "deviation alone): a filter's roll-off at the short taus is drawn by the "
                 "other terms; pass spectrum=imunoise.psd(x, fs) or fit the log",)
@@ -562,11 +583,13 @@ def _record_length(result) -> int:
     return n0 + 2 * m0 - 1 if overlapping else (n0 + 1) * m0
 
 
-def _bootstrap_std(result, n, coef, markov, oscillators, replicates, rng, options):
-    """Standard deviation of each coefficient (and Gauss–Markov σ, τc, tone A, f0,
-    resonance σ, f_r, τr, skew, motion σθ, τc, and the datasheet values Q…R) over fits to
-    records simulated from the model with the rate and taus of ``result`` and its
-    length ``n``; ``oscillators`` is (tones, resonances, motions)."""
+def _bootstrap_std(result, n, terms, coef, markov, oscillators, replicates, rng, options,
+                   found=None):
+    """``terms`` (one channel's) with the standard deviation of each parameter, and that
+    of the datasheet values Q…R, over fits to records simulated from the model with the
+    rate and taus of ``result`` and its length ``n``; ``oscillators`` is (tones,
+    resonances, motions). With the channel's output filter ``found`` the records pass
+    through it and are refitted with it, as the point fit was."""
     from imunoise._simulation.simulate import simulate
     from imunoise.allan import adev
 
@@ -575,28 +598,42 @@ def _bootstrap_std(result, n, coef, markov, oscillators, replicates, rng, option
                     sinusoid=tones or None,
                     resonance=oscs[0] if oscs else None,
                     motion=motions[0] if motions else None)
+    if found is not None:
+        sims = found.apply(sims)
     again = adev(sims, result.fs, taus=np.asarray(result.taus), overlapping=result.overlapping,
                  confidence=result.confidence)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)
-        refit = fit(again, **options)
-    parts = refit._arrays
-    values = np.stack([np.atleast_1d(parts.value(t)) for t in TERMS], axis=1)
-    gm = np.stack([np.reshape(parts.gm_sigma, (-1, GM_MAX)),
-                   np.reshape(parts.gm_tau, (-1, GM_MAX))], axis=-1)
-    tone = np.stack([np.reshape(parts.sine_amplitude, (-1, TONES_MAX)),
-                     np.reshape(parts.sine_freq, (-1, TONES_MAX))], axis=-1)
-    osc = np.stack([np.atleast_1d(a) for a in (parts.resonance_sigma, parts.resonance_freq,
-                                               parts.resonance_tau,
-                                               parts.resonance_skew)], axis=-1)
-    moving = np.stack([np.atleast_1d(parts.motion_sigma), np.atleast_1d(parts.motion_tau)],
-                      axis=-1)
+        refit = _fit(again, uncertainty="independent", replicates=replicates, seed=None,
+                     warn_coverage=False, spectrum=None, sensor="gyro", output_filter=True,
+                     filters=None if found is None else (found,) * replicates, **options)
     sheet = np.stack([refit.value(t) for t in TERMS], axis=1)  # NaN: not resolved
     with warnings.catch_warnings():
-        warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN: no tone
-        return (values.std(axis=0, ddof=1), np.nanstd(gm, axis=0, ddof=1),
-                np.nanstd(tone, axis=0, ddof=1), np.nanstd(osc, axis=0, ddof=1),
-                np.nanstd(moving, axis=0, ddof=1), np.nanstd(sheet, axis=0, ddof=1))
+        warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN: no such term
+        return _spread(terms, refit.terms), np.nanstd(sheet, axis=0, ddof=1)
+
+
+def _spread(terms, replicas) -> tuple:
+    """``terms`` (one channel's) with each parameter's uncertainty the standard deviation
+    of that parameter over ``replicas`` (per replicate, its refitted terms): the k-th
+    term of a kind against each replicate's k-th of that kind. A replicate without it
+    has an IEEE coefficient at 0 (the data put it there) and another term missing."""
+    out, seen = [], {}
+    for term in terms:
+        kind = type(term)
+        k = seen[kind] = seen.get(kind, -1) + 1
+        ieee = isinstance(term, _typed._Ieee)
+        same = [[t for t in replica if type(t) is kind] for replica in replicas]
+        spread = {}
+        for f in fields(term):
+            if f.name.endswith("_std"):
+                continue
+            v = np.array([float(getattr(s[k], f.name)) if len(s) > k else
+                          (0.0 if ieee else np.nan) for s in same])
+            spread[f.name + "_std"] = float(np.std(v, ddof=1) if ieee
+                                            else np.nanstd(v, ddof=1))
+        out.append(replace(term, **spread))
+    return tuple(out)
 
 
 def _readonly(a):
@@ -614,7 +651,8 @@ def _fit_wls(t, v, e, fs, mask, gm_count, oscillators, select, found=None):
             r = _core_fit.fit_noise(*args)
         else:
             r = _core_fit.fit_noise(*_less(args, found.excess(t)),
-                                    filter=np.ascontiguousarray(found.gain))
+                                    filter=np.ascontiguousarray(found.gain),
+                                    filter_level_std=float(found.white_std))
     except ValueError as exc:
         raise ImunoiseValueError(f"cannot fit the noise model to result: {exc}") from None
     terms = _typed.from_core(r.terms, np.asarray(r.cov))
@@ -671,23 +709,6 @@ def _unplaced_note(names) -> tuple[str, ...]:
         return ()
     return (f"requested {', '.join(names)} came out at 0: the data hold none of "
             f"{'it' if len(names) == 1 else 'them'} at this record's length and noise",)
-
-
-def _typed_terms(coef, std, gm, gm_std, sine, sine_std, osc, osc_std, moving, moving_std):
-    """One channel's typed terms from its arrays (after a bootstrap has replaced
-    their uncertainties): the terms present, in the model's order."""
-    terms: list[_typed.Term] = [
-        _typed.IEEE[name](float(coef[j]), float(std[j]))
-        for j, name in enumerate(TERMS) if coef[j] > 0]
-    terms += [_typed.GaussMarkov(*map(float, (*gm[k], *gm_std[k])))
-              for k in range(len(gm)) if np.isfinite(gm[k, 0])]
-    terms += [_typed.Tone(*map(float, (*sine[k], *sine_std[k])))
-              for k in range(len(sine)) if np.isfinite(sine[k, 0])]
-    if np.isfinite(osc[0]):
-        terms.append(_typed.Resonance(*map(float, (*osc, *osc_std))))
-    if np.isfinite(moving[0]):
-        terms.append(_typed.Motion(*map(float, (*moving, *moving_std))))
-    return tuple(terms)
 
 
 def _slot_covariance(core_terms, cov):

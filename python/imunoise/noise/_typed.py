@@ -162,14 +162,11 @@ class Ramp(_Ieee):
 
 
 @dataclass(frozen=True, repr=False)
-class GaussMarkov(Term):
-    """First-order Gauss–Markov bias: standard deviation ``sigma`` (rate) and
-    correlation time ``tau_c`` (s); its Allan variance is the sampled AR1 form of
-    IEEE 952 Annex C (rising as +½ below τc, a hump near 1.89 τc, −½ beyond)."""
+class _VarianceAndTime(Term):
+    """A term of a standard deviation ``sigma`` and a time ``tau_c`` (s): the core
+    holds σ² and τc, its covariance σ² and ln τc (the Gauss–Markov term, the
+    bounded motion)."""
 
-    kind: ClassVar[str] = "gauss_markov"
-    noun: ClassVar[str] = "Gauss–Markov bump"
-    requested: ClassVar[str] = "GM"
     sigma: float
     tau_c: float
     sigma_std: float = math.nan
@@ -178,13 +175,24 @@ class GaussMarkov(Term):
     def core(self) -> tuple[str, list[float]]:
         return self.kind, [self.sigma**2, self.tau_c]
 
-    def label(self) -> str:
-        return f"GM({_summary.number(self.tau_c)} s)"
-
     @classmethod
     def from_core(cls, parameters, cov):
         sigma, u_sigma = _sigma(parameters[0], cov[0, 0])
         return cls(sigma, parameters[1], u_sigma, _from_log(parameters[1], cov[1, 1]))
+
+
+@dataclass(frozen=True, repr=False)
+class GaussMarkov(_VarianceAndTime):
+    """First-order Gauss–Markov bias: standard deviation ``sigma`` (rate) and
+    correlation time ``tau_c`` (s); its Allan variance is the sampled AR1 form of
+    IEEE 952 Annex C (rising as +½ below τc, a hump near 1.89 τc, −½ beyond)."""
+
+    kind: ClassVar[str] = "gauss_markov"
+    noun: ClassVar[str] = "Gauss–Markov bump"
+    requested: ClassVar[str] = "GM"
+
+    def label(self) -> str:
+        return f"GM({_summary.number(self.tau_c)} s)"
 
 
 @dataclass(frozen=True, repr=False)
@@ -249,7 +257,7 @@ class Resonance(Term):
 
 
 @dataclass(frozen=True, repr=False)
-class Motion(Term):
+class Motion(_VarianceAndTime):
     """A bounded motion of the mount: its angle (velocity, for an accelerometer)
     wanders as a Gauss–Markov process of standard deviation ``sigma`` (rate·s) and
     correlation time ``tau_c`` (s) and comes back; the platform's, not the sensor's."""
@@ -257,21 +265,9 @@ class Motion(Term):
     kind: ClassVar[str] = "motion"
     noun: ClassVar[str] = "bounded motion"
     requested: ClassVar[str] = "motion"
-    sigma: float
-    tau_c: float
-    sigma_std: float = math.nan
-    tau_c_std: float = math.nan
-
-    def core(self) -> tuple[str, list[float]]:
-        return self.kind, [self.sigma**2, self.tau_c]
 
     def label(self) -> str:
         return f"motion({_summary.number(self.tau_c)} s)"
-
-    @classmethod
-    def from_core(cls, parameters, cov):
-        sigma, u_sigma = _sigma(parameters[0], cov[0, 0])
-        return cls(sigma, parameters[1], u_sigma, _from_log(parameters[1], cov[1, 1]))
 
 
 #: Every kind, by the core's name, in the order a model lists them.
