@@ -78,7 +78,13 @@ pub fn identify_alphas(c: &[f64], ms: &[usize], dmax: u32) -> Vec<Option<i32>> {
     for (i, &m) in ms.iter().enumerate() {
         match decimation(c.len(), m) {
             Some((len, _)) if len == MAX_POINTS => full.push(i),
-            _ => out[i] = identify_alpha(c, m, dmax),
+            // Its points gathered once: the passes then read them contiguously
+            // (the series of factor 1 of the gathered points is the same).
+            Some((len, first)) => {
+                let points: Vec<f64> = (first..first + len).map(|k| c[k * m]).collect();
+                out[i] = identify_alpha(&points, 1, dmax);
+            }
+            None => {}
         }
     }
     for group in full.chunks(LANES) {
