@@ -323,14 +323,11 @@ mod x86 {
         let (mut sum, mut comp) = ([zero; 2], [zero; 2]);
         for i in (0..CHUNK).step_by(4) {
             // SAFETY: (first + l)·CHUNK + i + 4 ≤ LANES·CHUNK = group.len().
-            let steps = [
-                load_steps256(group.as_ptr(), 0, i),
-                load_steps256(group.as_ptr(), 4, i),
-            ];
-            for j in 0..4 {
-                for h in 0..2 {
-                    (sum[h], comp[h]) = step256(sum[h], comp[h], _mm256_sub_pd(steps[h][j], m));
-                }
+            let low = load_steps256(group.as_ptr(), 0, i);
+            let high = load_steps256(group.as_ptr(), 4, i);
+            for (a, b) in low.into_iter().zip(high) {
+                (sum[0], comp[0]) = step256(sum[0], comp[0], _mm256_sub_pd(a, m));
+                (sum[1], comp[1]) = step256(sum[1], comp[1], _mm256_sub_pd(b, m));
             }
         }
         let (mut s, mut c) = ([0.0f64; LANES], [0.0f64; LANES]);

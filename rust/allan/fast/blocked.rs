@@ -151,12 +151,12 @@ impl Sweep<'_> {
         let mut k0 = start;
         while k0 < end {
             let k1 = (k0 + BLOCK).min(end);
-            for j in 0..self.ms.len() {
+            for (j, acc) in acc.iter_mut().enumerate() {
                 if self.by_column[j] {
                     continue;
                 }
                 if let Some(s) = self.block_sum(j, k0, k1) {
-                    acc[j].add(s);
+                    acc.add(s);
                 }
             }
             k0 = k1;
