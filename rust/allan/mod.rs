@@ -95,9 +95,10 @@ pub fn analyse_plan_with(
     }
     let mut job = Job::new(phases, plan, n_phase)?;
     job.ratio = ratio;
-    let swept = job.sweep_blocked(stop);
+    // The noise types need only the phase: identified beside the sweep.
+    let (swept, alphas) = rayon::join(|| job.sweep_blocked(stop), || job.identify(stop));
     stop.check()?;
-    let estimates = job.estimate_pairs(&swept, stop);
+    let estimates = job.estimate_pairs(&swept, &alphas, stop);
     stop.check()?;
     let (var, mut alpha, alpha_identified) = job.gather(estimates)?;
     for c in 0..job.channels {
@@ -265,10 +266,45 @@ impl<'a> Job<'a> {
         swept
     }
 
-    /// The variance of every pair (from the sweep where it ran) and the noise type
-    /// identified there, if the series is long enough.
-    /// Pairs not started before `stop` is raised are NaN.
-    fn estimate_pairs(&self, swept: &[Option<f64>], stop: &Interrupt) -> Vec<(f64, Option<i32>)> {
+    /// The noise type of every pair, if its series is long enough: each channel's
+    /// factors of one statistic together (`noise_id::identify_alphas`).
+    /// Meaningless once `stop` is raised.
+    fn identify(&self, stop: &Interrupt) -> Vec<Option<i32>> {
+        let groups: Vec<(Statistic, Vec<usize>, Vec<usize>, usize)> = self
+            .by_statistic()
+            .into_iter()
+            .flat_map(|(s, taus, ms)| {
+                let factors: Vec<usize> = ms.iter().map(|&m| s.noise_id_factor(m)).collect();
+                (0..self.channels).map(move |c| (s, taus.clone(), factors.clone(), c))
+            })
+            .collect();
+        let found: Vec<Vec<Option<i32>>> = groups
+            .par_iter()
+            .map(|(s, _, factors, c)| {
+                if stop.raised() {
+                    return vec![None; factors.len()];
+                }
+                let phase = runs::identification_phase(&self.phases[*c]);
+                noise_id::identify_alphas(phase, factors, s.spec().dmax)
+            })
+            .collect();
+        let mut alphas = vec![None; self.pairs.len()];
+        for ((_, taus, _, c), found) in groups.iter().zip(found) {
+            for (&t, alpha) in taus.iter().zip(found) {
+                alphas[t * self.channels + c] = alpha;
+            }
+        }
+        alphas
+    }
+
+    /// The variance of every pair (from the sweep where it ran) beside its noise
+    /// type from `alphas`. Pairs not started before `stop` is raised are NaN.
+    fn estimate_pairs(
+        &self,
+        swept: &[Option<f64>],
+        alphas: &[Option<i32>],
+        stop: &Interrupt,
+    ) -> Vec<(f64, Option<i32>)> {
         // ThêoBR's bias ratio belongs to a channel, not a tau: computed once each.
         // The sweep behind it also gives Theo1 at ThêoBR's factors up to ≈ 0.13·N.
         let theobr_ms: Vec<usize> = self
@@ -302,12 +338,7 @@ impl<'a> Job<'a> {
                         .estimate_in_segments(&phase.c, &g.segments, m)
                         .map_or(f64::NAN, |e| e.var),
                 };
-                let alpha = noise_id::identify_alpha(
-                    runs::identification_phase(phase),
-                    statistic.noise_id_factor(m),
-                    statistic.spec().dmax,
-                );
-                (var, alpha)
+                (var, alphas[i])
             })
             .collect()
     }

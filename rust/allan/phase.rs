@@ -145,29 +145,34 @@ pub fn into_cumulative_phase(mut phase: Vec<f64>) -> CoreResult<Phase> {
     with_gaps_located(phase, chunk_sums)
 }
 
-/// [`into_cumulative_phase`] of one contiguous channel, with the same result:
-/// the copy into the phase vector and the chunk sums run together on all cores.
+/// [`into_cumulative_phase`] of one contiguous channel, with the same result.
+/// The samples are summed (for the mean) and their chunks totalled where they
+/// are; the phase is written once, by the running sum itself. A record whose sum
+/// is not finite (missing samples, ±∞, overflow) is copied and goes the general
+/// way.
 pub fn contiguous_phase(samples: &[f64]) -> CoreResult<Phase> {
     let n = samples.len();
     if n == 0 {
         return Err(CoreError::InvalidArgument("x must not be empty".into()));
     }
+    let chunk_sums: Vec<f64> = samples.par_chunks(CHUNK).map(compensated_sum).collect();
+    let total = chunk_sums.iter().sum::<Neumaier>().value();
+    if !total.is_finite() {
+        return with_gaps_located(gather(samples.iter().copied()), chunk_sums);
+    }
+    // running_phase without gaps, from the samples into a fresh phase vector.
+    let mean = total / n as f64;
+    let starts = chunk_starts(samples, mean);
     let mut phase = Vec::with_capacity(n + 1);
     crate::memory::advise_huge_pages(&phase);
     phase.push(0.0);
-    let chunk_sums: Vec<f64> = phase.spare_capacity_mut()[..n]
-        .par_chunks_mut(CHUNK)
-        .zip(samples.par_chunks(CHUNK))
-        .map(|(out, values)| {
-            for (slot, &v) in out.iter_mut().zip(values) {
-                slot.write(v);
-            }
-            compensated_sum(values)
-        })
-        .collect();
-    // SAFETY: the loop above wrote all n slots after the leading 0.
+    running_sum::run_chunks_into(samples, &mut phase.spare_capacity_mut()[..n], &starts, mean);
+    // SAFETY: run_chunks_into wrote all n slots after the leading 0.
     unsafe { phase.set_len(n + 1) };
-    with_gaps_located(phase, chunk_sums)
+    Ok(Phase {
+        c: phase,
+        gaps: None,
+    })
 }
 
 /// The cumulative phase of `phase[1..]` given the sums of its chunks. A finite
@@ -206,8 +211,15 @@ fn running_phase(mut phase: Vec<f64>, chunk_sums: &[f64], gaps: Option<Gaps>) ->
             at = s.end;
         }
     }
-    // Each chunk's total as (sum, error), then the running pair at each chunk start.
-    let totals = running_sum::chunk_totals(&phase[1..], mean);
+    let starts = chunk_starts(&phase[1..], mean);
+    running_sum::run_chunks(&mut phase[1..], &starts, mean);
+    Phase { c: phase, gaps }
+}
+
+/// The running pair (sum, error) at the start of each chunk of `values`: each
+/// chunk's total of `v − mean` as (sum, error), then their prefix.
+fn chunk_starts(values: &[f64], mean: f64) -> Vec<(f64, f64)> {
+    let totals = running_sum::chunk_totals(values, mean);
     let mut starts = Vec::with_capacity(totals.len());
     let mut at = (0.0f64, 0.0f64);
     for (sum, comp) in totals {
@@ -215,8 +227,7 @@ fn running_phase(mut phase: Vec<f64>, chunk_sums: &[f64], gaps: Option<Gaps>) ->
         let (t, err) = two_sum(at.0, sum);
         at = (t, at.1 + err + comp);
     }
-    running_sum::run_chunks(&mut phase[1..], &starts, mean);
-    Phase { c: phase, gaps }
+    starts
 }
 
 /// The runs of valid samples of `y`, whose first non-finite value is at `first`;

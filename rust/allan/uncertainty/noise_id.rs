@@ -25,15 +25,12 @@ pub const MAX_POINTS: usize = 1 << 16;
 /// central [`MAX_POINTS`]. Streams over `c` without copying it: the quadratic is fitted in one pass and
 /// the residuals and their differences are evaluated on the fly.
 pub fn identify_alpha(c: &[f64], m: usize, dmax: u32) -> Option<i32> {
-    if m == 0 {
-        return None;
-    }
-    let available = c.len().div_ceil(m);
-    if available < MIN_POINTS {
-        return None;
-    }
-    let len = available.min(MAX_POINTS);
-    let first = (available - len) / 2;
+    identify(c, m, dmax).map(|(alpha, _)| alpha)
+}
+
+/// [`identify_alpha`] with the ρ it was decided on.
+fn identify(c: &[f64], m: usize, dmax: u32) -> Option<(i32, f64)> {
+    let (len, first) = decimation(c.len(), m)?;
     let x = |k: usize| c[(first + k) * m];
     let trend = QuadraticTrend::fit(len, x)?;
     let residual = |k: usize| x(k) - trend.at(k);
@@ -43,10 +40,233 @@ pub fn identify_alpha(c: &[f64], m: usize, dmax: u32) -> Option<i32> {
         let r1 = lag1_autocorrelation(count, value)?;
         let rho = r1 / (1.0 + r1);
         if rho < 0.25 || d >= dmax {
-            return Some(2 - (2.0 * rho).round_ties_even() as i32 - 2 * d as i32);
+            return Some((alpha_of(rho, d), rho));
         }
     }
     None
+}
+
+/// The points of the decimated series and the first of them (its central
+/// stretch), or `None` when it is too short to identify.
+fn decimation(points: usize, m: usize) -> Option<(usize, usize)> {
+    if m == 0 {
+        return None;
+    }
+    let available = points.div_ceil(m);
+    if available < MIN_POINTS {
+        return None;
+    }
+    let len = available.min(MAX_POINTS);
+    Some((len, (available - len) / 2))
+}
+
+fn alpha_of(rho: f64, d: u32) -> i32 {
+    2 - (2.0 * rho).round_ties_even() as i32 - 2 * d as i32
+}
+
+/// [`identify_alpha`] of `c` at every averaging factor of `ms`, with the same
+/// bits: the factors whose decimated series are equally long (all those of a
+/// long record up to `len(c)/MAX_POINTS`) run [`LANES`] at a time, one in each
+/// lane of the same operations in the same order, on a gathered copy of their
+/// points, with the quadratic's normal matrix (which depends on the length
+/// only) formed once. The identification of a long record's short taus was a
+/// few passes of dependent additions over strided points for each tau; here
+/// the lanes' chains overlap and the points are read contiguously.
+pub fn identify_alphas(c: &[f64], ms: &[usize], dmax: u32) -> Vec<Option<i32>> {
+    let mut out = vec![None; ms.len()];
+    let mut full: Vec<usize> = Vec::new();
+    for (i, &m) in ms.iter().enumerate() {
+        match decimation(c.len(), m) {
+            Some((len, _)) if len == MAX_POINTS => full.push(i),
+            // Its points gathered once: the passes then read them contiguously
+            // (the series of factor 1 of the gathered points is the same).
+            Some((len, first)) => {
+                let points: Vec<f64> = (first..first + len).map(|k| c[k * m]).collect();
+                out[i] = identify_alpha(&points, 1, dmax);
+            }
+            None => {}
+        }
+    }
+    for group in full.chunks(LANES) {
+        // A short group is padded with its first factor (its result is dropped).
+        let lanes: [usize; LANES] = std::array::from_fn(|l| ms[group[l.min(group.len() - 1)]]);
+        let found = identify_lanes(c, lanes, dmax);
+        for (l, &i) in group.iter().enumerate() {
+            out[i] = found[l].map(|(alpha, _)| alpha);
+        }
+    }
+    out
+}
+
+/// Factors identified together by [`identify_alphas`].
+const LANES: usize = 8;
+
+/// [`identify`] at `LANES` factors whose decimated series all have
+/// [`MAX_POINTS`] points; compiled for AVX2 or AVX-512 where the CPU has them
+/// (the operations, and so the bits, are the same on every path).
+fn identify_lanes(c: &[f64], ms: [usize; LANES], dmax: u32) -> [Option<(i32, f64)>; LANES] {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use crate::simd::{level, Level};
+        if level() >= Level::Avx512 {
+            // SAFETY: the CPU has AVX-512F (the level never exceeds the CPU's).
+            return unsafe { identify_lanes_avx512(c, ms, dmax) };
+        }
+        if level() >= Level::Avx2 {
+            // SAFETY: the CPU has AVX2.
+            return unsafe { identify_lanes_avx2(c, ms, dmax) };
+        }
+    }
+    identify_lanes_portable(c, ms, dmax)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+unsafe fn identify_lanes_avx512(
+    c: &[f64],
+    ms: [usize; LANES],
+    dmax: u32,
+) -> [Option<(i32, f64)>; LANES] {
+    identify_lanes_portable(c, ms, dmax)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn identify_lanes_avx2(
+    c: &[f64],
+    ms: [usize; LANES],
+    dmax: u32,
+) -> [Option<(i32, f64)>; LANES] {
+    identify_lanes_portable(c, ms, dmax)
+}
+
+type Lanes = [f64; LANES];
+
+#[inline(always)]
+fn identify_lanes_portable(
+    c: &[f64],
+    ms: [usize; LANES],
+    dmax: u32,
+) -> [Option<(i32, f64)>; LANES] {
+    let len = MAX_POINTS;
+    let firsts: [usize; LANES] = std::array::from_fn(|l| {
+        decimation(c.len(), ms[l])
+            .expect("a full decimated series")
+            .1
+    });
+    let mut r: Vec<Lanes> = (0..len)
+        .map(|k| std::array::from_fn(|l| c[(firsts[l] + k) * ms[l]]))
+        .collect();
+    // The quadratic: QuadraticTrend::fit's sums, the normal matrix once.
+    let scale = 2.0 / (len - 1) as f64;
+    let mut gram = [[0.0f64; 3]; 3];
+    let mut rhs = [[0.0f64; LANES]; 3];
+    for (k, x) in r.iter().enumerate() {
+        let t = k as f64 * scale - 1.0;
+        let basis = [1.0, t, t * t];
+        for p in 0..3 {
+            for l in 0..LANES {
+                rhs[p][l] += basis[p] * x[l];
+            }
+            for q in p..3 {
+                gram[p][q] += basis[p] * basis[q];
+            }
+        }
+    }
+    for p in 0..3 {
+        for q in 0..p {
+            gram[p][q] = gram[q][p];
+        }
+    }
+    let mut coef = [[0.0f64; 3]; LANES];
+    for l in 0..LANES {
+        match solve3(gram, [rhs[0][l], rhs[1][l], rhs[2][l]]) {
+            Some(x) => coef[l] = x,
+            None => return [None; LANES],
+        }
+    }
+    // The residuals in place (QuadraticTrend::at).
+    for (k, x) in r.iter_mut().enumerate() {
+        let t = k as f64 * scale - 1.0;
+        for l in 0..LANES {
+            x[l] -= coef[l][0] + t * (coef[l][1] + t * coef[l][2]);
+        }
+    }
+    let mut found: [Option<Option<(i32, f64)>>; LANES] = [None; LANES];
+    for d in 0..=dmax {
+        let count = len - d as usize;
+        let r1 = match d {
+            0 => lag1_lanes(count, |k| r[k]),
+            1 => lag1_lanes(count, |k| {
+                std::array::from_fn(|l| difference(1, 0, |j| r[k + j][l]))
+            }),
+            2 => lag1_lanes(count, |k| {
+                std::array::from_fn(|l| difference(2, 0, |j| r[k + j][l]))
+            }),
+            _ => lag1_lanes(count, |k| {
+                std::array::from_fn(|l| difference(3, 0, |j| r[k + j][l]))
+            }),
+        };
+        for l in 0..LANES {
+            if found[l].is_some() {
+                continue;
+            }
+            match r1[l] {
+                None => found[l] = Some(None),
+                Some(r1) => {
+                    let rho = r1 / (1.0 + r1);
+                    if rho < 0.25 || d >= dmax {
+                        found[l] = Some(Some((alpha_of(rho, d), rho)));
+                    }
+                }
+            }
+        }
+        if found.iter().all(Option::is_some) {
+            break;
+        }
+    }
+    found.map(Option::flatten)
+}
+
+/// [`lag1_autocorrelation`] in every lane.
+#[inline(always)]
+fn lag1_lanes(count: usize, x: impl Fn(usize) -> Lanes) -> [Option<f64>; LANES] {
+    if count < 2 {
+        return [None; LANES];
+    }
+    // The start of `Iterator::sum` of f64 (its sign of zero).
+    let zero: f64 = std::iter::empty::<f64>().sum();
+    let mut total = [zero; LANES];
+    for k in 0..count {
+        let v = x(k);
+        for l in 0..LANES {
+            total[l] += v[l];
+        }
+    }
+    let mean: Lanes = std::array::from_fn(|l| total[l] / count as f64);
+    let mut num = [0.0; LANES];
+    let mut den = [0.0; LANES];
+    let v = x(0);
+    let mut previous: Lanes = std::array::from_fn(|l| v[l] - mean[l]);
+    for l in 0..LANES {
+        den[l] += previous[l] * previous[l];
+    }
+    for k in 1..count {
+        let v = x(k);
+        for l in 0..LANES {
+            let a = v[l] - mean[l];
+            den[l] += a * a;
+            num[l] += previous[l] * a;
+            previous[l] = a;
+        }
+    }
+    std::array::from_fn(|l| {
+        if den[l] > 0.0 && den[l].is_finite() {
+            Some(num[l] / den[l])
+        } else {
+            None
+        }
+    })
 }
 
 /// The d-th forward difference Σ_j (−1)^(d−j) C(d, j) r_{k+j} (d ≤ 3).
@@ -249,6 +469,42 @@ mod tests {
         for k in [0, 17, 99] {
             assert!((trend.at(k) - x(k)).abs() < 1e-9);
         }
+    }
+
+    #[test]
+    fn lanes_give_the_bits_of_one_factor_at_a_time() {
+        // Long enough for factors 1..=12 to have the full MAX_POINTS points;
+        // several noise types, so the lanes stop at different differences.
+        let n = 12 * MAX_POINTS + 5;
+        let w = white(n, 21);
+        let walk = cumsum(&w);
+        let mix: Vec<f64> = w
+            .iter()
+            .zip(cumsum(&cumsum(&white(n, 4))))
+            .map(|(a, b)| 3e3 * a + 1e-3 * b)
+            .collect();
+        let ms: Vec<usize> = (1..=12).chain([20, 40, 1000, 9000, 20000]).collect();
+        for c in [w, walk.clone(), cumsum(&walk), mix] {
+            for dmax in [2, 3] {
+                let batch = identify_alphas(&c, &ms, dmax);
+                for (i, &m) in ms.iter().enumerate() {
+                    assert_eq!(batch[i], identify_alpha(&c, m, dmax), "m {m} dmax {dmax}");
+                }
+                let lanes: [usize; LANES] = std::array::from_fn(|l| ms[l + 1]);
+                for (l, got) in identify_lanes(&c, lanes, dmax).into_iter().enumerate() {
+                    let want = identify(&c, lanes[l], dmax);
+                    assert_eq!(
+                        got.map(|(a, rho)| (a, rho.to_bits())),
+                        want.map(|(a, rho)| (a, rho.to_bits())),
+                        "m {} dmax {dmax}",
+                        lanes[l]
+                    );
+                }
+            }
+        }
+        assert!(identify_alphas(&[0.0; 50], &[1, 2], 2)
+            .iter()
+            .all(Option::is_none));
     }
 
     #[test]
