@@ -9,9 +9,7 @@ use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2}
 use pyo3::prelude::*;
 
 use crate::fit::filter::OutputFilter;
-use crate::fit::{
-    self, Kind, Options, Term, FLICKER_FACTOR, IEEE_TERMS, IEEE_TERM_NAMES, MAX_GM, MAX_TONES,
-};
+use crate::fit::{self, Kind, Options, Term, FLICKER_FACTOR, IEEE_TERM_NAMES, MAX_GM, MAX_TONES};
 
 /// The fit of one channel, as `_core.fit.NoiseFit`.
 #[pyclass(name = "NoiseFit", module = "imunoise._core.fit", frozen, get_all)]
@@ -37,18 +35,6 @@ struct PyNoiseFit {
     ambiguous: Vec<(&'static str, &'static str, f64)>,
 }
 
-fn ieee_flags(terms: &[bool]) -> PyResult<[bool; IEEE_TERMS]> {
-    if terms.len() != IEEE_TERMS {
-        return Err(super::value_error(format!(
-            "terms must have {IEEE_TERMS} flags (Q, N, B, K, R); got {}",
-            terms.len()
-        )));
-    }
-    let mut mask = [false; IEEE_TERMS];
-    mask.copy_from_slice(terms);
-    Ok(mask)
-}
-
 /// The output filter's gains, checked by the core.
 fn output_filter(gain: Option<PyReadonlyArray1<'_, f64>>) -> PyResult<Option<OutputFilter>> {
     gain.map(|g| OutputFilter::new(g.as_array().to_vec()))
@@ -62,36 +48,32 @@ fn to_matrix(rows: Vec<Vec<f64>>, cols: usize) -> PyResult<Array2<f64>> {
         .map_err(|e| super::value_error(e.to_string()))
 }
 
-/// fit_noise(taus, var, edf, fs, terms, gm, select, tones, resonance, motion, filter,
-/// filter_level_std) -> NoiseFit
+/// fit_noise(taus, var, edf, fs, counts, select=True, filter=None, filter_level_std=0.0)
+/// -> NoiseFit: `counts` the (kind, number) of each kind of term the model may use
+/// (`select`, the most) or has (not `select`, exactly); kinds not named have none.
 #[pyfunction]
 #[allow(clippy::too_many_arguments)] // mirrors the Python keyword arguments
-#[pyo3(signature = (taus, var, edf, fs, terms, gm=3, select=true, tones=2, resonance=true, motion=true, filter=None, filter_level_std=0.0))]
+#[pyo3(signature = (taus, var, edf, fs, counts, select=true, filter=None, filter_level_std=0.0))]
 fn fit_noise<'py>(
     py: Python<'py>,
     taus: PyReadonlyArray1<'py, f64>,
     var: PyReadonlyArray1<'py, f64>,
     edf: PyReadonlyArray1<'py, f64>,
     fs: f64,
-    terms: Vec<bool>,
-    gm: usize,
+    counts: Vec<(String, usize)>,
     select: bool,
-    tones: usize,
-    resonance: bool,
-    motion: bool,
     filter: Option<PyReadonlyArray1<'py, f64>>,
     filter_level_std: f64,
 ) -> PyResult<PyNoiseFit> {
     let filter = output_filter(filter)?
         .map(|f| f.with_level_std(filter_level_std))
         .transpose()?;
+    let kinds = (counts.iter())
+        .map(|(name, n)| Ok((Kind::from_name(name)?, *n)))
+        .collect::<Result<Vec<_>, crate::error::CoreError>>()?;
     let opts = Options {
-        ieee: ieee_flags(&terms)?,
-        gm,
-        tones,
-        resonance,
-        motion,
         select,
+        ..Options::exactly(&kinds)
     };
     let taus = taus.as_array().to_vec();
     let var = var.as_array().to_vec();
@@ -327,6 +309,8 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
         })
         .collect();
     m.add("TERM_KINDS", kinds)?;
+    let most: Vec<(&str, usize)> = Kind::ALL.iter().map(|k| (k.name(), k.most())).collect();
+    m.add("TERM_MOST", most)?;
     m.add("FLICKER_FACTOR", FLICKER_FACTOR)?;
     m.add("GM_PEAK", fit::term::GM_PEAK)?;
     m.add("FLAT_SLOPE", fit::datasheet::FLAT_SLOPE)?;

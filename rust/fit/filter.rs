@@ -399,14 +399,7 @@ mod tests {
             .map(|r| r.iter().sum())
             .collect();
         let edf: Vec<f64> = taus.iter().map(|t| 1e5 / (t * fs)).collect();
-        let opts = Options {
-            ieee: [false, true, true, true, false],
-            gm: 0,
-            tones: 0,
-            resonance: false,
-            motion: false,
-            select: false,
-        };
+        let opts = Options::exactly(&[(Kind::White, 1), (Kind::Flicker, 1), (Kind::RandomWalk, 1)]);
         let white = |f: &OutputFilter| {
             let fit = fit_noise(&taus, &var, &edf, fs, &opts, Some(f)).unwrap();
             let k = fit

@@ -50,34 +50,64 @@ pub const MAX_GM: usize = 3;
 
 pub use search::MAX_TONES;
 
-/// What [`fit_noise`] may use.
-#[derive(Debug, Clone, Copy)]
+/// What [`fit_noise`] may use: how many terms of each kind.
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Options {
-    /// Which of Q, N, B, K, R may enter the model.
-    pub ieee: [bool; IEEE_TERMS],
-    /// Gauss–Markov terms: the most allowed (`select`) or the exact number.
-    pub gm: usize,
-    /// Tones: the most allowed (`select`, at most [`MAX_TONES`]) or the exact
-    /// number fitted.
-    pub tones: usize,
-    /// A resonance: may enter (`select`) or is fitted (not `select`).
-    pub resonance: bool,
-    /// A bounded motion: may enter (`select`) or is fitted (not `select`).
-    pub motion: bool,
-    /// Choose the structure by BIC (`true`), or fit exactly the terms given.
+    /// Terms of each kind, indexed as [`Kind::ALL`]: the most the selection may
+    /// use (`select`), or the number fitted; at most [`Kind::most`].
+    pub counts: [usize; Kind::ALL.len()],
+    /// Choose the structure by its score (`true`), or fit exactly the terms given.
     pub select: bool,
+}
+
+impl Options {
+    /// Every kind of term up to its most, the structure selected.
+    pub fn auto() -> Options {
+        Options {
+            counts: Kind::ALL.map(Kind::most),
+            select: true,
+        }
+    }
+
+    /// Exactly `kinds` (kind, count), nothing else, no selection.
+    pub fn exactly(kinds: &[(Kind, usize)]) -> Options {
+        let mut counts = [0; Kind::ALL.len()];
+        for &(kind, n) in kinds {
+            counts[kind as usize] += n;
+        }
+        Options {
+            counts,
+            select: false,
+        }
+    }
+
+    /// How many terms of `kind`.
+    pub fn count(&self, kind: Kind) -> usize {
+        self.counts[kind as usize]
+    }
+
+    /// Which of Q, N, B, K, R may enter.
+    pub fn ieee(&self) -> [bool; IEEE_TERMS] {
+        Kind::IEEE.map(|k| self.count(k) > 0)
+    }
+
+    /// An error naming the first kind asked for more often than it may be.
+    fn check(&self) -> CoreResult<()> {
+        match Kind::ALL.into_iter().find(|&k| self.count(k) > k.most()) {
+            Some(k) => Err(CoreError::InvalidArgument(format!(
+                "at most {} {} term(s); got {}",
+                k.most(),
+                k.name(),
+                self.count(k)
+            ))),
+            None => Ok(()),
+        }
+    }
 }
 
 impl Default for Options {
     fn default() -> Self {
-        Options {
-            ieee: [true; IEEE_TERMS],
-            gm: MAX_GM,
-            tones: MAX_TONES,
-            resonance: true,
-            motion: true,
-            select: true,
-        }
+        Options::auto()
     }
 }
 
@@ -147,18 +177,8 @@ pub fn fit_noise(
     opts: &Options,
     filter: Option<&OutputFilter>,
 ) -> CoreResult<NoiseFit> {
-    if opts.tones > MAX_TONES {
-        return Err(CoreError::InvalidArgument(format!(
-            "at most {MAX_TONES} tones; got {}",
-            opts.tones
-        )));
-    }
-    if opts.gm > MAX_GM {
-        return Err(CoreError::InvalidArgument(format!(
-            "at most {MAX_GM} Gauss-Markov terms; got {}",
-            opts.gm
-        )));
-    }
+    opts.check()?;
+    let (ieee, gm) = (opts.ieee(), opts.count(Kind::GaussMarkov));
     let reported = Data::new(taus, var, edf, fs)?.with_filter(filter);
     // The search and its pruning judge terms by what the data constrain; the white
     // level the filter was measured against, one number for every tau, enters the
@@ -169,12 +189,16 @@ pub fn fit_noise(
     };
     let chosen = if opts.select {
         let selected = |motion: bool| -> CoreResult<Candidate> {
-            let kinds = (opts.tones, opts.resonance, motion);
-            let best = search::select(&data, fs, opts.ieee, opts.gm, kinds)?;
-            let best = search::prefer_random_walk(&data, fs, opts.ieee, opts.gm, kinds, best)?;
+            let kinds = (
+                opts.count(Kind::Tone),
+                opts.count(Kind::Resonance) > 0,
+                motion,
+            );
+            let best = search::select(&data, fs, ieee, gm, kinds)?;
+            let best = search::prefer_random_walk(&data, fs, ieee, gm, kinds, best)?;
             prune_insignificant(&data, fs, best)
         };
-        let best = selected(opts.motion)?;
+        let best = selected(opts.count(Kind::Motion) > 0)?;
         // A motion is searched last, on what the search had then; pruning and the
         // walk's check after it can leave a structure the search without it beats
         // (on the first half of the VN-100 accelerometer X, by 1.9, and it predicted
@@ -190,66 +214,13 @@ pub fn fit_noise(
             best
         }
     } else {
-        fixed_structure(&data, fs, opts)?
+        search::requested(&data, fs, opts)?
     };
     let mut fit = summarise(&reported, fs, &chosen);
     if opts.select {
-        fit.ambiguous = ambiguity::ambiguities(&data, fs, opts.ieee, opts.gm, &chosen);
+        fit.ambiguous = ambiguity::ambiguities(&data, fs, ieee, gm, &chosen);
     }
     Ok(fit)
-}
-
-/// The structure `opts` names, fitted as it is (no selection): the IEEE terms and
-/// Gauss–Markov terms, then the tone, the resonance and the bounded motion each
-/// searched on top of what came before. Any of them may be the only term.
-fn fixed_structure(data: &Data, fs: f64, opts: &Options) -> CoreResult<Candidate> {
-    let base = search::fit_structure(data, fs, opts.ieee, 0, 0.0, &[]);
-    let d2 = base.as_ref().map_or(0.0, |b| b.solution.d2);
-    let mut current = if opts.gm == 0 {
-        base.ok()
-    } else {
-        Some(search::fit_structure(
-            data,
-            fs,
-            opts.ieee,
-            opts.gm,
-            d2,
-            &[],
-        )?)
-    };
-    let shape = |c: &Option<Candidate>| match c {
-        Some(c) => (c.gm_tau.clone(), c.sine, c.resonance, c.solution.d2),
-        None => (Vec::new(), search::Tones::NONE, None, d2),
-    };
-    for _ in 0..opts.tones {
-        let (times, tones, _, d2) = shape(&current);
-        let toned = search::with_sine(data, fs, opts.ieee, (&times, tones, None), d2, false)?;
-        current = toned.or(current);
-    }
-    if opts.resonance {
-        // The resonance with and without a quadrature part; the lower BIC is its fit.
-        let (times, sine, _, d2) = shape(&current);
-        let mut fitted: Option<Candidate> = None;
-        for skewed in [false, true] {
-            let shape = (times.as_slice(), sine, skewed);
-            if let Some(c) = search::with_resonance(data, fs, opts.ieee, shape, d2, false)? {
-                if fitted.as_ref().is_none_or(|f| c.bic < f.bic) {
-                    fitted = Some(c);
-                }
-            }
-        }
-        current = fitted.or(current);
-    }
-    if opts.motion {
-        let (times, sine, res, d2) = shape(&current);
-        let moved = search::with_motion(data, fs, opts.ieee, (&times, sine, res), d2, false)?;
-        current = moved.or(current);
-    }
-    current.ok_or_else(|| {
-        CoreError::Numerical(
-            "noise-model fit found no model with a positive Allan variance at every tau".into(),
-        )
-    })
 }
 
 /// Smallest z = variance / standard uncertainty a selected term may have.
@@ -742,10 +713,8 @@ mod tests {
                 assert!(u.is_finite() && u < s2, "{per_decade}: {u}");
             }
             assert!((fit.ieee()[1] / ieee[1] - 1.0).abs() < 0.01, "{fit:?}");
-            let one = Options {
-                tones: 1,
-                ..Options::default()
-            };
+            let mut one = Options::auto();
+            one.counts[Kind::Tone as usize] = 1;
             let edf = vec![1e6; taus.len()];
             let single = fit_noise(&taus, &var, &edf, FS, &one, None).unwrap();
             assert!(
@@ -877,14 +846,7 @@ mod tests {
         for (i, v) in var.iter_mut().enumerate() {
             *v *= 1.0 + 1e-3 * ((i % 3) as f64 - 1.0);
         }
-        let opts = Options {
-            select: false,
-            gm: 0,
-            tones: 0,
-            resonance: false,
-            motion: false,
-            ieee: [false, true, true, true, false],
-        };
+        let opts = Options::exactly(&[(Kind::White, 1), (Kind::Flicker, 1), (Kind::RandomWalk, 1)]);
         let lo = fit_noise(&taus, &var, &edf_white(&taus, 1e4), FS, &opts, None).unwrap();
         let hi = fit_noise(&taus, &var, &edf_white(&taus, 1e6), FS, &opts, None).unwrap();
         for j in [1, 2, 3] {
@@ -902,10 +864,8 @@ mod tests {
         assert!(fit_noise(&[2.0, 1.0], &[1.0, 2.0], &[1.0, 1.0], FS, &o, None).is_err());
         assert!(fit_noise(&[1.0, 2.0], &[1.0, 2.0], &[0.0, 1.0], FS, &o, None).is_err());
         assert!(fit_noise(&[1.0, 2.0], &[1.0, 2.0], &[1.0, 1.0], 0.0, &o, None).is_err());
-        let too_many = Options {
-            gm: MAX_GM + 1,
-            ..o
-        };
+        let mut too_many = o;
+        too_many.counts[Kind::GaussMarkov as usize] = MAX_GM + 1;
         assert!(fit_noise(&[1.0, 2.0], &[1.0, 2.0], &[1.0, 1.0], FS, &too_many, None).is_err());
         let one = fit_noise(&[1.0], &[1.0], &[5.0], FS, &o, None).unwrap();
         assert!(one.ieee().iter().all(|c| c.is_finite() && *c >= 0.0));

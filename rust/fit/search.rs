@@ -48,8 +48,9 @@ use faer::Mat;
 use super::basis::{self, IEEE_TERMS};
 use super::estimate::{self, Data, Solution};
 pub use super::oscillators::{Resonance, Tones, MAX_TONES};
-use super::term::Term;
-use crate::error::CoreResult;
+use super::term::{Kind, Term};
+use super::Options;
+use crate::error::{CoreError, CoreResult};
 
 /// Grid of candidate correlation times per decade.
 const PER_DECADE: f64 = 6.0;
@@ -944,6 +945,54 @@ pub fn with_resonance(
     Ok((!(gated && on_bound(&better))).then_some(better))
 }
 
+/// The structure `opts` names, fitted as it is (no selection): the IEEE terms and
+/// Gauss–Markov terms, then the tone, the resonance and the bounded motion each
+/// searched on top of what came before. Any of them may be the only term.
+pub fn requested(data: &Data, fs: f64, opts: &Options) -> CoreResult<Candidate> {
+    let ieee = opts.ieee();
+    let gm = opts.count(Kind::GaussMarkov);
+    let base = fit_structure(data, fs, ieee, 0, 0.0, &[]);
+    let d2 = base.as_ref().map_or(0.0, |b| b.solution.d2);
+    let mut current = if gm == 0 {
+        base.ok()
+    } else {
+        Some(fit_structure(data, fs, ieee, gm, d2, &[])?)
+    };
+    let shape = |c: &Option<Candidate>| match c {
+        Some(c) => (c.gm_tau.clone(), c.sine, c.resonance, c.solution.d2),
+        None => (Vec::new(), Tones::NONE, None, d2),
+    };
+    for _ in 0..opts.count(Kind::Tone) {
+        let (times, tones, _, d2) = shape(&current);
+        let toned = with_sine(data, fs, ieee, (&times, tones, None), d2, false)?;
+        current = toned.or(current);
+    }
+    if opts.count(Kind::Resonance) > 0 {
+        // The resonance with and without a quadrature part; the lower BIC is its fit.
+        let (times, sine, _, d2) = shape(&current);
+        let mut fitted: Option<Candidate> = None;
+        for skewed in [false, true] {
+            let shape = (times.as_slice(), sine, skewed);
+            if let Some(c) = with_resonance(data, fs, ieee, shape, d2, false)? {
+                if fitted.as_ref().is_none_or(|f| c.bic < f.bic) {
+                    fitted = Some(c);
+                }
+            }
+        }
+        current = fitted.or(current);
+    }
+    if opts.count(Kind::Motion) > 0 {
+        let (times, sine, res, d2) = shape(&current);
+        let moved = with_motion(data, fs, ieee, (&times, sine, res), d2, false)?;
+        current = moved.or(current);
+    }
+    current.ok_or_else(|| {
+        CoreError::Numerical(
+            "noise-model fit found no model with a positive Allan variance at every tau".into(),
+        )
+    })
+}
+
 /// Stepwise selection of the IEEE terms among `allowed`: remove the term whose
 /// removal lowers the score most, while one does; then add back the removed term
 /// that lowers it most, if one does, and remove again. Removal alone is greedy:
@@ -962,7 +1011,10 @@ fn eliminate(
         for j in (0..IEEE_TERMS).filter(|&j| active(j, &best)) {
             let mut ieee = best.ieee;
             ieee[j] = false;
-            let trial = rebuilt(data, fs, ieee, &best)?;
+            // A structure that fits no positive curve is no step to take.
+            let Ok(trial) = rebuilt(data, fs, ieee, &best) else {
+                continue;
+            };
             let bar = improved.as_ref().map_or(best.score(), |c| c.score());
             if trial.score() < bar {
                 improved = Some(trial);
@@ -972,7 +1024,9 @@ fn eliminate(
             for j in (0..IEEE_TERMS).filter(|&j| allowed[j] && !active(j, &best)) {
                 let mut ieee = best.ieee;
                 ieee[j] = true;
-                let trial = rebuilt(data, fs, ieee, &best)?;
+                let Ok(trial) = rebuilt(data, fs, ieee, &best) else {
+                    continue;
+                };
                 let bar = improved.as_ref().map_or(best.score(), |c| c.score());
                 // Strictly lower by a margin, so that add and remove cannot cycle
                 // on a tie.

@@ -46,6 +46,15 @@ impl Kind {
         Kind::Ramp,
     ];
 
+    /// Most terms of this kind a model may have.
+    pub fn most(self) -> usize {
+        match self {
+            Kind::GaussMarkov => super::MAX_GM,
+            Kind::Tone => super::MAX_TONES,
+            _ => 1,
+        }
+    }
+
     /// The kind's name, as Python spells its class in snake case.
     pub fn name(self) -> &'static str {
         match self {

@@ -62,6 +62,7 @@ def test_bad_options():
     st.sampled_from(["wls", "slopes"]),
 )
 @example(np.array([7.93270207e307, 7.93270207e307]), "slopes")  # K² overflowed a float
+@example(np.array([7.932702075510204e307, 7.932702075510204e307]), "slopes")  # and B²
 def test_arbitrary_variances_never_crash(var, method):
     """Any variance vector either fits (each value finite and > 0, or NaN with a
     non-negative bound or none) or raises ValueError."""

@@ -89,7 +89,7 @@ def test_explicit_motion_term_and_its_table_rows(rocking):
     assert rows["σθ"]["unit"] == rows["Q"]["unit"]  # an angle, in Q's unit
     assert rows["τm"]["unit"] == "s"
     assert only.components.to_dict()["motion"][0][0]["tau_c"] > 1.0
-    with pytest.raises(ValueError, match="each of 'resonance', 'motion' at most once"):
+    with pytest.raises(ValueError, match=r"every other name at most once; got \['N', 'motion'"):
         imunoise.fit(rocking, terms=["N", "motion", "motion"])
 
 

@@ -161,7 +161,7 @@ def test_the_ekf_export_folds_the_resonance_into_the_white_noise(resonant):
 
 
 def test_explicit_resonance_terms_are_checked(resonant):
-    with pytest.raises(ValueError, match="each of 'resonance', 'motion' at most once"):
+    with pytest.raises(ValueError, match="every other name at most once"):
         imunoise.fit(resonant, terms=["N", "resonance", "resonance"])
     only = quiet_fit(resonant, terms=["N", "resonance"])
     assert all(len(only.components.resonance(c)) == 1 for c in range(2))

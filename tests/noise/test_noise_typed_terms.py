@@ -119,3 +119,24 @@ def test_a_requested_term_the_data_put_at_zero_is_said_not_lost():
         warnings.simplefilter("error", imunoise.CoverageWarning)
         full = imunoise.fit(r, terms=["N"])
     assert not any("requested" in note for note in full.notes[0])
+
+
+def test_fit_asks_for_each_kind_by_its_class_name_and_the_core_checks_the_counts():
+    from imunoise._core import fit as core_fit
+    from imunoise.noise import _typed
+
+    x = imunoise.simulate(20_000, 50.0, N=1e-3, seed=4)
+    r = imunoise.adev(x, 50.0)
+    most = dict(core_fit.TERM_MOST)
+    assert set(most) == set(_typed.KINDS)
+    assert most["gauss_markov"] == imunoise.noise.GM_MAX
+    assert most["tone"] == imunoise.noise.TONES_MAX
+    with pytest.raises(ValueError, match=r"every other name at most once; got \['N', 'N'\]"):
+        imunoise.fit(r, terms=["N", "N"])
+    t, v, e = (np.ascontiguousarray(a, dtype=float) for a in (r.taus, r.var, r.edf))
+    with pytest.raises(ValueError, match="at most 1 white term"):
+        core_fit.fit_noise(t, v, e, 50.0, [("white", 2)], False)
+    with pytest.raises(ValueError, match="term kind must be one of"):
+        core_fit.fit_noise(t, v, e, 50.0, [("pink", 1)], False)
+    fitted = core_fit.fit_noise(t, v, e, 50.0, [("white", 1)], False)
+    assert [kind for kind, _ in fitted.terms] == ["white"]

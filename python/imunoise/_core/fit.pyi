@@ -11,6 +11,8 @@ MAX_GAUSS_MARKOV: int
 """Most first-order Gauss–Markov terms a model may have."""
 MAX_TONES: int
 """Most tones a model may have."""
+#: (kind, the most terms of it a model may have) per kind.
+TERM_MOST: list[tuple[str, int]]
 TERM_KINDS: list[tuple[str, list[str], list[str]]]
 """Every kind of term in the order a model lists them: (name, parameter names,
 covariance coordinate names)."""
@@ -57,19 +59,15 @@ def fit_noise(
     var: npt.NDArray[np.float64],
     edf: npt.NDArray[np.float64],
     fs: float,
-    terms: list[bool],
-    gm: int = 3,
+    counts: list[tuple[str, int]],
     select: bool = True,
-    tones: int = 2,
-    resonance: bool = True,
-    motion: bool = True,
     filter: npt.NDArray[np.float64] | None = None,
     filter_level_std: float = 0.0,
 ) -> NoiseFit:
-    """Log-space, octave-weighted fit of the noise model (IEEE terms, up to
-    ``gm`` Gauss–Markov terms, up to ``tones`` tones, with ``resonance`` a
-    damped oscillator and with ``motion`` a bounded motion of the mount) to one
-    channel; structure chosen by BIC when ``select``. ``filter``: the sensor's
+    """Log-space, octave-weighted fit of the noise model to one channel: ``counts``
+    the (kind, number) of each kind of term (``TERM_KINDS``' names; a kind not named
+    has none), the most the structure may use when ``select`` (chosen by its
+    score), exactly those terms otherwise. ``filter``: the sensor's
     output-filter power gain G at L ≥ 2 frequencies evenly spaced from 0 Hz
     (G = 1) to fs/2; the white term is seen through it. ``filter_level_std``: the
     relative standard uncertainty of the white level G was measured against (G

@@ -122,25 +122,33 @@ def _edf_cap(result, taus):
     return np.where(np.isfinite(cap) & (cap > 1.0), cap, 1.0)
 
 
-def _parse_terms(terms) -> tuple[np.ndarray, int, tuple[int, bool, bool], bool]:
-    """``terms`` → (IEEE mask, Gauss–Markov count, (tones, resonance, motion), select
-    by BIC)."""
+#: Largest Allan variance the fit takes: a term's coefficient is read as the variance
+#: over its form's factor (2 ln2/π for B), which must not overflow float64 when squared
+#: back.
+_LARGEST_VARIANCE = 1e300
+
+
+def _parse_terms(terms) -> tuple[dict[str, int], bool]:
+    """``terms`` → ({kind: count}, select by score): ``"auto"`` allows every kind of term
+    up to its most and selects; a sequence names exactly the terms fitted, each by the
+    name ``fit(terms=...)`` asks for its kind by (the term classes' ``requested``)."""
+    most = dict(_core_fit.TERM_MOST)
     if isinstance(terms, str) and terms == "auto":
-        return np.ones(len(TERMS), dtype=bool), GM_MAX, (TONES_MAX, True, True), True
-    names = tuple(terms) if not isinstance(terms, str) else tuple(terms)
-    allowed = (*TERMS, "GM", "sine", "resonance", "motion")
-    bad = [t for t in names if t not in allowed]
-    gm = names.count("GM")
-    tones = names.count("sine")
-    if (bad or not names or gm > GM_MAX or tones > TONES_MAX
-            or any(names.count(once) > 1 for once in ("resonance", "motion"))):
+        return most, True
+    names = tuple(terms)
+    kind_of = {cls.requested: cls.kind for cls in _typed.KINDS.values()}
+    counts = dict.fromkeys(most, 0)
+    for name in names:
+        if name in kind_of:
+            counts[kind_of[name]] += 1
+    bad = [t for t in names if t not in kind_of]
+    if bad or not names or any(n > most[kind] for kind, n in counts.items()):
+        several = [f"{cls.requested!r} at most {most[kind]} times"
+                   for kind, cls in _typed.KINDS.items() if most[kind] > 1]
         raise ImunoiseValueError(
-            f"terms must be 'auto' or a non-empty sequence of {allowed} with 'GM' at most "
-            f"{GM_MAX} times, 'sine' at most {TONES_MAX} times and each of 'resonance', "
-            f"'motion' at most once; got {terms!r}"
-        )
-    mask = np.array([t in names for t in TERMS])
-    return mask, gm, (tones, "resonance" in names, "motion" in names), False
+            f"terms must be 'auto' or a non-empty sequence of {tuple(kind_of)} with "
+            f"{', '.join(several)} and every other name at most once; got {terms!r}")
+    return counts, False
 
 
 @old_call_forms(keyword_only=("method", "terms", "tau_range"))
@@ -263,7 +271,8 @@ def _fit(result, *, method, terms, tau_range, uncertainty, replicates, seed, war
                 + f" (the simulated records, replicates x samples, are held at once: at most "
                 f"{MAX_BOOTSTRAP_SAMPLES:,}); got replicates={replicates:,}"
             )
-    mask, gm_count, oscillators, select = _parse_terms(terms)
+    counts, select = _parse_terms(terms)
+    mask = np.array([counts[_typed.IEEE[t].kind] > 0 for t in TERMS])
     _check_spectrum(spectrum, result)
     taus, var, edf, one = _extract(result, tau_range)
     dev_all, edf_raw = measured(result, taus)
@@ -289,6 +298,12 @@ def _fit(result, *, method, terms, tau_range, uncertainty, replicates, seed, war
     usable = []
     for c in range(channels):
         ok = np.isfinite(var[:, c]) & (var[:, c] > 0) & np.isfinite(edf[:, c]) & (edf[:, c] > 0)
+        huge = ok & (var[:, c] > _LARGEST_VARIANCE)
+        if huge.any():
+            raise ImunoiseValueError(
+                f"result's Allan variance for channel {c} is {var[huge, c].max():.3g} at tau = "
+                f"{taus[huge][0]:.3g} s; the fit needs it ≤ {_LARGEST_VARIANCE:.0e} (a term's "
+                "coefficient squared must stay within float64): rescale the data")
         if not ok.any():
             raise ImunoiseValueError(
                 f"result has no usable tau for channel {c}: var and edf must be finite and > 0"
@@ -303,8 +318,8 @@ def _fit(result, *, method, terms, tau_range, uncertainty, replicates, seed, war
         # The Rust fit releases the GIL: channels run in parallel threads.
         def fit_channel(c):
             ok = usable[c]
-            return _fit_wls(taus[ok], var[ok, c], edf[ok, c], float(result.fs), mask,
-                            gm_count, oscillators, select, filters[c])
+            return _fit_wls(taus[ok], var[ok, c], edf[ok, c], float(result.fs), counts,
+                            select, filters[c])
 
         with ThreadPoolExecutor(max_workers=min(channels, os.cpu_count() or 1)) as pool:
             fits = list(pool.map(fit_channel, range(channels)))
@@ -642,10 +657,9 @@ def _readonly(a):
     return out
 
 
-def _fit_wls(t, v, e, fs, mask, gm_count, oscillators, select, found=None):
-    tone, resonance, motion = oscillators
+def _fit_wls(t, v, e, fs, counts, select, found=None):
     args = [np.ascontiguousarray(t), np.ascontiguousarray(v), np.ascontiguousarray(e), fs,
-            [bool(m) for m in mask], gm_count, select, tone, resonance, motion]
+            list(counts.items()), select]
     try:
         if found is None:
             r = _core_fit.fit_noise(*args)
@@ -728,10 +742,13 @@ def _slot_covariance(core_terms, cov):
             counts[kind] += 1
         elif kind == "resonance":
             slots += [RES_SLOT, RES_SLOT + 1, RES_SLOT + 2, SKEW_SLOT]
-        else:
+        elif kind == "motion":
             slots += [MOTION_SLOT, MOTION_SLOT + 1]
+        else:  # a kind newer than the deprecated view: not in it
+            slots += [-1] * _typed.COORDINATES[kind]
     index = np.array(slots, dtype=int)
-    out[np.ix_(index, index)] = cov
+    kept = index >= 0
+    out[np.ix_(index[kept], index[kept])] = cov[np.ix_(kept, kept)]
     return out
 
 

@@ -281,7 +281,8 @@ IEEE: dict[str, type[_Ieee]] = {
     cls.name: cls for cls in (Quantization, White, Flicker, RandomWalk, Ramp)
 }
 
-_COORDINATES = {name: len(coords) for name, _, coords in _core_fit.TERM_KINDS}
+#: Covariance coordinates per kind of term.
+COORDINATES = {name: len(coords) for name, _, coords in _core_fit.TERM_KINDS}
 
 
 def from_core(core_terms, cov: np.ndarray) -> tuple[Term, ...]:
@@ -290,7 +291,7 @@ def from_core(core_terms, cov: np.ndarray) -> tuple[Term, ...]:
     out = []
     at = 0
     for kind, parameters in core_terms:
-        width = _COORDINATES[kind]
+        width = COORDINATES[kind]
         out.append(KINDS[kind].from_core(parameters, cov[at:at + width, at:at + width]))
         at += width
     return tuple(out)
