@@ -200,9 +200,8 @@ pub fn fit_noise(
         };
         let best = selected(opts.count(Kind::Motion) > 0)?;
         // A motion is searched last, on what the search had then; pruning and the
-        // walk's check after it can leave a structure the search without it beats
-        // (on the first half of the VN-100 accelerometer X, by 1.9, and it predicted
-        // the second half at 57 % of taus against 87 %). It stays only if it wins.
+        // walk's check after it can leave a structure the search without it beats.
+        // It stays only if it wins.
         if best.motion.is_some() {
             let without = selected(false)?;
             if without.score() <= best.score() {

@@ -34,7 +34,7 @@
 //! plain one with one parameter more.
 //! It is tried on the best structure found without it (tone or not), and a tone
 //! is then searched again on top of it: a line and a band next to each other
-//! (the VN-100 gyro's 13.5 Hz line and its 15–20 Hz band) are two terms.
+//! are two terms.
 //!
 //! A bounded motion (`basis::motion`: the mount's angle wandering and coming
 //! back, a parked vehicle's rocking) is one more column, linear in the angle's
@@ -93,9 +93,9 @@ const RES_Q: [f64; 4] = [1.0, 2.0, 4.0, 8.0];
 
 /// Bounds of the refined quality factor. Below Q = 1 the band is wider than its
 /// centre frequency and its spectrum has no peak to speak of: a low-pass
-/// shape, which the Gauss–Markov terms describe (on the ADIS16405, whose own
-/// filter is such a shape, a free Q went to 0.5 on most channels and moved the
-/// long-tau coefficients). Above Q = 30 it is a line, which the tone describes
+/// shape, which the Gauss–Markov terms describe (a free Q below 1 takes the
+/// sensor's filter and moves the long-tau coefficients). Above Q = 30 it is a
+/// line, which the tone describes
 /// with one parameter fewer. A resonance refined onto either bound is dropped.
 const RES_Q_MIN: f64 = 1.0;
 const RES_Q_MAX: f64 = 30.0;
@@ -609,20 +609,15 @@ pub fn parameters(theta: &[f64], resonance: Option<Resonance>, motion: bool) -> 
 /// tone, a resonance) must lower the criterion, on top of its parameters' own
 /// penalty: 6 is "strong" evidence on Kass and Raftery's scale (JASA 90, 1995).
 /// BIC counts each octave of overlapping Allan estimates as independent, which
-/// they are not, so its own penalty lets a correlated wiggle of the long taus in.
-/// Measured (10 taus per decade, IEEE-only structure against the selected one):
-/// on 64 clean simulated N + B + K axes (5 h at 40 Hz) the components that
-/// entered gained −2.0 to 6.6 (one outlier at 27: a flicker realisation with a
-/// bump); on 31 real channels (ADIS16405, phone, MTi-G, VN-100) 11 to 83, except
-/// a VN-100 accelerometer at 5.5.
+/// they are not, so its own penalty lets a correlated wiggle of the long taus in
+/// (the gains measured on clean and real channels: docs/noise.md).
 pub const COMPONENT_EVIDENCE: f64 = 6.0;
 
 impl Candidate {
     /// Components beyond the IEEE terms in use: Gauss–Markov terms with a
     /// positive variance, the tones, the resonance — twice when it is skewed: its
     /// quadrature part is asked the evidence of a component of its own (counted
-    /// once, a skewed band on the VN-100 gyro X took its 13.4 Hz line as well and
-    /// the model followed 85 % of taus instead of 95 %, out of sample no better).
+    /// once, a skewed band takes a line beside it as well).
     pub fn components(&self) -> usize {
         let theta = &self.solution.theta;
         let gm = (0..self.gm_tau.len())
@@ -828,11 +823,9 @@ pub fn with_sine(
         return Ok(None);
     }
     // A tone refined onto the grid's slowest frequencies is the longest taus'
-    // rise or scatter, which the loss would bend a slower one to (a wander:
-    // on an ADIS16405 accelerometer Z, whose spectrum has no line there, a
-    // second tone at 0.0022 Hz took the rise from K on the denser grids and K
-    // moved by 2.7 standard uncertainties across them). Like a resonance on a
-    // bound of its Q, it is dropped.
+    // rise or scatter, which the loss would bend a slower one to (a wander, not
+    // a line: it takes the rise from K). Like a resonance on a bound of its Q,
+    // it is dropped.
     let lowest = frequency_grid(data, fs).first().copied().unwrap_or(0.0);
     let on_bound = |c: &Candidate| {
         let slowest = c
@@ -912,10 +905,8 @@ pub fn with_resonance(
         s.resonance = Some(res);
         s.polish(&mut times, step);
         s.sine = Tones::NONE;
-        // A band beside a line can take part of it: the line is searched again
-        // (on the ADIS16405 run 4 gyro Z, a band at fs/2 moved its 18.5 Hz line
-        // to 19.5 Hz, two grid steps, and the fit with the line left in place
-        // scored 6 worse, so that 10 taus per decade kept no band).
+        // A band beside a line can take part of it and move it off its
+        // frequency: the line is searched again.
         let sine = s.rescan_tones(&times, sine);
         candidate(data, fs, ieee, times, (sine, Some(res), None), d2)
     };
@@ -997,8 +988,7 @@ pub fn requested(data: &Data, fs: f64, opts: &Options) -> CoreResult<Candidate> 
 /// removal lowers the score most, while one does; then add back the removed term
 /// that lowers it most, if one does, and remove again. Removal alone is greedy:
 /// with K and R in place B can look redundant and go first, and once K and R go
-/// too nothing brought it back (a VN-100 gyro's flat part at 30–130 s went
-/// undescribed while the structure with B scored 5 lower).
+/// too nothing brings it back.
 fn eliminate(
     data: &Data,
     fs: f64,
@@ -1088,10 +1078,8 @@ pub fn select(
     }
     // A slow Gauss–Markov term in place of the walk. The times above are searched
     // with K and R in the model, which take the rise past the floor first; a
-    // bounded wander that falls again at the longest taus (an ADIS16405 gyro X:
-    // a bump at 300 s) then never gets a term of its own, and which structure
-    // wins moved with the tau grid (B + K on octaves, K 4.5 standard
-    // uncertainties from the wander's walk rate on 5–50 per decade).
+    // bounded wander that falls again at the longest taus then never gets a term
+    // of its own, and which structure wins moves with the tau grid.
     if best.solution.theta[WALK] > 0.0 && best.gm_tau.len() < max_gm {
         let mut still = ieee;
         still[WALK] = false;
@@ -1114,10 +1102,8 @@ pub fn select(
     if max_tones > 0 {
         // The tone on its own, beside the best structure and beside the one BIC
         // alone prefers (refined around their times): a tone may complete a
-        // structure that lost without it. Beside the best one only, a tone was
-        // never tried with the filter's fast Gauss–Markov term on the ADIS16405
-        // accelerometers once N + B + K beat that term alone (a score 20 worse
-        // than the structure with both).
+        // structure that lost without it (a sensor's fast filter term and a line
+        // can each lose alone and win together).
         let mut times = vec![Vec::new()];
         for t in [best.gm_tau.clone(), by_bic.gm_tau.clone()] {
             if !times.contains(&t) {
@@ -1171,12 +1157,8 @@ pub fn select(
 const RES_REACH: f64 = 2.0;
 
 /// Log miss of the model's Allan variance that counts as a miss: 0.05 (5 % in
-/// variance, 2.5 % in deviation, half the coverage measure's tolerance). Chosen
-/// from the largest short-tau miss of the structure without a resonance: 0.09
-/// and 0.14 on simulated resonant data (the tests' 30 Hz band), 0.06–0.15 on the
-/// ADIS16405 accelerometers (a 10 Hz peak in their spectrum), 0.17–0.47 on the
-/// VN-100 gyros X and Y, and 0.027–0.045 on the ADIS16405 gyros X and Y, whose
-/// spectrum has no peak (their filter's shape).
+/// variance, 2.5 % in deviation, half the coverage measure's tolerance: a miss
+/// the coverage would not count is no reason to search).
 const RES_MISS: f64 = 0.05;
 
 /// Whether the structure misses the curve at the short taus a resonance shapes
@@ -1255,9 +1237,7 @@ struct Bases<'a> {
     /// The best structure without tones.
     plain: &'a Candidate,
     /// The lowest-scoring structure with tones, whether or not it won: a line
-    /// and the band beside it each leave the other's misfit (the VN-100 gyro X:
-    /// its 13.4 Hz line and 15–20 Hz band; with the tones first, the resonance
-    /// on top, 97 % of taus followed against 81 % by the band alone).
+    /// and the band beside it each leave the other's misfit.
     toned: Option<&'a Candidate>,
 }
 
@@ -1268,9 +1248,8 @@ struct Bases<'a> {
 /// each leave the other's misfit, so the first of them alone can lose and the
 /// pair win. Where `start` has a resonance, it is searched again after each
 /// tone with the tones in place: held fixed, a broad resonance that took a
-/// line's power leaves the line little to gain (on the VN-100 gyro X a 16.6 Hz
-/// band of Q 6 beside its 13.4 Hz line). Returns the toned structure that
-/// scored lowest, won or not.
+/// line's power leaves the line little to gain. Returns the toned structure
+/// that scored lowest, won or not.
 fn add_tones(
     data: &Data,
     fs: f64,
@@ -1313,8 +1292,8 @@ const MOTION_FASTEST: f64 = 2.0;
 /// Shortest correlation time of a bounded motion, in seconds. What the term is
 /// for — a parked vehicle, a building, a bench settling — moves over seconds to
 /// minutes; faster, a mount's motion is a vibration, the tone's and the
-/// resonance's, and a motion there took N's place at the shortest taus, where
-/// the EDF is largest, on 2 of 48 clean N + B + K axes (τc 0.15 and 0.62 s).
+/// resonance's, and a motion there takes N's place at the shortest taus, where
+/// the EDF is largest.
 const MOTION_SHORTEST: f64 = 1.0;
 
 /// Add a bounded motion (`basis::motion`) to the Gauss–Markov times `gm_tau`,
@@ -1361,10 +1340,8 @@ pub fn with_motion(
     let step = 10f64.powf(1.0 / PER_DECADE);
     let lo = (coarse / step).max(shortest);
     let tau_c = golden(lo, (coarse * step).min(tau_max), coarse, TIME_TOL, loss);
-    // On the lower bound it is a shape at the shortest taus the search cut off
-    // rather than a motion: (on the first half of the VN-100 accelerometer X, N +
-    // K + a motion at 1 s predicted the second half at 57 % of taus, N + K alone
-    // at 87 %).
+    // On the lower bound it is a shape at the shortest taus the search cut off,
+    // not a motion.
     if gated && tau_c <= shortest * (1.0 + TIME_TOL) {
         return Ok(None);
     }

@@ -220,8 +220,11 @@ sys.exit(1)
 
 def _interrupt_after_ready(args, env_path):
     env = dict(os.environ, PYTHONPATH=env_path)
+    # A shell's background job inherits SIGINT ignored, and Python then installs no
+    # KeyboardInterrupt: the child gets Ctrl-C's default disposition back.
     proc = subprocess.Popen([sys.executable, *args], stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True, env=env)
+                            stderr=subprocess.PIPE, text=True, env=env,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     assert proc.stdout.readline().strip() == "ready"
     time.sleep(1.5)  # well inside the computation (tens of seconds on 10^6 samples)
     proc.send_signal(signal.SIGINT)
