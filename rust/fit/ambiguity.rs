@@ -14,7 +14,6 @@ use super::estimate::Data;
 use super::search::{self, Candidate};
 use super::term::{Kind, GM_PEAK};
 use super::{IEEE_TERMS, MAX_GM};
-use crate::error::CoreResult;
 
 /// BIC difference below which the data do not prefer one structure to another:
 /// 2, where "positive" evidence starts on Kass and Raftery's scale (JASA 90,
@@ -32,10 +31,6 @@ pub struct Ambiguity {
     pub delta_bic: f64,
 }
 
-fn slot(kind: Kind) -> usize {
-    Kind::IEEE.iter().position(|&k| k == kind).unwrap_or(0)
-}
-
 /// The terms of `chosen` (selected among the IEEE terms `allowed` and up to
 /// `max_gm` Gauss–Markov terms) that an alternative structure fits with a BIC
 /// less than [`DECISIVE`] higher: the random walk against a ramp in its place
@@ -50,10 +45,11 @@ pub fn ambiguities(
     max_gm: usize,
     chosen: &Candidate,
 ) -> Vec<Ambiguity> {
-    let (walk, ramp) = (slot(Kind::RandomWalk), slot(Kind::Ramp));
+    let (walk, ramp) = (search::WALK, search::RAMP);
     let in_use = |j: usize| chosen.ieee[j] && chosen.solution.theta[j] > 0.0;
-    let tie = |kind: Kind, alternative: Kind, other: CoreResult<Candidate>| {
-        let delta_bic = other.ok()?.bic - chosen.bic;
+    // An alternative that fits no positive curve is no alternative.
+    let tie = |kind: Kind, alternative: Kind, other: Option<Candidate>| {
+        let delta_bic = other?.bic - chosen.bic;
         (delta_bic < DECISIVE).then_some(Ambiguity {
             kind,
             alternative,
@@ -64,14 +60,14 @@ pub fn ambiguities(
         let mut ieee = chosen.ieee;
         ieee[off] = false;
         ieee[on] = true;
-        rebuilt(data, fs, ieee, chosen)
+        search::rebuilt(data, fs, ieee, chosen).ok()
     };
     let found = match (in_use(walk), in_use(ramp)) {
         (true, false) => (allowed[ramp])
             .then(|| tie(Kind::RandomWalk, Kind::Ramp, swapped(walk, ramp)))
             .flatten()
             .or_else(|| {
-                let bump = slow_bump(data, fs, max_gm, chosen)?;
+                let bump = slow_bump(data, fs, max_gm, chosen);
                 tie(Kind::RandomWalk, Kind::GaussMarkov, bump)
             }),
         (false, true) if allowed[walk] => tie(Kind::Ramp, Kind::RandomWalk, swapped(ramp, walk)),
@@ -85,62 +81,24 @@ pub fn ambiguities(
 /// correlation time the best of [`search::time_grid`] among those whose hump
 /// (GM_PEAK·τc) the fitted taus show (past the longest, it rises to the end like
 /// the walk, and is one: the datasheet K counts it). None when the structure has
-/// [`MAX_GM`] Gauss–Markov terms in use already.
-fn slow_bump(
-    data: &Data,
-    fs: f64,
-    max_gm: usize,
-    chosen: &Candidate,
-) -> Option<CoreResult<Candidate>> {
-    let theta = &chosen.solution.theta;
-    let times: Vec<f64> = (chosen.gm_tau.iter().enumerate())
-        .filter(|&(k, _)| theta[IEEE_TERMS + k] > 0.0)
-        .map(|(_, &t)| t)
-        .collect();
+/// [`MAX_GM`] Gauss–Markov terms in use already, or no such time fits.
+fn slow_bump(data: &Data, fs: f64, max_gm: usize, chosen: &Candidate) -> Option<Candidate> {
+    let times = chosen.gm_in_use();
     if times.len() >= max_gm.min(MAX_GM) {
         return None;
     }
     let mut ieee = chosen.ieee;
-    ieee[slot(Kind::RandomWalk)] = false;
-    ieee[slot(Kind::Ramp)] = false;
+    ieee[search::WALK] = false;
+    ieee[search::RAMP] = false;
     let extras = (chosen.sine, chosen.resonance, chosen.motion);
     let longest = data.taus[data.len() - 1];
-    let mut best: Option<CoreResult<Candidate>> = None;
-    for tau_c in search::time_grid(data, fs) {
-        if GM_PEAK * tau_c > longest {
-            break;
-        }
-        let mut with = times.clone();
-        with.push(tau_c);
-        let c = search::candidate(data, fs, ieee, with, extras, chosen.solution.d2);
-        let better = match (&best, &c) {
-            (None, _) | (Some(Err(_)), Ok(_)) => true,
-            (Some(Ok(b)), Ok(c)) => c.bic < b.bic,
-            _ => false,
-        };
-        if better {
-            best = Some(c);
-        }
-    }
-    best
-}
-
-/// `base`'s structure with the IEEE terms `ieee`, refitted.
-fn rebuilt(
-    data: &Data,
-    fs: f64,
-    ieee: [bool; IEEE_TERMS],
-    base: &Candidate,
-) -> CoreResult<Candidate> {
-    let extras = (base.sine, base.resonance, base.motion);
-    search::candidate(
-        data,
-        fs,
-        ieee,
-        base.gm_tau.clone(),
-        extras,
-        base.solution.d2,
-    )
+    (search::time_grid(data, fs).into_iter())
+        .take_while(|&tau_c| GM_PEAK * tau_c <= longest)
+        .filter_map(|tau_c| {
+            let with = [times.as_slice(), &[tau_c]].concat();
+            search::candidate(data, fs, ieee, with, extras, chosen.solution.d2).ok()
+        })
+        .min_by(|a, b| a.bic.total_cmp(&b.bic))
 }
 
 #[cfg(test)]

@@ -626,6 +626,14 @@ impl Candidate {
         gm + extra_columns((self.sine, self.resonance, self.motion))
     }
 
+    /// The correlation times of the Gauss–Markov terms with a positive variance.
+    pub fn gm_in_use(&self) -> Vec<f64> {
+        (self.gm_tau.iter().enumerate())
+            .filter(|&(k, _)| self.solution.theta[IEEE_TERMS + k] > 0.0)
+            .map(|(_, &t)| t)
+            .collect()
+    }
+
     /// What structure selection minimises: the BIC, with [`COMPONENT_EVIDENCE`]
     /// asked of every component beyond the IEEE terms.
     pub fn score(&self) -> f64 {
@@ -1028,7 +1036,7 @@ fn eliminate(
 }
 
 /// `base`'s structure with the IEEE terms `ieee`, refitted.
-fn rebuilt(
+pub(super) fn rebuilt(
     data: &Data,
     fs: f64,
     ieee: [bool; IEEE_TERMS],
@@ -1134,10 +1142,7 @@ pub fn select(
         for base in bases {
             // Only the times in use: an unused slot the polish revives is one more
             // component to pay for (a 15 s one beside the motion cost 6).
-            let times: Vec<f64> = (base.gm_tau.iter().enumerate())
-                .filter(|&(k, _)| base.solution.theta[IEEE_TERMS + k] > 0.0)
-                .map(|(_, &t)| t)
-                .collect();
+            let times = base.gm_in_use();
             let shape = (times.as_slice(), base.sine, base.resonance);
             if let Some(moved) = with_motion(data, fs, ieee, shape, base.solution.d2, true)? {
                 keep_lower(data, fs, ieee, moved, &mut best)?;
@@ -1358,10 +1363,10 @@ pub fn with_motion(
 }
 
 /// Slot of the rate random walk K among the IEEE terms.
-const WALK: usize = 3;
+pub(super) const WALK: usize = 3;
 
 /// Slot of the rate ramp R among the IEEE terms.
-const RAMP: usize = 4;
+pub(super) const RAMP: usize = 4;
 
 /// BIC by which a structure with a rate ramp must beat the best one without: 2,
 /// "positive" evidence on Kass and Raftery's scale (JASA 90, 1995). A ramp is a trend, what the warm-up and temperature
