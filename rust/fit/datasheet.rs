@@ -73,9 +73,10 @@ pub struct Model<'a> {
 /// of the curve (where its slope turns from falling to rising), else the lowest
 /// point of its flat parts: a slow Gauss–Markov bump beyond a flat bottom falls
 /// again past its peak, and the bottom before it is the floor a reader sees. A
-/// curve that never flattens after falling has none (a filter's rising head at
-/// the shortest taus is no floor). Tones and resonances are left out of that
-/// search: a tone's comb has a zero at every period.
+/// curve that never flattens after falling has none. A rising head at the
+/// shortest taus (an output filter's) is no floor either way. Tones and
+/// resonances are left out of that search: a tone's comb has a zero at every
+/// period.
 pub fn floor(model: &Model) -> Option<(f64, f64)> {
     let (lo, hi) = (model.taus[0], model.taus[model.taus.len() - 1]);
     let grid: Vec<f64> = if hi > lo {
@@ -96,8 +97,11 @@ pub fn floor(model: &Model) -> Option<(f64, f64)> {
             .filter(|&i| ok(i) && !v[i].is_nan())
             .min_by(|&a, &b| v[a].total_cmp(&v[b]))
     };
-    let mut i = argmin(&dev, &|_| true)?;
+    // The head before the curve first falls is no floor: an output filter
+    // lowers the shortest taus, and the curve rises from there to its top.
     let n = grid.len();
+    let head = (1..n).find(|&k| dev[k] < dev[k - 1]).map_or(0, |k| k - 1);
+    let mut i = argmin(&dev, &|k| k >= head)?;
     if n >= 2 && i == n - 1 {
         let end_slope = (dev[n - 1] / dev[n - 2]).ln() / (grid[n - 1] / grid[n - 2]).ln();
         if end_slope < FLAT_SLOPE {
@@ -281,6 +285,48 @@ mod tests {
         assert!(n_with(0.01) > 1.1e-3, "{}", n_with(0.01));
         // a bump whose hump (1.89 s) lies beyond 1 s: a bias state, not N
         assert_eq!(n_with(1.0), 1e-3);
+    }
+
+    #[test]
+    fn an_output_filters_head_is_no_floor() {
+        // a 20-sample moving average lowers the shortest taus below the floor
+        let taps = 20.0;
+        let gain: Vec<f64> = (0..4097)
+            .map(|k| {
+                let nu = 0.5 * k as f64 / 4096.0;
+                if k == 0 {
+                    1.0
+                } else {
+                    let x = std::f64::consts::PI * nu;
+                    ((taps * x).sin() / (taps * x.sin())).powi(2)
+                }
+            })
+            .collect();
+        let filter = OutputFilter::new(gain).unwrap();
+        let taus = [0.01, 100.0];
+        let terms = [
+            Term::White { variance: 1e-6 },
+            Term::Flicker { variance: 1e-8 },
+            Term::RandomWalk { variance: 1e-6 },
+        ];
+        let unfiltered = floor(&model(&terms, &taus)).unwrap();
+        let filtered = floor(&Model {
+            filter: Some(&filter),
+            ..model(&terms, &taus)
+        })
+        .unwrap();
+        let head = allan_terms(&[0.01], 100.0, &terms, Some(&filter))[0]
+            .iter()
+            .sum::<f64>()
+            .sqrt();
+        assert!(
+            head < filtered.1,
+            "the head {head} is not below the floor {filtered:?}"
+        );
+        assert!(filtered.0 > 0.05, "floor at {} s", filtered.0);
+        // past the head the filter lowers the white part a little
+        let ratio = filtered.1 / unfiltered.1;
+        assert!(ratio > 0.8 && ratio <= 1.0, "{filtered:?} {unfiltered:?}");
     }
 
     #[test]

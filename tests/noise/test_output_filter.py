@@ -331,3 +331,28 @@ def test_n_std_carries_the_white_levels_uncertainty():
     assert np.sqrt(np.mean(z**2)) < 1.6 and np.all(np.abs(z) < 3.5), z
     # the level's part dominates u(N) here (the sampling part alone is ≈ 0.12 %)
     assert np.median(share) > 0.003, share
+
+
+def test_b_is_read_off_the_curve_the_model_draws_through_its_filter():
+    # a floor at short taus, where a low-pass at fs/10 still lowers the white
+    # noise: B, the floor the plot marks and the predicted curve are one number
+    fs = 200.0
+    x = imunoise.simulate(int(fs * 1200), fs, N=3e-4, B=2e-3, K=7e-3, channels=2, seed=3)
+    b, a = butter(2, 20 / (fs / 2))
+    x = lfilter(b, a, x, axis=0)
+    r = imunoise.adev(x, fs, taus=20)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        m = imunoise.fit(r, spectrum=imunoise.psd(x, fs))
+    flicker = math.sqrt(2 * math.log(2) / math.pi)
+    for c in range(2):
+        assert m.filter[c] is not None
+        tau, sigma = m.floor(c)
+        assert tau > 5 / fs  # past the filter's head, not on it
+        assert m.B[c] == pytest.approx(sigma / flicker, rel=1e-12)
+        # the drawn curve is the floor's plus the flicker's share the filter takes
+        drawn = m.predict([tau]).dev[0, c]
+        assert drawn**2 == pytest.approx(sigma**2 + m.filter[c].excess([tau])[0], rel=1e-9)
+        unfiltered = core_fit.model_floor([t.core() for t in m.terms[c]],
+                                          np.ascontiguousarray(m.taus), fs)
+        assert unfiltered[1] > sigma * 1.005  # the filter lowers the floor here

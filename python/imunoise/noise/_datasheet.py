@@ -51,17 +51,15 @@ from imunoise.noise._terms import (
 )
 from imunoise.noise._typed import GaussMarkov
 
-#: Points of the log-spaced grid over the fitted taus on which B's minimum is sought.
-_B_GRID = 200
 
-
-def datasheet_values(components, core, taus, method: str,
-                     record: float) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+def datasheet_values(components, core, taus, method: str, record: float,
+                     filters=None) -> dict[str, tuple[np.ndarray, np.ndarray]]:
     """``{term: (values, stds)}``, each of shape (channels,), for Q, N, B, K, R.
     ``core``: per channel, the core fit's (kind, parameters) terms and the
     covariance of their coordinates (``"wls"``), from which N, B, K and their
     uncertainties come (Rust: ``rust/fit/datasheet.rs``); ``record`` the record's
-    duration (s)."""
+    duration (s); ``filters`` each channel's output filter or None (B is read off
+    the curve the model draws, through it)."""
     out = {term: (components.value(term).astype(float), components.std(term).astype(float))
            for term in TERMS}
     if method != "wls":
@@ -70,8 +68,10 @@ def datasheet_values(components, core, taus, method: str,
     values = {t: np.full(components.channels, np.nan) for t in ("N", "B", "K")}
     stds = {t: np.full(components.channels, np.nan) for t in ("N", "B", "K")}
     for c, (terms, cov) in enumerate(core):
+        found = None if filters is None else filters[c]
+        gain = None if found is None else np.ascontiguousarray(found.gain)
         for name, (v, e) in _core_fit.datasheet(terms, cov, taus, float(components.fs),
-                                                record=float(record)):
+                                                record=float(record), filter=gain):
             values[name][c], stds[name][c] = v, e
     out.update({t: (values[t], stds[t]) for t in values})
     return out

@@ -415,7 +415,7 @@ def _fit(result, *, method, terms, tau_range, uncertainty, replicates, seed, war
         fs=float(result.fs),
     )
     record = _record_seconds(result, taus)
-    sheet = datasheet_values(components, core, taus, method, record)
+    sheet = datasheet_values(components, core, taus, method, record, filters)
     if uncertainty == "bootstrap":
         sheet = {k: (v, sheet_std[:, i]) for i, (k, (v, _)) in enumerate(sheet.items())}
     resolved = {k: (v > 0) & np.isfinite(v) for k, (v, _) in sheet.items()}

@@ -203,8 +203,11 @@ class NoiseModel(PerTerm):
         (B = σ/√(2 ln2/π)); None where the curve has none (B not resolved)."""
         if self.method != "wls":
             return None
-        return _core_fit.model_floor([t.core() for t in self.terms[channel]],
-                                     np.ascontiguousarray(self.taus, dtype=float), float(self.fs))
+        found = self.filter[channel]
+        return _core_fit.model_floor(
+            [t.core() for t in self.terms[channel]],
+            np.ascontiguousarray(self.taus, dtype=float), float(self.fs),
+            filter=None if found is None else np.ascontiguousarray(found.gain))
 
     def plot(self, result: AllanResult, **kwargs) -> Figure:
         """The model over ``result``, the Allan result it was fitted to, with its terms,
