@@ -356,3 +356,21 @@ def test_b_is_read_off_the_curve_the_model_draws_through_its_filter():
         unfiltered = core_fit.model_floor([t.core() for t in m.terms[c]],
                                           np.ascontiguousarray(m.taus), fs)
         assert unfiltered[1] > sigma * 1.005  # the filter lowers the floor here
+
+
+def test_the_upper_bound_on_n_holds_through_a_filter():
+    # a low-pass lowers the short taus' variance below N²/τ: a bound read off
+    # 1/τ there would lie below the sensor's N; read off c(τ)/τ it holds
+    from imunoise.noise._datasheet import upper_bounds
+
+    n_true = 1e-3
+    x = imunoise.simulate(200_000, FS, N=n_true, channels=2, seed=4)
+    b, a = butter(4, 5 / (FS / 2))
+    x = lfilter(b, a, x, axis=0)
+    r = imunoise.adev(x, FS, taus=20)
+    found = [estimate_filter(imunoise.psd(x, FS), c) for c in range(2)]
+    assert all(f is not None for f in found)
+    blind = upper_bounds(r.taus, r.dev**2, r.edf)["N"]
+    seen = upper_bounds(r.taus, r.dev**2, r.edf, found)["N"]
+    assert np.all(blind < 0.5 * n_true)
+    assert np.all(seen >= n_true) and np.all(seen < 1.2 * n_true)

@@ -81,7 +81,7 @@ def datasheet_values(components, core, taus, method: str, record: float,
 UPPER_CONFIDENCE = 0.95
 
 
-def upper_bounds(taus, var, edf) -> dict[str, np.ndarray]:
+def upper_bounds(taus, var, edf, filters=None) -> dict[str, np.ndarray]:
     """``{term: (channels,)}``: the largest value of each of Q, N, B, K, R that the
     measured Allan variance allows at 95 % confidence.
 
@@ -92,7 +92,9 @@ def upper_bounds(taus, var, edf) -> dict[str, np.ndarray]:
     holds whatever they are. α is 5 % shared over the octaves the taus span
     (Bonferroni: estimates an octave apart are nearly independent, neighbours
     within one are not), so the bound holds at 95 % over the whole curve.
-    ``var``, ``edf``: (taus, channels).
+    ``var``, ``edf``: (taus, channels); ``filters``: each channel's output filter or
+    None. Through a filter the white term's variance is c(τ)/τ per N², below 1/τ at
+    the short taus the filter lowers, so N's bound is read off that.
     """
     from scipy import stats
 
@@ -105,10 +107,15 @@ def upper_bounds(taus, var, edf) -> dict[str, np.ndarray]:
         limit = np.where(ok, var * edf / stats.chi2.ppf(alpha, np.where(ok, edf, 1.0)), np.inf)
     # each IEEE term's own column at unit coefficient: its variance per coefficient²
     per_unit = term_variances(taus, 1.0, np.ones(len(TERMS)))
+    per_unit = np.repeat(per_unit[:, :, None], var.shape[1], axis=2)
+    white = TERMS.index("N")
+    for c, found in enumerate(filters or ()):
+        if found is not None:
+            per_unit[:, white, c] *= found.factor(taus)
     out = {}
     for k, term in enumerate(TERMS):
         with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-            bound = np.sqrt(np.min(limit / per_unit[:, k, None], axis=0))
+            bound = np.sqrt(np.min(limit / per_unit[:, k, :], axis=0))
         out[term] = np.where(np.isfinite(bound), bound, np.nan)
     return out
 

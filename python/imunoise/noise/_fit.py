@@ -424,7 +424,7 @@ def _fit(result, *, method, terms, tau_range, uncertainty, replicates, seed, war
     for c, channel_ties in enumerate(tied):
         for tie in channel_ties:
             resolved[tie.term][c] = False
-    bounds = upper_bounds(taus, np.square(dev_all), edf_raw)
+    bounds = upper_bounds(taus, np.square(dev_all), edf_raw, filters)
     model = NoiseModel(
         **{k: shaped(np.where(resolved[k], v, np.nan)) for k, (v, _) in sheet.items()},
         **{k + "_std": shaped(np.where(resolved[k], e, np.nan)) for k, (_, e) in sheet.items()},
