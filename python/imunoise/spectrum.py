@@ -451,37 +451,25 @@ def model_psd(model: NoiseModel, f: npt.ArrayLike) -> np.ndarray:
 
 
 def model_psd_terms(model: NoiseModel, f: npt.ArrayLike) -> dict[str, np.ndarray]:
-    """Each fitted component of ``model`` that is present (non-zero) as its one-sided
-    PSD at ``f``:
-    keys "Q", "N", "B", "K", "R", "GM1", … (GM: the sampled AR1, see the module) and
-    "resonance" (:func:`resonance_psd`). A tone is a line, no density: plots mark
-    its frequency (:attr:`NoiseModel.lines`)."""
+    """Each fitted term of ``model`` that is present (non-zero) as its one-sided PSD
+    at ``f``, by the name ``fit(terms=...)`` asks for it: keys "Q", "N", "B", "K",
+    "R", "GM1", … (GM: the sampled AR1, see the module), "resonance"
+    (:func:`resonance_psd`) and "motion" (the rate of the angle's AR1). The white
+    term passes the channel's measured output filter. A tone is a line, no
+    density: plots mark its frequency (:attr:`NoiseModel.lines`)."""
     from imunoise.noise import _typed
 
     f = _check_frequencies(f)
     fs = float(model.fs)
     channels = 1 if model.one_channel else model.channels
+    filters = getattr(model, "filter", ()) or (None,) * channels
     out: dict[str, np.ndarray] = {}
-    for term in POWER_LAWS:
-        c = np.array([_typed.coefficient(terms, term) for terms in model.terms])
-        if np.any(c > 0):
-            out[term] = term_psd(term, c[None, :], f[:, None], fs=fs)
-    if "N" in out:  # the white term through each channel's measured output filter
-        for j, found in enumerate(getattr(model, "filter", ())):
-            if found is not None:
-                out["N"][:, j] = out["N"][:, j] * np.interp(f, found.f, found.gain)
     for j in range(channels):
-        terms = model.terms[j]
-        for k, (sigma, tau_c) in enumerate(_typed.pairs(terms, _typed.GaussMarkov, "sigma",
-                                                        "tau_c")):
-            phi = math.exp(-1.0 / (fs * tau_c))
-            gm = (2 * sigma**2 * (1 - phi**2) / fs
-                  / np.abs(1 - phi * np.exp(-2j * np.pi * f / fs)) ** 2)
-            out.setdefault(f"GM{k + 1}", np.zeros((f.size, channels)))[:, j] = gm
-        for sigma, f_r, tau_r, skew in _typed.pairs(terms, _typed.Resonance, "sigma", "freq",
-                                                    "tau", "skew"):
-            out.setdefault("resonance", np.zeros((f.size, channels)))[:, j] = resonance_psd(
-                sigma, f_r, tau_r, skew, f, fs)
+        for name, density in _typed.psd_parts(model.terms[j], f, fs).items():
+            if name == "N" and filters[j] is not None:
+                density = density * np.interp(f, filters[j].f, filters[j].gain)
+            if np.any(density > 0):
+                out.setdefault(name, np.zeros((f.size, channels)))[:, j] = density
     return {k: (v[:, 0] if model.one_channel else v) for k, v in out.items()}
 
 

@@ -1,10 +1,10 @@
 """Noise like a measured sensor's: from its fitted noise model, its Allan deviation
 or its power spectral density (``imunoise.simulate(n, fs, like=...)``).
 
-- A :class:`~imunoise.NoiseModel`: each channel simulated from its fitted
-  components (IEEE terms, Gauss–Markov terms, tones, resonance, bounded motion), the
-  processes :func:`imunoise.fit` models, so the simulated record's Allan deviation
-  follows the model.
+- A :class:`~imunoise.NoiseModel`: each channel simulated from its fitted terms
+  (``model.terms``: each term's own process, ``Term.sample``) and passed
+  through its measured output filter, the processes :func:`imunoise.fit` models, so
+  the simulated record's Allan deviation follows the model.
 - An :class:`~imunoise.AllanResult` of rate data: fitted first (:func:`imunoise.fit`),
   then as a model: the route from a measured Allan deviation to its PSD
   (:func:`imunoise.spectrum.model_psd`) and to noise with that PSD.
@@ -23,9 +23,8 @@ import numpy as np
 
 from imunoise._support.validate import integer, sample_rate
 from imunoise.errors import ImunoiseTypeError, ImunoiseValueError
-from imunoise.noise import _typed
 
-__all__ = ["simulate_like"]
+__all__ = ["simulate_like", "simulate_terms"]
 
 
 def simulate_like(source, n_samples: int, fs: float | None, *, channels: int | None,
@@ -80,22 +79,23 @@ def _channels(channels, available: int) -> list[int]:
     return list(range(c))
 
 
-def _from_model(model, n: int, fs: float, channels, rng) -> np.ndarray:
-    from imunoise._simulation.simulate import simulate
+def simulate_terms(terms, n: int, fs: float, rng, *, channels: int = 1,
+                   through=None) -> np.ndarray:
+    """``channels`` independent records of ``n`` samples at ``fs`` of one channel's
+    model: the sum of each term's own process (``Term.sample``), through the output
+    filter ``through`` where given. Shape (n,) for one channel else (n, c)."""
+    out = np.zeros((n, channels))
+    for term in terms:
+        out += term.sample(n, fs, rng, channels)
+    if through is not None:
+        out = through.apply(out)
+    return out[:, 0].copy() if channels == 1 else out
 
+
+def _from_model(model, n: int, fs: float, channels, rng) -> np.ndarray:
     picked = _channels(channels, model.channels)
-    columns = []
-    for c in picked:
-        terms = model.terms[c]
-        coef = {t: _typed.coefficient(terms, t) for t in "QNBKR"}
-        resonance = _typed.pairs(terms, _typed.Resonance, "sigma", "freq", "tau", "skew")
-        motion = _typed.pairs(terms, _typed.Motion, "sigma", "tau_c")
-        columns.append(simulate(
-            n, fs, **coef, seed=rng,
-            gm=_typed.pairs(terms, _typed.GaussMarkov, "sigma", "tau_c"),
-            sinusoid=_typed.pairs(terms, _typed.Tone, "amplitude", "freq") or None,
-            resonance=resonance[0] if resonance else None,
-            motion=motion[0] if motion else None))
+    columns = [simulate_terms(model.terms[c], n, fs, rng, through=model.filter[c])
+               for c in picked]
     out = np.column_stack(columns)
     return out[:, 0] if out.shape[1] == 1 and (channels is None or channels == 1) else out
 

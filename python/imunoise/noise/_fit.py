@@ -352,21 +352,12 @@ def _fit(result, *, method, terms, tau_range, uncertainty, replicates, seed, war
     if uncertainty == "bootstrap":
         generator = np.random.default_rng(seed)
         for c in range(channels):
-            kept = [t for t, keep in zip(TERMS, sup[c], strict=True) if keep]
-            markov = [(float(a), float(b)) for a, b in gm[c] if np.isfinite(a)]
-            tones = [(float(a), float(f0)) for a, f0 in sine[c] if np.isfinite(a)]
-            oscs = [tuple(map(float, osc[c]))] if np.isfinite(osc[c, 0]) else []
-            motions = [tuple(map(float, moving[c]))] if np.isfinite(moving[c, 0]) else []
-            if not kept and not markov and not tones and not oscs and not motions:
+            if not typed[c]:
                 continue
-            options = dict(method=method, terms=[*kept, *["GM"] * len(markov),
-                                                 *["sine"] * len(tones),
-                                                 *["resonance"] * len(oscs),
-                                                 *["motion"] * len(motions)],
+            options = dict(method=method, terms=[t.requested for t in typed[c]],
                            tau_range=tau_range)
             typed[c], sheet_std[c] = _bootstrap_std(
-                result, n_record, typed[c], coef[c], markov, (tones, oscs, motions),
-                int(replicates), generator, options, filters[c])
+                result, n_record, typed[c], int(replicates), generator, options, filters[c])
             # the deprecated arrays' uncertainties from the terms'
             (_, std[c], _, _, gm_std[c], _, sine_std[c], _, osc_std[c], _,
              moving_std[c]) = _legacy_arrays(typed[c])
@@ -598,23 +589,16 @@ def _record_length(result) -> int:
     return n0 + 2 * m0 - 1 if overlapping else (n0 + 1) * m0
 
 
-def _bootstrap_std(result, n, terms, coef, markov, oscillators, replicates, rng, options,
-                   found=None):
+def _bootstrap_std(result, n, terms, replicates, rng, options, found=None):
     """``terms`` (one channel's) with the standard deviation of each parameter, and that
-    of the datasheet values Q…R, over fits to records simulated from the model with the
-    rate and taus of ``result`` and its length ``n``; ``oscillators`` is (tones,
-    resonances, motions). With the channel's output filter ``found`` the records pass
-    through it and are refitted with it, as the point fit was."""
-    from imunoise._simulation.simulate import simulate
+    of the datasheet values Q…R, over fits to records simulated from them with the
+    rate and taus of ``result`` and its length ``n``. With the channel's output filter
+    ``found`` the records pass through it and are refitted with it, as the point fit
+    was."""
+    from imunoise._simulation.like import simulate_terms
     from imunoise.allan import adev
 
-    tones, oscs, motions = oscillators
-    sims = simulate(n, result.fs, *coef, channels=replicates, seed=rng, gm=markov,
-                    sinusoid=tones or None,
-                    resonance=oscs[0] if oscs else None,
-                    motion=motions[0] if motions else None)
-    if found is not None:
-        sims = found.apply(sims)
+    sims = simulate_terms(terms, n, result.fs, rng, channels=replicates, through=found)
     again = adev(sims, result.fs, taus=np.asarray(result.taus), overlapping=result.overlapping,
                  confidence=result.confidence)
     with warnings.catch_warnings():

@@ -60,6 +60,24 @@ class Term:
         """The term in a structure's words: ``"N"``, ``"GM(0.05 s)"``, ``"tone 13.4 Hz"``."""
         raise NotImplementedError
 
+    def sample(self, n: int, fs: float, rng: np.random.Generator,
+               channels: int = 1) -> np.ndarray:
+        """``channels`` independent records, shape (n, channels), of this term's own
+        process at ``fs`` (Hz): a model's record is the sum of its terms'."""
+        from imunoise._simulation.simulate import simulate
+
+        x = simulate(n, fs, channels=channels, seed=rng, **self._simulate())
+        return x.reshape(n, channels)
+
+    def _simulate(self) -> dict:
+        """The keyword arguments of :func:`imunoise.simulate` that draw this term alone."""
+        raise NotImplementedError
+
+    def psd(self, f, fs: float) -> np.ndarray | None:
+        """This term's one-sided PSD at ``f`` (Hz) for data sampled at ``fs`` (Hz);
+        None for a tone, a line with no density (plots mark its frequency)."""
+        raise NotImplementedError
+
     def to_dict(self) -> dict:
         """Plain-Python view: ``kind`` and every parameter and its ``*_std``
         (None where not finite: JSON has no NaN)."""
@@ -94,6 +112,14 @@ class _Ieee(Term):
 
     def label(self) -> str:
         return self.name
+
+    def _simulate(self) -> dict:
+        return {self.name: self.value}
+
+    def psd(self, f, fs: float) -> np.ndarray:
+        from imunoise.spectrum import term_psd
+
+        return term_psd(self.name, self.value, np.asarray(f, dtype=float), fs=fs)
 
     @classmethod
     def from_core(cls, parameters, cov):
@@ -175,6 +201,13 @@ class _VarianceAndTime(Term):
     def core(self) -> tuple[str, list[float]]:
         return self.kind, [self.sigma**2, self.tau_c]
 
+    def _ar1_psd(self, f, fs: float) -> np.ndarray:
+        """One-sided PSD of the sampled AR1 of standard deviation σ and time τc:
+        2σ²(1 − φ²)/fs / |1 − φe^(−iω)|², φ = e^(−1/(fs·τc)), ω = 2πf/fs."""
+        phi = math.exp(-1.0 / (fs * self.tau_c))
+        e = np.exp(-2j * np.pi * np.asarray(f, dtype=float) / fs)
+        return 2 * self.sigma**2 * (1 - phi**2) / fs / np.abs(1 - phi * e) ** 2
+
     @classmethod
     def from_core(cls, parameters, cov):
         sigma, u_sigma = _sigma(parameters[0], cov[0, 0])
@@ -194,6 +227,12 @@ class GaussMarkov(_VarianceAndTime):
     def label(self) -> str:
         return f"GM({_summary.number(self.tau_c)} s)"
 
+    def _simulate(self) -> dict:
+        return {"gm": [(self.sigma, self.tau_c)]}
+
+    def psd(self, f, fs: float) -> np.ndarray:
+        return self._ar1_psd(f, fs)
+
 
 @dataclass(frozen=True, repr=False)
 class Tone(Term):
@@ -212,6 +251,12 @@ class Tone(Term):
 
     def label(self) -> str:
         return f"tone {_summary.number(self.freq)} Hz"
+
+    def _simulate(self) -> dict:
+        return {"sinusoid": [(self.amplitude, self.freq)]}
+
+    def psd(self, f, fs: float) -> None:
+        return None
 
     @classmethod
     def from_core(cls, parameters, cov):
@@ -247,6 +292,14 @@ class Resonance(Term):
         skew = f" (skew {self.skew:.2g})" if self.skew else ""
         return f"resonance {_summary.number(self.freq)} Hz{skew}"
 
+    def _simulate(self) -> dict:
+        return {"resonance": (self.sigma, self.freq, self.tau, self.skew)}
+
+    def psd(self, f, fs: float) -> np.ndarray:
+        from imunoise.spectrum import resonance_psd
+
+        return resonance_psd(self.sigma, self.freq, self.tau, self.skew, f, fs)
+
     @classmethod
     def from_core(cls, parameters, cov):
         sigma, u_sigma = _sigma(parameters[0], cov[0, 0])
@@ -269,6 +322,14 @@ class Motion(_VarianceAndTime):
     def label(self) -> str:
         return f"motion({_summary.number(self.tau_c)} s)"
 
+    def _simulate(self) -> dict:
+        return {"motion": (self.sigma, self.tau_c)}
+
+    def psd(self, f, fs: float) -> np.ndarray:
+        # the rate (θ[t] − θ[t−1])·fs of the angle's AR1: |1 − e^(−iω)|²·fs² = 4 sin²(ω/2)·fs²
+        omega = 2 * np.pi * np.asarray(f, dtype=float) / fs
+        return self._ar1_psd(f, fs) * (2 * fs * np.sin(omega / 2)) ** 2
+
 
 #: Every kind, by the core's name, in the order a model lists them.
 KINDS: dict[str, type[Term]] = {
@@ -283,6 +344,9 @@ IEEE: dict[str, type[_Ieee]] = {
 
 #: Covariance coordinates per kind of term.
 COORDINATES = {name: len(coords) for name, _, coords in _core_fit.TERM_KINDS}
+
+#: The most terms of each kind a channel's model holds.
+MOST = dict(_core_fit.TERM_MOST)
 
 
 def from_core(core_terms, cov: np.ndarray) -> tuple[Term, ...]:
@@ -321,6 +385,22 @@ def coefficient(terms, name: str) -> float:
 def pairs(terms, cls: type[Term], *names: str) -> list[tuple[float, ...]]:
     """``names``' values of each term of class ``cls``, as tuples, in order."""
     return [tuple(float(getattr(t, n)) for n in names) for t in terms if isinstance(t, cls)]
+
+
+def psd_parts(terms, f, fs: float) -> dict[str, np.ndarray]:
+    """One channel's terms as one-sided PSDs at ``f``, by name: the ``fit(terms=...)``
+    name, numbered where a model may hold several of the kind (``"N"``, ``"GM1"``,
+    ``"resonance"``, ``"motion"``); tones, lines without a density, are left out."""
+    out: dict[str, np.ndarray] = {}
+    seen: dict[str, int] = {}
+    for term in terms:
+        density = term.psd(f, fs)
+        if density is None:
+            continue
+        k = seen[term.kind] = seen.get(term.kind, 0) + 1
+        name = term.requested + (str(k) if MOST[term.kind] > 1 else "")
+        out[name] = density
+    return out
 
 
 def structure(terms) -> str:
