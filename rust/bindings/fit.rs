@@ -30,9 +30,9 @@ struct PyNoiseFit {
     parameters: usize,
     /// Its Bayesian information criterion.
     bic: f64,
-    /// (kind, alternative kind, ΔBIC) of each term of a selected structure that
-    /// the alternative fits as well: not resolved by the data.
-    ambiguous: Vec<(&'static str, &'static str, f64)>,
+    /// (kind, alternative kind or None, ΔBIC) of each term of a selected
+    /// structure that the alternative fits as well: not resolved by the data.
+    ambiguous: Vec<(&'static str, Option<&'static str>, f64)>,
 }
 
 /// The output filter's gains, checked by the core.
@@ -91,7 +91,7 @@ fn fit_noise<'py>(
         parameters: r.parameters,
         bic: r.bic,
         ambiguous: (r.ambiguous.iter())
-            .map(|a| (a.kind.name(), a.alternative.name(), a.delta_bic))
+            .map(|a| (a.kind.name(), a.alternative.map(Kind::name), a.delta_bic))
             .collect(),
     })
 }

@@ -25,8 +25,9 @@ pub const DECISIVE: f64 = 2.0;
 pub struct Ambiguity {
     /// The term not resolved.
     pub kind: Kind,
-    /// The kind of term that describes the same part of the curve instead.
-    pub alternative: Kind,
+    /// The kind of term that describes the same part of the curve instead; None
+    /// where a structure without the term needs no other kind for it.
+    pub alternative: Option<Kind>,
     /// The alternative structure's BIC minus the chosen one's (< [`DECISIVE`]).
     pub delta_bic: f64,
 }
@@ -35,26 +36,34 @@ pub struct Ambiguity {
 /// `max_gm` Gauss–Markov terms) that an alternative structure fits with a BIC
 /// less than [`DECISIVE`] higher: the random walk against a ramp in its place
 /// and against one more Gauss–Markov term whose hump the fitted taus show; the
-/// ramp against a walk in its place. The alternatives keep every other term
-/// of `chosen` (a walk and a ramp together are not questioned: each then has
-/// a part of the curve the other does not describe).
+/// ramp against a walk in its place (these keep every other term of `chosen`);
+/// and each against `selected_without` — the structures the selection chooses
+/// with the walk, and with the ramp, left out ([`search::WALK`],
+/// [`search::RAMP`]; None where it was not run). A walk and a ramp together
+/// are not questioned by a swap: each then has a part of the curve the other
+/// does not describe.
 pub fn ambiguities(
     data: &Data,
     fs: f64,
     allowed: [bool; IEEE_TERMS],
     max_gm: usize,
     chosen: &Candidate,
+    selected_without: &[Option<Candidate>; 2],
 ) -> Vec<Ambiguity> {
     let (walk, ramp) = (search::WALK, search::RAMP);
     let in_use = |j: usize| chosen.ieee[j] && chosen.solution.theta[j] > 0.0;
     // An alternative that fits no positive curve is no alternative.
-    let tie = |kind: Kind, alternative: Kind, other: Option<Candidate>| {
+    let tie = |kind: Kind, alternative: Option<Kind>, other: Option<&Candidate>| {
         let delta_bic = other?.bic - chosen.bic;
         (delta_bic < DECISIVE).then_some(Ambiguity {
             kind,
             alternative,
             delta_bic,
         })
+    };
+    let reselected = |kind: Kind, j: usize| {
+        let other = selected_without[usize::from(j == ramp)].as_ref()?;
+        tie(kind, first_added(fs, chosen, other), Some(other))
     };
     let swapped = |off: usize, on: usize| {
         let mut ieee = chosen.ieee;
@@ -64,16 +73,35 @@ pub fn ambiguities(
     };
     let found = match (in_use(walk), in_use(ramp)) {
         (true, false) => (allowed[ramp])
-            .then(|| tie(Kind::RandomWalk, Kind::Ramp, swapped(walk, ramp)))
+            .then(|| {
+                let other = swapped(walk, ramp);
+                tie(Kind::RandomWalk, Some(Kind::Ramp), other.as_ref())
+            })
             .flatten()
             .or_else(|| {
                 let bump = slow_bump(data, fs, max_gm, chosen);
-                tie(Kind::RandomWalk, Kind::GaussMarkov, bump)
-            }),
-        (false, true) if allowed[walk] => tie(Kind::Ramp, Kind::RandomWalk, swapped(ramp, walk)),
+                tie(Kind::RandomWalk, Some(Kind::GaussMarkov), bump.as_ref())
+            })
+            .or_else(|| reselected(Kind::RandomWalk, walk)),
+        (false, true) => (allowed[walk])
+            .then(|| {
+                let other = swapped(ramp, walk);
+                tie(Kind::Ramp, Some(Kind::RandomWalk), other.as_ref())
+            })
+            .flatten()
+            .or_else(|| reselected(Kind::Ramp, ramp)),
+        (true, true) => reselected(Kind::RandomWalk, walk).or_else(|| reselected(Kind::Ramp, ramp)),
         _ => None,
     };
     found.into_iter().collect()
+}
+
+/// The first kind, in the order of [`Kind::ALL`], of which `other` has more terms
+/// than `chosen`: what describes instead the part of the curve a term of
+/// `chosen` that `other` lacks took. None when `other` adds no kind.
+fn first_added(fs: f64, chosen: &Candidate, other: &Candidate) -> Option<Kind> {
+    let count = |c: &Candidate, kind: Kind| c.terms(fs).iter().filter(|t| t.kind() == kind).count();
+    (Kind::ALL.into_iter()).find(|&kind| count(other, kind) > count(chosen, kind))
 }
 
 /// `chosen` with its walk (and any ramp it may have had room for) replaced by
@@ -130,7 +158,7 @@ mod tests {
         let ieee = [false, true, true, true, true];
         let chosen = search::select(&data, 100.0, ieee, 0, (0, false, false)).unwrap();
         assert!(chosen.solution.theta[3] > 0.0);
-        assert!(ambiguities(&data, 100.0, ieee, 0, &chosen).is_empty());
+        assert!(ambiguities(&data, 100.0, ieee, 0, &chosen, &[None, None]).is_empty());
     }
 
     #[test]
@@ -151,11 +179,11 @@ mod tests {
         )
         .unwrap();
         assert!(walk.solution.theta[3] > 0.0);
-        let found = ambiguities(&data, 100.0, ieee, 0, &walk);
+        let found = ambiguities(&data, 100.0, ieee, 0, &walk, &[None, None]);
         assert!(
             found
                 .iter()
-                .any(|a| a.kind == Kind::RandomWalk && a.alternative == Kind::Ramp),
+                .any(|a| a.kind == Kind::RandomWalk && a.alternative == Some(Kind::Ramp)),
             "{found:?}"
         );
         assert!(found.iter().all(|a| a.delta_bic < DECISIVE));

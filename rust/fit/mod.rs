@@ -188,38 +188,52 @@ pub fn fit_noise(
         ..reported.clone()
     };
     let chosen = if opts.select {
-        let selected = |motion: bool| -> CoreResult<Candidate> {
-            let kinds = (
-                opts.count(Kind::Tone),
-                opts.count(Kind::Resonance) > 0,
-                motion,
-            );
-            let best = search::select(&data, fs, ieee, gm, kinds)?;
-            let best = search::prefer_random_walk(&data, fs, ieee, gm, kinds, best)?;
-            prune_insignificant(&data, fs, best)
-        };
-        let best = selected(opts.count(Kind::Motion) > 0)?;
-        // A motion is searched last, on what the search had then; pruning and the
-        // walk's check after it can leave a structure the search without it beats.
-        // It stays only if it wins.
-        if best.motion.is_some() {
-            let without = selected(false)?;
-            if without.score() <= best.score() {
-                without
-            } else {
-                best
-            }
-        } else {
-            best
-        }
+        choose(&data, fs, opts, ieee)?
     } else {
         search::requested(&data, fs, opts)?
     };
     let mut fit = summarise(&reported, fs, &chosen);
     if opts.select {
-        fit.ambiguous = ambiguity::ambiguities(&data, fs, ieee, gm, &chosen);
+        // The best structure the selection finds with the walk (the ramp) left
+        // out, where the chosen one has it: the rise it takes may need no such term.
+        let without = |j: usize| -> Option<Candidate> {
+            let mut none = ieee;
+            none[j] = false;
+            (chosen.ieee[j] && chosen.solution.theta[j] > 0.0)
+                .then(|| choose(&data, fs, opts, none).ok())
+                .flatten()
+        };
+        let selected_without = [without(search::WALK), without(search::RAMP)];
+        fit.ambiguous = ambiguity::ambiguities(&data, fs, ieee, gm, &chosen, &selected_without);
     }
     Ok(fit)
+}
+
+/// The structure the selection chooses among the IEEE terms `ieee` and the
+/// other kinds `opts` allows.
+fn choose(data: &Data, fs: f64, opts: &Options, ieee: [bool; IEEE_TERMS]) -> CoreResult<Candidate> {
+    let gm = opts.count(Kind::GaussMarkov);
+    let selected = |motion: bool| -> CoreResult<Candidate> {
+        let kinds = (
+            opts.count(Kind::Tone),
+            opts.count(Kind::Resonance) > 0,
+            motion,
+        );
+        let best = search::select(data, fs, ieee, gm, kinds)?;
+        let best = search::prefer_random_walk(data, fs, ieee, gm, kinds, best)?;
+        prune_insignificant(data, fs, best)
+    };
+    let best = selected(opts.count(Kind::Motion) > 0)?;
+    // A motion is searched last, on what the search had then; pruning and the
+    // walk's check after it can leave a structure the search without it beats.
+    // It stays only if it wins.
+    if best.motion.is_some() {
+        let without = selected(false)?;
+        if without.score() <= best.score() {
+            return Ok(without);
+        }
+    }
+    Ok(best)
 }
 
 /// Smallest z = variance / standard uncertainty a selected term may have.

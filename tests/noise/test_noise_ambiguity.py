@@ -14,6 +14,7 @@ import warnings
 import imunoise
 import numpy as np
 import pytest
+from imunoise.noise._typed import KINDS
 
 FS = 10.0
 N_WHITE, K_WALK = 1e-3, 1.5e-5  # the walk crosses the white noise at 115 s of a 2 h record
@@ -40,7 +41,7 @@ def test_k_is_either_the_walk_or_not_resolved_with_a_bound_above_it(walks):
         if np.isnan(k):
             ties += 1
             assert len(notes) == 1
-            assert "in place of the rate random walk fits the curve as well" in notes[0]
+            assert "rate random walk fits the curve as well" in notes[0]
             assert bound >= K_WALK
             assert not model.resolved("K")
         else:
@@ -80,13 +81,14 @@ def test_the_model_types_each_tie_and_the_report_says_it(walks):
         (tie,) = model.ties[0]
         assert isinstance(tie, imunoise.noise.Tie)
         assert tie.term == "K" and tie.noun == "rate random walk"
-        assert tie.alternative in ("rate ramp", "Gauss–Markov bump")
+        nouns = {kind.noun for kind in KINDS.values()} - {"rate random walk"}
+        assert tie.alternative is None or tie.alternative in nouns
         assert tie.delta_bic < 2 and tie.value > 0
         assert tie.note() in model.notes[0]
         (sentence,) = model_sentences(model, "gyro")
-        assert f"K not resolved: a {tie.alternative} fits the rise" in sentence
+        assert f"K not resolved: {tie.instead()} fits the rise" in sentence
     resolved = [m for _, m in walks if not m.ties[0]]
-    assert all("not resolved: a" not in model_sentences(m, "gyro")[0] for m in resolved)
+    assert all("K not resolved" not in model_sentences(m, "gyro")[0] for m in resolved)
 
 
 def test_ties_go_to_json(walks):
@@ -96,3 +98,33 @@ def test_ties_go_to_json(walks):
         d = json.loads(json.dumps(model.to_dict()))
         assert len(d["ties"]) == 1
         assert [t["term"] for t in d["ties"][0]] == [t.term for t in model.ties[0]]
+
+
+def _wander_record():
+    """3 h at 100 Hz: white noise, a small walk and a Gauss–Markov bump of τc 451 s
+    (σ ten times the white at its hump), as the truth bench draws its axis."""
+    from scipy.signal import lfilter
+
+    fs, n = 100.0, 3 * 3600 * 100
+    x = imunoise.simulate(n, fs, N=1e-3, K=2e-7, channels=3, seed=702)[:, 1]
+    rng = np.random.default_rng(702)
+    for tau_c in (188.0, 451.0):  # the first is the bench's other axis: the same draws
+        sigma = 1e-2 / np.sqrt(tau_c)
+        phi = np.exp(-1 / (fs * tau_c))
+        w = rng.standard_normal(n) * sigma * np.sqrt(1 - phi * phi)
+        bump = lfilter([1.0], [1.0, -phi], w, zi=[phi * sigma * rng.standard_normal()])[0]
+    return x + bump, fs
+
+
+def test_a_walk_that_a_structure_without_one_fits_as_well_is_not_resolved():
+    # the selection took this bump for a bounded motion, flicker and a walk 75
+    # times the true one; the best structure without a walk, white noise and a
+    # Gauss–Markov bump, fits the curve as well
+    x, fs = _wander_record()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        model = imunoise.fit(imunoise.adev(x, fs, taus=20), spectrum=imunoise.psd(x, fs))
+    k, bound = float(model.K), float(model.upper["K"])
+    assert np.isnan(k) or 0.5 <= k / 2e-7 <= 2
+    if np.isnan(k):
+        assert bound >= 2e-7

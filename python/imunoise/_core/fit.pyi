@@ -50,7 +50,7 @@ class NoiseFit:
     def bic(self) -> float:
         """Its Bayesian information criterion."""
     @property
-    def ambiguous(self) -> list[tuple[str, str, float]]:
+    def ambiguous(self) -> list[tuple[str, str | None, float]]:
         """(kind, alternative kind, ΔBIC) of each term of a selected structure that
         the alternative fits as well: not resolved by the data."""
 

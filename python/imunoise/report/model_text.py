@@ -178,9 +178,9 @@ def model_sentences(model: NoiseModel, sensor: str,
             parts += _resolution_sentence(model, c, steps[c], sensor, (b_unit, n_unit, q_unit))
         for term, unit in (("N", n_unit), ("B", b_unit)):
             parts += _readoff_agreement(model, c, term, unit, sensor)
-        parts += [f"{tie.term} not resolved: a {tie.alternative} fits the rise of the "
-                  f"longest taus as well as a {tie.noun} (BIC {tie.delta_bic:+.2g}), so the "
-                  "record cannot tell them apart (the table gives its 95 % bound)"
+        parts += [f"{tie.term} not resolved: {tie.instead()} fits the rise of the longest "
+                  f"taus as well (BIC {tie.delta_bic:+.2g}), so the record cannot tell them "
+                  "apart (the table gives its 95 % bound)"
                   for tie in (model.ties[c] if model.ties else ())]
         out.append("; ".join(parts) + ".")
     return out
