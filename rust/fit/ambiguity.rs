@@ -37,9 +37,9 @@ pub struct Ambiguity {
 /// less than [`DECISIVE`] higher: the random walk against a ramp in its place
 /// and against one more Gauss–Markov term whose hump the fitted taus show; the
 /// ramp against a walk in its place (these keep every other term of `chosen`);
-/// and each against `selected_without` — the structures the selection chooses
-/// with the walk, and with the ramp, left out ([`search::WALK`],
-/// [`search::RAMP`]; None where it was not run). A walk and a ramp together
+/// and each against `selected_without` — the best structures found with the
+/// walk, and with the ramp, left out ([`search::WALK`], [`search::RAMP`]; None
+/// where none was sought). A walk and a ramp together
 /// are not questioned by a swap: each then has a part of the curve the other
 /// does not describe.
 pub fn ambiguities(

@@ -194,19 +194,42 @@ pub fn fit_noise(
     };
     let mut fit = summarise(&reported, fs, &chosen);
     if opts.select {
-        // The best structure the selection finds with the walk (the ramp) left
-        // out, where the chosen one has it: the rise it takes may need no such term.
+        // The best structure with the walk (the ramp) left out, where the chosen
+        // one has it: the rise it takes may need no such term.
         let without = |j: usize| -> Option<Candidate> {
-            let mut none = ieee;
-            none[j] = false;
             (chosen.ieee[j] && chosen.solution.theta[j] > 0.0)
-                .then(|| choose(&data, fs, opts, none).ok())
+                .then(|| without_term(&data, fs, opts, &chosen, j))
                 .flatten()
         };
         let selected_without = [without(search::WALK), without(search::RAMP)];
         fit.ambiguous = ambiguity::ambiguities(&data, fs, ieee, gm, &chosen, &selected_without);
     }
     Ok(fit)
+}
+
+/// The best structure without IEEE term `j`: its IEEE and Gauss–Markov terms
+/// selected again with `j` left out, alone and with `chosen`'s tones, resonance
+/// and motion kept (their searches, most of the selection's time, are not
+/// repeated: a structure that needs them has them from `chosen`). Its BIC decides.
+fn without_term(
+    data: &Data,
+    fs: f64,
+    opts: &Options,
+    chosen: &Candidate,
+    j: usize,
+) -> Option<Candidate> {
+    let mut ieee = opts.ieee();
+    ieee[j] = false;
+    let gm = opts.count(Kind::GaussMarkov);
+    let plain = search::select(data, fs, ieee, gm, (0, false, false)).ok()?;
+    let plain = prune_insignificant(data, fs, plain).ok()?;
+    let extras = (chosen.sine, chosen.resonance, chosen.motion);
+    let (times, d2) = (plain.gm_in_use(), plain.solution.d2);
+    let kept = search::candidate(data, fs, plain.ieee, times, extras, d2).ok();
+    Some(match kept {
+        Some(k) if k.bic < plain.bic => k,
+        _ => plain,
+    })
 }
 
 /// The structure the selection chooses among the IEEE terms `ieee` and the
