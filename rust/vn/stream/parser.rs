@@ -11,7 +11,8 @@ use std::collections::BTreeMap;
 use crate::error::{CoreError, CoreResult};
 use crate::vn::ascii::{self, Decoded};
 use crate::vn::binary::{self, HeaderScan, Layout};
-use crate::vn::messages::{spec_by_id, MsgSpec};
+use crate::vn::messages::{spec_by_id, MsgSpec, MAX_FIELDS};
+use crate::vn::shape::Shape;
 use crate::vn::stream::scan::{count_newlines, eat_eol, scan_ascii, Ascii, Outcome};
 use crate::vn::{IssueKind, Location, Table, VnData, FIRST_KEEP};
 
@@ -23,6 +24,8 @@ pub(super) const PARALLEL_MIN: usize = 1 << 20;
 pub(super) const MAX_LAYOUTS: usize = 16;
 /// CRC failures remembered before their configuration is confirmed.
 const MAX_PENDING: usize = 64;
+/// Sentence shapes remembered per parser (message types interleaved).
+const MAX_SHAPES: usize = 4;
 
 /// A strict-mode failure: the first damaged record.
 #[derive(Debug, Clone, PartialEq)]
@@ -80,6 +83,13 @@ pub struct Parser {
     pub fail: Option<Failure>,
     /// Message type of the last sentence taken by the fast path.
     pub(super) last_spec: Option<&'static MsgSpec>,
+    /// Shapes of the last sentences of up to [`MAX_SHAPES`] message types.
+    pub(super) shapes: Vec<Shape>,
+    /// Sentences of the fast path since the last one a shape took.
+    pub(super) shape_misses: u32,
+    /// Sentences a shape took (for tests).
+    #[cfg(test)]
+    pub(super) shape_hits: u64,
     /// Whether common sentences take [`ascii::fast_sentence`] (off only to check
     /// that the result is the same without it).
     pub(super) fast: bool,
@@ -116,6 +126,10 @@ impl Parser {
             pending: Vec::new(),
             fail: None,
             last_spec: None,
+            shapes: Vec::new(),
+            shape_misses: 0,
+            #[cfg(test)]
+            shape_hits: 0,
             fast: true,
             parallel_min: PARALLEL_MIN,
             merged_pieces: 0,
@@ -374,9 +388,23 @@ impl Parser {
     /// decoded and `*i` moved past it, or `false` with nothing changed.
     #[inline]
     fn fast_ascii(&mut self, buf: &[u8], i: &mut usize, level: crate::simd::Level) -> bool {
-        let Some((spec, values, star)) = ascii::fast_sentence(&buf[*i..], self.last_spec, level)
-        else {
-            return false;
+        let b = &buf[*i..];
+        let (spec, values, star) = match self.shaped(b, level) {
+            Some(hit) => {
+                self.shape_misses = 0;
+                #[cfg(test)]
+                {
+                    self.shape_hits += 1;
+                }
+                hit
+            }
+            None => {
+                let Some(hit) = ascii::fast_sentence(b, self.last_spec, level) else {
+                    return false;
+                };
+                self.learn_shape(b, hit.0, hit.2, level);
+                hit
+            }
         };
         self.last_spec = Some(spec);
         let end = eat_eol(buf, *i + star + 3);
@@ -394,6 +422,48 @@ impl Parser {
         self.data.ascii_records += 1;
         *i = end;
         true
+    }
+
+    /// The values of the sentence at `b` by the shape of its message type.
+    #[inline(always)]
+    fn shaped(
+        &self,
+        b: &[u8],
+        level: crate::simd::Level,
+    ) -> Option<(&'static MsgSpec, [f64; MAX_FIELDS], usize)> {
+        let id = b.get(1..6)?;
+        let shape = self.shapes.iter().find(|s| s.spec.id.as_bytes() == id)?;
+        Some((shape.spec, shape.parse(b, level)?, shape.star))
+    }
+
+    /// Learn the shape of a sentence the fast path took without one, at the
+    /// first miss and then at the 2nd, 4th, 8th ... and every 64th: a stream
+    /// of fixed-width sentences changes shape rarely and relearns at once,
+    /// one of varying widths does not pay for learning every sentence.
+    #[cold]
+    fn learn_shape(
+        &mut self,
+        b: &[u8],
+        spec: &'static MsgSpec,
+        star: usize,
+        level: crate::simd::Level,
+    ) {
+        self.shape_misses = self.shape_misses.saturating_add(1);
+        let m = self.shape_misses;
+        if !m.is_power_of_two() && !m.is_multiple_of(64) {
+            return;
+        }
+        let Some(shape) = Shape::learn(b, spec, star, level) else {
+            return;
+        };
+        match self.shapes.iter().position(|s| s.spec.id == spec.id) {
+            Some(k) => self.shapes[k] = shape,
+            None if self.shapes.len() < MAX_SHAPES => self.shapes.push(shape),
+            None => {
+                self.shapes.remove(0);
+                self.shapes.push(shape);
+            }
+        }
     }
 
     /// Try a binary packet at `buf[i] == 0xFA`; `None` means "need more input".
