@@ -95,6 +95,8 @@ pub struct Parser {
     pub(super) fast: bool,
     /// Blocks at least this long are parsed on all cores.
     pub(super) parallel_min: usize,
+    /// Whether a block parsed on all cores held a 0xFA byte.
+    pub(super) saw_binary: bool,
     /// Pieces parsed on other cores and merged (for tests).
     pub(super) merged_pieces: u64,
     /// Locations kept for runs of skipped bytes (one more in a piece of a
@@ -132,6 +134,7 @@ impl Parser {
             shape_hits: 0,
             fast: true,
             parallel_min: PARALLEL_MIN,
+            saw_binary: false,
             merged_pieces: 0,
             skip_keep: FIRST_KEEP,
             spare: Vec::new(),

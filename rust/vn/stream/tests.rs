@@ -482,7 +482,7 @@ proptest! {
                 proptest::collection::vec((any::<bool>(), 0usize..9, any::<bool>(), 0usize..9), 1..5),
                 any::<u64>(),
                 1usize..14,
-                0u8..6,
+                0u8..7,
             ),
             1..6,
         ),
@@ -495,12 +495,13 @@ proptest! {
         // Streams of sentences whose fields keep their widths (the sensor's
         // output, which the shapes of the vector levels take), with the width
         // changing between runs, checksums wrong, line ends LF, CRLF or none,
-        // '$' in noise, lines longer than a shape's window, then damage; cut
+        // '$' in noise, lines longer than a shape's window, binary packets
+        // (in any piece of a parallel block), then damage; cut
         // into parallel pieces and chunks. Every level gives the reference's
         // rows, counts and first locations.
         let mut s = Vec::new();
         for (m, widths, seed, count, kind) in parts {
-            let eol = ["\r\n", "\n", "", "\r\n", "\r\n", "\n"][kind as usize];
+            let eol = ["\r\n", "\n", "", "\r\n", "\r\n", "\n", "\r\n"][kind as usize];
             let mut run = fixed_width(m, &widths, seed, count, eol);
             match kind {
                 3 => run.extend_from_slice(b"noise $ $VN $VNYMR,+1*00 garbage\r\n"),
@@ -514,6 +515,11 @@ proptest! {
                     run.extend_from_slice(b"$VNYMR");
                     run.extend(std::iter::repeat_n(b",+0.5", 80).flatten());
                     run.extend_from_slice(b"*00\r\n");
+                }
+                6 => {
+                    // A binary packet inside a run of sentences.
+                    let at = run.len() / 2;
+                    run.splice(at..at, B1);
                 }
                 _ => {}
             }
