@@ -122,27 +122,41 @@ impl Shape {
         (k == n).then_some(s)
     }
 
-    /// The values of the sentence at `b[0] == b'$'` if it has this shape and a
-    /// matching XOR-8 checksum (the conditions of `fast_sentence`).
+    /// Writes the values of the sentence at `b[0] == b'$'` at `out` (lanes
+    /// past the message's fields too) if it has this shape and a matching
+    /// XOR-8 checksum (the conditions of `fast_sentence`); `false` with nothing
+    /// written otherwise.
+    ///
+    /// # Safety
+    /// `out` is valid for writes of [`MAX_FIELDS`] values.
     #[inline]
-    pub(crate) fn parse(&self, b: &[u8], level: Level) -> Option<[f64; MAX_FIELDS]> {
+    pub(crate) unsafe fn parse_into(&self, b: &[u8], level: Level, out: *mut f64) -> bool {
         if b.len() < WINDOW {
-            return None;
+            return false;
         }
         #[cfg(target_arch = "x86_64")]
         match level {
             // SAFETY: the level is at most the CPU's (simd::level), which then
-            // has AVX-512 F, DQ and BW; `b` holds the WINDOW bytes read.
-            Level::Avx512 | Level::Ifma => unsafe { x86::parse_avx512(self, b) },
+            // has AVX-512 F, DQ and BW; `b` holds the WINDOW bytes read; `out`
+            // as the caller promises.
+            Level::Avx512 | Level::Ifma => unsafe { x86::parse_avx512(self, b, out) },
             // SAFETY: as above, with AVX2.
-            Level::Avx2 => unsafe { x86::parse_avx2(self, b) },
-            Level::Scalar => None,
+            Level::Avx2 => unsafe { x86::parse_avx2(self, b, out) },
+            Level::Scalar => false,
         }
         #[cfg(not(target_arch = "x86_64"))]
         {
-            let _ = level;
-            None
+            let _ = (level, out);
+            false
         }
+    }
+
+    /// [`Shape::parse_into`] into an array.
+    #[cfg(test)]
+    pub(crate) fn parse(&self, b: &[u8], level: Level) -> Option<[f64; MAX_FIELDS]> {
+        let mut out = [0.0; MAX_FIELDS];
+        // SAFETY: `out` holds MAX_FIELDS values.
+        unsafe { self.parse_into(b, level, out.as_mut_ptr()) }.then_some(out)
     }
 
     /// Whether the check field after the `*` holds the two hex digits of `x`
@@ -199,7 +213,7 @@ mod x86 {
     }
 
     #[target_feature(enable = "avx512f,avx512dq,avx512bw")]
-    pub(super) unsafe fn parse_avx512(s: &Shape, b: &[u8]) -> Option<[f64; MAX_FIELDS]> {
+    pub(super) unsafe fn parse_avx512(s: &Shape, b: &[u8], out: *mut f64) -> bool {
         let p = b.as_ptr();
         // SAFETY (all loads): b holds WINDOW = 128 bytes (the caller checks), and
         // every field's 16 bytes lie inside them (Shape::learn).
@@ -222,13 +236,13 @@ mod x86 {
             x = _mm512_xor_si512(x, _mm512_and_si512(v, m));
         }
         if (e & s.exact != s.exact) | (d & s.digit != s.digit) | (g & s.sign != s.sign) {
-            return None;
+            return false;
         }
         let x = _mm256_xor_si256(_mm512_castsi512_si256(x), _mm512_extracti64x4_epi64(x, 1));
         let x = _mm_xor_si128(_mm256_castsi256_si128(x), _mm256_extracti128_si256(x, 1));
         let x = _mm_cvtsi128_si64(x) as u64 ^ _mm_extract_epi64(x, 1) as u64;
         if !s.check_ok(b, fold_bytes(x)) {
-            return None;
+            return false;
         }
         let n = s.spec.fields.len();
         let mut mant = [_mm512_setzero_si512(); MAX_FIELDS / 4];
@@ -254,7 +268,6 @@ mod x86 {
         // Each 128-bit lane holds its field's mantissa in its low word.
         let pick = _mm512_set_epi64(14, 12, 10, 8, 6, 4, 2, 0);
         let sign = _mm512_set1_epi64(i64::MIN);
-        let mut out = [0.0f64; MAX_FIELDS];
         for h in 0..n.div_ceil(8) {
             let m = _mm512_permutex2var_epi64(mant[2 * h], pick, mant[2 * h + 1]);
             let v = _mm512_div_pd(
@@ -263,13 +276,14 @@ mod x86 {
             );
             let v = _mm512_castpd_si512(v);
             let v = _mm512_mask_or_epi64(v, (neg >> (8 * h)) as u8, v, sign);
-            _mm512_storeu_pd(out.as_mut_ptr().add(8 * h), _mm512_castsi512_pd(v));
+            // SAFETY: 8h + 8 <= MAX_FIELDS values at `out` (the caller's promise).
+            _mm512_storeu_pd(out.add(8 * h), _mm512_castsi512_pd(v));
         }
-        Some(out)
+        true
     }
 
     #[target_feature(enable = "avx2")]
-    pub(super) unsafe fn parse_avx2(s: &Shape, b: &[u8]) -> Option<[f64; MAX_FIELDS]> {
+    pub(super) unsafe fn parse_avx2(s: &Shape, b: &[u8], out: *mut f64) -> bool {
         let p = b.as_ptr();
         let (zero, nine) = (_mm256_set1_epi8(b'0' as i8), _mm256_set1_epi8(9));
         let (plus, minus) = (_mm256_set1_epi8(b'+' as i8), _mm256_set1_epi8(b'-' as i8));
@@ -289,12 +303,12 @@ mod x86 {
             x = _mm256_xor_si256(x, _mm256_and_si256(v, m));
         }
         if (e & s.exact != s.exact) | (d & s.digit != s.digit) | (g & s.sign != s.sign) {
-            return None;
+            return false;
         }
         let x = _mm_xor_si128(_mm256_castsi256_si128(x), _mm256_extracti128_si256(x, 1));
         let x = _mm_cvtsi128_si64(x) as u64 ^ _mm_extract_epi64(x, 1) as u64;
         if !s.check_ok(b, fold_bytes(x)) {
-            return None;
+            return false;
         }
         let n = s.spec.fields.len();
         let mut mant = [_mm256_setzero_si256(); MAX_FIELDS / 2];
@@ -319,7 +333,6 @@ mod x86 {
         let two52 = _mm256_set1_pd(4_503_599_627_370_496.0);
         let lane = _mm256_set_epi64x(8, 4, 2, 1);
         let sign = _mm256_set1_epi64x(i64::MIN);
-        let mut out = [0.0f64; MAX_FIELDS];
         for h in 0..n.div_ceil(4) {
             // Words 0 and 2 hold the two fields of a register.
             let m = _mm256_unpacklo_epi64(mant[2 * h], mant[2 * h + 1]);
@@ -329,9 +342,10 @@ mod x86 {
             let k = _mm256_set1_epi64x(((neg >> (4 * h)) & 0xF) as i64);
             let k = _mm256_cmpeq_epi64(_mm256_and_si256(k, lane), lane);
             let v = _mm256_or_si256(_mm256_castpd_si256(v), _mm256_and_si256(k, sign));
-            _mm256_storeu_pd(out.as_mut_ptr().add(4 * h), _mm256_castsi256_pd(v));
+            // SAFETY: 4h + 4 <= MAX_FIELDS values at `out` (the caller's promise).
+            _mm256_storeu_pd(out.add(4 * h), _mm256_castsi256_pd(v));
         }
-        Some(out)
+        true
     }
 }
 

@@ -98,8 +98,8 @@ impl Parser {
         // parsed in parallel; only the tail after it (part of one line, which may
         // continue in the next block) is parsed sequentially and carried over.
         // A binary packet may hold a newline: a block with a 0xFA byte is cut at
-        // packets instead. Each piece looks for 0xFA itself, on its own core,
-        // rather than one core scanning the block first.
+        // packets instead. Each piece's parser notes a 0xFA it meets (every
+        // one it holds), rather than one core scanning the block first.
         let end_nl = buf.iter().rposition(|&c| c == b'\n').map(|p| p + 1);
         let Some(end_nl) = end_nl.filter(|&e| !has_byte(&buf[e..], 0xFA)) else {
             return match has_byte(buf, 0xFA) {
@@ -130,9 +130,6 @@ impl Parser {
             .zip(lent)
             .map(|(&(a, b), spare)| {
                 let piece = &buf[a..b];
-                if has_byte(piece, 0xFA) {
-                    return Err(spare);
-                }
                 let mut p = Parser::with_size_hint(strict, piece.len() as u64);
                 p.fast = fast;
                 p.spare = spare;
@@ -143,7 +140,10 @@ impl Parser {
                 // `feed` consumed the whole piece and counted its newlines
                 // (unless strict mode stopped it, when the count is not used).
                 let nl = p.lines;
-                Ok((p.data, p.fail, nl, p.skip_end, p.spare))
+                match p.met_0xfa {
+                    true => Err(p.spare),
+                    false => Ok((p.data, p.fail, nl, p.skip_end, p.spare)),
+                }
             })
             .collect();
         if results.iter().any(|r| r.is_err()) {

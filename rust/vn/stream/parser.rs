@@ -11,7 +11,7 @@ use std::collections::BTreeMap;
 use crate::error::{CoreError, CoreResult};
 use crate::vn::ascii::{self, Decoded};
 use crate::vn::binary::{self, HeaderScan, Layout};
-use crate::vn::messages::{spec_by_id, MsgSpec, MAX_FIELDS};
+use crate::vn::messages::{spec_by_id, MsgSpec};
 use crate::vn::shape::Shape;
 use crate::vn::stream::scan::{count_newlines, eat_eol, scan_ascii, Ascii, Outcome};
 use crate::vn::{IssueKind, Location, Table, VnData, FIRST_KEEP};
@@ -97,6 +97,9 @@ pub struct Parser {
     pub(super) parallel_min: usize,
     /// Whether a block parsed on all cores held a 0xFA byte.
     pub(super) saw_binary: bool,
+    /// Whether `feed` met a 0xFA byte: every byte outside the records it
+    /// decodes passes its main loop, and no ASCII record holds one.
+    pub(super) met_0xfa: bool,
     /// Pieces parsed on other cores and merged (for tests).
     pub(super) merged_pieces: u64,
     /// Locations kept for runs of skipped bytes (one more in a piece of a
@@ -135,6 +138,7 @@ impl Parser {
             fast: true,
             parallel_min: PARALLEL_MIN,
             saw_binary: false,
+            met_0xfa: false,
             merged_pieces: 0,
             skip_keep: FIRST_KEEP,
             spare: Vec::new(),
@@ -363,10 +367,13 @@ impl Parser {
                         i = end;
                     }
                 },
-                0xFA => match self.binary_at(buf, i, fin) {
-                    None => break,
-                    Some(next) => i = next,
-                },
+                0xFA => {
+                    self.met_0xfa = true;
+                    match self.binary_at(buf, i, fin) {
+                        None => break,
+                        Some(next) => i = next,
+                    }
+                }
                 _ => {
                     let j = buf[i..]
                         .iter()
@@ -392,7 +399,7 @@ impl Parser {
     #[inline]
     fn fast_ascii(&mut self, buf: &[u8], i: &mut usize, level: crate::simd::Level) -> bool {
         let b = &buf[*i..];
-        let (spec, values, star) = match self.shaped(b, level) {
+        let (spec, star) = match self.shaped(b, level) {
             Some(hit) => {
                 self.shape_misses = 0;
                 #[cfg(test)]
@@ -402,41 +409,72 @@ impl Parser {
                 hit
             }
             None => {
-                let Some(hit) = ascii::fast_sentence(b, self.last_spec, level) else {
+                let Some((spec, values, star)) = ascii::fast_sentence(b, self.last_spec, level)
+                else {
                     return false;
                 };
-                self.learn_shape(b, hit.0, hit.2, level);
-                hit
+                self.learn_shape(b, spec, star, level);
+                let len = eat_eol(b, star + 3);
+                let table = match self.data.tables.get_mut(spec.id) {
+                    Some(t) => t,
+                    None => {
+                        let mut table = self.new_table(spec);
+                        table.reserve(self.rows_hint(len));
+                        self.data.tables.entry(spec.id.to_string()).or_insert(table)
+                    }
+                };
+                table.push_row(&values[..spec.fields.len()]);
+                (spec, star)
             }
         };
         self.last_spec = Some(spec);
         let end = eat_eol(buf, *i + star + 3);
-        let len = end - *i;
-        let table = match self.data.tables.get_mut(spec.id) {
-            Some(t) => t,
-            None => {
-                let mut table = self.new_table(spec);
-                table.reserve(self.rows_hint(len));
-                self.data.tables.entry(spec.id.to_string()).or_insert(table)
-            }
-        };
-        table.push_row(&values[..spec.fields.len()]);
-        self.data.bytes_parsed += len as u64;
+        // The line count follows the sentences (its only newline is its line
+        // end), so that the block's end has no bytes left to count.
+        let at = self.base + *i as u64;
+        if self.line_pos < at {
+            let from = (self.line_pos - self.base) as usize;
+            self.lines += count_newlines(&buf[from..*i]);
+        }
+        self.lines += (buf[end - 1] == b'\n') as u64;
+        self.line_pos = self.base + end as u64;
+        self.data.bytes_parsed += (end - *i) as u64;
         self.data.ascii_records += 1;
         *i = end;
         true
     }
 
-    /// The values of the sentence at `b` by the shape of its message type.
+    /// The sentence at `b`, appended to its table by the shape of its message
+    /// type: its spec and the offset of its `*`, or `None` with nothing changed.
     #[inline(always)]
-    fn shaped(
-        &self,
-        b: &[u8],
-        level: crate::simd::Level,
-    ) -> Option<(&'static MsgSpec, [f64; MAX_FIELDS], usize)> {
+    fn shaped(&mut self, b: &[u8], level: crate::simd::Level) -> Option<(&'static MsgSpec, usize)> {
         let id = b.get(1..6)?;
-        let shape = self.shapes.iter().find(|s| s.spec.id.as_bytes() == id)?;
-        Some((shape.spec, shape.parse(b, level)?, shape.star))
+        let k = self
+            .shapes
+            .iter()
+            .position(|s| s.spec.id.as_bytes() == id)?;
+        let (spec, star) = (self.shapes[k].spec, self.shapes[k].star);
+        let len = eat_eol(b, star + 3);
+        if b.len() < crate::vn::shape::WINDOW {
+            return None;
+        }
+        let shape = &self.shapes[k];
+        let table = match self.data.tables.get_mut(spec.id) {
+            Some(t) => t,
+            None => {
+                let mut table = Table::with_buffer(
+                    spec.fields.iter().map(|s| s.to_string()).collect(),
+                    self.spare.pop().unwrap_or_default(),
+                );
+                let left = self.size_hint.saturating_sub(self.base);
+                table.reserve((left / len.max(1) as u64).min(1 << 32) as usize);
+                self.data.tables.entry(spec.id.to_string()).or_insert(table)
+            }
+        };
+        // SAFETY: push_with's pointer has room for SCRATCH = MAX_FIELDS values,
+        // all parse_into writes; it writes every lane when it returns true.
+        let pushed = unsafe { table.push_with(|dst| shape.parse_into(b, level, dst)) };
+        pushed.then_some((spec, star))
     }
 
     /// Learn the shape of a sentence the fast path took without one, at the
