@@ -23,7 +23,8 @@ pub enum Level {
     Avx2,
     /// AVX-512 F, DQ and BW, on top of AVX2 (every CPU with DQ has BW).
     Avx512,
-    /// AVX-512 IFMA (52-bit integer multiply-add), on top of AVX-512.
+    /// AVX-512 IFMA (52-bit integer multiply-add) and VBMI (byte permutes), with
+    /// BMI2, on top of AVX-512 (every CPU with IFMA has the other two).
     Ifma,
 }
 
@@ -62,7 +63,7 @@ fn detect() -> Level {
         Level::Scalar
     } else if !(has!("avx512f") && has!("avx512dq") && has!("avx512bw")) {
         Level::Avx2
-    } else if !has!("avx512ifma") {
+    } else if !(has!("avx512ifma") && has!("avx512vbmi") && has!("bmi2")) {
         Level::Avx512
     } else {
         Level::Ifma

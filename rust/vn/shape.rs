@@ -15,7 +15,8 @@
 //! there are no shapes (the scalar level is the reference path).
 //!
 //! Cost: two (AVX-512) or four (AVX2) 64/32-byte windows compared, plus one
-//! byte shuffle and four multiply-adds per four (two) fields.
+//! byte permute (VBMI, at the IFMA level) or four loads and a shuffle, and four
+//! multiply-adds, per four (AVX2: two) fields.
 
 use crate::simd::Level;
 use crate::vn::messages::{MsgSpec, MAX_FIELDS};
@@ -45,6 +46,12 @@ pub(crate) struct Shape {
     shuffle: [[u8; 16]; MAX_FIELDS],
     /// Per field, 10^(digits after the dot).
     den: [f64; MAX_FIELDS],
+    /// The same digits as window offsets, four fields per 64 bytes (for a
+    /// two-register byte permute), and which of those bytes are digits.
+    gather: [[u8; 64]; MAX_FIELDS / 4],
+    gathered: [u64; MAX_FIELDS / 4],
+    /// Bit k: field k starts with a sign.
+    signed: u32,
 }
 
 impl Shape {
@@ -74,6 +81,9 @@ impl Shape {
             start: [0; MAX_FIELDS],
             shuffle: [[0x80; 16]; MAX_FIELDS],
             den: [1.0; MAX_FIELDS],
+            gather: [[0; 64]; MAX_FIELDS / 4],
+            gathered: [0; MAX_FIELDS / 4],
+            signed: 0,
         };
         // The header `$VNxxx,` is exact: a digit class there would let another
         // message type through.
@@ -111,10 +121,13 @@ impl Shape {
             for (q, c) in field.iter().enumerate() {
                 if c.is_ascii_digit() {
                     s.shuffle[k][slot] = q as u8;
+                    s.gather[k / 4][16 * (k % 4) + slot] = (from + q) as u8;
+                    s.gathered[k / 4] |= 1 << (16 * (k % 4) + slot);
                     slot += 1;
                 }
             }
             s.start[k] = from as u32;
+            s.signed |= (((s.sign >> from) & 1) as u32) << k;
             s.den[k] = *POW10.get(frac)?;
             k += 1;
             from = p + 1;
@@ -137,9 +150,11 @@ impl Shape {
         #[cfg(target_arch = "x86_64")]
         match level {
             // SAFETY: the level is at most the CPU's (simd::level), which then
-            // has AVX-512 F, DQ and BW; `b` holds the WINDOW bytes read; `out`
-            // as the caller promises.
-            Level::Avx512 | Level::Ifma => unsafe { x86::parse_avx512(self, b, out) },
+            // has AVX-512 F, DQ, BW and VBMI and BMI2; `b` holds the WINDOW bytes
+            // read; `out` as the caller promises.
+            Level::Ifma => unsafe { x86::parse_vbmi(self, b, out) },
+            // SAFETY: as above, with AVX-512 F, DQ and BW.
+            Level::Avx512 => unsafe { x86::parse_avx512(self, b, out) },
             // SAFETY: as above, with AVX2.
             Level::Avx2 => unsafe { x86::parse_avx2(self, b, out) },
             Level::Scalar => false,
@@ -266,6 +281,73 @@ mod x86 {
             *m = _mm512_add_epi64(hi, _mm512_srli_epi64(v, 32));
         }
         // Each 128-bit lane holds its field's mantissa in its low word.
+        let pick = _mm512_set_epi64(14, 12, 10, 8, 6, 4, 2, 0);
+        let sign = _mm512_set1_epi64(i64::MIN);
+        for h in 0..n.div_ceil(8) {
+            let m = _mm512_permutex2var_epi64(mant[2 * h], pick, mant[2 * h + 1]);
+            let v = _mm512_div_pd(
+                _mm512_cvtepu64_pd(m),
+                _mm512_loadu_pd(s.den.as_ptr().add(8 * h)),
+            );
+            let v = _mm512_castpd_si512(v);
+            let v = _mm512_mask_or_epi64(v, (neg >> (8 * h)) as u8, v, sign);
+            // SAFETY: 8h + 8 <= MAX_FIELDS values at `out` (the caller's promise).
+            _mm512_storeu_pd(out.add(8 * h), _mm512_castsi512_pd(v));
+        }
+        true
+    }
+
+    /// [`parse_avx512`] with every field's digits gathered from the two window
+    /// registers by one byte permute per four fields, and the signs by bit
+    /// extraction from the window's `-` mask.
+    #[target_feature(enable = "avx512f,avx512dq,avx512bw,avx512vbmi,bmi2")]
+    pub(super) unsafe fn parse_vbmi(s: &Shape, b: &[u8], out: *mut f64) -> bool {
+        let p = b.as_ptr();
+        // SAFETY (all loads): b holds WINDOW = 128 bytes (the caller checks).
+        let c = [
+            _mm512_loadu_si512(p.cast()),
+            _mm512_loadu_si512(p.add(64).cast()),
+        ];
+        let (zero, nine) = (_mm512_set1_epi8(b'0' as i8), _mm512_set1_epi8(9));
+        let (plus, minus) = (_mm512_set1_epi8(b'+' as i8), _mm512_set1_epi8(b'-' as i8));
+        let (mut e, mut d, mut g, mut m) = (0u128, 0u128, 0u128, [0u64; 2]);
+        let mut x = _mm512_setzero_si512();
+        let mut z = [_mm512_setzero_si512(); 2];
+        for (h, &v) in c.iter().enumerate() {
+            let t = _mm512_loadu_si512(s.template.as_ptr().add(64 * h).cast());
+            e |= (_mm512_cmpeq_epi8_mask(v, t) as u128) << (64 * h);
+            z[h] = _mm512_sub_epi8(v, zero);
+            d |= (_mm512_cmple_epu8_mask(z[h], nine) as u128) << (64 * h);
+            m[h] = _mm512_cmpeq_epi8_mask(v, minus);
+            g |= ((_mm512_cmpeq_epi8_mask(v, plus) | m[h]) as u128) << (64 * h);
+            let body = _mm512_loadu_si512(s.body.as_ptr().add(64 * h).cast());
+            x = _mm512_xor_si512(x, _mm512_and_si512(v, body));
+        }
+        if (e & s.exact != s.exact) | (d & s.digit != s.digit) | (g & s.sign != s.sign) {
+            return false;
+        }
+        let x = _mm256_xor_si256(_mm512_castsi512_si256(x), _mm512_extracti64x4_epi64(x, 1));
+        let x = _mm_xor_si128(_mm256_castsi256_si128(x), _mm256_extracti128_si256(x, 1));
+        let x = _mm_cvtsi128_si64(x) as u64 ^ _mm_extract_epi64(x, 1) as u64;
+        if !s.check_ok(b, fold_bytes(x)) {
+            return false;
+        }
+        // The signed fields' `-` bits, in field order, then spread to the fields.
+        let (lo, hi) = (s.sign as u64, (s.sign >> 64) as u64);
+        let packed = _pext_u64(m[0], lo) | (_pext_u64(m[1], hi) << (lo.count_ones() & 63));
+        let neg = _pdep_u32(packed as u32, s.signed);
+        let n = s.spec.fields.len();
+        let mut mant = [_mm512_setzero_si512(); MAX_FIELDS / 4];
+        for (q, mq) in mant.iter_mut().enumerate().take(n.div_ceil(4)) {
+            let idx = _mm512_loadu_si512(s.gather[q].as_ptr().cast());
+            let digits = _mm512_maskz_permutex2var_epi8(s.gathered[q], z[0], idx, z[1]);
+            let v = _mm512_maddubs_epi16(digits, _mm512_set1_epi16(0x010A));
+            let v = _mm512_madd_epi16(v, _mm512_set1_epi32(0x0001_0064));
+            let v = _mm512_packus_epi32(v, v);
+            let v = _mm512_madd_epi16(v, _mm512_set1_epi32(0x0001_2710));
+            let hi = _mm512_mul_epu32(v, _mm512_set1_epi64(100_000_000));
+            *mq = _mm512_add_epi64(hi, _mm512_srli_epi64(v, 32));
+        }
         let pick = _mm512_set_epi64(14, 12, 10, 8, 6, 4, 2, 0);
         let sign = _mm512_set1_epi64(i64::MIN);
         for h in 0..n.div_ceil(8) {
