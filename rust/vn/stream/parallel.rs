@@ -136,6 +136,7 @@ impl Parser {
                 // One spare location, for a run of skipped bytes that turns out
                 // to continue one from the previous piece.
                 p.skip_keep = FIRST_KEEP + 1;
+                p.ascii_piece = true;
                 p.feed(piece, true);
                 // `feed` consumed the whole piece and counted its newlines
                 // (unless strict mode stopped it, when the count is not used).

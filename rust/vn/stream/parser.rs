@@ -100,6 +100,9 @@ pub struct Parser {
     /// Whether `feed` met a 0xFA byte: every byte outside the records it
     /// decodes passes its main loop, and no ASCII record holds one.
     pub(super) met_0xfa: bool,
+    /// A piece of a block cut at newlines: its result is dropped once it
+    /// meets a 0xFA, so it stops there.
+    pub(super) ascii_piece: bool,
     /// Pieces parsed on other cores and merged (for tests).
     pub(super) merged_pieces: u64,
     /// Locations kept for runs of skipped bytes (one more in a piece of a
@@ -139,6 +142,7 @@ impl Parser {
             parallel_min: PARALLEL_MIN,
             saw_binary: false,
             met_0xfa: false,
+            ascii_piece: false,
             merged_pieces: 0,
             skip_keep: FIRST_KEEP,
             spare: Vec::new(),
@@ -369,6 +373,9 @@ impl Parser {
                 },
                 0xFA => {
                     self.met_0xfa = true;
+                    if self.ascii_piece {
+                        return n;
+                    }
                     match self.binary_at(buf, i, fin) {
                         None => break,
                         Some(next) => i = next,
