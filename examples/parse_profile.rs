@@ -1,5 +1,6 @@
 //! Time the VN parser on a file without Python: `cargo run --release
-//! --no-default-features --example parse_profile -- FILE [REPEATS]`.
+//! --no-default-features --example parse_profile -- FILE [REPEATS]`
+//! (`IMUNOISE_SIMD=scalar|avx2|avx512|ifma` pins the level, as in Python).
 use std::time::Instant;
 
 fn main() {
@@ -7,6 +8,10 @@ fn main() {
     let path = std::path::Path::new(&args[1]);
     let reps: usize = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(5);
     let bytes = std::fs::read(path).unwrap();
+    if let Ok(name) = std::env::var("IMUNOISE_SIMD") {
+        _core::simd::force(_core::simd::Level::from_name(&name));
+    }
+    println!("level {}", _core::simd::level().name());
     for mode in ["file", "bytes"] {
         let mut times = Vec::new();
         for _ in 0..reps {

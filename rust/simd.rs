@@ -21,9 +21,10 @@ pub enum Level {
     Scalar,
     /// AVX2 with FMA.
     Avx2,
-    /// AVX-512 F and DQ, on top of AVX2.
+    /// AVX-512 F, DQ and BW, on top of AVX2 (every CPU with DQ has BW).
     Avx512,
-    /// AVX-512 IFMA (52-bit integer multiply-add), on top of AVX-512.
+    /// AVX-512 IFMA (52-bit integer multiply-add) and VBMI (byte permutes), with
+    /// BMI2, on top of AVX-512 (every CPU with IFMA has the other two).
     Ifma,
 }
 
@@ -60,9 +61,9 @@ fn detect() -> Level {
     use std::arch::is_x86_feature_detected as has;
     if !(has!("avx2") && has!("fma")) {
         Level::Scalar
-    } else if !(has!("avx512f") && has!("avx512dq")) {
+    } else if !(has!("avx512f") && has!("avx512dq") && has!("avx512bw")) {
         Level::Avx2
-    } else if !has!("avx512ifma") {
+    } else if !(has!("avx512ifma") && has!("avx512vbmi") && has!("bmi2")) {
         Level::Avx512
     } else {
         Level::Ifma

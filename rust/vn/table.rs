@@ -3,6 +3,9 @@
 //! Cost: one `push_row` is a copy of the record's fields into a vector that grows
 //! geometrically; merging pieces of a parallel parse copies them on all cores.
 
+/// Values [`Table::push_with`] may write at the end of a table.
+pub(crate) const SCRATCH: usize = crate::vn::messages::MAX_FIELDS;
+
 /// One message type's decoded records: a row-major matrix of `f64`.
 ///
 /// Row `r` holds the record's fields in `names` order at
@@ -64,9 +67,11 @@ impl Table {
         }
     }
 
-    /// Make room for `rows` more rows.
+    /// Make room for `rows` more rows (and the scratch of [`Table::push_with`]).
     pub fn reserve(&mut self, rows: usize) {
-        let want = (self.len + rows).saturating_mul(self.ncols());
+        let want = (self.len + rows)
+            .saturating_mul(self.ncols())
+            .saturating_add(SCRATCH);
         if self.values.capacity() < want {
             self.values.reserve(want - self.values.len());
             crate::memory::advise_huge_pages(&self.values);
@@ -82,6 +87,30 @@ impl Table {
         }
         self.values.extend_from_slice(row);
         self.len += 1;
+    }
+
+    /// Append one record that `fill` writes at the pointer it gets: room for
+    /// [`SCRATCH`] values, of which the first `ncols()` are the record (the
+    /// rest may be overwritten by the next one). Nothing is appended when
+    /// `fill` returns `false`. Vector kernels store their lanes in place so,
+    /// without a copy through a temporary.
+    ///
+    /// # Safety
+    /// `fill` writes at most `SCRATCH` values at the pointer, and all of the
+    /// first `ncols()` when it returns `true`.
+    #[inline]
+    pub(crate) unsafe fn push_with(&mut self, fill: impl FnOnce(*mut f64) -> bool) -> bool {
+        if self.values.capacity() - self.values.len() < SCRATCH {
+            self.reserve(self.len.max(1024));
+        }
+        let dst = self.values.spare_capacity_mut().as_mut_ptr().cast::<f64>();
+        if !fill(dst) {
+            return false;
+        }
+        // SAFETY: the first ncols() spare values were written by `fill`.
+        unsafe { self.values.set_len(self.values.len() + self.ncols()) };
+        self.len += 1;
+        true
     }
 
     /// Set an extra column's value for the last pushed row.

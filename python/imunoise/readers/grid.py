@@ -49,6 +49,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
+from functools import cached_property
 
 import numpy as np
 
@@ -508,8 +509,10 @@ class TimeGrid:
                 f"{len(p)} missing rows, more than {MAX_GRID_RATIO}x the samples: the log "
                 f"is not a sample sequence (a damaged or crafted file)"
             )
-        shift = np.searchsorted(np.sort(p), np.arange(n_records), side="right")
-        slot = np.arange(n_records, dtype=np.int64) + shift
+        slot = np.arange(n_records, dtype=np.int64)
+        if len(p):
+            # Skipped when nothing is missing: a serial pass over every record.
+            slot += np.searchsorted(np.sort(p), slot, side="right")
         return cls(slot=slot, n=n_records + len(p))
 
     @property
@@ -520,14 +523,22 @@ class TimeGrid:
     @property
     def valid(self) -> np.ndarray:
         """Boolean mask of the grid rows that hold a sample."""
+        if self.is_identity:
+            return np.ones(self.n, dtype=bool)
         mask = np.zeros(self.n, dtype=bool)
         mask[self.slot[self.slot >= 0]] = True
         return mask
 
-    @property
+    @cached_property
     def is_identity(self) -> bool:
-        """Every input sample in its own row, in order, nothing missing."""
-        return self.n == len(self.slot) and bool(np.all(self.slot == np.arange(self.n)))
+        """Every input sample in its own row, in order, nothing missing (asked once
+        per channel: computed once, a pass over every sample)."""
+        s = self.slot
+        if self.n != len(s) or not len(s):
+            return self.n == len(s)
+        # n increasing integers from 0 to n - 1 are 0, 1, ..., n - 1: no index
+        # array to allocate and compare against.
+        return bool(s[0] == 0 and s[-1] == self.n - 1 and np.all(s[1:] > s[:-1]))
 
     def gaps(self, fs: float) -> Gaps:
         """The missing rows as a :class:`Gaps` table (``fs`` from the reader)."""

@@ -1,6 +1,7 @@
 //! Large blocks on all cores, with exactly the result of the sequential
 //! [`Parser::feed`]: pure-ASCII blocks are cut at newlines, blocks with binary
-//! packets at packets with a good CRC; each piece gets a fresh parser and the
+//! packets (found by the pieces of the first cut) at packets with a good CRC;
+//! each piece gets a fresh parser and the
 //! pieces are merged in order (locations shifted, runs of skipped bytes joined
 //! across cuts, tables appended in one parallel copy).
 //!
@@ -88,14 +89,23 @@ impl Parser {
         if buf.len() < self.parallel_min || self.fail.is_some() {
             return self.feed(buf, fin);
         }
-        if has_byte(buf, 0xFA) {
+        // Once a block held binary packets, the next are scanned for them first
+        // (a piece that finds one wastes the parse of the other pieces).
+        if self.saw_binary && has_byte(buf, 0xFA) {
             return self.feed_block_binary(buf, fin);
         }
         // Everything up to the last newline is split into pieces at newlines and
         // parsed in parallel; only the tail after it (part of one line, which may
         // continue in the next block) is parsed sequentially and carried over.
-        let Some(end_nl) = buf.iter().rposition(|&c| c == b'\n').map(|p| p + 1) else {
-            return self.feed(buf, fin);
+        // A binary packet may hold a newline: a block with a 0xFA byte is cut at
+        // packets instead. Each piece's parser notes a 0xFA it meets (every
+        // one it holds), rather than one core scanning the block first.
+        let end_nl = buf.iter().rposition(|&c| c == b'\n').map(|p| p + 1);
+        let Some(end_nl) = end_nl.filter(|&e| !has_byte(&buf[e..], 0xFA)) else {
+            return match has_byte(buf, 0xFA) {
+                true => self.feed_block_binary(buf, fin),
+                false => self.feed(buf, fin),
+            };
         };
         let pieces = (rayon::current_num_threads() * 4).max(2);
         let step = end_nl / pieces;
@@ -115,7 +125,7 @@ impl Parser {
         let strict = self.strict;
         let fast = self.fast;
         let lent = self.lend_spare(inner.len());
-        let results: Vec<PieceResult> = inner
+        let results: Vec<Result<PieceResult, Vec<Vec<f64>>>> = inner
             .par_iter()
             .zip(lent)
             .map(|(&(a, b), spare)| {
@@ -126,13 +136,25 @@ impl Parser {
                 // One spare location, for a run of skipped bytes that turns out
                 // to continue one from the previous piece.
                 p.skip_keep = FIRST_KEEP + 1;
+                p.ascii_piece = true;
                 p.feed(piece, true);
                 // `feed` consumed the whole piece and counted its newlines
                 // (unless strict mode stopped it, when the count is not used).
                 let nl = p.lines;
-                (p.data, p.fail, nl, p.skip_end, p.spare)
+                match p.met_0xfa {
+                    true => Err(p.spare),
+                    false => Ok((p.data, p.fail, nl, p.skip_end, p.spare)),
+                }
             })
             .collect();
+        if results.iter().any(|r| r.is_err()) {
+            for r in results {
+                self.spare.extend(r.map_or_else(|spare| spare, |r| r.4));
+            }
+            self.saw_binary = true;
+            return self.feed_block_binary(buf, fin);
+        }
+        let results = results.into_iter().flatten();
         // Lines before the block (kept current by `feed`).
         let mut line_shift = self.lines;
         let mut parts = TableParts::default();

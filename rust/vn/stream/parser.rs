@@ -12,6 +12,7 @@ use crate::error::{CoreError, CoreResult};
 use crate::vn::ascii::{self, Decoded};
 use crate::vn::binary::{self, HeaderScan, Layout};
 use crate::vn::messages::{spec_by_id, MsgSpec};
+use crate::vn::shape::Shape;
 use crate::vn::stream::scan::{count_newlines, eat_eol, scan_ascii, Ascii, Outcome};
 use crate::vn::{IssueKind, Location, Table, VnData, FIRST_KEEP};
 
@@ -23,6 +24,8 @@ pub(super) const PARALLEL_MIN: usize = 1 << 20;
 pub(super) const MAX_LAYOUTS: usize = 16;
 /// CRC failures remembered before their configuration is confirmed.
 const MAX_PENDING: usize = 64;
+/// Sentence shapes remembered per parser (message types interleaved).
+const MAX_SHAPES: usize = 4;
 
 /// A strict-mode failure: the first damaged record.
 #[derive(Debug, Clone, PartialEq)]
@@ -80,11 +83,26 @@ pub struct Parser {
     pub fail: Option<Failure>,
     /// Message type of the last sentence taken by the fast path.
     pub(super) last_spec: Option<&'static MsgSpec>,
+    /// Shapes of the last sentences of up to [`MAX_SHAPES`] message types.
+    pub(super) shapes: Vec<Shape>,
+    /// Sentences of the fast path since the last one a shape took.
+    pub(super) shape_misses: u32,
+    /// Sentences a shape took (for tests).
+    #[cfg(test)]
+    pub(super) shape_hits: u64,
     /// Whether common sentences take [`ascii::fast_sentence`] (off only to check
     /// that the result is the same without it).
     pub(super) fast: bool,
     /// Blocks at least this long are parsed on all cores.
     pub(super) parallel_min: usize,
+    /// Whether a block parsed on all cores held a 0xFA byte.
+    pub(super) saw_binary: bool,
+    /// Whether `feed` met a 0xFA byte: every byte outside the records it
+    /// decodes passes its main loop, and no ASCII record holds one.
+    pub(super) met_0xfa: bool,
+    /// A piece of a block cut at newlines: its result is dropped once it
+    /// meets a 0xFA, so it stops there.
+    pub(super) ascii_piece: bool,
     /// Pieces parsed on other cores and merged (for tests).
     pub(super) merged_pieces: u64,
     /// Locations kept for runs of skipped bytes (one more in a piece of a
@@ -116,8 +134,15 @@ impl Parser {
             pending: Vec::new(),
             fail: None,
             last_spec: None,
+            shapes: Vec::new(),
+            shape_misses: 0,
+            #[cfg(test)]
+            shape_hits: 0,
             fast: true,
             parallel_min: PARALLEL_MIN,
+            saw_binary: false,
+            met_0xfa: false,
+            ascii_piece: false,
             merged_pieces: 0,
             skip_keep: FIRST_KEEP,
             spare: Vec::new(),
@@ -346,10 +371,16 @@ impl Parser {
                         i = end;
                     }
                 },
-                0xFA => match self.binary_at(buf, i, fin) {
-                    None => break,
-                    Some(next) => i = next,
-                },
+                0xFA => {
+                    self.met_0xfa = true;
+                    if self.ascii_piece {
+                        return n;
+                    }
+                    match self.binary_at(buf, i, fin) {
+                        None => break,
+                        Some(next) => i = next,
+                    }
+                }
                 _ => {
                     let j = buf[i..]
                         .iter()
@@ -374,26 +405,113 @@ impl Parser {
     /// decoded and `*i` moved past it, or `false` with nothing changed.
     #[inline]
     fn fast_ascii(&mut self, buf: &[u8], i: &mut usize, level: crate::simd::Level) -> bool {
-        let Some((spec, values, star)) = ascii::fast_sentence(&buf[*i..], self.last_spec, level)
-        else {
-            return false;
+        let b = &buf[*i..];
+        let (spec, star) = match self.shaped(b, level) {
+            Some(hit) => {
+                self.shape_misses = 0;
+                #[cfg(test)]
+                {
+                    self.shape_hits += 1;
+                }
+                hit
+            }
+            None => {
+                let Some((spec, values, star)) = ascii::fast_sentence(b, self.last_spec, level)
+                else {
+                    return false;
+                };
+                self.learn_shape(b, spec, star, level);
+                let len = eat_eol(b, star + 3);
+                let table = match self.data.tables.get_mut(spec.id) {
+                    Some(t) => t,
+                    None => {
+                        let mut table = self.new_table(spec);
+                        table.reserve(self.rows_hint(len));
+                        self.data.tables.entry(spec.id.to_string()).or_insert(table)
+                    }
+                };
+                table.push_row(&values[..spec.fields.len()]);
+                (spec, star)
+            }
         };
         self.last_spec = Some(spec);
         let end = eat_eol(buf, *i + star + 3);
-        let len = end - *i;
-        let table = match self.data.tables.get_mut(spec.id) {
-            Some(t) => t,
-            None => {
-                let mut table = self.new_table(spec);
-                table.reserve(self.rows_hint(len));
-                self.data.tables.entry(spec.id.to_string()).or_insert(table)
-            }
-        };
-        table.push_row(&values[..spec.fields.len()]);
-        self.data.bytes_parsed += len as u64;
+        // The line count follows the sentences (its only newline is its line
+        // end), so that the block's end has no bytes left to count.
+        let at = self.base + *i as u64;
+        if self.line_pos < at {
+            let from = (self.line_pos - self.base) as usize;
+            self.lines += count_newlines(&buf[from..*i]);
+        }
+        self.lines += (buf[end - 1] == b'\n') as u64;
+        self.line_pos = self.base + end as u64;
+        self.data.bytes_parsed += (end - *i) as u64;
         self.data.ascii_records += 1;
         *i = end;
         true
+    }
+
+    /// The sentence at `b`, appended to its table by the shape of its message
+    /// type: its spec and the offset of its `*`, or `None` with nothing changed.
+    #[inline(always)]
+    fn shaped(&mut self, b: &[u8], level: crate::simd::Level) -> Option<(&'static MsgSpec, usize)> {
+        let id = b.get(1..6)?;
+        let k = self
+            .shapes
+            .iter()
+            .position(|s| s.spec.id.as_bytes() == id)?;
+        let (spec, star) = (self.shapes[k].spec, self.shapes[k].star);
+        let len = eat_eol(b, star + 3);
+        if b.len() < crate::vn::shape::WINDOW {
+            return None;
+        }
+        let shape = &self.shapes[k];
+        let table = match self.data.tables.get_mut(spec.id) {
+            Some(t) => t,
+            None => {
+                let mut table = Table::with_buffer(
+                    spec.fields.iter().map(|s| s.to_string()).collect(),
+                    self.spare.pop().unwrap_or_default(),
+                );
+                let left = self.size_hint.saturating_sub(self.base);
+                table.reserve((left / len.max(1) as u64).min(1 << 32) as usize);
+                self.data.tables.entry(spec.id.to_string()).or_insert(table)
+            }
+        };
+        // SAFETY: push_with's pointer has room for SCRATCH = MAX_FIELDS values,
+        // all parse_into writes; it writes every lane when it returns true.
+        let pushed = unsafe { table.push_with(|dst| shape.parse_into(b, level, dst)) };
+        pushed.then_some((spec, star))
+    }
+
+    /// Learn the shape of a sentence the fast path took without one, at the
+    /// first miss and then at the 2nd, 4th, 8th ... and every 64th: a stream
+    /// of fixed-width sentences changes shape rarely and relearns at once,
+    /// one of varying widths does not pay for learning every sentence.
+    #[cold]
+    fn learn_shape(
+        &mut self,
+        b: &[u8],
+        spec: &'static MsgSpec,
+        star: usize,
+        level: crate::simd::Level,
+    ) {
+        self.shape_misses = self.shape_misses.saturating_add(1);
+        let m = self.shape_misses;
+        if !m.is_power_of_two() && !m.is_multiple_of(64) {
+            return;
+        }
+        let Some(shape) = Shape::learn(b, spec, star, level) else {
+            return;
+        };
+        match self.shapes.iter().position(|s| s.spec.id == spec.id) {
+            Some(k) => self.shapes[k] = shape,
+            None if self.shapes.len() < MAX_SHAPES => self.shapes.push(shape),
+            None => {
+                self.shapes.remove(0);
+                self.shapes.push(shape);
+            }
+        }
     }
 
     /// Try a binary packet at `buf[i] == 0xFA`; `None` means "need more input".

@@ -353,6 +353,80 @@ fn damaged_stream(kinds: &[u8], flip: u16) -> Vec<u8> {
     s
 }
 
+/// Field widths of a fixed-width message: sign, whole digits, dot, decimals
+/// (cycled over the fields; some outside the fast path's grammar).
+type Widths = Vec<(bool, usize, bool, usize)>;
+
+/// `count` sentences of message `m`, every field at its width of `widths`,
+/// digits and signs from `seed`, XOR-8 in either case, ended by `eol`.
+fn fixed_width(m: usize, widths: &Widths, seed: u64, count: usize, eol: &str) -> Vec<u8> {
+    let spec = &messages::MESSAGES[m % messages::MESSAGES.len()];
+    let mut r = seed | 1;
+    let mut next = move || {
+        r ^= r << 13;
+        r ^= r >> 7;
+        r ^= r << 17;
+        r
+    };
+    let mut out = Vec::new();
+    for _ in 0..count {
+        let mut body = spec.id.to_string();
+        for k in 0..spec.fields.len() {
+            let (sign, whole, dot, frac) = widths[k % widths.len()];
+            body.push(',');
+            if sign {
+                body.push(if next() % 2 == 0 { '+' } else { '-' });
+            }
+            let digits = whole + if dot { frac } else { 0 };
+            for d in 0..digits {
+                if dot && d == whole {
+                    body.push('.');
+                }
+                body.push((b'0' + (next() % 10) as u8) as char);
+            }
+            if dot && frac == 0 {
+                body.push('.');
+            }
+        }
+        let x = checksum::xor8(body.as_bytes());
+        let check = match next() % 4 {
+            0 => format!("{x:02x}"),
+            _ => format!("{x:02X}"),
+        };
+        out.extend_from_slice(format!("${body}*{check}{eol}").as_bytes());
+    }
+    out
+}
+
+#[test]
+fn shapes_take_fixed_width_sentences_from_avx2_on() {
+    // The sensor's widths, with a width change, a bad checksum and two
+    // message types interleaved: the shapes take all but the sentences after
+    // a change, and the values are the reference's.
+    let w = |whole, frac| vec![(true, whole, true, frac)];
+    let mut s = fixed_width(0, &w(3, 3), 7, 200, "\r\n");
+    s.extend(fixed_width(0, &w(2, 4), 8, 100, "\n"));
+    let bad = s.len() - 40;
+    s[bad] ^= 1;
+    for k in 0..50 {
+        s.extend(fixed_width(0, &w(3, 3), k, 1, "\r\n"));
+        s.extend(fixed_width(1, &w(1, 2), k, 1, "\r\n"));
+    }
+    let want = format!("{:?}", reference(&s, false));
+    crate::simd::at_every_level(|level| {
+        let mut p = Parser::with_size_hint(false, s.len() as u64);
+        p.feed(&s, true);
+        let hits = p.shape_hits;
+        assert_eq!(format!("{:?}", p.finish()), want, "{level:?}");
+        let expect = if level >= crate::simd::Level::Avx2 {
+            390
+        } else {
+            0
+        };
+        assert!(hits >= expect, "{level:?}: {hits} sentences by shape");
+    });
+}
+
 proptest! {
     #![proptest_config(ProptestConfig { cases: 300, ..ProptestConfig::default() })]
 
@@ -397,6 +471,75 @@ proptest! {
             assert_eq!(text(parse_bytes(&s, false)), want, "{level:?}");
             let p = Parser::with_size_hint(false, s.len() as u64).with_parallel_min(64);
             assert_eq!(text(parse_bytes_with(p, &s)), want, "{level:?} parallel");
+        });
+    }
+
+    #[test]
+    fn fixed_width_streams_agree_at_every_level(
+        parts in proptest::collection::vec(
+            (
+                0usize..64,
+                proptest::collection::vec((any::<bool>(), 0usize..9, any::<bool>(), 0usize..9), 1..5),
+                any::<u64>(),
+                1usize..14,
+                0u8..7,
+            ),
+            1..6,
+        ),
+        edits in proptest::collection::vec(
+            (any::<u16>(), proptest::sample::select(b"$*,.+-07aX\r\n\xfa ".to_vec()), 0u8..3),
+            0..6,
+        ),
+        chunk in 50usize..400,
+    ) {
+        // Streams of sentences whose fields keep their widths (the sensor's
+        // output, which the shapes of the vector levels take), with the width
+        // changing between runs, checksums wrong, line ends LF, CRLF or none,
+        // '$' in noise, lines longer than a shape's window, binary packets
+        // (in any piece of a parallel block), then damage; cut
+        // into parallel pieces and chunks. Every level gives the reference's
+        // rows, counts and first locations.
+        let mut s = Vec::new();
+        for (m, widths, seed, count, kind) in parts {
+            let eol = ["\r\n", "\n", "", "\r\n", "\r\n", "\n", "\r\n"][kind as usize];
+            let mut run = fixed_width(m, &widths, seed, count, eol);
+            match kind {
+                3 => run.extend_from_slice(b"noise $ $VN $VNYMR,+1*00 garbage\r\n"),
+                4 => {
+                    // A wrong checksum in the middle of the run.
+                    if let Some(p) = run.iter().rposition(|&c| c == b'*') {
+                        run[p + 1] = if run[p + 1] == b'0' { b'1' } else { b'0' };
+                    }
+                }
+                5 => {
+                    run.extend_from_slice(b"$VNYMR");
+                    run.extend(std::iter::repeat_n(b",+0.5", 80).flatten());
+                    run.extend_from_slice(b"*00\r\n");
+                }
+                6 => {
+                    // A binary packet inside a run of sentences.
+                    let at = run.len() / 2;
+                    run.splice(at..at, B1);
+                }
+                _ => {}
+            }
+            s.extend(run);
+        }
+        apply_edits(&mut s, &edits);
+        let text = |d: CoreResult<VnData>| match d {
+            Ok(d) => format!("{d:?}"),
+            Err(e) => e.to_string(),
+        };
+        let want = text(reference(&s, false));
+        let want_strict = text(reference(&s, true));
+        crate::simd::at_every_level(|level| {
+            assert_eq!(text(parse_bytes(&s, false)), want, "{level:?}");
+            assert_eq!(text(parse_bytes(&s, true)), want_strict, "{level:?} strict");
+            let p = Parser::with_size_hint(false, s.len() as u64).with_parallel_min(64);
+            assert_eq!(text(parse_bytes_with(p, &s)), want, "{level:?} parallel");
+            let p = Parser::with_size_hint(false, s.len() as u64).with_parallel_min(0);
+            let got = parse_reader_with(p, &s[..], s.len() as u64, chunk, &mut |_, _| Ok(()));
+            assert_eq!(text(got), want, "{level:?} chunks of {chunk}");
         });
     }
 
