@@ -16,7 +16,7 @@ import numpy as np
 from imunoise import allan as _allan
 from imunoise import noise, plot, stats
 from imunoise._analysis.align import Aligned
-from imunoise._analysis.events import Events, events
+from imunoise._analysis.events import Baselines, Events, events, search
 from imunoise._analysis.mount import OwnNoise, own_noise
 from imunoise._analysis.thermal import Thermal, thermal
 from imunoise._analysis.warmup import Warmup, warmup
@@ -200,11 +200,17 @@ class Context:
                 for sensor, r in self.allan.items()}
 
     @cached_property
-    def events(self) -> Events | None:
-        """Events of the short log's gyro and accel (None without them)."""
+    def event_search(self) -> tuple[Events, Baselines] | None:
+        """Events of the short log's gyro and accel and the baselines the search
+        standardised them by (None without gyro and accel)."""
         if not any(getattr(self.short, s) is not None for s in ALLAN_SENSORS):
             return None
-        return events(self.short)
+        return search(self.short)
+
+    @property
+    def events(self) -> Events | None:
+        """Events of the short log's gyro and accel (None without them)."""
+        return None if self.event_search is None else self.event_search[0]
 
     @cached_property
     def long_events(self) -> Events | None:

@@ -16,6 +16,7 @@ import numpy as np
 
 from imunoise import allan as _allan
 from imunoise import display, noise, plot, stats, units
+from imunoise._analysis.events import rms_ratio
 from imunoise._support import stream as _stream
 from imunoise._support import warn as _warn
 from imunoise._support.schema import CHANNELS, SAMPLE_SENSORS, axis_names
@@ -488,7 +489,8 @@ def events_section(ctx: Context, doc: Doc) -> None:
         return found.kind[i] if j < 0 else (
             f"{found.kind[i]} inside the event from {format_number(found.start[j] + offset)} s")
 
-    loud = found.rms_ratio(log)
+    # the search's baselines: the same numbers as found.rms_ratio(log), no medians again
+    loud = rms_ratio(found, log, ctx.event_search[1])
     column = {name: j for j, name in enumerate(found.names)}
 
     def loudest(i: int) -> str:
