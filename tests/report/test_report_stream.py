@@ -3,6 +3,7 @@ a channel at a time print the numbers of the in-memory report. Small blocks and 
 pieces force many of them on small logs (the memory bound itself is measured by
 benches/report_scale.py, not here)."""
 
+import gc
 import os
 import re
 import subprocess
@@ -67,6 +68,19 @@ def test_streamed_report_prints_the_in_memory_numbers(both):
     assert streamed.models["gyro"].N == pytest.approx(memory.models["gyro"].N, rel=1e-12)
     # the parsed copy beside the output is gone
     assert not list(out.glob(".imunoise-stream-*"))
+    # what the stages froze for their collections is unfrozen again
+    assert gc.get_freeze_count() == 0
+
+
+def test_a_callers_frozen_objects_stay_frozen(tmp_path, small_blocks):
+    gc.freeze()
+    try:
+        before = gc.get_freeze_count()
+        report.build(_gappy_log(), out_dir=tmp_path / "stream", spec=None, stream=True,
+                     progress=False)
+        assert 0 < gc.get_freeze_count() <= before  # neither unfrozen nor frozen more
+    finally:
+        gc.unfreeze()
 
 
 def test_appendix_lists_the_stages_with_time_and_memory(both):

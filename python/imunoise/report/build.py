@@ -8,6 +8,7 @@ Adding a section is one function in :mod:`.sections` and one entry in
 from __future__ import annotations
 
 import datetime as _dt
+import gc
 import os
 import shutil
 import time
@@ -235,6 +236,7 @@ def build(
         streams(p, options) for p in (short, long) if p is not None)
     workdirs: list[Path] = []
     undo = folder.Undo(out)
+    freeze = streamed and gc.get_freeze_count() == 0
 
     def clean(failed: bool) -> None:
         for w in workdirs:
@@ -247,10 +249,13 @@ def build(
         with _interrupt.undo_on_exit(lambda: clean(True)):
             rep = _build(short, long, out, previous, inputs, options, workdirs, spec=spec,
                          fs=fs, progress=progress, trim=trim, streamed=streamed, units=units,
-                         mount=mount, mount_clock=mount_clock)
+                         mount=mount, mount_clock=mount_clock, freeze=freeze)
     except BaseException:
         clean(True)
         raise
+    finally:
+        if freeze:
+            gc.unfreeze()  # the stages froze what survived them (Context.stage)
     clean(False)
     return rep
 
@@ -270,7 +275,7 @@ def _mount_sources(mount) -> list:
 
 def _build(short, long, out: Path, previous, inputs, options, workdirs: list[Path], *,
            spec, fs, progress, trim, streamed: bool, units: str | None, mount: list,
-           mount_clock: str) -> Report:
+           mount_clock: str, freeze: bool) -> Report:
     """:func:`build` once the folder is claimed; ``workdirs`` collects the folders of
     the streamed path's memory maps (the caller removes them)."""
     timings: list[tuple[str, float, float]] = []
@@ -301,7 +306,7 @@ def _build(short, long, out: Path, previous, inputs, options, workdirs: list[Pat
     (out / "figures").mkdir(parents=True, exist_ok=True)
     ctx = Context(short=short_log, long=long_log, one_log=long is None, spec=spec, out_dir=out,
                   streamed=streamed, block=_stream.BLOCK_ROWS, timings=timings,
-                  units=report_units(units, spec))
+                  units=report_units(units, spec), freeze=freeze)
     if trim == "auto":
         start = time.perf_counter()
         _trim_warmup(ctx)
