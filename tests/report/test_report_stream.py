@@ -215,3 +215,19 @@ def test_a_killed_runs_parsed_log_is_removed_by_the_next(tmp_path):
         fresh = _stream.workdir_for(tmp_path / "report")
     assert not left.exists() and mine.exists() and fresh.exists()
     assert fresh.name.startswith(f".imunoise-stream-{os.getpid()}-")
+
+
+def test_block_moments_a_column_at_a_time_are_the_blocks_numbers():
+    """Extremes and centred blocks taken a column at a time: numpy's numbers for the
+    whole block, bit for bit, a zero's sign included."""
+    rng = np.random.default_rng(8)
+    v = rng.standard_normal((5000, 3))
+    v[[10, 20], 1] = [0.0, -0.0]
+    v[:, 2] = np.abs(v[:, 2])
+    v[[30, 40], 2] = [-0.0, 0.0]  # the minimum is a zero of either sign
+    for f in (np.min, np.max):
+        got, want = _stream._extreme(v, f), f(v, axis=0)
+        np.testing.assert_array_equal(got, want)
+        assert np.array_equal(np.signbit(got), np.signbit(want))
+    mean = v.mean(axis=0)
+    np.testing.assert_array_equal(_stream._less(v, mean), v - mean)
