@@ -840,19 +840,29 @@ def _energy_law(z: _blocks.Series, n: int, w: int) -> tuple[float, np.ndarray]:
         x = z(a, b)
         ok = np.isfinite(x)
         valid[a:b] = ok
-        x = np.where(ok, x, 0.0)
         k = int(np.count_nonzero(ok))
-        clipped[m:m + k] = np.clip(x[ok], -3.0, 3.0)
+        # a block with every sample (the usual case) needs no mask: the same numbers
+        # without three copies of the block
+        every = k == b - a
+        if not every:
+            x = np.where(ok, x, 0.0)
+        np.clip(x if every else x[ok], -3.0, 3.0, out=clipped[m:m + k])
         m += k
         rows = min(b, full * w) - a  # the complete windows' mean z² (windows at rows i·w)
         if rows > 0:
             squares = (x[:rows] ** 2).reshape(rows // w, w)
-            means.append(squares[ok[:rows].reshape(rows // w, w).all(axis=1)].mean(axis=1))
+            if not every:
+                squares = squares[ok[:rows].reshape(rows // w, w).all(axis=1)]
+            means.append(squares.mean(axis=1))
     centre = clipped[:m].mean() if m else 0.0
     del clipped
 
     def centred(a: int, b: int) -> np.ndarray:
         ok = valid[a:b]
+        if ok.all():
+            out = np.clip(z(a, b), -3.0, 3.0)  # a new array, not the series' rows
+            out -= centre
+            return out
         return np.where(ok, np.clip(np.where(ok, z(a, b), 0.0), -3.0, 3.0) - centre, 0.0)
 
     acf = _blocks.lag_products(centred, n, w)
