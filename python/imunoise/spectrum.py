@@ -364,7 +364,7 @@ def psd(
     n = data.shape[0]
     if n < 16:
         raise ImunoiseValueError(f"x must have at least 16 samples for a spectrum; got {n}")
-    present = ~np.isnan(data).any(axis=1)
+    present = _stream.present_rows(data)
     if nperseg is None:
         seg = _default_nperseg(n)
         if not present.all():

@@ -231,3 +231,11 @@ def test_block_moments_a_column_at_a_time_are_the_blocks_numbers():
         assert np.array_equal(np.signbit(got), np.signbit(want))
     mean = v.mean(axis=0)
     np.testing.assert_array_equal(_stream._less(v, mean), v - mean)
+
+
+def test_present_rows_are_the_rows_without_nan():
+    y = np.random.default_rng(9).standard_normal((1000, 3))
+    y[[3, 500], 1] = np.nan
+    y[999, 2] = np.nan
+    np.testing.assert_array_equal(_stream.present_rows(y), ~np.isnan(y).any(axis=1))
+    np.testing.assert_array_equal(_stream.present_rows(y[:, 1]), ~np.isnan(y[:, 1]))

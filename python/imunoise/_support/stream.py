@@ -29,8 +29,8 @@ from imunoise.errors import DataWarning
 from imunoise.readers.log import ImuLog
 
 __all__ = ["BLOCK_ROWS", "CHANNEL_WORKERS", "PARSE_BYTES", "STREAM_BYTES", "adev", "blocks",
-           "column", "describe", "each_channel", "is_mapped", "open_mapped", "release",
-           "release_log", "trim_heap", "workdir_for"]
+           "column", "describe", "each_channel", "is_mapped", "open_mapped", "present_rows",
+           "release", "release_log", "trim_heap", "workdir_for"]
 
 T = TypeVar("T")
 
@@ -183,6 +183,19 @@ class _Moments:
         self.sxx += sums[0]
         self.stt += sums[1]
         self.stx += sums[2]
+
+
+def present_rows(arr: np.ndarray) -> np.ndarray:
+    """Boolean (rows,): the rows of ``arr`` (rows, k) without a NaN, as
+    ``~np.isnan(arr).any(axis=1)``, a column at a time: numpy reduces a (rows, 3)
+    array's rows with an inner loop of 3 values, four times slower, and through a
+    (rows, 3) array of flags."""
+    if arr.ndim == 1:
+        return ~np.isnan(arr)
+    missing = np.isnan(arr[:, 0])
+    for j in range(1, arr.shape[1]):
+        missing |= np.isnan(arr[:, j])
+    return ~missing
 
 
 def _less(v: np.ndarray, mean: np.ndarray) -> np.ndarray:

@@ -185,7 +185,7 @@ class Context:
         out = {}
         for sensor in ALLAN_SENSORS:
             y = getattr(self.long, sensor)
-            if y is None or np.count_nonzero(~np.isnan(y).any(axis=1)) < 256:
+            if y is None or np.count_nonzero(_stream.present_rows(y)) < 256:
                 continue
             try:  # segments with a missing sample are left out
                 out[sensor] = spectrum.psd(y, self.long.fs)

@@ -379,7 +379,7 @@ def power_spectral_density(ctx: Context, doc: Doc) -> None:
         y = getattr(ctx.short, sensor)
         if y is None:
             continue
-        if np.count_nonzero(~np.isnan(y).any(axis=1)) < 256:
+        if np.count_nonzero(_stream.present_rows(y)) < 256:
             continue
         _stream.release(y)
         if ctx.one_log:  # the models' own spectrum
