@@ -95,6 +95,9 @@ def test_appendix_lists_the_stages_with_time_and_memory(both):
     times = [float(r.split("|")[2]) for r in rows]
     assert times[-1] == pytest.approx(sum(times[:-1]), abs=0.01 * len(times))
     assert all(float(r.split("|")[3]) > 0 for r in rows)
+    cpu = [float(r.split("|")[4]) for r in rows]
+    assert cpu[-1] == pytest.approx(sum(cpu[:-1]), abs=0.01 * len(cpu))
+    assert all(c >= 0 for c in cpu)
 
 
 def _gappy_log(seed: int = 5) -> imunoise.ImuLog:

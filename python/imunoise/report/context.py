@@ -29,7 +29,7 @@ from imunoise.report import sections
 from imunoise.report.document import Doc
 from imunoise.spectrum import Spectrum
 
-__all__ = ["TAUS_PER_DECADE", "Context", "peak_mib"]
+__all__ = ["TAUS_PER_DECADE", "Context", "clock", "peak_mib", "since"]
 
 #: Tau grid of the Allan analysis: log-spaced points per decade.
 TAUS_PER_DECADE = _schema.TAUS_PER_DECADE
@@ -56,8 +56,9 @@ class Context:
     streamed: bool = False
     #: Rows per block of the streamed path.
     block: int = _stream.BLOCK_ROWS
-    #: (stage, seconds, peak RSS in MiB so far) of each stage, for the appendix.
-    timings: list[tuple[str, float, float]] = field(default_factory=list)
+    #: (stage, seconds, peak RSS in MiB so far, CPU seconds) of each stage, for the
+    #: appendix.
+    timings: list[tuple[str, float, float, float]] = field(default_factory=list)
     #: Units of the noise coefficients in every table (None: the defaults, or
     #: "datasheet"; :meth:`imunoise.noise.NoiseModel.table`).
     units: str | None = None
@@ -249,9 +250,9 @@ class Context:
         lo, hi = fit.temperature_range
         return fit if hi - lo >= sections.THERMAL_MIN_RANGE else None
 
-    def stage(self, name: str, start: float) -> None:
-        """Record a stage that began at ``start`` (``time.perf_counter()``); on the
-        streamed path, give the memory maps' pages back after it."""
+    def stage(self, name: str, start: tuple[float, float]) -> None:
+        """Record a stage that began at ``start`` (:func:`clock`); on the streamed
+        path, give the memory maps' pages back after it."""
         if self.streamed:
             for log in (self.short, self.long, self.untrimmed):
                 _stream.release_log(log)
@@ -264,7 +265,8 @@ class Context:
             if self.freeze:
                 gc.freeze()
             _stream.trim_heap()
-        self.timings.append((name, time.perf_counter() - start, peak_mib()))
+        wall, cpu = since(start)
+        self.timings.append((name, wall, peak_mib(), cpu))
 
     def add_figure(self, doc: Doc, fig, name: str, caption: str) -> None:
         """Save ``fig`` as ``figures/<name>.png`` and ``.svg`` and show it in ``doc``."""
@@ -272,6 +274,17 @@ class Context:
         plot.plain_ticks(fig)  # no offset in a corner: it goes into the axis label
         self.figures += plot.save(fig, path)
         doc.figure(path.with_suffix(".png"), caption)
+
+
+def clock() -> tuple[float, float]:
+    """Now, as wall time and the process's CPU time (every thread's), for :func:`since`."""
+    return time.perf_counter(), time.process_time()
+
+
+def since(start: tuple[float, float]) -> tuple[float, float]:
+    """Wall and CPU seconds from ``start`` (:func:`clock`) to now."""
+    wall, cpu = clock()
+    return wall - start[0], cpu - start[1]
 
 
 def peak_mib() -> float:
