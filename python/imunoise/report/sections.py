@@ -529,7 +529,9 @@ def events_section(ctx: Context, doc: Doc) -> None:
             # a channel at a time, not the sensor: streamed, its column read is ours,
             # and the events are made missing in it in place
             col = _stream.column(y, j, ctx.block) if ctx.streamed else y[:, j]
-            std = np.nanstd(col, ddof=1)
+            # without a missing sample np.std is np.nanstd's arithmetic (the same bits)
+            # without its copy and masks: a third of the time
+            std = np.nanstd(col, ddof=1) if np.isnan(col).any() else np.std(col, ddof=1)
             z = col if ctx.streamed else np.array(col, dtype=np.float64)
             del col
             z[inside] = np.nan  # found.exclude(col)
