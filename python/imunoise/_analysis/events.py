@@ -466,7 +466,8 @@ def search(data, fs: float | None = None, *, channels=None, false_alarm: float =
                 continue  # the first pass found nothing: its law is the quiet part's
             if law is not None and _same_mask(law[0], quiet):
                 # the pass before had these quiet samples: its law, spikes and
-                # outliers are this pass's (two full passes over the channel saved)
+                # outliers are this pass's (not computed again: a quarter of the passes
+                # over the channel)
                 _quiet, scale, rho, z, spikes, isolated = law
             else:
                 scale, rho = _energy_law(_masked(_blocks.view(r), quiet), n, w)
