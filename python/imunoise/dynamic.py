@@ -411,21 +411,49 @@ def _phase(y: np.ndarray, mean: np.ndarray, any_missing: bool
     return c, bad
 
 
-def _prefix_at(values: np.ndarray, points: np.ndarray) -> np.ndarray:
-    """Prefix sums Σ values[:, :p] (channels, len(points)) at ``points`` (0 ≤ p ≤ k),
-    from one reduction over the segments between them."""
-    k = values.shape[1]
+def _second_sums_at(c: np.ndarray, bad: np.ndarray | None, mm: int, points: np.ndarray
+                    ) -> tuple[np.ndarray, np.ndarray]:
+    """Prefix sums at ``points`` (0 ≤ p ≤ k) of the squared second differences
+    (c[i + 2m] − 2 c[i + m] + c[i])², i < k = len(c) − 2m, of the phase ``c`` (1-D),
+    and of their count; with ``bad`` (the running count of missing samples) a
+    difference that touches a missing sample is 0 and not counted.
+
+    Segment by segment between the points: the differences of one segment in memory
+    (they stay in the cache; those of the whole channel for every τ were read and
+    written five times from memory). Each segment's total is its first term plus
+    the pairwise sum of the rest, the operations ``np.add.reduceat`` does, so the
+    numbers are those of the whole-array computation."""
+    k = len(c) - 2 * mm
     cuts = np.unique(np.r_[0, points[points < k]])
-    totals = np.zeros((values.shape[0], cuts.size + 1), dtype=values.dtype)
-    np.cumsum(np.add.reduceat(values, cuts, axis=1), axis=1, out=totals[:, 1:])
-    return totals[:, np.searchsorted(np.r_[cuts, k], points)]
+    bounds = np.r_[cuts, k]
+    seg_sums = np.empty(cuts.size)
+    seg_terms = np.empty(cuts.size, dtype=np.int64)
+    longest = int(np.max(np.diff(bounds))) if cuts.size else 0
+    second, twice = np.empty(longest), np.empty(longest)
+    for i, (a, b) in enumerate(zip(bounds[:-1].tolist(), bounds[1:].tolist(), strict=True)):
+        d = np.add(c[a + 2 * mm:b + 2 * mm], c[a:b], out=second[:b - a])
+        d -= np.multiply(c[a + mm:b + mm], 2.0, out=twice[:b - a])
+        d *= d
+        if bad is None:
+            seg_terms[i] = b - a
+        else:
+            ok = (bad[a + 2 * mm:b + 2 * mm] - bad[a:b]) == 0
+            d[~ok] = 0.0
+            seg_terms[i] = np.count_nonzero(ok)
+        seg_sums[i] = d[0] + d[1:].sum()
+    sums = np.zeros(cuts.size + 1)
+    np.cumsum(seg_sums, out=sums[1:])
+    terms = np.zeros(cuts.size + 1, dtype=np.int64)
+    np.cumsum(seg_terms, out=terms[1:])
+    at = np.searchsorted(bounds, points)
+    return sums[at], (points if bad is None else terms[at])
 
 
 def _window_sums(data, m, starts, width, stride):
     """Sums of the squared second differences and their counts, (W, T, channels), of
     every window; and per tau searched for intervals, the same per block of ``stride``.
-    A channel at a time (the phase and the differences of one channel in memory), each
-    centred on its mean over the whole record."""
+    A channel at a time (the phase and the differences of a segment of one channel in
+    memory), each centred on its mean over the whole record."""
     n, ch = data.shape
     any_missing = bool(np.isnan(data).any())
     mean = np.nanmean(data, axis=0) if any_missing else data.mean(axis=0)
@@ -440,34 +468,21 @@ def _window_sums(data, m, starts, width, stride):
         column = _stream.column(data, j)[:, None] if mapped else data[:, j:j + 1]
         c, bad = _phase(column, mean[j:j + 1], any_missing)
         del column
-        # the second differences of every tau in two arrays reused (fresh ones per tau
-        # cost the kernel a channel length of page faults each)
-        buffer, twice = np.empty((1, n + 1)), np.empty((1, n + 1))
+        c, bad = c[0], None if bad is None else bad[0]
         for t, mm in enumerate(int(v) for v in m):
             k = n + 1 - 2 * mm
-            second = np.add(c[:, 2 * mm:], c[:, :k], out=buffer[:, :k])
-            second -= np.multiply(c[:, mm:mm + k], 2.0, out=twice[:, :k])
-            second *= second
             last = starts + width + 1 - 2 * mm
             edges = np.minimum(block_edges, k)
             points = np.r_[starts, last, edges]
-            if bad is None:
-                prefix = _prefix_at(second, points)
-                terms = np.broadcast_to(points, prefix.shape)
-            else:
-                ok = (bad[:, 2 * mm:] - bad[:, :k]) == 0
-                second[~ok] = 0.0
-                prefix = _prefix_at(second, points)
-                terms = _prefix_at(ok.astype(np.int64), points)
-            del second
+            prefix, terms = _second_sums_at(c, bad, mm, points)
             w, e = len(starts), len(edges)
-            sums[:, t, j] = prefix[0, w:2 * w] - prefix[0, :w]
-            counts[:, t, j] = terms[0, w:2 * w] - terms[0, :w]
+            sums[:, t, j] = prefix[w:2 * w] - prefix[:w]
+            counts[:, t, j] = terms[w:2 * w] - terms[:w]
             if mm * _BLOCK_TERMS_PER_M <= stride:
-                block_p, block_n = prefix[:, 2 * w:2 * w + e], terms[:, 2 * w:2 * w + e]
-                per_tau.setdefault(t, []).append((np.diff(block_p, axis=1).T,
-                                                  np.diff(block_n, axis=1).T))
-        del c, bad, buffer, twice
+                block_p, block_n = prefix[2 * w:2 * w + e], terms[2 * w:2 * w + e]
+                per_tau.setdefault(t, []).append((np.diff(block_p)[:, None],
+                                                  np.diff(block_n)[:, None]))
+        del c, bad
     blocks = tuple((t, np.hstack([p for p, _n in parts]), np.hstack([q for _p, q in parts]))
                    for t, parts in per_tau.items())
     return sums, counts, blocks

@@ -364,7 +364,7 @@ def psd(
     n = data.shape[0]
     if n < 16:
         raise ImunoiseValueError(f"x must have at least 16 samples for a spectrum; got {n}")
-    present = ~np.isnan(data).any(axis=1)
+    present = _stream.present_rows(data)
     if nperseg is None:
         seg = _default_nperseg(n)
         if not present.all():
@@ -633,8 +633,13 @@ def _log_bins(f, p, edf, bins_per_decade: int, correlation: np.ndarray):
 
 def _chi2_band(p, edf, confidence: float):
     tail = (1.0 - confidence) / 2.0
-    e = edf[:, None] if np.ndim(p) == 2 else edf
-    return p * e / _stats.chi2.ppf(1 - tail, e), p * e / _stats.chi2.ppf(tail, e)
+    # the quantiles once per distinct EDF, not per frequency: a Welch spectrum has
+    # two values (millions of frequencies on a day's log) and each costs microseconds
+    values, which = np.unique(edf, return_inverse=True)
+    upper, lower = (_stats.chi2.ppf(q, values)[which] for q in (1 - tail, tail))
+    if np.ndim(p) == 2:
+        edf, upper, lower = edf[:, None], upper[:, None], lower[:, None]
+    return p * edf / upper, p * edf / lower
 
 
 # -- the white-noise read-off ---------------------------------------------------------

@@ -201,3 +201,39 @@ def test_window_count_is_bounded(monkeypatch):
                                          r"21 s \(21 samples\)"):
         imunoise.dynamic_adev(y, 1.0, window=10.0, step=1.0)
     assert len(imunoise.dynamic_adev(y, 1.0, window=10.0, step=21.0).times) <= 100
+
+
+def _reference_sums_at(c, bad, mm, points):
+    """The whole-array computation the segment-wise one replaced: every τ's squared
+    second differences as one array, summed by np.add.reduceat between the points."""
+    k = len(c) - 2 * mm
+    second = (c[2 * mm:] + c[:k] - 2.0 * c[mm:mm + k]) ** 2
+    ok = None if bad is None else (bad[2 * mm:] - bad[:k]) == 0
+    if ok is not None:
+        second[~ok] = 0.0
+    cuts = np.unique(np.r_[0, points[points < k]])
+    at = np.searchsorted(np.r_[cuts, k], points)
+    sums = np.r_[0.0, np.cumsum(np.add.reduceat(second, cuts))][at]
+    if ok is None:
+        return sums, points
+    return sums, np.r_[0, np.cumsum(np.add.reduceat(ok.astype(np.int64), cuts))][at]
+
+
+@pytest.mark.parametrize("gaps", [False, True])
+def test_segment_wise_second_differences_are_the_whole_arrays_bit_for_bit(gaps):
+    from imunoise import dynamic
+
+    rng = np.random.default_rng(5)
+    y = rng.standard_normal((50_000, 1)) + np.linspace(0, 3, 50_000)[:, None]
+    if gaps:
+        y[100:130] = np.nan
+        y[31_000] = np.nan
+    c, bad = dynamic._phase(y, np.nanmean(y, axis=0), gaps)
+    c, bad = c[0], None if bad is None else bad[0]
+    for mm in (1, 7, 64, 1000):
+        k = len(c) - 2 * mm
+        points = np.r_[np.arange(0, k, 4111), rng.integers(0, k + 1, 30), k, 0]
+        got = dynamic._second_sums_at(c, bad, mm, points)
+        want = _reference_sums_at(c, bad, mm, points)
+        np.testing.assert_array_equal(got[0], want[0])
+        np.testing.assert_array_equal(got[1], want[1])

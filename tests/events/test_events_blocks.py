@@ -97,3 +97,36 @@ def test_whitening_a_block_at_a_time_is_one_filter_over_the_record(monkeypatch):
     monkeypatch.setattr(_blocks, "SERIES_BLOCK", 100)
     np.testing.assert_array_equal(
         _events._whiten(_blocks.view(z), len(z), None, rho, 5.0, isolated), whole)
+
+
+@pytest.mark.parametrize("gaps", [False, True])
+def test_search_baselines_give_rms_ratio_without_the_medians_again(gaps):
+    """The report's path: the events search's baselines read the standardised samples
+    again, and give Events.rms_ratio's numbers bit for bit; the events are events()'s."""
+    x = record(gaps)
+    ev, rms = found(x)
+    searched, baselines = _events.search(x, FS)
+    for name in ("start_index", "end_index", "peak", "sigma"):
+        np.testing.assert_array_equal(getattr(searched, name), getattr(ev, name), err_msg=name)
+    assert searched.kind == ev.kind and searched.channels == ev.channels
+    np.testing.assert_array_equal(_events.rms_ratio(searched, x, baselines), rms)
+    with pytest.raises(ValueError, match="record the events"):
+        _events.rms_ratio(searched, x[:, :2], baselines)
+
+
+def test_a_pass_whose_quiet_part_did_not_change_reuses_the_law(monkeypatch):
+    """The last pass's energy law is the middle pass's when their quiet samples are
+    the same: computed once (the same events as computing it again)."""
+    x = record(False)
+    calls = []
+    law = _events._energy_law
+    monkeypatch.setattr(_events, "_energy_law",
+                        lambda z, n, w: calls.append(n) or law(z, n, w))
+    reused = imunoise.events(x, FS)
+    n_reused = len(calls)
+    monkeypatch.setattr(_events, "_same_mask", lambda a, b: False)
+    calls.clear()
+    again = imunoise.events(x, FS)
+    assert n_reused < len(calls)
+    for name in ("start_index", "end_index", "peak", "sigma"):
+        np.testing.assert_array_equal(getattr(reused, name), getattr(again, name))

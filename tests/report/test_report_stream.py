@@ -3,6 +3,7 @@ a channel at a time print the numbers of the in-memory report. Small blocks and 
 pieces force many of them on small logs (the memory bound itself is measured by
 benches/report_scale.py, not here)."""
 
+import gc
 import os
 import re
 import subprocess
@@ -67,6 +68,19 @@ def test_streamed_report_prints_the_in_memory_numbers(both):
     assert streamed.models["gyro"].N == pytest.approx(memory.models["gyro"].N, rel=1e-12)
     # the parsed copy beside the output is gone
     assert not list(out.glob(".imunoise-stream-*"))
+    # what the stages froze for their collections is unfrozen again
+    assert gc.get_freeze_count() == 0
+
+
+def test_a_callers_frozen_objects_stay_frozen(tmp_path, small_blocks):
+    gc.freeze()
+    try:
+        before = gc.get_freeze_count()
+        report.build(_gappy_log(), out_dir=tmp_path / "stream", spec=None, stream=True,
+                     progress=False)
+        assert 0 < gc.get_freeze_count() <= before  # neither unfrozen nor frozen more
+    finally:
+        gc.unfreeze()
 
 
 def test_appendix_lists_the_stages_with_time_and_memory(both):
@@ -81,6 +95,9 @@ def test_appendix_lists_the_stages_with_time_and_memory(both):
     times = [float(r.split("|")[2]) for r in rows]
     assert times[-1] == pytest.approx(sum(times[:-1]), abs=0.01 * len(times))
     assert all(float(r.split("|")[3]) > 0 for r in rows)
+    cpu = [float(r.split("|")[4]) for r in rows]
+    assert cpu[-1] == pytest.approx(sum(cpu[:-1]), abs=0.01 * len(cpu))
+    assert all(c >= 0 for c in cpu)
 
 
 def _gappy_log(seed: int = 5) -> imunoise.ImuLog:
@@ -201,3 +218,27 @@ def test_a_killed_runs_parsed_log_is_removed_by_the_next(tmp_path):
         fresh = _stream.workdir_for(tmp_path / "report")
     assert not left.exists() and mine.exists() and fresh.exists()
     assert fresh.name.startswith(f".imunoise-stream-{os.getpid()}-")
+
+
+def test_block_moments_a_column_at_a_time_are_the_blocks_numbers():
+    """Extremes and centred blocks taken a column at a time: numpy's numbers for the
+    whole block, bit for bit, a zero's sign included."""
+    rng = np.random.default_rng(8)
+    v = rng.standard_normal((5000, 3))
+    v[[10, 20], 1] = [0.0, -0.0]
+    v[:, 2] = np.abs(v[:, 2])
+    v[[30, 40], 2] = [-0.0, 0.0]  # the minimum is a zero of either sign
+    for f in (np.min, np.max):
+        got, want = _stream._extreme(v, f), f(v, axis=0)
+        np.testing.assert_array_equal(got, want)
+        assert np.array_equal(np.signbit(got), np.signbit(want))
+    mean = v.mean(axis=0)
+    np.testing.assert_array_equal(_stream._less(v, mean), v - mean)
+
+
+def test_present_rows_are_the_rows_without_nan():
+    y = np.random.default_rng(9).standard_normal((1000, 3))
+    y[[3, 500], 1] = np.nan
+    y[999, 2] = np.nan
+    np.testing.assert_array_equal(_stream.present_rows(y), ~np.isnan(y).any(axis=1))
+    np.testing.assert_array_equal(_stream.present_rows(y[:, 1]), ~np.isnan(y[:, 1]))

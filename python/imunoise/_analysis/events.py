@@ -67,8 +67,8 @@ from imunoise._support.validate import positive_finite
 from imunoise.errors import ImunoiseValueError
 from imunoise.readers.log import ImuLog
 
-__all__ = ["Events", "events", "FALSE_ALARM", "OVERLAP_FACTOR", "CHANGE_POINT_DOF",
-           "BURST_SCALES"]
+__all__ = ["Baselines", "Events", "events", "rms_ratio", "search", "FALSE_ALARM",
+           "OVERLAP_FACTOR", "CHANGE_POINT_DOF", "BURST_SCALES"]
 
 #: A burst this many energy windows long is searched for bursts inside it.
 INNER_MIN_WINDOWS = 10
@@ -266,20 +266,7 @@ class Events:
                              f"samples of {', '.join(self.names)}); got {cols.n} samples "
                              f"of {', '.join(names)}")
         baseline = positive_finite(baseline, "baseline", unit="s")
-        block = max(2 * self.window, int(round(baseline * self.fs)))
-        quiet = ~self.mask
-        out = np.full((len(self), len(cols)), np.nan)
-        any_quiet = bool(quiet.any())
-        for j in range(len(cols)):
-            sq, _sigma, _knots = _standardise(cols.owned(j), block)
-            sq *= sq  # NaN where missing
-            with np.errstate(invalid="ignore", divide="ignore"):
-                level = np.sqrt(_nanmean(sq, quiet)) if any_quiet else np.nan
-                for i, (a, b) in enumerate(zip(self.start_index, self.end_index, strict=True)):
-                    inside = sq[a:b]
-                    if np.isfinite(inside).any():
-                        out[i, j] = np.sqrt(np.nanmean(inside)) / level
-        return out
+        return _rms_ratio(self, cols, max(2 * self.window, int(round(baseline * self.fs))))
 
     def rows(self) -> list[dict]:
         """One dict per event: start, end, duration (s), kind, channels, peak (sigmas),
@@ -329,6 +316,57 @@ class Events:
         )
 
 
+@dataclass(frozen=True)
+class Baselines:
+    """What :func:`search` standardised each channel by: per channel the knots of its
+    median baseline and its σ̂ (:func:`_standardise`), for blocks of ``block`` rows.
+    :func:`rms_ratio` of the same record reads its standardised samples from them
+    instead of taking the blocks' medians and the MAD again."""
+
+    block: int
+    per_channel: tuple[tuple[tuple | None, float], ...]
+
+
+def rms_ratio(found: Events, data, baselines: Baselines) -> np.ndarray:
+    """``found.rms_ratio(data)`` of the record ``data`` that :func:`search` returned
+    ``found`` and ``baselines`` for (the default baseline): the same numbers, each
+    channel standardised from its baseline's knots (one pass, no medians)."""
+    cols, _fs, names = rate_columns(data, None if isinstance(data, ImuLog) else found.fs,
+                                    None)
+    if cols.n != found.n_samples or names != found.names or len(
+            baselines.per_channel) != len(cols):
+        raise ImunoiseValueError("data must be the record the events and baselines were "
+                                 "found in")
+    return _rms_ratio(found, cols, baselines.block, baselines)
+
+
+def _rms_ratio(found: Events, cols, block: int,
+               baselines: Baselines | None = None) -> np.ndarray:
+    """:meth:`Events.rms_ratio` of the columns ``cols``, standardised over blocks of
+    ``block`` rows (from ``baselines`` when given: the numbers :func:`_standardise`
+    gives)."""
+    quiet = ~found.mask
+    out = np.full((len(found), len(cols)), np.nan)
+    any_quiet = bool(quiet.any())
+    for j in range(len(cols)):
+        if baselines is None:
+            sq, _sigma, _knots = _standardise(cols.owned(j), block)
+        else:
+            knots, sigma = baselines.per_channel[j]
+            sq = cols.owned(j)
+            for a, b in _blocks.ranges(cols.n):
+                sq[a:b] = _standardised_rows(sq[a:b], a, knots, sigma)
+        sq *= sq  # NaN where missing
+        with np.errstate(invalid="ignore", divide="ignore"):
+            level = np.sqrt(_nanmean(sq, quiet)) if any_quiet else np.nan
+            for i, (a, b) in enumerate(zip(found.start_index, found.end_index,
+                                           strict=True)):
+                inside = sq[a:b]
+                if np.isfinite(inside).any():
+                    out[i, j] = np.sqrt(np.nanmean(inside)) / level
+    return out
+
+
 def events(
     data,
     fs: float | None = None,
@@ -370,6 +408,15 @@ def events(
     whole channel: a log whose noise level changes (a sensor switched to a
     different filter) needs to be split first.
     """
+    return search(data, fs, channels=channels, false_alarm=false_alarm, window=window,
+                  baseline=baseline, merge=merge)[0]
+
+
+def search(data, fs: float | None = None, *, channels=None, false_alarm: float = FALSE_ALARM,
+           window: float = 1.0, baseline: float = 10.0,
+           merge: float = 0.5) -> tuple[Events, Baselines]:
+    """:func:`events`, and the baselines it standardised each channel by (for
+    :func:`rms_ratio` of the same record)."""
     cols, fs, names = rate_columns(data, fs, channels)
     if isinstance(false_alarm, bool) or not (0 < float(false_alarm) < 0.01):
         raise ImunoiseValueError(
@@ -413,15 +460,24 @@ def events(
         # the first pass, whose quiet part still holds such a line, cut that
         # vibration into fragments.)
         quiet = None  # every sample
+        law = None  # (quiet, scale, rho, z, spikes, isolated) of the pass before
         for step, whiten in enumerate((False, False, True)):
             if step == 1 and quiet is None:
                 continue  # the first pass found nothing: its law is the quiet part's
-            scale, rho = _energy_law(_masked(_blocks.view(r), quiet), n, w)
-            z = _scaled(r, np.sqrt(scale))
-            spans = _spikes(z, n, k_spike)
-            quiet_level = _sstats.chi2.isf(p_v[-1], _dof(rho, windows[-1])) / _dof(
-                rho, windows[-1])
-            isolated = _isolated(z, n, k_spike, touch, quiet_level)
+            if law is not None and _same_mask(law[0], quiet):
+                # the pass before had these quiet samples: its law, spikes and
+                # outliers are this pass's (not computed again: a quarter of the passes
+                # over the channel)
+                _quiet, scale, rho, z, spikes, isolated = law
+            else:
+                scale, rho = _energy_law(_masked(_blocks.view(r), quiet), n, w)
+                z = _scaled(r, np.sqrt(scale))
+                spikes = tuple(_spikes(z, n, k_spike))
+                quiet_level = _sstats.chi2.isf(p_v[-1], _dof(rho, windows[-1])) / _dof(
+                    rho, windows[-1])
+                isolated = _isolated(z, n, k_spike, touch, quiet_level)
+                law = (quiet, scale, rho, z, spikes, isolated)
+            spans = list(spikes)
             spans += _burst_test(z, n, valid, rho, quiet, windows, p_v, k_spike, isolated,
                                  whiten=whiten)
             if spans:
@@ -437,8 +493,8 @@ def events(
         # from the baseline's knots: one channel's samples in memory at a time
         per_channel.append((joined, (j, scale, knots, mad_sigma),
                             [(a, b, kind, {j}) for a, b, kind in inner]))
-        del r, z, valid, quiet, isolated
-    return _merge_channels(
+        del r, z, valid, quiet, isolated, law
+    found = _merge_channels(
         per_channel, names, fs, n, gap, touch, sigma,
         lambda j, scale, knots, mad_sigma, a, b: _standardised_rows(
             cols.rows(j, a, b), a, knots, mad_sigma) / np.sqrt(scale),
@@ -447,6 +503,8 @@ def events(
         window=w,
         false_alarm=false_alarm,
     )
+    return found, Baselines(block, tuple((knots, mad_sigma) for _j, _scale, knots, mad_sigma in
+                                         (key for _spans, key, _inner in per_channel)))
 
 
 def _standardise(col: np.ndarray, block: int) -> tuple[np.ndarray, float, tuple | None]:
@@ -560,6 +618,13 @@ def _span_mask(spans: list[tuple[int, int, str]], n: int, *, pad: int) -> np.nda
     for a, b, _kind in spans:
         out[max(0, a - pad):min(n, b + pad)] = True
     return out
+
+
+def _same_mask(a: np.ndarray | None, b: np.ndarray | None) -> bool:
+    """Whether two quiet masks (None: every sample) keep the same samples."""
+    if a is None or b is None:
+        return a is b
+    return a is b or bool(np.array_equal(a, b))
 
 
 def _masked(series: _blocks.Series, keep: np.ndarray | None) -> _blocks.Series:
@@ -776,19 +841,29 @@ def _energy_law(z: _blocks.Series, n: int, w: int) -> tuple[float, np.ndarray]:
         x = z(a, b)
         ok = np.isfinite(x)
         valid[a:b] = ok
-        x = np.where(ok, x, 0.0)
         k = int(np.count_nonzero(ok))
-        clipped[m:m + k] = np.clip(x[ok], -3.0, 3.0)
+        # a block with every sample (the usual case) needs no mask: the same numbers
+        # without three copies of the block
+        every = k == b - a
+        if not every:
+            x = np.where(ok, x, 0.0)
+        np.clip(x if every else x[ok], -3.0, 3.0, out=clipped[m:m + k])
         m += k
         rows = min(b, full * w) - a  # the complete windows' mean z² (windows at rows i·w)
         if rows > 0:
             squares = (x[:rows] ** 2).reshape(rows // w, w)
-            means.append(squares[ok[:rows].reshape(rows // w, w).all(axis=1)].mean(axis=1))
+            if not every:
+                squares = squares[ok[:rows].reshape(rows // w, w).all(axis=1)]
+            means.append(squares.mean(axis=1))
     centre = clipped[:m].mean() if m else 0.0
     del clipped
 
     def centred(a: int, b: int) -> np.ndarray:
         ok = valid[a:b]
+        if ok.all():
+            out = np.clip(z(a, b), -3.0, 3.0)  # a new array, not the series' rows
+            out -= centre
+            return out
         return np.where(ok, np.clip(np.where(ok, z(a, b), 0.0), -3.0, 3.0) - centre, 0.0)
 
     acf = _blocks.lag_products(centred, n, w)

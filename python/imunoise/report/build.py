@@ -8,9 +8,9 @@ Adding a section is one function in :mod:`.sections` and one entry in
 from __future__ import annotations
 
 import datetime as _dt
+import gc
 import os
 import shutil
-import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -28,7 +28,7 @@ from imunoise.datasheet import load_spec
 from imunoise.errors import ImunoiseValueError
 from imunoise.readers.log import DEFAULT_FS, ImuLog
 from imunoise.report import folder, sections
-from imunoise.report.context import TAUS_PER_DECADE, Context, peak_mib
+from imunoise.report.context import TAUS_PER_DECADE, Context, clock, peak_mib, since
 from imunoise.report.document import Doc
 from imunoise.report.formatting import format_duration
 from imunoise.report.inputs import read_log, streams
@@ -235,6 +235,7 @@ def build(
         streams(p, options) for p in (short, long) if p is not None)
     workdirs: list[Path] = []
     undo = folder.Undo(out)
+    freeze = streamed and gc.get_freeze_count() == 0
 
     def clean(failed: bool) -> None:
         for w in workdirs:
@@ -247,10 +248,13 @@ def build(
         with _interrupt.undo_on_exit(lambda: clean(True)):
             rep = _build(short, long, out, previous, inputs, options, workdirs, spec=spec,
                          fs=fs, progress=progress, trim=trim, streamed=streamed, units=units,
-                         mount=mount, mount_clock=mount_clock)
+                         mount=mount, mount_clock=mount_clock, freeze=freeze)
     except BaseException:
         clean(True)
         raise
+    finally:
+        if freeze:
+            gc.unfreeze()  # the stages froze what survived them (Context.stage)
     clean(False)
     return rep
 
@@ -270,14 +274,14 @@ def _mount_sources(mount) -> list:
 
 def _build(short, long, out: Path, previous, inputs, options, workdirs: list[Path], *,
            spec, fs, progress, trim, streamed: bool, units: str | None, mount: list,
-           mount_clock: str) -> Report:
+           mount_clock: str, freeze: bool) -> Report:
     """:func:`build` once the folder is claimed; ``workdirs`` collects the folders of
     the streamed path's memory maps (the caller removes them)."""
-    timings: list[tuple[str, float, float]] = []
+    timings: list[tuple[str, float, float, float]] = []
     assumed: list[str] = []  # logs whose sample rate the reader assumed
 
     def read(source, label: str) -> ImuLog:
-        start = time.perf_counter()
+        start = clock()
         workdir = None
         if streamed and isinstance(source, str | os.PathLike) and streams(source, options,
                                                                           forced=True):
@@ -291,8 +295,9 @@ def _build(short, long, out: Path, previous, inputs, options, workdirs: list[Pat
         if (fs is None and not isinstance(source, ImuLog) and log.time is None
                 and log.fs == DEFAULT_FS):
             assumed.append(name)  # the reader assumed the rate (it warned)
-        timings.append((f"reading {name}" + (" into memory maps" if workdir else ""),
-                        time.perf_counter() - start, peak_mib()))
+        wall, cpu = since(start)
+        timings.append((f"reading {name}" + (" into memory maps" if workdir else ""), wall,
+                        peak_mib(), cpu))
         return log
 
     short_log = read(short, "short")
@@ -301,9 +306,9 @@ def _build(short, long, out: Path, previous, inputs, options, workdirs: list[Pat
     (out / "figures").mkdir(parents=True, exist_ok=True)
     ctx = Context(short=short_log, long=long_log, one_log=long is None, spec=spec, out_dir=out,
                   streamed=streamed, block=_stream.BLOCK_ROWS, timings=timings,
-                  units=report_units(units, spec))
+                  units=report_units(units, spec), freeze=freeze)
     if trim == "auto":
-        start = time.perf_counter()
+        start = clock()
         _trim_warmup(ctx)
         ctx.stage(f"warm-up of the {'' if ctx.one_log else 'long '}log (--trim auto)", start)
     others: list[ImuLog] = []  # the mount logs as read (the report's logs)
@@ -311,7 +316,7 @@ def _build(short, long, out: Path, previous, inputs, options, workdirs: list[Pat
         # before any analysis: a log that cannot be aligned fails the report at once
         others = [source if isinstance(source, ImuLog) else read(source, f"mount {i}")
                   for i, source in enumerate(mount, start=1)]
-        start = time.perf_counter()
+        start = clock()
         ctx.aligned = align([ctx.long, *others], clock=mount_clock)
         ctx.stage("aligning the logs of the mount", start)
     doc = Doc()
@@ -329,18 +334,18 @@ def _build(short, long, out: Path, previous, inputs, options, workdirs: list[Pat
         doc.p(f"**Trim**: {ctx.trim_note}")
     doc.contents()
     # the sections that apply, known before the bar starts: its total never changes
-    start = time.perf_counter()
+    start = clock()
     present = [s for s in SECTIONS if s.applies(ctx)]
     ctx.stage("finding the sections that apply (events, warm-up, temperature)", start)
     with Progress(progress, total=len(present) + 1) as bar:
         for number, section in enumerate(present, start=1):
             bar.step(section.title)
-            start = time.perf_counter()
+            start = clock()
             doc.h(2, f"{number}. {section.title}")
             section.write(ctx, doc)
             ctx.stage(section.title, start)
         bar.step("writing")
-        start = time.perf_counter()
+        start = clock()
         model_files = _write_model_files(ctx.models, out, long_log.fs)
         ctx.stage("writing the model files", start)
         _timings_appendix(doc, ctx)
@@ -371,12 +376,15 @@ def _timings_appendix(doc: Doc, ctx: Context) -> None:
     doc.p(("Streamed: the logs were parsed once into memory maps and analysed a block or "
            "a channel at a time" if ctx.streamed else "In memory: the logs were read whole")
           + "; an analysis is timed in the first stage that uses it. Peak memory is the "
-          "process's largest resident set so far (memory-mapped pages included).")
-    doc.table(["stage", "time [s]", "peak memory [MiB]"],
-              [[name, f"{sec:.2f}", f"{peak:.0f}"] for name, sec, peak in ctx.timings]
-              + [["total", f"{sum(sec for _n, sec, _p in ctx.timings):.2f}",
-                  f"{peak_mib():.0f}"]],
-              caption="Wall time and peak resident memory per stage")
+          "process's largest resident set so far (memory-mapped pages included). CPU time "
+          "is that of every thread of the process (above the wall time where two threads "
+          "ran; on a busy machine the wall time grows and the CPU time hardly).")
+    doc.table(["stage", "time [s]", "peak memory [MiB]", "CPU [s]"],
+              [[name, f"{sec:.2f}", f"{peak:.0f}", f"{cpu:.2f}"]
+               for name, sec, peak, cpu in ctx.timings]
+              + [["total", f"{sum(t[1] for t in ctx.timings):.2f}", f"{peak_mib():.0f}",
+                  f"{sum(t[3] for t in ctx.timings):.2f}"]],
+              caption="Wall time, peak resident memory and CPU time per stage")
 
 
 def _trim_warmup(ctx: Context) -> None:

@@ -16,7 +16,7 @@ import numpy as np
 from imunoise import allan as _allan
 from imunoise import noise, plot, stats
 from imunoise._analysis.align import Aligned
-from imunoise._analysis.events import Events, events
+from imunoise._analysis.events import Baselines, Events, events, search
 from imunoise._analysis.mount import OwnNoise, own_noise
 from imunoise._analysis.thermal import Thermal, thermal
 from imunoise._analysis.warmup import Warmup, warmup
@@ -29,7 +29,7 @@ from imunoise.report import sections
 from imunoise.report.document import Doc
 from imunoise.spectrum import Spectrum
 
-__all__ = ["TAUS_PER_DECADE", "Context", "peak_mib"]
+__all__ = ["TAUS_PER_DECADE", "Context", "clock", "peak_mib", "since"]
 
 #: Tau grid of the Allan analysis: log-spaced points per decade.
 TAUS_PER_DECADE = _schema.TAUS_PER_DECADE
@@ -56,11 +56,15 @@ class Context:
     streamed: bool = False
     #: Rows per block of the streamed path.
     block: int = _stream.BLOCK_ROWS
-    #: (stage, seconds, peak RSS in MiB so far) of each stage, for the appendix.
-    timings: list[tuple[str, float, float]] = field(default_factory=list)
+    #: (stage, seconds, peak RSS in MiB so far, CPU seconds) of each stage, for the
+    #: appendix.
+    timings: list[tuple[str, float, float, float]] = field(default_factory=list)
     #: Units of the noise coefficients in every table (None: the defaults, or
     #: "datasheet"; :meth:`imunoise.noise.NoiseModel.table`).
     units: str | None = None
+    #: Whether :meth:`stage` freezes the objects that survive it (the build then
+    #: unfreezes them): only when the process had frozen none.
+    freeze: bool = False
     #: The long log and the logs of the other sensors on its mount on one grid
     #: (``--mount``); None without them.
     aligned: Aligned | None = None
@@ -182,7 +186,7 @@ class Context:
         out = {}
         for sensor in ALLAN_SENSORS:
             y = getattr(self.long, sensor)
-            if y is None or np.count_nonzero(~np.isnan(y).any(axis=1)) < 256:
+            if y is None or np.count_nonzero(_stream.present_rows(y)) < 256:
                 continue
             try:  # segments with a missing sample are left out
                 out[sensor] = spectrum.psd(y, self.long.fs)
@@ -200,11 +204,17 @@ class Context:
                 for sensor, r in self.allan.items()}
 
     @cached_property
-    def events(self) -> Events | None:
-        """Events of the short log's gyro and accel (None without them)."""
+    def event_search(self) -> tuple[Events, Baselines] | None:
+        """Events of the short log's gyro and accel and the baselines the search
+        standardised them by (None without gyro and accel)."""
         if not any(getattr(self.short, s) is not None for s in ALLAN_SENSORS):
             return None
-        return events(self.short)
+        return search(self.short)
+
+    @property
+    def events(self) -> Events | None:
+        """Events of the short log's gyro and accel (None without them)."""
+        return None if self.event_search is None else self.event_search[0]
 
     @cached_property
     def long_events(self) -> Events | None:
@@ -240,17 +250,23 @@ class Context:
         lo, hi = fit.temperature_range
         return fit if hi - lo >= sections.THERMAL_MIN_RANGE else None
 
-    def stage(self, name: str, start: float) -> None:
-        """Record a stage that began at ``start`` (``time.perf_counter()``); on the
-        streamed path, give the memory maps' pages back after it."""
+    def stage(self, name: str, start: tuple[float, float]) -> None:
+        """Record a stage that began at ``start`` (:func:`clock`); on the streamed
+        path, give the memory maps' pages back after it."""
         if self.streamed:
             for log in (self.short, self.long, self.untrimmed):
                 _stream.release_log(log)
             # arrays a section's reference cycles still hold (its figures), then the heap:
-            # without the collection 7 channel lengths outlived the attitude section
+            # without the collection 7 channel lengths outlived the attitude section.
+            # What survives is frozen (build unfreezes it at its end), unless the caller
+            # froze objects of its own: the next stage's collection then scans only that
+            # stage's objects, not matplotlib's and scipy's again (0.1 s a stage)
             gc.collect()
+            if self.freeze:
+                gc.freeze()
             _stream.trim_heap()
-        self.timings.append((name, time.perf_counter() - start, peak_mib()))
+        wall, cpu = since(start)
+        self.timings.append((name, wall, peak_mib(), cpu))
 
     def add_figure(self, doc: Doc, fig, name: str, caption: str) -> None:
         """Save ``fig`` as ``figures/<name>.png`` and ``.svg`` and show it in ``doc``."""
@@ -258,6 +274,17 @@ class Context:
         plot.plain_ticks(fig)  # no offset in a corner: it goes into the axis label
         self.figures += plot.save(fig, path)
         doc.figure(path.with_suffix(".png"), caption)
+
+
+def clock() -> tuple[float, float]:
+    """Now, as wall time and the process's CPU time (every thread's), for :func:`since`."""
+    return time.perf_counter(), time.process_time()
+
+
+def since(start: tuple[float, float]) -> tuple[float, float]:
+    """Wall and CPU seconds from ``start`` (:func:`clock`) to now."""
+    wall, cpu = clock()
+    return wall - start[0], cpu - start[1]
 
 
 def peak_mib() -> float:
