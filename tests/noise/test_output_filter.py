@@ -374,3 +374,14 @@ def test_the_upper_bound_on_n_holds_through_a_filter():
     seen = upper_bounds(r.taus, r.dev**2, r.edf, found)["N"]
     assert np.all(blind < 0.5 * n_true)
     assert np.all(seen >= n_true) and np.all(seen < 1.2 * n_true)
+
+
+def test_the_running_median_is_each_reflected_windows_middle_value():
+    from imunoise.noise._filter import HALF_WIDTH, _running_median
+
+    rng = np.random.default_rng(5)
+    for n in (2 * HALF_WIDTH + 1, 2 * HALF_WIDTH + 2, 1000):
+        p = rng.chisquare(8, n)
+        padded = np.pad(p, HALF_WIDTH, mode="reflect")
+        windows = np.lib.stride_tricks.sliding_window_view(padded, 2 * HALF_WIDTH + 1)
+        assert np.array_equal(_running_median(p, HALF_WIDTH), np.median(windows, axis=1))

@@ -74,6 +74,7 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
+from scipy import ndimage as _ndimage
 from scipy import optimize as _optimize
 from scipy import signal as _signal
 from scipy import stats as _stats
@@ -209,10 +210,11 @@ def estimate_filter(spectrum, channel: int = 0) -> OutputFilter | None:
     if f.size < 2 * HALF_WIDTH + 1 or not np.all(np.isfinite(p)) or not np.any(p > 0):
         return None
     # The running median, unbiased: a Welch value is S·χ²_ν/ν, whose median is below S.
-    smooth = _running_median(p, HALF_WIDTH) / (_stats.chi2.median(edf) / edf)
+    smooth = _running_median(p, HALF_WIDTH) / (_per_edf(_stats.chi2.median, edf) / edf)
     # A bin is a line where it stands above the local median beyond the χ² quantile
     # at FALSE_LINE shared over the bins: the white fit and the test are about shape.
-    clean = p <= smooth * _stats.chi2.ppf(1 - FALSE_LINE / f.size, edf) / edf
+    quantile = _per_edf(lambda nu: _stats.chi2.ppf(1 - FALSE_LINE / f.size, nu), edf)
+    clean = p <= smooth * quantile / edf
     fb, pb, eb = _log_bins(f[clean], p[clean], edf[clean], spectrum.nperseg)
     fitted = _white_fit(fb, pb, eb)
     if fitted is None:
@@ -264,12 +266,19 @@ def _gain(f, psd, low, white, top):
     return np.maximum(gain, 0.0)
 
 
+def _per_edf(function, edf: np.ndarray) -> np.ndarray:
+    """``function`` of each bin's EDF, evaluated once per distinct value: a Welch
+    spectrum has two (its ends and the rest), and scipy's χ² quantiles cost
+    microseconds each over millions of frequencies."""
+    values, which = np.unique(edf, return_inverse=True)
+    return np.asarray(function(values), dtype=float)[which]
+
+
 def _running_median(p: np.ndarray, half: int) -> np.ndarray:
     """Median of ``p`` over ``half`` bins either side, reflected at both ends (the
-    spectrum of a sampled process is even about 0 and fs/2)."""
-    padded = np.pad(p, half, mode="reflect")
-    windows = np.lib.stride_tricks.sliding_window_view(padded, 2 * half + 1)
-    return np.median(windows, axis=1)
+    spectrum of a sampled process is even about 0 and fs/2): scipy's selection
+    filter, the same values as the sorted windows' middle element."""
+    return _ndimage.median_filter(p, size=2 * half + 1, mode="mirror")
 
 
 def _log_bins(f, p, edf, nperseg):
