@@ -3,8 +3,9 @@
 
 use std::collections::BTreeMap;
 use std::path::PathBuf;
+use std::sync::{Arc, Mutex, Weak};
 
-use numpy::{IntoPyArray, PyReadonlyArray1};
+use numpy::{IntoPyArray, PyArray2, PyReadonlyArray1};
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict, PyList, PySlice};
 
@@ -15,25 +16,88 @@ use crate::vn::messages::MESSAGES;
 use crate::vn::write::{self, AsciiCheck};
 use crate::vn::{stream, IssueKind, Table, VnData, FIRST_KEEP};
 
+/// Value buffers given back by the arrays of a stream's pieces, for its next
+/// piece ([`StreamValues`]).
+type GivenBack = Arc<Mutex<Vec<Vec<f64>>>>;
+
+/// The values of a table handed out by `VnStream.feed`, owned by the arrays that
+/// view them. When the last view goes, the buffer goes back to the stream and
+/// the next piece is decoded into it: memory already mapped, where a fresh
+/// buffer per piece is zeroed page by page by the kernel (a third of convert's
+/// CPU on a 1 GB log).
+#[pyclass(module = "imunoise._core.vn", frozen)]
+struct StreamValues {
+    /// Never changed while the object lives (the arrays point into it).
+    values: Vec<f64>,
+    back: Weak<Mutex<Vec<Vec<f64>>>>,
+}
+
+impl Drop for StreamValues {
+    fn drop(&mut self) {
+        // A stream that is gone, a poisoned lock or a full pool: the buffer is
+        // freed as before.
+        let Some(pool) = self.back.upgrade() else {
+            return;
+        };
+        if let Ok(mut kept) = pool.lock() {
+            if kept.len() < stream::HANDED_BACK {
+                kept.push(std::mem::take(&mut self.values));
+            }
+        };
+    }
+}
+
+/// The (rows, columns) array of `table`'s values: handed over without a copy,
+/// owned by a [`StreamValues`] that gives the buffer back to `back` when it goes
+/// (a stream's pieces), or by numpy (a whole parse).
+fn values_to_py<'py>(
+    py: Python<'py>,
+    name: &str,
+    table: &mut Table,
+    back: Option<&GivenBack>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let shape = (table.len, table.names.len());
+    let values = std::mem::take(&mut table.values);
+    let Some(back) = back else {
+        return Ok(numpy::ndarray::Array2::from_shape_vec(shape, values)
+            .map_err(|e| super::value_error(format!("table {name}: {e}")))?
+            .into_pyarray(py)
+            .into_any());
+    };
+    let owner = Bound::new(
+        py,
+        StreamValues {
+            values,
+            back: Arc::downgrade(back),
+        },
+    )?;
+    let view = numpy::ndarray::ArrayView2::from_shape(shape, &owner.get().values)
+        .map_err(|e| super::value_error(format!("table {name}: {e}")))?;
+    // SAFETY: `owner` holds the values and becomes the array's base, so they live
+    // as long as the array; it is frozen and its values are never changed or
+    // reallocated (its Drop only runs once no array refers to it).
+    let matrix = unsafe { PyArray2::borrow_from_array(&view, owner.clone().into_any()) };
+    Ok(matrix.into_any())
+}
+
 /// Tables as `{name: {column: float64 array}}` and the damaged-record rows as
-/// `{name: uint64 array}` (types with damaged records only).
+/// `{name: uint64 array}` (types with damaged records only); `back` as for
+/// [`values_to_py`].
 fn tables_to_py<'py>(
     py: Python<'py>,
     tables: BTreeMap<String, Table>,
+    back: Option<&GivenBack>,
 ) -> PyResult<(Bound<'py, PyDict>, Bound<'py, PyDict>)> {
     let out = PyDict::new(py);
     let missing = PyDict::new(py);
-    for (name, table) in tables {
+    for (name, mut table) in tables {
         if !table.missing.is_empty() {
-            missing.set_item(&name, table.missing.into_pyarray(py))?;
+            missing.set_item(&name, std::mem::take(&mut table.missing).into_pyarray(py))?;
         }
         let cols = PyDict::new(py);
         // One (rows, columns) array, handed over without a copy; every column is
         // a strided view of it, so adjacent columns (x, y, z) form (n, 3) views.
-        let shape = (table.len, table.names.len());
-        let matrix = numpy::ndarray::Array2::from_shape_vec(shape, table.values)
-            .map_err(|e| super::value_error(format!("table {name}: {e}")))?
-            .into_pyarray(py);
+        let matrix = values_to_py(py, &name, &mut table, back)?;
         let all = PySlice::full(py);
         for (k, col_name) in table.names.into_iter().enumerate() {
             cols.set_item(col_name, matrix.get_item((&all, k))?)?;
@@ -81,7 +145,7 @@ impl VnResult {
 }
 
 fn to_result(py: Python<'_>, data: VnData) -> PyResult<VnResult> {
-    let (tables, missing) = tables_to_py(py, data.tables)?;
+    let (tables, missing) = tables_to_py(py, data.tables, None)?;
     let messages = PyDict::new(py);
     for (name, n) in data.messages {
         messages.set_item(name, n)?;
@@ -127,6 +191,8 @@ pub struct VnRows {
 #[pyclass(module = "imunoise._core.vn")]
 pub struct VnStream {
     pieces: Option<stream::Pieces>,
+    /// Buffers of earlier pieces' arrays, no longer used, for the next piece.
+    given_back: GivenBack,
 }
 
 impl VnStream {
@@ -144,6 +210,7 @@ impl VnStream {
     fn new(strict: bool) -> VnStream {
         VnStream {
             pieces: Some(stream::Pieces::new(strict)),
+            given_back: GivenBack::default(),
         }
     }
 
@@ -182,9 +249,17 @@ impl VnStream {
                 .extract::<PyReadonlyArray1<'py, u8>>()?;
             viewed.as_slice()?
         };
+        let given_back = match self.given_back.lock() {
+            Ok(mut pool) => std::mem::take(&mut *pool),
+            Err(_) => Vec::new(),
+        };
+        let back = Arc::clone(&self.given_back);
         let pieces = self.pieces()?;
+        for buffer in given_back {
+            pieces.give_back(buffer);
+        }
         let tables = py.detach(|| pieces.feed(slice))?;
-        let (tables, missing) = tables_to_py(py, tables)?;
+        let (tables, missing) = tables_to_py(py, tables, Some(&back))?;
         Ok(VnRows {
             tables: tables.unbind(),
             missing: missing.unbind(),
@@ -195,6 +270,8 @@ impl VnStream {
         let pieces = self.pieces.take().ok_or_else(|| {
             super::value_error("VnStream is finished; finish must be called once")
         })?;
+        // No piece follows: buffers of arrays still alive are then freed, not kept.
+        self.given_back = GivenBack::default();
         let data = py.detach(|| pieces.finish())?;
         to_result(py, data)
     }

@@ -85,3 +85,38 @@ def test_missing_file_and_result_attributes(tmp_path):
     result = _core_vn.parse_vn(b"$VNYPR,+010.071,+000.278,-002.026*60\r\n")
     assert result.format == "vn-ascii" and result.messages == {"VNYPR": 1}
     assert set(result.issues) == set(_core_vn.ISSUE_KINDS)
+
+
+def test_rows_of_a_dropped_piece_make_room_for_the_next_and_kept_ones_stay():
+    # A piece's arrays, once dropped, give their buffer back for the next piece's
+    # rows (convert's pieces reuse memory); arrays still held are never written.
+    data = _damaged()
+    whole = _core_vn.parse_vn(data)
+    stream = _core_vn.VnStream()
+    kept = []  # every other piece's arrays, held; their copies to compare
+    rows: dict[str, dict[str, list[np.ndarray]]] = {}
+    piece = 20_000
+    seen: set[int] = set()
+    reused = 0
+    for k, start in enumerate(range(0, len(data), piece)):
+        part = stream.feed(data[start : start + piece])
+        for name, cols in part.tables.items():
+            at = next(iter(cols.values())).__array_interface__["data"][0]
+            reused += at in seen and len(next(iter(cols.values()))) > 0
+            seen.add(at)
+            for col, values in cols.items():
+                rows.setdefault(name, {}).setdefault(col, []).append(values.copy())
+                if k % 2:
+                    kept.append((values, values.copy()))
+        del part, cols, values
+    summary = stream.finish()
+    for name, cols in summary.tables.items():
+        for col, values in cols.items():
+            rows.setdefault(name, {}).setdefault(col, []).append(values)
+    for name, cols in whole.tables.items():
+        for col, values in cols.items():
+            np.testing.assert_array_equal(np.concatenate(rows[name][col]), values,
+                                          err_msg=f"{name}.{col}")
+    for held, copy in kept:
+        np.testing.assert_array_equal(held, copy)
+    assert reused, "no piece reused the buffer of a dropped one"

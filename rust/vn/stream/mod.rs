@@ -33,7 +33,7 @@ mod scan;
 mod tests;
 
 pub use parser::{Failure, Parser};
-pub use pieces::Pieces;
+pub use pieces::{Pieces, HANDED_BACK};
 pub use reader::{
     parse_bytes, parse_bytes_with, parse_file, parse_reader, parse_reader_with, CHUNK,
 };

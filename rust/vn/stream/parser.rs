@@ -111,6 +111,10 @@ pub struct Parser {
     /// Emptied value buffers of merged pieces, lent to the next block's pieces:
     /// memory already mapped is filled at once, a fresh buffer page-faults.
     pub(super) spare: Vec<Vec<f64>>,
+    /// Value buffers of tables handed out by [`Parser::take_tables`] and given
+    /// back once their rows were used ([`super::Pieces::give_back`]): the next
+    /// piece's tables fill them, where fresh ones are zeroed page by page.
+    pub(super) handed_back: Vec<Vec<f64>>,
 }
 
 impl Parser {
@@ -146,6 +150,7 @@ impl Parser {
             merged_pieces: 0,
             skip_keep: FIRST_KEEP,
             spare: Vec::new(),
+            handed_back: Vec::new(),
         }
     }
 
@@ -601,18 +606,54 @@ impl Parser {
         Some(end)
     }
 
+    /// Take `buffer` for the values of the next rows: an empty table with less
+    /// room swaps it in at once (its own buffer is kept instead), else it waits
+    /// for [`Parser::take_tables`]; at most `keep` buffers wait.
+    pub(super) fn give_back(&mut self, mut buffer: Vec<f64>, keep: usize) {
+        if buffer.capacity() == 0 {
+            return;
+        }
+        let empty = self
+            .data
+            .tables
+            .values_mut()
+            .chain(self.layouts.iter_mut().map(|(_, _, t)| t))
+            .filter(|t| t.len == 0 && !t.names.is_empty())
+            .min_by_key(|t| t.values.capacity());
+        if let Some(table) = empty {
+            if table.values.capacity() < buffer.capacity() {
+                buffer.clear();
+                std::mem::swap(&mut table.values, &mut buffer);
+            }
+        }
+        if buffer.capacity() > 0 && self.handed_back.len() < keep {
+            self.handed_back.push(buffer);
+        }
+    }
+
     /// Move out the rows decoded so far, by table name (ASCII message types and
     /// binary configurations), padded as [`Parser::finish`] pads them; parsing
     /// goes on with empty tables of the same columns (see [`super::Pieces`]).
     pub fn take_tables(&mut self) -> BTreeMap<String, Table> {
         let mut out = BTreeMap::new();
+        // A table that took rows gets a buffer given back (the largest first:
+        // the busiest table); an empty one keeps its own.
+        self.handed_back.sort_by_key(|b| b.capacity());
         for (name, table) in self.data.tables.iter_mut() {
-            let fresh = Table::new(table.names.clone());
+            let buffer = match table.len {
+                0 => std::mem::take(&mut table.values),
+                _ => self.handed_back.pop().unwrap_or_default(),
+            };
+            let fresh = Table::with_buffer(table.names.clone(), buffer);
             out.insert(name.clone(), std::mem::replace(table, fresh));
         }
         for (_, name, table) in self.layouts.iter_mut() {
             if !table.names.is_empty() {
-                let fresh = Table::new(table.names.clone());
+                let buffer = match table.len {
+                    0 => std::mem::take(&mut table.values),
+                    _ => self.handed_back.pop().unwrap_or_default(),
+                };
+                let fresh = Table::with_buffer(table.names.clone(), buffer);
                 out.insert(name.clone(), std::mem::replace(table, fresh));
             }
         }

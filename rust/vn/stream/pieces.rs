@@ -19,6 +19,10 @@ use crate::vn::{Table, VnData};
 /// record, so that the join nearly always completes it).
 const BRIDGE: usize = 1 << 16;
 
+/// Buffers kept by [`Pieces::give_back`]: one piece's rows is a few tens of MB, so
+/// a bound keeps idle memory to a few pieces whatever the caller gives back.
+pub const HANDED_BACK: usize = 2;
+
 /// The streaming parser: feed pieces, take their rows, finish for the summary.
 pub struct Pieces {
     parser: Parser,
@@ -84,6 +88,13 @@ impl Pieces {
             *data.messages.entry(name).or_insert(0) += rows;
         }
         Ok(data)
+    }
+
+    /// Give back the value buffer of a table [`Pieces::feed`] returned, once its
+    /// rows are used: the next piece's rows are decoded into it. At most
+    /// [`HANDED_BACK`] are kept (one per table of a log, in practice one).
+    pub fn give_back(&mut self, buffer: Vec<f64>) {
+        self.parser.give_back(buffer, HANDED_BACK);
     }
 
     fn check(&mut self) -> CoreResult<()> {
