@@ -37,18 +37,18 @@ pub struct Ambiguity {
 /// less than [`DECISIVE`] higher: the random walk against a ramp in its place
 /// and against one more Gauss–Markov term whose hump the fitted taus show; the
 /// ramp against a walk in its place (these keep every other term of `chosen`);
-/// and each against `selected_without` — the best structures found with the
-/// walk, and with the ramp, left out ([`search::WALK`], [`search::RAMP`]; None
-/// where none was sought). A walk and a ramp together
-/// are not questioned by a swap: each then has a part of the curve the other
-/// does not describe.
+/// and each against `without(j)`, the best structure found with IEEE term `j`
+/// ([`search::WALK`] or [`search::RAMP`]) left out, sought only when the
+/// alternatives before it do not tie. A walk and a ramp together are not
+/// questioned by a swap: each then has a part of the curve the other does not
+/// describe.
 pub fn ambiguities(
     data: &Data,
     fs: f64,
     allowed: [bool; IEEE_TERMS],
     max_gm: usize,
     chosen: &Candidate,
-    selected_without: &[Option<Candidate>; 2],
+    without: impl Fn(usize) -> Option<Candidate>,
 ) -> Vec<Ambiguity> {
     let (walk, ramp) = (search::WALK, search::RAMP);
     let in_use = |j: usize| chosen.ieee[j] && chosen.solution.theta[j] > 0.0;
@@ -62,8 +62,8 @@ pub fn ambiguities(
         })
     };
     let reselected = |kind: Kind, j: usize| {
-        let other = selected_without[usize::from(j == ramp)].as_ref()?;
-        tie(kind, first_added(fs, chosen, other), Some(other))
+        let other = without(j)?;
+        tie(kind, first_added(fs, chosen, &other), Some(&other))
     };
     let swapped = |off: usize, on: usize| {
         let mut ieee = chosen.ieee;
@@ -100,8 +100,15 @@ pub fn ambiguities(
 /// than `chosen`: what describes instead the part of the curve a term of
 /// `chosen` that `other` lacks took. None when `other` adds no kind.
 fn first_added(fs: f64, chosen: &Candidate, other: &Candidate) -> Option<Kind> {
-    let count = |c: &Candidate, kind: Kind| c.terms(fs).iter().filter(|t| t.kind() == kind).count();
-    (Kind::ALL.into_iter()).find(|&kind| count(other, kind) > count(chosen, kind))
+    let counts = |c: &Candidate| {
+        let mut n = [0usize; Kind::ALL.len()];
+        for t in c.terms(fs) {
+            n[t.kind() as usize] += 1;
+        }
+        n
+    };
+    let (had, has) = (counts(chosen), counts(other));
+    (Kind::ALL.into_iter()).find(|&kind| has[kind as usize] > had[kind as usize])
 }
 
 /// `chosen` with its walk (and any ramp it may have had room for) replaced by
@@ -158,7 +165,7 @@ mod tests {
         let ieee = [false, true, true, true, true];
         let chosen = search::select(&data, 100.0, ieee, 0, (0, false, false)).unwrap();
         assert!(chosen.solution.theta[3] > 0.0);
-        assert!(ambiguities(&data, 100.0, ieee, 0, &chosen, &[None, None]).is_empty());
+        assert!(ambiguities(&data, 100.0, ieee, 0, &chosen, |_| None).is_empty());
     }
 
     #[test]
@@ -179,7 +186,7 @@ mod tests {
         )
         .unwrap();
         assert!(walk.solution.theta[3] > 0.0);
-        let found = ambiguities(&data, 100.0, ieee, 0, &walk, &[None, None]);
+        let found = ambiguities(&data, 100.0, ieee, 0, &walk, |_| None);
         assert!(
             found
                 .iter()

@@ -188,21 +188,14 @@ pub fn fit_noise(
         ..reported.clone()
     };
     let chosen = if opts.select {
-        choose(&data, fs, opts, ieee)?
+        choose(&data, fs, opts)?
     } else {
         search::requested(&data, fs, opts)?
     };
     let mut fit = summarise(&reported, fs, &chosen);
     if opts.select {
-        // The best structure with the walk (the ramp) left out, where the chosen
-        // one has it: the rise it takes may need no such term.
-        let without = |j: usize| -> Option<Candidate> {
-            (chosen.ieee[j] && chosen.solution.theta[j] > 0.0)
-                .then(|| without_term(&data, fs, opts, &chosen, j))
-                .flatten()
-        };
-        let selected_without = [without(search::WALK), without(search::RAMP)];
-        fit.ambiguous = ambiguity::ambiguities(&data, fs, ieee, gm, &chosen, &selected_without);
+        let without = |j: usize| without_term(&data, fs, opts, &chosen, j);
+        fit.ambiguous = ambiguity::ambiguities(&data, fs, ieee, gm, &chosen, without);
     }
     Ok(fit)
 }
@@ -232,10 +225,9 @@ fn without_term(
     })
 }
 
-/// The structure the selection chooses among the IEEE terms `ieee` and the
-/// other kinds `opts` allows.
-fn choose(data: &Data, fs: f64, opts: &Options, ieee: [bool; IEEE_TERMS]) -> CoreResult<Candidate> {
-    let gm = opts.count(Kind::GaussMarkov);
+/// The structure the selection chooses among the kinds of terms `opts` allows.
+fn choose(data: &Data, fs: f64, opts: &Options) -> CoreResult<Candidate> {
+    let (ieee, gm) = (opts.ieee(), opts.count(Kind::GaussMarkov));
     let selected = |motion: bool| -> CoreResult<Candidate> {
         let kinds = (
             opts.count(Kind::Tone),
