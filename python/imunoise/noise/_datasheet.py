@@ -69,7 +69,7 @@ def datasheet_values(components, core, taus, method: str, record: float,
     stds = {t: np.full(components.channels, np.nan) for t in ("N", "B", "K")}
     for c, (terms, cov) in enumerate(core):
         found = None if filters is None else filters[c]
-        gain = None if found is None else np.ascontiguousarray(found.gain)
+        gain = None if found is None else found.gain
         for name, (v, e) in _core_fit.datasheet(terms, cov, taus, float(components.fs),
                                                 record=float(record), filter=gain):
             values[name][c], stds[name][c] = v, e

@@ -144,6 +144,7 @@ class OutputFilter:
     white_std: float = 0.0
 
     def __post_init__(self) -> None:
+        # Each array a read-only contiguous float copy: the core takes it as it is.
         for name in ("f", "gain", "psd", "low"):
             if getattr(self, name) is None:
                 continue
@@ -164,7 +165,7 @@ class OutputFilter:
         """c(τ): the white term's Allan variance with the filter over N²/τ, from the
         core (the same c(τ) the fit used)."""
         t = np.ascontiguousarray(np.atleast_1d(np.asarray(taus, dtype=float)))
-        return _core_fit.filter_factor(t, float(self.fs), np.ascontiguousarray(self.gain))
+        return _core_fit.filter_factor(t, float(self.fs), self.gain)
 
     def apply(self, x) -> np.ndarray:
         """``x``, (n,) or (n, k) sampled at ``fs``, through this filter: each rFFT bin

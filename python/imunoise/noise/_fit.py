@@ -649,7 +649,7 @@ def _fit_wls(t, v, e, fs, counts, select, found=None):
             r = _core_fit.fit_noise(*args)
         else:
             r = _core_fit.fit_noise(*_less(args, found.excess(t)),
-                                    filter=np.ascontiguousarray(found.gain),
+                                    filter=found.gain,
                                     filter_level_std=float(found.white_std))
     except ValueError as exc:
         raise ImunoiseValueError(f"cannot fit the noise model to result: {exc}") from None

@@ -207,7 +207,7 @@ class NoiseModel(PerTerm):
         return _core_fit.model_floor(
             [t.core() for t in self.terms[channel]],
             np.ascontiguousarray(self.taus, dtype=float), float(self.fs),
-            filter=None if found is None else np.ascontiguousarray(found.gain))
+            filter=None if found is None else found.gain)
 
     def plot(self, result: AllanResult, **kwargs) -> Figure:
         """The model over ``result``, the Allan result it was fitted to, with its terms,
