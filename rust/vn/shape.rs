@@ -227,6 +227,49 @@ mod x86 {
         (((m & 0x0001_0001_0001_0001).wrapping_mul(GATHER) >> 48) & 0xF) as u32
     }
 
+    /// The XOR of a 512-bit register's eight 64-bit words.
+    #[target_feature(enable = "avx512f,avx512dq,avx512bw")]
+    #[inline]
+    unsafe fn fold_words(x: __m512i) -> u64 {
+        let x = _mm256_xor_si256(_mm512_castsi512_si256(x), _mm512_extracti64x4_epi64(x, 1));
+        let x = _mm_xor_si128(_mm256_castsi256_si128(x), _mm256_extracti128_si256(x, 1));
+        _mm_cvtsi128_si64(x) as u64 ^ _mm_extract_epi64(x, 1) as u64
+    }
+
+    /// Each 128-bit lane's 16 digit values (most significant first) as one u64 in
+    /// the lane's low word: pairs, fours, eights, then the two eights.
+    #[target_feature(enable = "avx512f,avx512dq,avx512bw")]
+    #[inline]
+    unsafe fn mantissas(digits: __m512i) -> __m512i {
+        let v = _mm512_maddubs_epi16(digits, _mm512_set1_epi16(0x010A));
+        let v = _mm512_madd_epi16(v, _mm512_set1_epi32(0x0001_0064));
+        let v = _mm512_packus_epi32(v, v);
+        let v = _mm512_madd_epi16(v, _mm512_set1_epi32(0x0001_2710));
+        let hi = _mm512_mul_epu32(v, _mm512_set1_epi64(100_000_000));
+        _mm512_add_epi64(hi, _mm512_srli_epi64(v, 32))
+    }
+
+    /// The `n` fields' values, mantissa over the shape's denominator with the
+    /// sign bit of each field set in `neg`, stored at `out`.
+    #[target_feature(enable = "avx512f,avx512dq,avx512bw")]
+    #[inline]
+    unsafe fn store_values(s: &Shape, mant: &[__m512i], neg: u32, n: usize, out: *mut f64) {
+        // Each 128-bit lane holds its field's mantissa in its low word.
+        let pick = _mm512_set_epi64(14, 12, 10, 8, 6, 4, 2, 0);
+        let sign = _mm512_set1_epi64(i64::MIN);
+        for h in 0..n.div_ceil(8) {
+            let m = _mm512_permutex2var_epi64(mant[2 * h], pick, mant[2 * h + 1]);
+            let v = _mm512_div_pd(
+                _mm512_cvtepu64_pd(m),
+                _mm512_loadu_pd(s.den.as_ptr().add(8 * h)),
+            );
+            let v = _mm512_castpd_si512(v);
+            let v = _mm512_mask_or_epi64(v, (neg >> (8 * h)) as u8, v, sign);
+            // SAFETY: 8h + 8 <= MAX_FIELDS values at `out` (the caller's promise).
+            _mm512_storeu_pd(out.add(8 * h), _mm512_castsi512_pd(v));
+        }
+    }
+
     #[target_feature(enable = "avx512f,avx512dq,avx512bw")]
     pub(super) unsafe fn parse_avx512(s: &Shape, b: &[u8], out: *mut f64) -> bool {
         let p = b.as_ptr();
@@ -253,10 +296,7 @@ mod x86 {
         if (e & s.exact != s.exact) | (d & s.digit != s.digit) | (g & s.sign != s.sign) {
             return false;
         }
-        let x = _mm256_xor_si256(_mm512_castsi512_si256(x), _mm512_extracti64x4_epi64(x, 1));
-        let x = _mm_xor_si128(_mm256_castsi256_si128(x), _mm256_extracti128_si256(x, 1));
-        let x = _mm_cvtsi128_si64(x) as u64 ^ _mm_extract_epi64(x, 1) as u64;
-        if !s.check_ok(b, fold_bytes(x)) {
+        if !s.check_ok(b, fold_bytes(fold_words(x))) {
             return false;
         }
         let n = s.spec.fields.len();
@@ -272,28 +312,9 @@ mod x86 {
             neg |= lane_bits(_mm512_cmpeq_epi8_mask(v, minus)) << f;
             let ctrl = _mm512_loadu_si512(s.shuffle[f].as_ptr().cast());
             let digits = _mm512_shuffle_epi8(_mm512_sub_epi8(v, zero), ctrl);
-            // Digits most significant first: pairs, fours, eights, then one u64.
-            let v = _mm512_maddubs_epi16(digits, _mm512_set1_epi16(0x010A));
-            let v = _mm512_madd_epi16(v, _mm512_set1_epi32(0x0001_0064));
-            let v = _mm512_packus_epi32(v, v);
-            let v = _mm512_madd_epi16(v, _mm512_set1_epi32(0x0001_2710));
-            let hi = _mm512_mul_epu32(v, _mm512_set1_epi64(100_000_000));
-            *m = _mm512_add_epi64(hi, _mm512_srli_epi64(v, 32));
+            *m = mantissas(digits);
         }
-        // Each 128-bit lane holds its field's mantissa in its low word.
-        let pick = _mm512_set_epi64(14, 12, 10, 8, 6, 4, 2, 0);
-        let sign = _mm512_set1_epi64(i64::MIN);
-        for h in 0..n.div_ceil(8) {
-            let m = _mm512_permutex2var_epi64(mant[2 * h], pick, mant[2 * h + 1]);
-            let v = _mm512_div_pd(
-                _mm512_cvtepu64_pd(m),
-                _mm512_loadu_pd(s.den.as_ptr().add(8 * h)),
-            );
-            let v = _mm512_castpd_si512(v);
-            let v = _mm512_mask_or_epi64(v, (neg >> (8 * h)) as u8, v, sign);
-            // SAFETY: 8h + 8 <= MAX_FIELDS values at `out` (the caller's promise).
-            _mm512_storeu_pd(out.add(8 * h), _mm512_castsi512_pd(v));
-        }
+        store_values(s, &mant, neg, n, out);
         true
     }
 
@@ -326,10 +347,7 @@ mod x86 {
         if (e & s.exact != s.exact) | (d & s.digit != s.digit) | (g & s.sign != s.sign) {
             return false;
         }
-        let x = _mm256_xor_si256(_mm512_castsi512_si256(x), _mm512_extracti64x4_epi64(x, 1));
-        let x = _mm_xor_si128(_mm256_castsi256_si128(x), _mm256_extracti128_si256(x, 1));
-        let x = _mm_cvtsi128_si64(x) as u64 ^ _mm_extract_epi64(x, 1) as u64;
-        if !s.check_ok(b, fold_bytes(x)) {
+        if !s.check_ok(b, fold_bytes(fold_words(x))) {
             return false;
         }
         // The signed fields' `-` bits, in field order, then spread to the fields.
@@ -341,26 +359,9 @@ mod x86 {
         for (q, mq) in mant.iter_mut().enumerate().take(n.div_ceil(4)) {
             let idx = _mm512_loadu_si512(s.gather[q].as_ptr().cast());
             let digits = _mm512_maskz_permutex2var_epi8(s.gathered[q], z[0], idx, z[1]);
-            let v = _mm512_maddubs_epi16(digits, _mm512_set1_epi16(0x010A));
-            let v = _mm512_madd_epi16(v, _mm512_set1_epi32(0x0001_0064));
-            let v = _mm512_packus_epi32(v, v);
-            let v = _mm512_madd_epi16(v, _mm512_set1_epi32(0x0001_2710));
-            let hi = _mm512_mul_epu32(v, _mm512_set1_epi64(100_000_000));
-            *mq = _mm512_add_epi64(hi, _mm512_srli_epi64(v, 32));
+            *mq = mantissas(digits);
         }
-        let pick = _mm512_set_epi64(14, 12, 10, 8, 6, 4, 2, 0);
-        let sign = _mm512_set1_epi64(i64::MIN);
-        for h in 0..n.div_ceil(8) {
-            let m = _mm512_permutex2var_epi64(mant[2 * h], pick, mant[2 * h + 1]);
-            let v = _mm512_div_pd(
-                _mm512_cvtepu64_pd(m),
-                _mm512_loadu_pd(s.den.as_ptr().add(8 * h)),
-            );
-            let v = _mm512_castpd_si512(v);
-            let v = _mm512_mask_or_epi64(v, (neg >> (8 * h)) as u8, v, sign);
-            // SAFETY: 8h + 8 <= MAX_FIELDS values at `out` (the caller's promise).
-            _mm512_storeu_pd(out.add(8 * h), _mm512_castsi512_pd(v));
-        }
+        store_values(s, &mant, neg, n, out);
         true
     }
 
