@@ -9,11 +9,16 @@ shows one there; its frequency is then the spectrum's.
 The test, on Welch's linear grid (:func:`imunoise.psd` before ``smooth``):
 
 - search the bins within ``max(3 bins, 5 %)`` of the tone's frequency (the Allan
-  fit places a line to a few per cent) for the highest one, P;
+  fit places a line to a few per cent), or within its 95 % interval (1.96 standard
+  uncertainties, up to half the frequency) where that is wider, for the highest
+  one, P;
 - the background is the geometric mean of the medians of the :data:`SIDE_BINS`
   bins on either side beyond a guard of :data:`GUARD_BINS` (a Hann window's main
   lobe spans ±2 bins), each median divided by the median of χ²_ν/ν (the medians of
-  a sloping background on both sides average to its level at the peak);
+  a sloping background on both sides average to its level at the peak). A peak
+  with fewer than half of them on one side, next to 0 Hz or fs/2, is no line: one
+  side's median is a slope's level beside the peak, not at it (a record's slow
+  wander rises steeply toward 0 Hz);
 - a line is there when P/background exceeds the F(ν, ν_b) quantile at 1 − α/k, k
   the bins searched (Bonferroni), α = :data:`FALSE_LINE`: a background bin alone
   would rarely reach it. ν is the bin's Welch EDF; ν_b that of the background,
@@ -49,6 +54,12 @@ MEDIAN_EFFICIENCY = 2 / math.pi
 #: Half-width of the search, relative to the tone's frequency, and its least in bins.
 SEARCH_RELATIVE = 0.05
 SEARCH_BINS = 3
+#: A wider search reaches the Allan fit's 95 % interval of the frequency
+#: (this many standard uncertainties) ...
+SEARCH_STD = 1.96
+#: ... up to this share of the frequency: where the interval is wider still, the
+#: Allan curve has not placed the tone at all.
+SEARCH_MOST = 0.5
 
 
 @dataclass(frozen=True)
@@ -98,9 +109,11 @@ def require_linear_grid(spectrum) -> None:
                                  f"smoothed; got bins_per_decade={spectrum.bins_per_decade}")
 
 
-def check_line(spectrum, channel: int, f0: float, amplitude: float = math.nan) -> SpectralLine:
+def check_line(spectrum, channel: int, f0: float, amplitude: float = math.nan,
+               f0_std: float = math.nan) -> SpectralLine:
     """Whether ``spectrum`` (from :func:`imunoise.psd`, not smoothed) shows a line
-    near ``f0`` Hz in ``channel``; see the module for the test."""
+    near ``f0`` Hz in ``channel``, ``f0_std`` the Allan fit's standard uncertainty of
+    ``f0`` (NaN: unknown); see the module for the test."""
     require_linear_grid(spectrum)
     f = np.asarray(spectrum.f, float)
     p = np.asarray(spectrum.psd, float)
@@ -111,7 +124,8 @@ def check_line(spectrum, channel: int, f0: float, amplitude: float = math.nan) -
                         frequency=math.nan)
     if not (f.size > 2 * (GUARD_BINS + SIDE_BINS) and math.isfinite(f0) and f0 > 0):
         return none
-    half = max(SEARCH_BINS * df, SEARCH_RELATIVE * f0)
+    spread = min(SEARCH_STD * f0_std, SEARCH_MOST * f0) if f0_std > 0 else 0.0
+    half = max(SEARCH_BINS * df, SEARCH_RELATIVE * f0, spread)
     search = np.flatnonzero(np.abs(f - f0) <= half)
     if search.size == 0:
         return none
@@ -119,8 +133,10 @@ def check_line(spectrum, channel: int, f0: float, amplitude: float = math.nan) -
     left = p[max(0, peak - GUARD_BINS - SIDE_BINS):max(0, peak - GUARD_BINS)]
     right = p[peak + GUARD_BINS + 1:peak + GUARD_BINS + 1 + SIDE_BINS]
     sides = [s for s in (left, right) if s.size >= SIDE_BINS // 2]
+    if len(sides) < 2:  # one side alone is a slope's level beside the peak, not at it
+        return none
     nu = float(edf[peak])
-    if not sides or not (nu > 0 and p[peak] > 0):
+    if not (nu > 0 and p[peak] > 0):
         return none
     median_chi2 = stats.chi2.median(nu) / nu
     background = math.exp(np.mean([math.log(max(np.median(s), 1e-300)) for s in sides]))

@@ -79,6 +79,38 @@ fn fit_noise<'py>(
     let var = var.as_array().to_vec();
     let edf = edf.as_array().to_vec();
     let r = py.detach(|| fit::fit_noise(&taus, &var, &edf, fs, &opts, filter.as_ref()))?;
+    noise_fit(py, r)
+}
+
+/// fit_noise_at(taus, var, edf, fs, terms, filter=None, filter_level_std=0.0) -> NoiseFit:
+/// the structure of `terms` (kind, parameters) with their times and frequencies
+/// held and their variances fitted again (no search, no ties).
+#[pyfunction]
+#[allow(clippy::too_many_arguments)] // mirrors the Python keyword arguments
+#[pyo3(signature = (taus, var, edf, fs, terms, filter=None, filter_level_std=0.0))]
+fn fit_noise_at<'py>(
+    py: Python<'py>,
+    taus: PyReadonlyArray1<'py, f64>,
+    var: PyReadonlyArray1<'py, f64>,
+    edf: PyReadonlyArray1<'py, f64>,
+    fs: f64,
+    terms: Vec<(String, Vec<f64>)>,
+    filter: Option<PyReadonlyArray1<'py, f64>>,
+    filter_level_std: f64,
+) -> PyResult<PyNoiseFit> {
+    let filter = output_filter(filter)?
+        .map(|f| f.with_level_std(filter_level_std))
+        .transpose()?;
+    let typed = typed_terms(&terms)?;
+    let taus = taus.as_array().to_vec();
+    let var = var.as_array().to_vec();
+    let edf = edf.as_array().to_vec();
+    let r = py.detach(|| fit::fit_noise_at(&taus, &var, &edf, fs, &typed, filter.as_ref()))?;
+    noise_fit(py, r)
+}
+
+/// The Python view of a core fit.
+fn noise_fit(py: Python<'_>, r: fit::NoiseFit) -> PyResult<PyNoiseFit> {
     let size = r.cov.len();
     Ok(PyNoiseFit {
         terms: (r.terms.iter())
@@ -316,6 +348,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("FLAT_SLOPE", fit::datasheet::FLAT_SLOPE)?;
     m.add_class::<PyNoiseFit>()?;
     m.add_function(wrap_pyfunction!(fit_noise, m)?)?;
+    m.add_function(wrap_pyfunction!(fit_noise_at, m)?)?;
     m.add_function(wrap_pyfunction!(allan_terms, m)?)?;
     m.add_function(wrap_pyfunction!(filter_factor, m)?)?;
     m.add_function(wrap_pyfunction!(density_allan, m)?)?;

@@ -200,6 +200,26 @@ pub fn fit_noise(
     Ok(fit)
 }
 
+/// One channel's model with the times and frequencies of `terms` held and their
+/// variances fitted again to `taus`, `var`, `edf` (as [`fit_noise`]): a tone's
+/// frequency confirmed by the spectrum replaces the Allan fit's own.
+pub fn fit_noise_at(
+    taus: &[f64],
+    var: &[f64],
+    edf: &[f64],
+    fs: f64,
+    terms: &[Term],
+    filter: Option<&OutputFilter>,
+) -> CoreResult<NoiseFit> {
+    let reported = Data::new(taus, var, edf, fs)?.with_filter(filter);
+    let data = Data {
+        level_var: 0.0,
+        ..reported.clone()
+    };
+    let held = search::held(&data, fs, terms)?;
+    Ok(summarise(&reported, fs, &held))
+}
+
 /// The best structure without IEEE term `j`: its IEEE and Gauss–Markov terms
 /// selected again with `j` left out, alone and with `chosen`'s tones, resonance
 /// and motion kept (their searches, most of the selection's time, are not
@@ -714,6 +734,30 @@ mod tests {
             let u = fit.var(Kind::Tone, 0, 0).sqrt();
             assert!(u.is_finite() && u < s2, "{per_decade}: {u}");
         }
+    }
+
+    #[test]
+    fn held_terms_keep_their_frequencies_and_refit_their_variances() {
+        let ieee = [0.0, 1e-6, 0.0, 1e-10, 0.0];
+        let taus = grid(20.0, 0.01, 1000.0);
+        let edf = vec![1e6; taus.len()];
+        let var = curve_with(&taus, &ieee, &[], (&[(2e-5, 17.0)], &[], &[]));
+        // the truth's structure with its variances wrong: fitted back to the truth
+        let guess = typed(&[0.0, 1.0, 0.0, 1.0, 0.0], &[], (&[(1.0, 17.0)], &[], &[]));
+        let fit = fit_noise_at(&taus, &var, &edf, FS, &guess, None).unwrap();
+        assert!((fit.ieee()[1] / ieee[1] - 1.0).abs() < 1e-3, "{fit:?}");
+        assert!((fit.sine()[0].0 / 2e-5 - 1.0).abs() < 1e-3, "{fit:?}");
+        assert!(fit.ambiguous.is_empty());
+        // a frequency given is kept, the variances follow it
+        let moved = typed(&[0.0, 1.0, 0.0, 1.0, 0.0], &[], (&[(1.0, 17.5)], &[], &[]));
+        let fit = fit_noise_at(&taus, &var, &edf, FS, &moved, None).unwrap();
+        assert_eq!(fit.sine()[0].1, 17.5);
+        let three = typed(
+            &ieee,
+            &[],
+            (&[(1.0, 1.0), (1.0, 2.0), (1.0, 3.0)], &[], &[]),
+        );
+        assert!(fit_noise_at(&taus, &var, &edf, FS, &three, None).is_err());
     }
 
     #[test]

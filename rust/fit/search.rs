@@ -728,6 +728,44 @@ pub fn candidate(
     })
 }
 
+/// The structure of `terms` with their times and frequencies held and every
+/// variance fitted again (a tone's frequency measured in the spectrum, where a
+/// line is far sharper than on the Allan curve, placed in the Allan fit).
+pub fn held(data: &Data, fs: f64, terms: &[Term]) -> CoreResult<Candidate> {
+    let mut ieee = [false; IEEE_TERMS];
+    let (mut gm_tau, mut freqs) = (Vec::new(), Vec::new());
+    let (mut resonance, mut motion) = (None, None);
+    for term in terms {
+        match *term {
+            Term::GaussMarkov { tau_c, .. } => gm_tau.push(tau_c),
+            Term::Tone { freq, .. } => freqs.push(freq),
+            Term::Resonance {
+                freq, tau, skew, ..
+            } => {
+                resonance = Some(Resonance {
+                    freq,
+                    tau,
+                    skewed: skew != 0.0,
+                })
+            }
+            Term::Motion { tau_c, .. } => motion = Some(tau_c),
+            _ => {
+                if let Some(j) = Kind::IEEE.iter().position(|&k| k == term.kind()) {
+                    ieee[j] = true;
+                }
+            }
+        }
+    }
+    if freqs.len() > MAX_TONES {
+        return Err(CoreError::InvalidArgument(format!(
+            "terms hold {} tones; a model has at most {MAX_TONES}",
+            freqs.len()
+        )));
+    }
+    let extras = (Tones::from_slice(&freqs), resonance, motion);
+    candidate(data, fs, ieee, gm_tau, extras, 0.0)
+}
+
 /// Fit `gm` Gauss–Markov terms with the IEEE terms `ieee` (times searched;
 /// `seed`: the best times of `gm − 1` terms, to extend).
 pub fn fit_structure(

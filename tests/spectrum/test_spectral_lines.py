@@ -42,7 +42,25 @@ def test_a_line_at_half_the_white_rms_is_found_at_the_spectrums_frequency():
         line = reported[0]
         assert line.in_spectrum and line.ratio > 100 * line.threshold
         assert line.frequency == pytest.approx(23.4, rel=0.002)
+        # one model: the tone is at the spectrum's frequency, its variance fitted there
+        (tone,) = [t for t in model.terms[c] if t.kind == "tone"]
+        assert tone.freq == line.frequency
+        assert tone.amplitude == line.amplitude
     assert "tone 23.4 Hz" in repr(model)
+
+
+def test_the_search_reaches_the_allan_fits_interval_of_the_frequency():
+    # a line at 1.2 Hz that an Allan fit placed 8 % high with a standard
+    # uncertainty of 5 %: outside the 5 % search, inside the fit's 95 % interval
+    w = _white(1800, 5)
+    t = np.arange(w.shape[0]) / FS
+    s = imunoise.psd(w + 0.3 * np.sin(2 * np.pi * 1.2 * t[:, None]), FS)
+    for c in range(3):
+        assert not spectral_lines.check_line(s, c, 1.3).in_spectrum
+        line = spectral_lines.check_line(s, c, 1.3, f0_std=0.06)
+        assert line.in_spectrum and line.frequency == pytest.approx(1.2, abs=0.005)
+        # an interval wider than the frequency's half searches only to half of it
+        assert not spectral_lines.check_line(s, c, 2.5, f0_std=2.0).in_spectrum
 
 
 def _filtered(kind: str, w: np.ndarray) -> np.ndarray:
@@ -114,3 +132,15 @@ def test_the_resonance_psd_is_its_allan_variances(skew):
     assert np.trapezoid(p, f) == pytest.approx(4.0, rel=1e-6)
     white = resonance_white_density(2.0, 13.0, 0.3, 40.0, skew)
     assert p[0] == pytest.approx(2 * white, rel=1e-9, abs=1e-15)
+
+
+def test_a_slope_next_to_0_hz_is_no_line():
+    # a random walk's spectrum rises as 1/f² toward 0 Hz: a peak within a few bins
+    # of it has a background on one side only, which stands far below it
+    rng = np.random.default_rng(6)
+    x = rng.standard_normal((180_000, 3)) + 0.05 * np.cumsum(rng.standard_normal((180_000, 3)), 0)
+    s = imunoise.psd(x, FS)
+    df = s.f[1] - s.f[0]
+    for c in range(3):
+        for bins in (3, 5, 8, 12):
+            assert not spectral_lines.check_line(s, c, bins * df).in_spectrum, bins

@@ -74,6 +74,20 @@ def fit_noise(
     scales as its inverse from its first point that is not 1); the covariance
     carries it."""
 
+def fit_noise_at(
+    taus: npt.NDArray[np.float64],
+    var: npt.NDArray[np.float64],
+    edf: npt.NDArray[np.float64],
+    fs: float,
+    terms: list[tuple[str, list[float]]],
+    filter: npt.NDArray[np.float64] | None = None,
+    filter_level_std: float = 0.0,
+) -> NoiseFit:
+    """The structure of ``terms`` ((kind, parameters) pairs, as ``NoiseFit.terms``)
+    fitted to one channel with their correlation times and frequencies held and
+    their variances fitted again: no search, no ``ambiguous``. ``filter`` and
+    ``filter_level_std`` as :func:`fit_noise`."""
+
 def allan_terms(
     taus: npt.NDArray[np.float64],
     fs: float,

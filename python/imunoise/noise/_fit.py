@@ -203,9 +203,12 @@ def fit(result, *, method: str = "wls", terms: str | Sequence[str] = "auto",
         The Welch PSD of the same sensor (:func:`imunoise.psd`, not smoothed; the
         same channels and rate): each fitted tone is checked against it
         (:mod:`imunoise.spectral_lines`) and reported as a line
-        (:attr:`NoiseModel.lines`) only where the spectrum shows one, at the
-        spectrum's frequency. Without it the tones are reported unchecked: the
-        Allan curve alone cannot tell a line from a filter's roll-off.
+        (:attr:`NoiseModel.lines`) only where the spectrum shows one. Such a tone
+        is placed at the spectrum's frequency (a fraction of a bin against the
+        Allan curve's few per cent) and the variances are fitted again around it:
+        ``Tone.freq``, the line and the curve are one model. Without it the tones
+        are reported unchecked: the Allan curve alone cannot tell a line from a
+        filter's roll-off.
         The sensor's output filter is measured from it too (``output_filter``).
     sensor : {"gyro", "accel"}
         Which channel group of a log ``result`` is; ignored for an Allan result.
@@ -294,6 +297,7 @@ def _fit(result, *, method, terms, tau_range, uncertainty, replicates, seed, war
     stats = np.full((channels, 3), np.nan)  # discrepancy, chi2, n_eff
     cov = np.full((channels, PARAMS, PARAMS), np.nan)
     core: list = [None] * channels  # per channel: the core's terms and their covariance
+    checked: list = [None] * channels  # per channel: its tones checked against the spectrum
     ambiguous: list = [[] for _ in range(channels)]  # per channel: the core's ties
     usable = []
     for c in range(channels):
@@ -323,6 +327,13 @@ def _fit(result, *, method, terms, tau_range, uncertainty, replicates, seed, war
 
         with ThreadPoolExecutor(max_workers=min(channels, os.cpu_count() or 1)) as pool:
             fits = list(pool.map(fit_channel, range(channels)))
+        if spectrum is not None:
+            for c in range(channels):
+                fits[c], checked[c] = _at_spectral_lines(
+                    fits[c], spectrum, c,
+                    lambda held, c=c: _fit_wls(taus[usable[c]], var[usable[c], c],
+                                               edf[usable[c], c], float(result.fs), counts,
+                                               select, filters[c], held=held))
         for c, out in enumerate(fits):
             coef[c], std[c], sup[c], gm[c], gm_std[c], sine[c], sine_std[c], osc[c], \
                 osc_std[c], moving[c], moving_std[c], stats[c], cov[c], core[c], \
@@ -426,7 +437,7 @@ def _fit(result, *, method, terms, tau_range, uncertainty, replicates, seed, war
                      *_unplaced_note(unplaced[c]),
                      *_filter_notes(filters[c], spectrum, output_filter, method))
                     for c in range(channels)),
-        lines=tuple(_lines(components, spectrum, c) for c in range(channels)),
+        lines=tuple(_lines(components, spectrum, c, checked[c]) for c in range(channels)),
         ties=tied,
         _arrays=components,
         terms=typed,
@@ -524,15 +535,49 @@ def _check_spectrum(spectrum, result) -> None:
     require_linear_grid(spectrum)
 
 
-def _lines(components, spectrum, channel: int) -> tuple:
+def _at_spectral_lines(out, spectrum, channel: int, refit):
+    """One channel's fit ``out`` (:func:`_fit_wls`) with each tone the spectrum
+    confirms moved to the spectrum's frequency and the variances fitted again by
+    ``refit(held core terms)``, and each tone's check against ``spectrum`` by its
+    final frequency. A line is a peak a fraction of a bin wide in the spectrum and a
+    few per cent wide on the Allan curve: one model has the spectrum's frequency."""
+    from imunoise import spectral_lines
+
+    core_terms, cov = out[13]
+    checks = {}
+    for t in _typed.from_core(core_terms, cov):
+        if isinstance(t, _typed.Tone):
+            checks[t.freq] = spectral_lines.check_line(spectrum, channel, t.freq, t.amplitude,
+                                                       t.freq_std)
+    moved: dict = {}
+    for f, line in checks.items():
+        if line.in_spectrum and line.frequency not in moved.values():
+            moved[f] = line.frequency
+    if all(moved.get(f, f) == f for f in checks):
+        return out, checks
+    held = []
+    for kind, parameters in core_terms:
+        if kind == "tone":
+            f = parameters[1]
+            if checks[f].in_spectrum and f not in moved:
+                continue  # another tone has its line: the spectrum shows one there
+            parameters = [parameters[0], moved.get(f, f)]
+        held.append((kind, list(parameters)))
+    again = refit(held)
+    return again[:-1] + (out[-1],), {moved.get(f, f): line for f, line in checks.items()}
+
+
+def _lines(components, spectrum, channel: int, checked) -> tuple:
     """Each fitted tone of ``channel`` checked against ``spectrum`` (unchecked
-    without one)."""
+    without one); ``checked``: the checks already made, by the tone's frequency."""
     from imunoise import spectral_lines
 
     tones = components.sine(channel)
     if spectrum is None:
         return tuple(spectral_lines.unchecked(a, f0) for a, f0 in tones)
-    return tuple(spectral_lines.check_line(spectrum, channel, f0, a) for a, f0 in tones)
+    checked = checked or {}
+    return tuple(replace(checked[f0], amplitude=a) if f0 in checked
+                 else spectral_lines.check_line(spectrum, channel, f0, a) for a, f0 in tones)
 
 
 #: Taus per decade below which a fitted line or correlated term is placed poorly.
@@ -641,16 +686,19 @@ def _readonly(a):
     return out
 
 
-def _fit_wls(t, v, e, fs, counts, select, found=None):
-    args = [np.ascontiguousarray(t), np.ascontiguousarray(v), np.ascontiguousarray(e), fs,
-            list(counts.items()), select]
+def _fit_wls(t, v, e, fs, counts, select, found=None, held=None):
+    """One channel's core fit and its deprecated arrays; ``held``: the core terms
+    whose structure, times and frequencies are kept, their variances fitted again
+    (no search)."""
+    args = [np.ascontiguousarray(t), np.ascontiguousarray(v), np.ascontiguousarray(e), fs]
+    args += [list(counts.items()), select] if held is None else [held]
+    core = _core_fit.fit_noise if held is None else _core_fit.fit_noise_at
     try:
         if found is None:
-            r = _core_fit.fit_noise(*args)
+            r = core(*args)
         else:
-            r = _core_fit.fit_noise(*_less(args, found.excess(t)),
-                                    filter=found.gain,
-                                    filter_level_std=float(found.white_std))
+            r = core(*_less(args, found.excess(t)), filter=found.gain,
+                     filter_level_std=float(found.white_std))
     except ValueError as exc:
         raise ImunoiseValueError(f"cannot fit the noise model to result: {exc}") from None
     terms = _typed.from_core(r.terms, np.asarray(r.cov))

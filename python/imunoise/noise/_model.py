@@ -101,8 +101,9 @@ class NoiseModel(PerTerm):
     lines : tuple of tuple of SpectralLine
         Per channel, each fitted tone checked against the spectrum given to
         :func:`imunoise.fit` (``in_spectrum`` None where none was given): a tone is
-        reported as a line only where the spectrum shows one, at its frequency
-        (:mod:`imunoise.spectral_lines`).
+        reported as a line only where the spectrum shows one, at its frequency,
+        which is then the ``Tone``'s (``allan_frequency``: where the Allan curve
+        alone had put it; :mod:`imunoise.spectral_lines`).
     terms : tuple of tuple of Term
         Per channel, the fitted terms, typed (``imunoise.noise.White``,
         ``GaussMarkov``, ``Tone``, …, each with its parameters and their standard

@@ -236,7 +236,11 @@ class GaussMarkov(_VarianceAndTime):
 
 @dataclass(frozen=True, repr=False)
 class Tone(Term):
-    """A sinusoid A·sin(2πf₀t + ϕ): peak ``amplitude`` (rate) and ``freq`` f₀ (Hz)."""
+    """A sinusoid A·sin(2πf₀t + ϕ): peak ``amplitude`` (rate) and ``freq`` f₀ (Hz).
+
+    Fitted with a spectrum that shows its line, ``freq`` is the spectrum's and
+    ``freq_std`` the Allan curve's uncertainty there (the spectrum's own is a
+    fraction of its bin)."""
 
     kind: ClassVar[str] = "tone"
     noun: ClassVar[str] = "tone"
