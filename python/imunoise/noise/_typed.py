@@ -9,7 +9,9 @@ all of them together (:class:`~imunoise.noise.NoiseModel`).
 
 Each kind has its Rust counterpart (``rust/fit/term.rs``, exported as
 ``imunoise._core.fit.TERM_KINDS``): the Allan variance of every term comes from
-there, the classes here only name and convert its parameters.
+there, the classes here name and convert its parameters and say what it gives an
+EKF's model of its channel (:meth:`Term.ekf`), so that the export iterates
+``model.terms`` without naming kinds.
 """
 
 from __future__ import annotations
@@ -22,6 +24,8 @@ import numpy as np
 
 from imunoise._core import fit as _core_fit
 from imunoise._support import summary as _summary
+from imunoise.noise._ekf import BiasState, EkfShare
+from imunoise.noise._terms import gm_white_density, resonance_white_density
 
 
 def _sigma(variance: float, u_variance: float) -> tuple[float, float]:
@@ -77,6 +81,19 @@ class Term:
         """This term's one-sided PSD at ``f`` (Hz) for data sampled at ``fs`` (Hz);
         None for a tone, a line with no density (plots mark its frequency)."""
         raise NotImplementedError
+
+    def ekf(self, fs: float, min_samples: float) -> EkfShare:
+        """This term's part of an extended Kalman filter's model of its channel
+        (:func:`imunoise.export.ekf_dict`) at ``fs`` Hz, where a bias state needs a
+        correlation time of at least ``min_samples`` samples.
+
+        By default nothing: a kind whose noise an estimator should carry gives it
+        here, as white noise or as bias states; any other is left out of the
+        filter's model, as a tone (a deterministic line, which no bias state
+        follows) and a bounded motion (the mount's, not the sensor's) are. Flicker
+        and the rate random walk give nothing either: the export writes B and K
+        from the model's datasheet values, beside the states."""
+        return EkfShare()
 
     def to_dict(self) -> dict:
         """Plain-Python view: ``kind`` and every parameter and its ``*_std``
@@ -149,6 +166,9 @@ class White(_Ieee):
     requested: ClassVar[str] = "N"
     N: float
     N_std: float = math.nan
+
+    def ekf(self, fs: float, min_samples: float) -> EkfShare:
+        return EkfShare(white_density=self.N**2)
 
 
 @dataclass(frozen=True, repr=False)
@@ -230,6 +250,12 @@ class GaussMarkov(_VarianceAndTime):
     def _simulate(self) -> dict:
         return {"gm": [(self.sigma, self.tau_c)]}
 
+    def ekf(self, fs: float, min_samples: float) -> EkfShare:
+        # Too fast to be a filter state at the IMU rate: white noise.
+        if self.tau_c * fs < min_samples:
+            return EkfShare(white_density=gm_white_density(self.sigma, self.tau_c, fs))
+        return EkfShare(states=(BiasState(self.sigma, self.tau_c),))
+
     def psd(self, f, fs: float) -> np.ndarray:
         return self._ar1_psd(f, fs)
 
@@ -294,6 +320,12 @@ class Resonance(Term):
 
     def _simulate(self) -> dict:
         return {"resonance": (self.sigma, self.freq, self.tau, self.skew)}
+
+    def ekf(self, fs: float, min_samples: float) -> EkfShare:
+        # Like a tone, no bias state; what it adds to the white floor (its
+        # spectrum at zero frequency) is measurement noise.
+        return EkfShare(white_density=resonance_white_density(self.sigma, self.freq,
+                                                              self.tau, fs, self.skew))
 
     def psd(self, f, fs: float) -> np.ndarray:
         from imunoise.spectrum import resonance_psd
