@@ -90,7 +90,8 @@ class Term:
         """The report's clause on this term in one channel's sentence (``imunoise
         fit`` prints it too), written with ``words`` (the channel's units, spelling
         of numbers, spectral lines and N); None where the tables say it all. By
-        default the kind's noun and the term's label: ``"rate ramp: R"``."""
+        default the kind's noun and the term's label (``"noun: label"``), so that a
+        kind without words of its own is still named."""
         return f"{self.noun}: {self.label()}"
 
     def remark(self, words: TermWords) -> str | None:
