@@ -48,7 +48,7 @@ from imunoise import units as _units
 from imunoise._support import atomic as _atomic
 from imunoise._support import warn as _warn
 from imunoise.errors import CoverageWarning, ImunoiseDeprecationWarning, ImunoiseValueError
-from imunoise.noise import _typed, gm_white_density, resonance_white_density
+from imunoise.noise import _typed
 
 __all__ = [
     "ekf_dict",
@@ -238,24 +238,17 @@ def _ekf_axes(model, sensor: str, input_unit, min_samples: float) -> dict:
     sheet = {t: _value_or_bound(model, t, sensor) for t in ("N", "B", "K")}
     for c, name in enumerate(names):
         terms = model.terms[c]
-        white2 = _typed.coefficient(terms, "N") ** 2
-        # A resonance (like a tone) is no bias state; what it adds to the white
-        # floor (its spectrum at zero frequency) is measurement noise. A bounded
-        # motion is the test mount's, not the sensor's: no state, no noise.
-        for sigma, f_r, tau_r, skew in _typed.pairs(terms, _typed.Resonance, "sigma", "freq",
-                                                    "tau", "skew"):
-            white2 += resonance_white_density(sigma, f_r, tau_r, model.fs, skew)
+        # Each kind says what it gives the filter (Term.ekf: white noise for the
+        # measurement, bias states), so a new kind needs no branch here.
+        white2 = 0.0
         states = []
-        for sigma, tau_c in _typed.pairs(terms, _typed.GaussMarkov, "sigma", "tau_c"):
-            if tau_c * model.fs < min_samples:
-                # Too fast to be a filter state at the IMU rate: white noise.
-                white2 += gm_white_density(sigma, tau_c, model.fs)
-                continue
-            states.append({
-                "sigma": sigma * scale,
-                "correlation_time": tau_c,
-                "driving_noise_density": sigma * math.sqrt(2.0 / tau_c) * scale,
-            })
+        for share in (term.ekf(model.fs, min_samples) for term in terms):
+            white2 += share.white_density
+            states += [{
+                "sigma": state.sigma * scale,
+                "correlation_time": state.correlation_time,
+                "driving_noise_density": state.driving_noise_density * scale,
+            } for state in share.states]
         # The walk's driving noise: the fitted K; where the data do not resolve K,
         # its bound (a slow Gauss–Markov term standing in for K is a state above).
         walk = _typed.coefficient(terms, "K")

@@ -9,19 +9,27 @@ all of them together (:class:`~imunoise.noise.NoiseModel`).
 
 Each kind has its Rust counterpart (``rust/fit/term.rs``, exported as
 ``imunoise._core.fit.TERM_KINDS``): the Allan variance of every term comes from
-there, the classes here only name and convert its parameters.
+there, the classes here name and convert its parameters, write the report's
+clause on it (:meth:`Term.describe`) and say what it gives an EKF's model of its
+channel (:meth:`Term.ekf`), so that the report and the export iterate
+``model.terms`` without naming kinds.
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass, fields
-from typing import ClassVar
+from typing import TYPE_CHECKING, ClassVar
 
 import numpy as np
 
 from imunoise._core import fit as _core_fit
 from imunoise._support import summary as _summary
+from imunoise.noise._ekf import BiasState, EkfShare
+from imunoise.noise._terms import gm_white_density, resonance_white_density
+
+if TYPE_CHECKING:
+    from imunoise.report.term_words import TermWords
 
 
 def _sigma(variance: float, u_variance: float) -> tuple[float, float]:
@@ -78,6 +86,32 @@ class Term:
         None for a tone, a line with no density (plots mark its frequency)."""
         raise NotImplementedError
 
+    def describe(self, words: TermWords) -> str | None:
+        """The report's clause on this term in one channel's sentence (``imunoise
+        fit`` prints it too), written with ``words`` (the channel's units, spelling
+        of numbers, spectral lines and N); None where the tables say it all. By
+        default the kind's noun and the term's label (``"noun: label"``), so that a
+        kind without words of its own is still named."""
+        return f"{self.noun}: {self.label()}"
+
+    def remark(self, words: TermWords) -> str | None:
+        """A clause after every term's own (:meth:`describe`): what this term means
+        for the model's other values. By default None."""
+        return None
+
+    def ekf(self, fs: float, min_samples: float) -> EkfShare:
+        """This term's part of an extended Kalman filter's model of its channel
+        (:func:`imunoise.export.ekf_dict`) at ``fs`` Hz, where a bias state needs a
+        correlation time of at least ``min_samples`` samples.
+
+        By default nothing: a kind whose noise an estimator should carry gives it
+        here, as white noise or as bias states; any other is left out of the
+        filter's model, as a tone (a deterministic line, which no bias state
+        follows) and a bounded motion (the mount's, not the sensor's) are. Flicker
+        and the rate random walk give nothing either: the export writes B and K
+        from the model's datasheet values, beside the states."""
+        return EkfShare()
+
     def to_dict(self) -> dict:
         """Plain-Python view: ``kind`` and every parameter and its ``*_std``
         (None where not finite: JSON has no NaN)."""
@@ -87,13 +121,10 @@ class Term:
             out[f.name] = v if math.isfinite(v) else None
         return out
 
-    def _describe(self) -> str:
+    def __repr__(self) -> str:
         values = [f"{f.name}={getattr(self, f.name):.4g}" for f in fields(self)
                   if not f.name.endswith("_std")]
         return f"{type(self).__name__}({', '.join(values)})"
-
-    def __repr__(self) -> str:
-        return self._describe()
 
 
 @dataclass(frozen=True, repr=False)
@@ -112,6 +143,10 @@ class _Ieee(Term):
 
     def label(self) -> str:
         return self.name
+
+    def describe(self, words: TermWords) -> str | None:
+        # The datasheet table and the read-off comparison say a coefficient.
+        return None
 
     def _simulate(self) -> dict:
         return {self.name: self.value}
@@ -149,6 +184,9 @@ class White(_Ieee):
     requested: ClassVar[str] = "N"
     N: float
     N_std: float = math.nan
+
+    def ekf(self, fs: float, min_samples: float) -> EkfShare:
+        return EkfShare(white_density=self.N**2)
 
 
 @dataclass(frozen=True, repr=False)
@@ -214,6 +252,10 @@ class _VarianceAndTime(Term):
         return cls(sigma, parameters[1], u_sigma, _from_log(parameters[1], cov[1, 1]))
 
 
+#: Share of the datasheet N² above which a Gauss–Markov term's white tail "carries" N.
+CARRIES_N = 0.5
+
+
 @dataclass(frozen=True, repr=False)
 class GaussMarkov(_VarianceAndTime):
     """First-order Gauss–Markov bias: standard deviation ``sigma`` (rate) and
@@ -227,8 +269,39 @@ class GaussMarkov(_VarianceAndTime):
     def label(self) -> str:
         return f"GM({_summary.number(self.tau_c)} s)"
 
+    def describe(self, words: TermWords) -> str:
+        return (f"Gauss–Markov bias σ = {words.amount(self.sigma, self.sigma_std, 'B')}, "
+                f"τc = {words.number(self.tau_c, self.tau_c_std)} s")
+
+    def remark(self, words: TermWords) -> str | None:
+        """Where most of the datasheet N² is this term's white tail and the curve
+        shows its hump (its peak, at ≈ 1.9 τc, beyond the first two taus): that N
+        is the sensor's output filter or a disturbance of the mount, which the
+        Allan curve cannot tell apart (a ring-laser gyro on a parked vehicle
+        printed the vehicle's vibration as its angle random walk, 100× the gyro's
+        own)."""
+        n2 = words.n**2
+        if not n2 > 0 or len(words.taus) < 3:
+            return None
+        share = gm_white_density(self.sigma, self.tau_c, words.fs) / n2
+        if not (self.tau_c < 1.0 and share > CARRIES_N
+                and 1.9 * self.tau_c > float(words.taus[1])):
+            return None
+        return (f"N is {words.percent(share)} the white tail of the Gauss–Markov term of "
+                f"τc {self.tau_c:.2g} s, whose hump the curve shows near "
+                f"{1.9 * self.tau_c:.2g} s: the sensor's own output filter, or a "
+                "disturbance of the mount (a vehicle's or a machine's vibration), which "
+                "the Allan deviation cannot tell apart; where the sensor's filter is "
+                "faster, its own white noise lies below this N")
+
     def _simulate(self) -> dict:
         return {"gm": [(self.sigma, self.tau_c)]}
+
+    def ekf(self, fs: float, min_samples: float) -> EkfShare:
+        # Too fast to be a filter state at the IMU rate: white noise.
+        if self.tau_c * fs < min_samples:
+            return EkfShare(white_density=gm_white_density(self.sigma, self.tau_c, fs))
+        return EkfShare(states=(BiasState(self.sigma, self.tau_c),))
 
     def psd(self, f, fs: float) -> np.ndarray:
         return self._ar1_psd(f, fs)
@@ -255,6 +328,25 @@ class Tone(Term):
 
     def label(self) -> str:
         return f"tone {_summary.number(self.freq)} Hz"
+
+    def describe(self, words: TermWords) -> str | None:
+        """A line where the spectrum shows one, at the spectrum's frequency; a tone
+        where no spectrum checked it; where the spectrum shows none, a shape of the
+        Allan curve. None where the model has no spectral check of it."""
+        line = words.line(self.freq)
+        if line is None:
+            return None
+        amplitude = words.amount(line.amplitude, self.amplitude_std, "B")
+        if line.in_spectrum is None:
+            return (f"a tone of amplitude {amplitude} at "
+                    f"{words.number(line.frequency, self.freq_std)} Hz "
+                    "(not checked against a spectrum)")
+        if line.in_spectrum:
+            return (f"a line of amplitude {amplitude} at {line.frequency:.4g} Hz (the "
+                    f"spectrum's peak, {words.three(line.ratio)}× its background)")
+        return (f"the Allan curve bends like a tone near {line.allan_frequency:.3g} Hz, but "
+                "the spectrum shows no line there: a shape of the sensor's filter or noise, "
+                "not a vibration")
 
     def _simulate(self) -> dict:
         return {"sinusoid": [(self.amplitude, self.freq)]}
@@ -296,8 +388,26 @@ class Resonance(Term):
         skew = f" (skew {self.skew:.2g})" if self.skew else ""
         return f"resonance {_summary.number(self.freq)} Hz{skew}"
 
+    def describe(self, words: TermWords) -> str:
+        text = (f"a resonance (damped oscillation, a band rather than a line) of "
+                f"σ = {words.amount(self.sigma, self.sigma_std, 'B')} at "
+                f"{words.number(self.freq, self.freq_std)} Hz, damping time "
+                f"{words.number(self.tau, self.tau_std)} s (quality factor "
+                f"{math.pi * self.freq * self.tau:.2g})")
+        if not self.skew:
+            return text
+        shape = (" — the shape of a second-order low-pass filter, as a sensor's own output "
+                 "filter is" if self.skew > 0 else "")
+        return text + f", skew {words.number(self.skew, self.skew_std)}{shape}"
+
     def _simulate(self) -> dict:
         return {"resonance": (self.sigma, self.freq, self.tau, self.skew)}
+
+    def ekf(self, fs: float, min_samples: float) -> EkfShare:
+        # Like a tone, no bias state; what it adds to the white floor (its
+        # spectrum at zero frequency) is measurement noise.
+        return EkfShare(white_density=resonance_white_density(self.sigma, self.freq,
+                                                              self.tau, fs, self.skew))
 
     def psd(self, f, fs: float) -> np.ndarray:
         from imunoise.spectrum import resonance_psd
@@ -325,6 +435,19 @@ class Motion(_VarianceAndTime):
 
     def label(self) -> str:
         return f"motion({_summary.number(self.tau_c)} s)"
+
+    def describe(self, words: TermWords) -> str:
+        """Its size and time, and that N leaves it out (where N is not resolved, an
+        upper bound on it: the motion's own white density below τc)."""
+        text = (f"**a bounded motion of the mount** (the platform's angle wanders by "
+                f"σ = {words.amount(self.sigma, self.sigma_std, 'Q')} over "
+                f"τc = {words.number(self.tau_c, self.tau_c_std)} s and comes back: white "
+                "below τc, falling as 1/τ beyond) — not the sensor's noise, so N leaves it out")
+        if words.n > 0:
+            return text
+        white = math.sqrt(2.0 * self.sigma**2 / self.tau_c)  # its density below τc
+        return (text + "; under it the sensor's own white noise does not show: N is not "
+                f"resolved, at most {words.amount(white, None, 'N')}")
 
     def _simulate(self) -> dict:
         return {"motion": (self.sigma, self.tau_c)}

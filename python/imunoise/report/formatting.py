@@ -7,8 +7,8 @@ import numpy as np
 
 from imunoise import display as _display
 
-__all__ = ["DOCS_URL", "docs_link", "format_duration", "format_number", "gap_note",
-           "missing_text", "terms_used", "unit_text"]
+__all__ = ["DOCS_URL", "docs_link", "format_duration", "format_number", "format_three",
+           "gap_note", "missing_text", "terms_used", "unit_text"]
 
 
 #: The documentation site; the report links its pages (a wheel user has no ``docs/``
@@ -33,6 +33,12 @@ def format_number(v: float, std: float | None = None) -> str:
     :func:`imunoise.display.format_value`), a bare ``v`` to six significant digits
     (report tables are compared with the API's numbers), ``—`` for NaN and inf."""
     return _display.cell(v, std, digits=6)
+
+
+def format_three(value) -> str:
+    """Three significant digits as the tables write them (``"4.14e-7"``, ``"1230"``),
+    not Python's ``"4.14e-07"`` or ``"1.23e+03"``: a ratio or a rough size."""
+    return _display.format_value(float(value), digits=3)
 
 
 #: ``"10 ms"``, ``"12.5 s"``, ``"3.2 min"`` or ``"5 h"``: the one time formatter of the

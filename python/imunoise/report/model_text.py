@@ -11,11 +11,12 @@ import numpy as np
 from imunoise import datasheet
 from imunoise import units as _units
 from imunoise._support.schema import axis_names
-from imunoise.display import format_value, percent
+from imunoise.display import percent
 from imunoise.errors import ImunoiseValueError
-from imunoise.noise import NoiseModel, _typed, gm_white_density, resolution_noise
+from imunoise.noise import NoiseModel, _typed, resolution_noise
 from imunoise.noise._model import table_cell
-from imunoise.report.formatting import format_number
+from imunoise.report.formatting import format_number, format_three
+from imunoise.report.term_words import TermWords
 
 __all__ = ["REPORT_UNITS", "comparison_rows", "datasheet_rows", "lab_rows",
            "model_sentences", "record_uncertainty", "report_units", "units_of"]
@@ -116,7 +117,9 @@ def model_sentences(model: NoiseModel, sensor: str,
                     units: str | dict | None = None, *, steps=None) -> list[str]:
     """One sentence per axis: the fitted components, how well the model follows the curve
     (and, below :data:`POOR_COVERAGE`, that its coefficients only summarise it),
-    the Gauss–Markov terms, whether the model's N and B agree with the
+    each term's clause in its kind's own words (``describe`` and ``remark`` of its
+    class in :mod:`imunoise.noise._typed`: a Gauss–Markov term, a tone, a
+    resonance, a bounded motion), whether the model's N and B agree with the
     datasheet read-offs of the curve and, given ``steps`` (per axis, the samples'
     resolution in input units — :func:`imunoise.stats.quantization_step` —, None
     where unknown), what that resolution adds to N and Q; in ``units`` (as for
@@ -126,9 +129,8 @@ def model_sentences(model: NoiseModel, sensor: str,
         raise ImunoiseValueError(f"steps must have one value per channel ({model.channels}); "
                          f"got {len(steps)}")
     chosen = _units.unit_choice(units_of(units, sensor), sensor)
-    b_unit = _units.unit_info("B", chosen.get("B"), sensor)
-    n_unit = _units.unit_info("N", chosen.get("N"), sensor)
-    q_unit = _units.unit_info("Q", chosen.get("Q"), sensor)
+    shown = {t: _units.unit_info(t, chosen.get(t), sensor) for t in ("B", "N", "Q")}
+    b_unit, n_unit, q_unit = shown["B"], shown["N"], shown["Q"]
     out = []
     for c, axis in enumerate(axis_names(model.channels)):
         terms = model.terms[c]
@@ -141,39 +143,12 @@ def model_sentences(model: NoiseModel, sensor: str,
         if cover < POOR_COVERAGE:
             parts.append("**the model does not describe this curve: read its coefficients "
                          "as a summary only** (see the data/model panel)")
-        for sigma, sigma_std, tau_c, tau_std in _gauss_markov_with_std(model, c):
-            value, value_std = _units.convert(np.array([sigma, sigma_std]), "B", b_unit.name,
-                                             sensor=sensor)
-            parts.append(f"Gauss–Markov bias σ = {format_number(value, value_std)} "
-                         f"{b_unit.label}, τc = {format_number(tau_c, tau_std)} s")
-        tone_stds = _typed.pairs(terms, _typed.Tone, "amplitude_std", "freq_std")
-        for line, (amp_std, f0_std) in zip(model.lines[c], tone_stds, strict=False):
-            value, value_std = _units.convert(np.array([line.amplitude, amp_std]), "B",
-                                             b_unit.name, sensor=sensor)
-            if line.in_spectrum is None:
-                parts.append(f"a tone of amplitude {format_number(value, value_std)} "
-                             f"{b_unit.label} at {format_number(line.frequency, f0_std)} Hz "
-                             "(not checked against a spectrum)")
-            elif line.in_spectrum:
-                parts.append(f"a line of amplitude {format_number(value, value_std)} "
-                             f"{b_unit.label} at {line.frequency:.4g} Hz (the spectrum's "
-                             f"peak, {_g(line.ratio)}× its background)")
-            else:
-                parts.append(f"the Allan curve bends like a tone near "
-                             f"{line.allan_frequency:.3g} Hz, but the spectrum shows no line "
-                             "there: a shape of the sensor's filter or noise, not a vibration")
-        for r in (t for t in terms if isinstance(t, _typed.Resonance)):
-            sigma, f_r, tau_r, skew = r.sigma, r.freq, r.tau, r.skew
-            stds = [r.sigma_std, r.freq_std, r.tau_std, r.skew_std]
-            value, value_std = _units.convert(np.array([sigma, stds[0]]), "B", b_unit.name,
-                                             sensor=sensor)
-            parts.append(f"a resonance (damped oscillation, a band rather than a line) of "
-                         f"σ = {format_number(value, value_std)} {b_unit.label} at "
-                         f"{format_number(f_r, stds[1])} Hz, damping time "
-                         f"{format_number(tau_r, stds[2])} s (quality factor "
-                         f"{math.pi * f_r * tau_r:.2g})" + _skew_words(skew, stds[3]))
-        parts += _motion_sentence(model, c, sensor, n_unit, q_unit)
-        parts += _correlated_white_sentence(model, c)
+        # Each kind writes its own clause (Term.describe, Term.remark), so a new
+        # kind needs no branch here.
+        words = TermWords(sensor, shown, model.fs, model.taus, float(model.value("N")[c]),
+                          model.lines[c])
+        parts += [text for term in terms if (text := term.describe(words))]
+        parts += [text for term in terms if (text := term.remark(words))]
         if steps is not None:
             parts += _resolution_sentence(model, c, steps[c], sensor, (b_unit, n_unit, q_unit))
         for term, unit in (("N", n_unit), ("B", b_unit)):
@@ -183,38 +158,6 @@ def model_sentences(model: NoiseModel, sensor: str,
                   "apart (the table gives its 95 % bound)"
                   for tie in (model.ties[c] if model.ties else ())]
         out.append("; ".join(parts) + ".")
-    return out
-
-
-def _skew_words(skew: float, skew_std: float) -> str:
-    """What a resonance's quadrature part adds to its sentence ("" without one)."""
-    if not skew:
-        return ""
-    shape = (" — the shape of a second-order low-pass filter, as a sensor's own output "
-             "filter is" if skew > 0 else "")
-    return f", skew {format_number(skew, skew_std)}{shape}"
-
-
-def _motion_sentence(model: NoiseModel, c: int, sensor: str, n_unit, q_unit) -> list[str]:
-    """What a bounded motion of the mount means for channel ``c``: its size and time,
-    and that N leaves it out (an upper bound on N where N is not resolved)."""
-    out = []
-    for m in (t for t in model.terms[c] if isinstance(t, _typed.Motion)):
-        sigma, tau_c, sigma_std, tau_std = m.sigma, m.tau_c, m.sigma_std, m.tau_c_std
-        value, value_std = _units.convert(np.array([sigma, sigma_std]), "Q", q_unit.name,
-                                          sensor=sensor)
-        white = math.sqrt(2.0 * sigma**2 / tau_c)  # its density below τc
-        n_now = float(model.value("N")[c])  # NaN where not resolved
-        bound = _units.convert(math.hypot(n_now if n_now > 0 else 0.0, white), "N",
-                               n_unit.name, sensor=sensor)
-        text = (f"**a bounded motion of the mount** (the platform's angle wanders by "
-                f"σ = {format_number(value, value_std)} {q_unit.label} over "
-                f"τc = {format_number(tau_c, tau_std)} s and comes back: white below τc, "
-                f"falling as 1/τ beyond) — not the sensor's noise, so N leaves it out")
-        if not n_now > 0:
-            text += (f"; under it the sensor's own white noise does not show: N is not "
-                     f"resolved, at most {format_number(float(bound))} {n_unit.label}")
-        out.append(text)
     return out
 
 
@@ -244,9 +187,9 @@ def _resolution_sentence(model: NoiseModel, c: int, step, sensor: str, units) ->
     if share >= RESOLUTION_SHOWN:
         shown = _units.convert(float(step), "B", b_unit.name, sensor=sensor)
         added = _units.convert(n_round, "N", n_unit.name, sensor=sensor)
-        text = (f"the samples are whole multiples of {_g(shown)} "
+        text = (f"the samples are whole multiples of {format_three(shown)} "
                 f"{b_unit.label}: rounding to it adds white noise of "
-                f"{_g(added)} {n_unit.label}"
+                f"{format_three(added)} {n_unit.label}"
                 + (f", {percent(share)} of N" if math.isfinite(share) else ""))
         if share >= RESOLUTION_LIMITS:
             text += (" — **the log's resolution limits the N measured here** (record with "
@@ -259,50 +202,11 @@ def _resolution_sentence(model: NoiseModel, c: int, step, sensor: str, units) ->
         times = f"{ratio:.0f}" if ratio >= 10 else f"{ratio:.2g}"
         integral = "velocity" if sensor == "accel" else "angle"
         out.append(f"counts of an integrated {integral} of the samples' resolution "
-                   f"({_g(shown)} {b_unit.label}) would give Q = "
-                   f"{_g(counted)} {q_unit.label}; the model's Q is {times}× that"
+                   f"({format_three(shown)} {b_unit.label}) would give Q = "
+                   f"{format_three(counted)} {q_unit.label}; the model's Q is {times}× that"
                    + (": more than the log's resolution explains (the sensor's own "
                       "quantization, or its filter)" if ratio > Q_OWN else ""))
     return out
-
-
-def _g(value) -> str:
-    """Three significant digits as the tables write them ("4.14e-7", "1230"), not
-    Python's "4.14e-07" or "1.23e+03"."""
-    return format_value(float(value), digits=3)
-
-
-#: Share of the datasheet N² above which a term's white tail "carries" N.
-CARRIES_N = 0.5
-
-
-def _correlated_white_sentence(model: NoiseModel, c: int) -> list[str]:
-    """Where most of the datasheet N² is the white tail of a Gauss–Markov term whose
-    hump the curve shows (its peak, at ≈ 1.9 τc, beyond the first two taus): say
-    that it is the sensor's output filter or a disturbance of the mount, which the
-    Allan curve cannot tell apart (a ring-laser gyro on a parked vehicle printed
-    the vehicle's vibration as its angle random walk, 100× the gyro's own)."""
-    n2 = float(model.value("N")[c]) ** 2
-    if not n2 > 0 or len(model.taus) < 3:
-        return []
-    out = []
-    for sigma, tau_c in _typed.pairs(model.terms[c], _typed.GaussMarkov, "sigma", "tau_c"):
-        share = gm_white_density(sigma, tau_c, model.fs) / n2
-        if tau_c < 1.0 and share > CARRIES_N and 1.9 * tau_c > float(model.taus[1]):
-            out.append(
-                f"N is {percent(share)} the white tail of the Gauss–Markov term of τc "
-                f"{tau_c:.2g} s, whose hump the curve shows near {1.9 * tau_c:.2g} s: "
-                "the sensor's own output filter, or a disturbance of the mount (a "
-                "vehicle's or a machine's vibration), which the Allan deviation cannot "
-                "tell apart; where the sensor's filter is faster, its own white noise "
-                "lies below this N")
-    return out
-
-
-def _gauss_markov_with_std(model: NoiseModel, c: int) -> list[tuple[float, ...]]:
-    """(σ, std of σ, τc, std of τc) of each Gauss–Markov term of channel ``c``."""
-    return _typed.pairs(model.terms[c], _typed.GaussMarkov, "sigma", "sigma_std", "tau_c",
-                        "tau_c_std")
 
 
 def _readoff_agreement(model: NoiseModel, c: int, term: str, unit, sensor: str) -> list[str]:
