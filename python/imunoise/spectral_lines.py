@@ -91,6 +91,12 @@ class SpectralLine:
     threshold: float = math.nan
 
     @property
+    def tone_frequency(self) -> float:
+        """The model's ``Tone.freq`` of this line: the spectrum's where it shows the
+        line, the Allan fit's otherwise."""
+        return self.frequency if self.in_spectrum else self.allan_frequency
+
+    @property
     def reported(self) -> bool:
         """Whether the line is reported: shown by the spectrum, or not checked."""
         return self.in_spectrum is not False

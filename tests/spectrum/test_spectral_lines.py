@@ -47,6 +47,10 @@ def test_a_line_at_half_the_white_rms_is_found_at_the_spectrums_frequency():
         assert tone.freq == line.frequency
         assert tone.amplitude == line.amplitude
     assert "tone 23.4 Hz" in repr(model)
+    from imunoise.report import model_text
+
+    said = " ".join(model_text.model_sentences(model, "gyro"))
+    assert said.count("a line of amplitude") == 3, said
 
 
 def test_the_search_reaches_the_allan_fits_interval_of_the_frequency():

@@ -70,6 +70,6 @@ class TermWords:
         return percent(fraction)
 
     def line(self, freq: float) -> SpectralLine | None:
-        """The spectral check of the tone the Allan fit placed at ``freq`` Hz, or
-        None where the model has none."""
-        return next((line for line in self.lines if line.allan_frequency == freq), None)
+        """The spectral check of the model's tone at ``freq`` Hz
+        (:attr:`SpectralLine.tone_frequency`), or None where the model has none."""
+        return next((line for line in self.lines if line.tone_frequency == freq), None)
