@@ -293,18 +293,9 @@ fn filter_factor<'py>(
     fs: f64,
     filter: PyReadonlyArray1<'py, f64>,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-    if !(fs.is_finite() && fs > 0.0) {
-        return Err(super::value_error(format!(
-            "fs must be finite and > 0; got {fs}"
-        )));
-    }
-    let filter = OutputFilter::new(filter.as_array().to_vec())?;
     let taus = taus.as_array().to_vec();
-    if let Some(t) = taus.iter().find(|t| !(t.is_finite() && **t > 0.0)) {
-        return Err(super::value_error(format!(
-            "taus must be finite and > 0; got {t}"
-        )));
-    }
+    check_model(&taus, fs)?;
+    let filter = OutputFilter::new(filter.as_array().to_vec())?;
     let ms: Vec<f64> = taus.iter().map(|t| t * fs).collect();
     let factors = py.detach(|| filter.white_factors(&ms));
     Ok(factors.into_pyarray(py))

@@ -58,3 +58,13 @@ def test_white_term_is_drawn_through_the_filter():
 def test_bad_gains_name_the_problem(gain, words):
     with pytest.raises(ImunoiseValueError, match=re.escape(words)):
         core_fit.filter_factor(np.array([1.0]), 10.0, np.array(gain))
+
+
+@pytest.mark.parametrize("taus, fs, words", [([], 10.0, "must not be empty"),
+                                             ([0.0], 10.0, "taus must be finite and > 0"),
+                                             ([1.0], np.inf, "fs must be finite")])
+def test_bad_taus_and_rates_name_the_problem(taus, fs, words):
+    # the same checks as every model evaluation of the core (density_allan, allan_terms)
+    for call in (core_fit.filter_factor, core_fit.density_allan):
+        with pytest.raises(ImunoiseValueError, match=re.escape(words)):
+            call(np.array(taus, dtype=float), fs, np.array([1.0, 0.5]))
