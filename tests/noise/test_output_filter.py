@@ -182,6 +182,25 @@ def test_a_fast_gauss_markov_bias_is_no_filter():
     assert estimate_filter(imunoise.psd(x, FS)) is None
 
 
+def test_a_shelf_below_fs_2_is_no_filter():
+    """A fast Gauss–Markov term (τc 4 samples, its shoulder a decade below fs/2, at a
+    zero-frequency level 0.3 of the white) over white noise: the spectrum falls by a
+    quarter to a shelf, where an output filter would keep attenuating up to fs/2 (a
+    parked ring-laser gyro's vibration hump over its mount's motion had been taken
+    for a filter, and the fit then lost the motion)."""
+    rng = np.random.default_rng(8)
+    phi = math.exp(-1 / 4)
+    sigma = math.sqrt(0.3 * (1 - phi) / (1 + phi))
+    white = rng.standard_normal((360_000, 3))
+    hump = lfilter([1.0], [1.0, -phi], rng.standard_normal((360_000, 3)), axis=0)
+    s = imunoise.psd(white + sigma * math.sqrt(1 - phi**2) * hump, FS)
+    assert all(estimate_filter(s, c) is None for c in range(3))
+    # white noise through a first-order low-pass, which keeps falling: a filter
+    b, a = butter(1, 0.3)
+    s = imunoise.psd(lfilter(b, a, white, axis=0), FS)
+    assert all(estimate_filter(s, c) is not None for c in range(3))
+
+
 def test_no_filter_on_a_rising_quantization_floor():
     """Counted angles (quantization's f² above the white region) are no filter: an
     output filter attenuates; the rise is the Q term's."""

@@ -40,11 +40,12 @@ The estimate, per channel (:func:`estimate_filter`):
   in 1/20-decade bins above the middle of the white band, must fall below the white
   level by more than their χ²_ν/ν quantile (and the level's own uncertainty) at a
   one-sided 5 % shared over the bins tested (Bonferroni), and the top quarter decade
-  below fs/2 must lie lower than the spectrum around fs/20 (:func:`_falls_to_the_top`:
-  a roll-off that ends in a floor by fs/20 is a slow correlated process above white
-  noise, which the Gauss–Markov terms describe). White noise passes as "no filter"
-  95 % of the time whatever the record's length; so does a spectrum that only rises
-  above its white level (quantization's f², which the Q term describes).
+  below fs/2 must lie lower than each quarter decade from fs/20 up to it
+  (:func:`_falls_to_the_top`: a roll-off that has levelled to a shelf by then is a
+  correlated process above white noise, which the Gauss–Markov terms describe).
+  White noise passes as "no filter" 95 % of the time whatever the record's length;
+  so does a spectrum that only rises above its white level (quantization's f², which
+  the Q term describes).
 
 The white level's error is G's common factor above the middle of the band, and the fit's
 N follows it by half: on simulated FIR, CIC and Butterworth filters (1 h at 100 Hz) N from
@@ -367,21 +368,28 @@ def _attenuates(f, relative, edf, u_level) -> bool:
 
 def _falls_to_the_top(f, relative, edf, fs) -> bool:
     """Whether the spectrum over the white level is lower in the top quarter decade
-    below fs/2 than around fs/20 (within ±1/8 decade), one-sided at
-    :data:`FALSE_FILTER`: an output filter bounds the band below fs/2 and attenuates
-    most at its top. A spectrum that has fallen to a floor by fs/20 and stays there
-    is white noise above a slower correlated process (a Gauss–Markov bias whose
-    plateau the white fit took for the level), the model's own terms; fs/20 is where
-    the resonance search stops for the same reason (a slower shape spans more than 20
-    samples)."""
+    below fs/2 than in each quarter decade from fs/20 up to it, one-sided at
+    :data:`FALSE_FILTER` each: an output filter bounds the band below fs/2 and
+    attenuates most at its top (a low-pass of any order, a CIC's or an FIR's lobes:
+    their gain still falls over the last quarter decade). A spectrum that has
+    levelled to a shelf by then is white noise above a correlated process that has
+    faded (a Gauss–Markov bias whose plateau the white fit took for the level, a
+    fast one whose shoulder ends below fs/2), the model's own terms; fs/20 is where
+    the resonance search stops for the same reason (a slower shape spans more than
+    20 samples)."""
     top = f >= fs / 2 * 10**-0.25
-    ref = np.abs(np.log10(f / (fs / 20))) <= 0.125
-    if not top.any() or not ref.any():
+    if not top.any():
         return True
-    w_top, w_ref = edf[top] / edf[top].sum(), edf[ref] / edf[ref].sum()
-    drop = math.log(np.sum(w_top * relative[top]) / np.sum(w_ref * relative[ref]))
-    spread = math.sqrt(2 / edf[top].sum() + 2 / edf[ref].sum())
-    return drop < -_stats.norm.isf(FALSE_FILTER) * spread
+    level = np.sum(edf[top] * relative[top]) / edf[top].sum()
+    for k in (1, 2, 3):
+        ref = (f >= fs / 2 * 10 ** (-0.25 * (k + 1))) & (f < fs / 2 * 10 ** (-0.25 * k))
+        if not ref.any():
+            continue
+        drop = math.log(level / (np.sum(edf[ref] * relative[ref]) / edf[ref].sum()))
+        spread = math.sqrt(2 / edf[top].sum() + 2 / edf[ref].sum())
+        if drop >= -_stats.norm.isf(FALSE_FILTER) * spread:
+            return False
+    return True
 
 
 def _hann_bin_correlation(seg: int) -> np.ndarray:
