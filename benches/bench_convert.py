@@ -11,10 +11,16 @@ in 64 MiB pieces, the rows placed on the time grid and written, with the metadat
 data's fingerprint: ``OUT.npy`` + ``OUT.npy.meta.json`` by default, a directory of
 ``.npy`` with ``--layout dir``) and the floor: the parse, then the parser's table
 (``OUT.npy``'s bytes: as many rows of as many float64 values, in the parser's column
-order) written to a file in one ``write`` and flushed with ``fsync``, with no hash: what
-any writer of these rows must pay. Prints wall time, CPU time, throughput (MB/s of log)
-and peak RSS of each, and the ratios convert/parser and convert/floor (of throughput) per
-round, with the load average, as a Markdown table, then the medians of the run.
+order) written to ``OUT`` in one ``write`` and flushed with ``fsync``, with no hash: what
+any writer of these rows must pay. Each of convert and the floor first removes the
+output the one before it left. Before each timed process an untimed one fills 2.5 times
+the log's size of memory and exits: on a virtual machine, memory the guest has not used
+for a while can cost about 2 s of system time per GB at its first touch (the host backs
+it then), which would otherwise fall on whichever variant needs the most fresh memory
+(the floor: the parser's table and the output's page cache at once). Prints wall time,
+CPU time, throughput (MB/s of log) and peak RSS of each, and the ratios convert/parser
+and convert/floor (of throughput) per round, with the load average, as a Markdown table,
+then the medians of the run.
 
 ``--against DIR`` runs every round a second time with ``PYTHONPATH=DIR`` (another build's
 ``python/`` folder with its ``_core`` extension), alternating with this one, and labels
@@ -67,29 +73,40 @@ print(json.dumps({"wall": wall, "cpu": cpu, "rows": done.samples, "bytes": size,
 
 
 FLOOR = """
-import json, os, resource, sys, time
+import json, os, resource, shutil, sys, time
 from imunoise._core import vn
-out = sys.argv[2] + ".floor"
+out = sys.argv[2]
+shutil.rmtree(out, ignore_errors=True)
+for stale in (out, out + ".meta.json"):
+    try:
+        os.unlink(stale)
+    except (FileNotFoundError, IsADirectoryError):
+        pass
 c, t = time.process_time(), time.perf_counter()
 r = vn.parse_vn(sys.argv[1])
 table = max((cols for cols in r.tables.values()), key=lambda cols: len(next(iter(cols.values()))))
 first = next(iter(table.values()))
 rows = len(first)
 data = memoryview(first.base).cast("B")  # the parser's row-major table under its columns
-fd = os.open(out, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o644)
+fd = os.open(out, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o644)
 try:
-    header = b"\\x93NUMPY" + bytes(186)  # as long as convert's .npy header (12 fields)
-    os.write(fd, header)
+    os.write(fd, b"\\x93NUMPY" + bytes(186))  # as long as convert's .npy header (12 fields)
     while data:  # one write; the loop only for a system that writes less at once
         data = data[os.write(fd, data):]
     os.fsync(fd)
 finally:
     os.close(fd)
 wall, cpu = time.perf_counter() - t, time.process_time() - c
-size = os.stat(out).st_size
-os.unlink(out)
-print(json.dumps({"wall": wall, "cpu": cpu, "rows": rows, "bytes": size,
+print(json.dumps({"wall": wall, "cpu": cpu, "rows": rows, "bytes": os.stat(out).st_size,
                   "rss": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024}))
+"""
+
+
+WARM = """
+import sys
+import numpy as np
+np.empty(int(float(sys.argv[1])) // 8).fill(1.0)
+print("{}")
 """
 
 
@@ -100,6 +117,12 @@ def run(code: str, *args: str, path: str | None = None) -> dict:
     res = subprocess.run([sys.executable, "-c", textwrap.dedent(code), *args],
                          capture_output=True, text=True, check=True, env=env)
     return json.loads(res.stdout.strip().splitlines()[-1])
+
+
+def timed(code: str, *args: str, path: str | None, warm: float) -> dict:
+    """``run`` after an untimed process that filled ``warm`` bytes of memory."""
+    run(WARM, str(warm))
+    return run(code, *args, path=path)
 
 
 def main() -> None:
@@ -140,9 +163,9 @@ def main() -> None:
         for k in range(args.repeats):
             for name, path in builds.items():
                 load = os.getloadavg()[0]
-                p = run(PARSE, str(src), path=path)
-                c = run(CONVERT, str(src), str(out), path=path)
-                f = run(FLOOR, str(src), str(out), path=path)
+                p = timed(PARSE, str(src), path=path, warm=2.5 * size)
+                c = timed(CONVERT, str(src), str(out), path=path, warm=2.5 * size)
+                f = timed(FLOOR, str(src), str(out), path=path, warm=2.5 * size)
                 assert c["rows"] == p["rows"] == f["rows"], (c["rows"], p["rows"], f["rows"])
                 assert c["bytes"] in (None, f["bytes"]), (c["bytes"], f["bytes"])
                 mbs = [size / 1e6 / r["wall"] for r in (p, c, f)]
@@ -163,7 +186,7 @@ def main() -> None:
         print(f"load {os.getloadavg()[0]:.1f}")
     finally:
         shutil.rmtree(out, ignore_errors=True)
-        for stale in (out, Path(f"{out}.meta.json"), Path(f"{out}.floor")):
+        for stale in (out, Path(f"{out}.meta.json")):
             if stale.is_file():
                 stale.unlink()
         if not args.log and not args.keep:
