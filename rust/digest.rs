@@ -1,14 +1,20 @@
 //! The fingerprint of a file's content (what convert's metadata records to tie
 //! itself to the data it describes): size, modification time and BLAKE3 digest.
 //!
-//! The file is mapped and hashed in blocks of [`BLOCK_BYTES`], each by every
-//! thread of the pool (BLAKE3's tree splits one block across threads), with the
-//! interrupt checked between blocks. Cost: O(bytes) reads of the page cache, no
-//! copy; memory: the mapping only.
+//! [`fingerprint`] maps a file and hashes it in blocks of [`BLOCK_BYTES`], each by
+//! every thread of the pool (BLAKE3's tree splits one block across threads), with
+//! the interrupt checked between blocks. Cost: O(bytes) reads of the page cache, no
+//! copy; memory: the mapping only. [`HeadLast`] hashes a file as it is written
+//! whose first bytes (a header) are known only at the end.
 
 use std::fs::File;
 use std::path::Path;
 use std::time::{SystemTime, UNIX_EPOCH};
+
+use blake3::hazmat::{
+    merge_subtrees_non_root, merge_subtrees_root, ChainingValue, HasherExt, Mode,
+};
+use blake3::{Hasher, CHUNK_LEN};
 
 use crate::error::{CoreError, CoreResult};
 use crate::interrupt::Interrupt;
@@ -78,6 +84,100 @@ pub fn fingerprint(path: &Path, stop: &Interrupt) -> CoreResult<Fingerprint> {
         mtime_ns: nanos_since_epoch(mtime),
         blake3: hasher.finalize().to_hex().to_string(),
     })
+}
+
+/// The BLAKE3 digest of a file of a head of `head` bytes, written last, and a body
+/// appended in order: the body is hashed as it comes, the head at [`HeadLast::finish`].
+///
+/// BLAKE3's tree over 1 KiB chunks: the head lies in the first `lead` chunks (a
+/// power of two), whose bytes are kept; each following span of chunks
+/// `[lead·2^k, lead·2^(k+1))` is a subtree of the whole file's tree whatever its
+/// final length (the last one, possibly short, the root's right child), hashed by
+/// a hasher of its own. Memory: the first `lead` chunks.
+pub struct HeadLast {
+    head: usize,
+    /// The file's first `lead * CHUNK_LEN` bytes: the head's zeros, then the body.
+    first: Vec<u8>,
+    lead: u64,
+    /// Chaining values of the finished spans, in order.
+    spans: Vec<ChainingValue>,
+    /// The span being filled: its hasher and the file offset where it ends.
+    current: Option<(Hasher, u64)>,
+    /// Bytes of the file so far, head included.
+    len: u64,
+}
+
+impl HeadLast {
+    /// A hasher of a file whose first `head` bytes come at [`HeadLast::finish`].
+    pub fn new(head: usize) -> HeadLast {
+        let lead = (head.div_ceil(CHUNK_LEN).max(1)).next_power_of_two() as u64;
+        let mut first = Vec::with_capacity(lead as usize * CHUNK_LEN);
+        first.resize(head, 0);
+        HeadLast {
+            head,
+            first,
+            lead,
+            spans: Vec::new(),
+            current: None,
+            len: head as u64,
+        }
+    }
+
+    /// Hash the next `body` bytes of the file.
+    pub fn update(&mut self, mut body: &[u8]) {
+        let lead_bytes = self.lead * CHUNK_LEN as u64;
+        while !body.is_empty() {
+            let n = if self.len < lead_bytes {
+                let n = body.len().min((lead_bytes - self.len) as usize);
+                self.first.extend_from_slice(&body[..n]);
+                n
+            } else {
+                // a span starts only when bytes come for it: the last one is never empty
+                if matches!(self.current, Some((_, end)) if end == self.len) {
+                    let (done, _) = self.current.take().expect("matched");
+                    self.spans.push(done.finalize_non_root());
+                }
+                let (hasher, end) = self.current.get_or_insert_with(|| {
+                    let mut hasher = Hasher::new();
+                    hasher.set_input_offset(self.len);
+                    (hasher, 2 * self.len)
+                });
+                let n = body.len().min((*end - self.len) as usize);
+                hasher.update(&body[..n]);
+                n
+            };
+            self.len += n as u64;
+            body = &body[n..];
+        }
+    }
+
+    /// The digest of the whole file, `head` being its first bytes; an error
+    /// unless `head` has the length given to [`HeadLast::new`].
+    pub fn finish(&self, head: &[u8]) -> CoreResult<blake3::Hash> {
+        if head.len() != self.head {
+            return Err(CoreError::InvalidArgument(format!(
+                "the head must have the {} bytes announced; got {}",
+                self.head,
+                head.len()
+            )));
+        }
+        let mut lead = Hasher::new();
+        lead.update(head).update(&self.first[self.head..]);
+        let Some((last, _)) = &self.current else {
+            return Ok(lead.finalize()); // the whole file lies in the first chunks
+        };
+        let left = self
+            .spans
+            .iter()
+            .fold(lead.finalize_non_root(), |left, span| {
+                merge_subtrees_non_root(&left, span, Mode::Hash)
+            });
+        Ok(merge_subtrees_root(
+            &left,
+            &last.finalize_non_root(),
+            Mode::Hash,
+        ))
+    }
 }
 
 #[cfg(test)]
@@ -166,5 +266,36 @@ mod tests {
             fingerprint_of(b"x", "stop", &stop),
             Err(CoreError::Interrupted)
         );
+    }
+
+    #[test]
+    fn a_head_written_last_gives_the_whole_files_digest() {
+        // lengths about each boundary of the tree: chunks, lead, spans of 2^k chunks
+        let heads = [0, 1, 192, 1023, 1024, 1500, 2049, 5000];
+        let mut lengths = vec![0, 1, 1000];
+        for k in 0..8 {
+            let b = CHUNK_LEN << k;
+            lengths.extend([b - 1, b, b + 1, b + 1000]);
+        }
+        lengths.push(3 * (CHUNK_LEN << 8) + 17);
+        let file = pattern(lengths.iter().max().unwrap() + heads.iter().max().unwrap());
+        for head in heads {
+            for &body in &lengths {
+                let whole = &file[..head + body];
+                for piece in [1, 333, 4096, usize::MAX] {
+                    let mut h = HeadLast::new(head);
+                    for part in whole[head..].chunks(piece.min(body.max(1))) {
+                        h.update(part);
+                    }
+                    let got = h.finish(&whole[..head]).unwrap();
+                    assert_eq!(
+                        got,
+                        blake3::hash(whole),
+                        "head {head}, body {body}, pieces {piece}"
+                    );
+                }
+            }
+        }
+        assert!(HeadLast::new(3).finish(b"ab").is_err());
     }
 }

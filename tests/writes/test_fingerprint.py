@@ -1,6 +1,7 @@
 """The data's fingerprint in metadata: bytes, modification time and a BLAKE3 digest
-hashed by the core; metadata written by earlier versions carries a SHA-256 instead
-and still verifies. Either digest refuses changed data; a malformed fingerprint
+hashed by the core (by convert while it writes the rows, the header joining at the
+end); metadata written by earlier versions carries a SHA-256 instead and still
+verifies. Either digest refuses changed data; a malformed fingerprint
 is an error naming the field."""
 
 import hashlib
@@ -67,6 +68,23 @@ def _converted(tmp_path: Path, digest: str) -> Path:
         meta["data"]["sha256"] = hashlib.sha256(out.read_bytes()).hexdigest()
         side.write_text(json.dumps(meta))
     return out
+
+
+@pytest.mark.parametrize("layout", [".npy", "dir"])
+def test_the_digest_convert_hashes_while_writing_is_the_files(layout, tmp_path):
+    src = tmp_path / "src.txt"
+    src.write_bytes((DATA / "rugged_0513test.txt").read_bytes())
+    out = tmp_path / ("log.npy" if layout == ".npy" else "log")
+    assert main(["convert", str(src), "-o", str(out), "--fs", "40", "--no-progress"]) == 0
+    if layout == ".npy":
+        marks = {out: json.loads(metafile.meta_path(out).read_text())["data"]}
+    else:
+        ties = json.loads((out / "meta.json").read_text())["data"]
+        marks = {out / name: mark for name, mark in ties.items()}
+    assert len(marks) >= (1 if layout == ".npy" else 4)
+    for path, mark in marks.items():
+        assert path.stat().st_size > 2048  # spans past the header's first chunk
+        assert mark == _atomic.fingerprint(path)
 
 
 @pytest.mark.parametrize(("digest", "name"), [("blake3", "BLAKE3"), ("sha256", "SHA-256")])

@@ -44,6 +44,7 @@ __all__ = [
     "TEMP_TAG",
     "exchange_dir",
     "fingerprint",
+    "hashed_fingerprint",
     "publish_pair",
     "refuse_input",
     "remove_stale",
@@ -261,6 +262,14 @@ def fingerprint(path) -> dict:
     return {"bytes": size, "mtime_ns": mtime_ns, "blake3": digest}
 
 
+def hashed_fingerprint(path, blake3: str) -> dict:
+    """:func:`fingerprint` of the file at ``path`` whose BLAKE3 digest ``blake3`` its
+    writer computed from the bytes it wrote (the data is not read again); size and
+    time are the file's now."""
+    st = os.stat(path)
+    return {"bytes": st.st_size, "mtime_ns": st.st_mtime_ns, "blake3": blake3}
+
+
 def _sha256(path) -> str:
     """The SHA-256 of the file at ``path`` (the digest earlier versions wrote)."""
     digest = hashlib.sha256()
@@ -315,13 +324,16 @@ def _directory_lock(directory: Path) -> Iterator[None]:
         os.close(fd)  # releases the lock
 
 
-def publish_pair(tmp, target, meta_of, meta_target) -> tuple[Path, Path]:
+def publish_pair(tmp, target, meta_of, meta_target, *, mark: dict | None = None
+                 ) -> tuple[Path, Path]:
     """Publish the finished temporary ``tmp`` as ``target`` with its metadata.
 
     ``meta_of(fingerprint)`` gives the metadata's text, which must carry the
-    fingerprint of the data (see the module docstring); the metadata is written to
-    its own temporary first, then both are renamed, data first, holding the
-    directory's lock. On an exception both temporaries are removed."""
+    fingerprint of the data (see the module docstring): ``mark`` when its writer
+    hashed it (:func:`hashed_fingerprint`), else :func:`synced_fingerprint`'s. The
+    metadata is written to its own temporary first, then both are renamed, data
+    first, holding the directory's lock. On an exception both temporaries are
+    removed."""
     tmp, target, meta_target = Path(tmp), Path(target), Path(meta_target)
     temporaries = [tmp]
 
@@ -333,7 +345,10 @@ def publish_pair(tmp, target, meta_of, meta_target) -> tuple[Path, Path]:
     # below (the fsync beside the hash can be slow): it removes the temporaries then.
     with _interrupt.undo_on_exit(discard):
         try:
-            mark = synced_fingerprint(tmp)
+            if mark is None:
+                mark = synced_fingerprint(tmp)
+            else:
+                sync(tmp)
             _keep_mode(tmp, target)
             text = meta_of(mark)
             meta_tmp = temporary_beside(meta_target)
