@@ -5,6 +5,7 @@
 //! the only place that knows pyo3 and numpy.
 
 pub mod allan;
+pub mod digest;
 pub mod error;
 pub mod fit;
 pub mod interrupt;

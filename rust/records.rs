@@ -5,13 +5,16 @@
 //! Each record is the concatenation of one row of every [`Columns`] block (a
 //! strided view of a matrix, e.g. three adjacent columns of the parser's
 //! row-major table): rows are gathered into a buffer of [`GATHER_BYTES`] that stays
-//! in cache and written from it, so a piece's rows reach the file in one copy.
+//! in cache and written from it, so a piece's rows reach the file in one copy,
+//! and hashed from it too ([`HeadLast`]: the file's BLAKE3 digest, the header
+//! joining it at the end), so the data need not be read again for the digest.
 //! Cost: O(values appended); memory: the buffer.
 
 use std::fs::File;
 use std::io::Write;
 use std::path::Path;
 
+use crate::digest::HeadLast;
 use crate::error::{CoreError, CoreResult};
 
 /// Bytes gathered before each write (a cache-sized buffer: larger ones only add
@@ -99,6 +102,7 @@ pub struct RecordFile {
     width: usize,
     rows: u64,
     buffer: Vec<u8>,
+    digest: HeadLast,
 }
 
 fn io_error(path: &Path, what: &str, e: std::io::Error) -> CoreError {
@@ -109,8 +113,8 @@ fn io_error(path: &Path, what: &str, e: std::io::Error) -> CoreError {
 }
 
 impl RecordFile {
-    /// Opens `path` (which must exist: the caller wrote its header) to append
-    /// records of `width` values.
+    /// Opens `path` (which must exist: the caller wrote its header, whose length
+    /// [`RecordFile::digest`] expects again) to append records of `width` values.
     pub fn append_to(path: &Path, width: usize) -> CoreResult<RecordFile> {
         if width == 0 {
             return Err(CoreError::InvalidArgument(
@@ -121,11 +125,19 @@ impl RecordFile {
             .append(true)
             .open(path)
             .map_err(|e| io_error(path, "open", e))?;
+        let head = file
+            .metadata()
+            .map_err(|e| io_error(path, "stat", e))?
+            .len();
+        let head = usize::try_from(head).map_err(|_| {
+            CoreError::InvalidArgument(format!("{} has a header of {head} bytes", path.display()))
+        })?;
         Ok(RecordFile {
             file,
             width,
             rows: 0,
             buffer: Vec::with_capacity(GATHER_BYTES),
+            digest: HeadLast::new(head),
         })
     }
 
@@ -164,10 +176,17 @@ impl RecordFile {
                     kind: e.kind(),
                     message: format!("cannot write records: {e}"),
                 })?;
+            self.digest.update(&self.buffer);
             r = end;
         }
         self.rows += rows as u64;
         Ok(())
+    }
+
+    /// The BLAKE3 digest of the file: `head`, which must be as long as the header
+    /// was at opening (the caller rewrites it in place), then every record.
+    pub fn digest(&self, head: &[u8]) -> CoreResult<blake3::Hash> {
+        self.digest.finish(head)
     }
 
     /// Start writing the bytes appended so far to disk, without waiting: the
@@ -206,8 +225,10 @@ mod tests {
         f.append(&[tail, first]).unwrap();
         assert_eq!(f.rows(), 8);
         f.start_writeback();
+        let digest = f.digest(b"HEAD").unwrap();
         drop(f);
         let bytes = std::fs::read(&dir).unwrap();
+        assert_eq!(digest, blake3::hash(&bytes));
         std::fs::remove_file(&dir).unwrap();
         assert_eq!(&bytes[..4], b"HEAD");
         let got: Vec<f64> = bytes[4..]

@@ -1,8 +1,8 @@
 //! The pyo3 binding layer: borrows numpy arrays, releases the GIL around every
 //! O(n) kernel, calls the pure core and converts `CoreError` into Python
 //! exceptions. One file per concern, each a submodule of `_core` with the same
-//! name (`_core.allan`, `_core.vn`, `_core.fit`, `_core.records`), so the Python side mirrors this
-//! folder.
+//! name (`_core.allan`, `_core.vn`, `_core.fit`, `_core.records`,
+//! `_core.digest`), so the Python side mirrors this folder.
 
 use pyo3::exceptions::{
     PyFileNotFoundError, PyKeyboardInterrupt, PyOSError, PyPermissionError, PyTypeError,
@@ -14,6 +14,7 @@ use pyo3::types::PyDict;
 use crate::error::CoreError;
 
 mod allan;
+mod digest;
 mod fit;
 mod interrupt;
 mod records;
@@ -141,5 +142,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     add_submodule(m, "fit", fit::register)?;
     add_submodule(m, "simd", simd::register)?;
     add_submodule(m, "records", records::register)?;
+    add_submodule(m, "digest", digest::register)?;
     Ok(())
 }

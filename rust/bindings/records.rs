@@ -92,6 +92,16 @@ impl RecordFile {
         self.file.as_ref().map_or(0, |f| f.rows())
     }
 
+    /// The file's BLAKE3 digest (64 hex digits) with `head` as its first bytes
+    /// (the header, as long as when the file was opened), then the records.
+    fn digest(&self, head: &[u8]) -> PyResult<String> {
+        let file = self
+            .file
+            .as_ref()
+            .ok_or_else(|| super::value_error("RecordFile is closed"))?;
+        Ok(file.digest(head)?.to_hex().to_string())
+    }
+
     /// Close the file (every append is already written to it).
     fn close(&mut self) {
         self.file = None;

@@ -14,6 +14,9 @@ class RecordFile:
     def __new__(cls, path: str | os.PathLike[str], width: int) -> RecordFile: ...
     def append(self, arrays: list[npt.NDArray[np.float64]]) -> None:
         """Append one record per row: row r of every array in ``arrays``, in order."""
+    def digest(self, head: bytes) -> str:
+        """The file's BLAKE3 digest (64 hex digits) with ``head`` as its first bytes
+        (the header, as long as when the file was opened), then the records."""
     @property
     def rows(self) -> int:
         """Rows appended so far."""

@@ -13,7 +13,7 @@ A replaced file keeps its permission bits; a new file gets the umask's (as
 
 A data file and its metadata file (:func:`publish_pair`) cannot be renamed in one
 step, so the metadata carries the data's :func:`fingerprint` (bytes, modification
-time, SHA-256) and readers refuse metadata whose fingerprint is not the file's: a
+time, BLAKE3 digest) and readers refuse metadata whose fingerprint is not the file's: a
 kill between the two renames leaves the new data beside the old metadata, which
 no reader takes for a pair. The two renames are made holding a lock on the
 directory, so two writers of one output publish their pairs one after the other,
@@ -36,6 +36,7 @@ from collections.abc import Iterable, Iterator
 from pathlib import Path
 from typing import BinaryIO
 
+from imunoise._core import digest as _core_digest
 from imunoise._support import interrupt as _interrupt
 from imunoise.errors import DataWarning, ImunoiseValueError
 
@@ -43,6 +44,7 @@ __all__ = [
     "TEMP_TAG",
     "exchange_dir",
     "fingerprint",
+    "hashed_fingerprint",
     "publish_pair",
     "refuse_input",
     "remove_stale",
@@ -248,20 +250,34 @@ def staged(target, *, inputs: Iterable = ()) -> Iterator[tuple[BinaryIO, Path]]:
             raise
 
 
-#: Bytes hashed at a time by :func:`fingerprint` (bounds the memory it needs).
+#: Bytes hashed at a time by :func:`_sha256` (bounds the memory it needs).
 _HASH_BLOCK = 1 << 22
 
 
 def fingerprint(path) -> dict:
     """What identifies the content of the file at ``path``: ``{"bytes", "mtime_ns",
-    "sha256"}`` (JSON-able). A rename keeps all three; a copy keeps bytes and digest."""
+    "blake3"}`` (JSON-able; the digest is hashed by the core on every thread). A
+    rename keeps all three; a copy keeps bytes and digest."""
+    size, mtime_ns, digest = _core_digest.fingerprint(path)
+    return {"bytes": size, "mtime_ns": mtime_ns, "blake3": digest}
+
+
+def hashed_fingerprint(path, blake3: str) -> dict:
+    """:func:`fingerprint` of the file at ``path`` whose BLAKE3 digest ``blake3`` its
+    writer computed from the bytes it wrote (the data is not read again); size and
+    time are the file's now."""
+    st = os.stat(path)
+    return {"bytes": st.st_size, "mtime_ns": st.st_mtime_ns, "blake3": blake3}
+
+
+def _sha256(path) -> str:
+    """The SHA-256 of the file at ``path`` (the digest earlier versions wrote)."""
     digest = hashlib.sha256()
     block = bytearray(_HASH_BLOCK)  # one buffer read into: fresh bytes per read page-fault
     with open(path, "rb") as f, memoryview(block) as view:
-        st = os.fstat(f.fileno())
         while got := f.readinto(block):
             digest.update(view[:got])
-    return {"bytes": st.st_size, "mtime_ns": st.st_mtime_ns, "sha256": digest.hexdigest()}
+    return digest.hexdigest()
 
 
 def synced_fingerprint(path) -> dict:
@@ -280,13 +296,16 @@ def synced_fingerprint(path) -> dict:
 def same_content(path, mark: dict) -> bool:
     """True when the file at ``path`` is the one :func:`fingerprint` described as
     ``mark``: same size, and the same modification time (the fast path: the file
-    was not rewritten since) or, after a copy, the same SHA-256."""
+    was not rewritten since) or, after a copy, the same digest: ``mark``'s
+    ``"blake3"``, or the ``"sha256"`` that earlier versions wrote instead."""
     st = os.stat(path)
     if st.st_size != mark["bytes"]:
         return False
     if st.st_mtime_ns == mark["mtime_ns"]:
         return True
-    return fingerprint(path)["sha256"] == mark["sha256"]
+    if "blake3" in mark:
+        return fingerprint(path)["blake3"] == mark["blake3"]
+    return _sha256(path) == mark["sha256"]
 
 
 @contextlib.contextmanager
@@ -305,13 +324,16 @@ def _directory_lock(directory: Path) -> Iterator[None]:
         os.close(fd)  # releases the lock
 
 
-def publish_pair(tmp, target, meta_of, meta_target) -> tuple[Path, Path]:
+def publish_pair(tmp, target, meta_of, meta_target, *, mark: dict | None = None
+                 ) -> tuple[Path, Path]:
     """Publish the finished temporary ``tmp`` as ``target`` with its metadata.
 
     ``meta_of(fingerprint)`` gives the metadata's text, which must carry the
-    fingerprint of the data (see the module docstring); the metadata is written to
-    its own temporary first, then both are renamed, data first, holding the
-    directory's lock. On an exception both temporaries are removed."""
+    fingerprint of the data (see the module docstring): ``mark`` when its writer
+    hashed it (:func:`hashed_fingerprint`), else :func:`synced_fingerprint`'s. The
+    metadata is written to its own temporary first, then both are renamed, data
+    first, holding the directory's lock. On an exception both temporaries are
+    removed."""
     tmp, target, meta_target = Path(tmp), Path(target), Path(meta_target)
     temporaries = [tmp]
 
@@ -323,7 +345,10 @@ def publish_pair(tmp, target, meta_of, meta_target) -> tuple[Path, Path]:
     # below (the fsync beside the hash can be slow): it removes the temporaries then.
     with _interrupt.undo_on_exit(discard):
         try:
-            mark = synced_fingerprint(tmp)
+            if mark is None:
+                mark = synced_fingerprint(tmp)
+            else:
+                sync(tmp)
             _keep_mode(tmp, target)
             text = meta_of(mark)
             meta_tmp = temporary_beside(meta_target)

@@ -18,9 +18,9 @@ most :data:`MAX_DEPTH` levels deep. Every fault is a
 the field (:func:`bad_field`).
 
 Tied to the data: what ``convert`` writes beside a file carries the file's
-fingerprint (``"data"``: bytes, modification time, SHA-256; see
-:func:`imunoise._support.atomic.publish_pair`); :func:`check_tie` refuses metadata whose
-fingerprint is not that of the file beside it.
+fingerprint (``"data"``: bytes, modification time and a digest, BLAKE3, or SHA-256
+in what earlier versions wrote; see :func:`imunoise._support.atomic.publish_pair`);
+:func:`check_tie` refuses metadata whose fingerprint is not that of the file beside it.
 """
 
 from __future__ import annotations
@@ -34,9 +34,9 @@ from pathlib import Path
 from imunoise._support import atomic as _atomic
 from imunoise.errors import ImunoiseValueError, ParseError
 
-__all__ = ["MAX_BYTES", "MAX_COUNT", "MAX_DEPTH", "MAX_FS", "SUFFIX", "bad_field", "check_tie",
-           "count", "legacy_path", "load", "meta_path", "parse", "rate", "shown", "tie_errors",
-           "tie_fields"]
+__all__ = ["DIGESTS", "MAX_BYTES", "MAX_COUNT", "MAX_DEPTH", "MAX_FS", "SUFFIX", "bad_field",
+           "check_tie", "count", "legacy_path", "load", "meta_path", "parse", "rate", "shown",
+           "tie_errors", "tie_fields"]
 
 #: Suffix of a metadata file: ``F.meta.json`` describes ``F``.
 SUFFIX = ".meta.json"
@@ -166,18 +166,27 @@ def shown(value) -> str:
     return text if len(text) <= 60 else text[:57] + "..."
 
 
+#: The digests a fingerprint may carry, each 64 hex digits, and their names in
+#: errors: BLAKE3 is written; SHA-256 is what earlier versions wrote.
+DIGESTS = {"blake3": "BLAKE3", "sha256": "SHA-256"}
+
+
 def tie_fields(tie, where) -> dict:
-    """``tie`` if it is a fingerprint (``{"bytes", "mtime_ns", "sha256"}``), else a
-    :class:`ParseError` naming the field of ``where``."""
+    """``tie`` if it is a fingerprint (``bytes``, ``mtime_ns`` and exactly one of the
+    :data:`DIGESTS`), else a :class:`ParseError` naming the field of ``where``."""
     if not isinstance(tie, dict):
-        raise bad_field(where, "data", f"must be an object (bytes, mtime_ns, sha256); got "
+        raise bad_field(where, "data", f"must be an object (bytes, mtime_ns, blake3); got "
                         f"{shown(tie)}")
     for key in ("bytes", "mtime_ns"):
         count(tie.get(key), where, f"data.{key}")
-    digest = tie.get("sha256")
+    keys = [key for key in DIGESTS if key in tie]
+    if len(keys) != 1:
+        raise bad_field(where, "data", "must carry exactly one digest, 'blake3' or 'sha256'; "
+                        f"got {' and '.join(map(repr, keys)) or 'neither'}")
+    digest = tie[keys[0]]
     if not (isinstance(digest, str) and len(digest) == 64
             and all(c in "0123456789abcdef" for c in digest)):
-        raise bad_field(where, "data.sha256", f"must be 64 hex digits; got {shown(digest)}")
+        raise bad_field(where, f"data.{keys[0]}", f"must be 64 hex digits; got {shown(digest)}")
     return tie
 
 
@@ -188,9 +197,10 @@ def tie_errors(tie, data: Path, where) -> str | None:
     if _atomic.same_content(data, tie):
         return None
     size = os.stat(data).st_size
-    return (f"{where} describes {tie['bytes']} bytes with SHA-256 {tie['sha256'][:12]}... but "
-            f"{data} ({size} bytes) is other data: the file was replaced without its metadata "
-            "(an interrupted or concurrent write, or an edit)")
+    key = next(k for k in DIGESTS if k in tie)
+    return (f"{where} describes {tie['bytes']} bytes with {DIGESTS[key]} {tie[key][:12]}... "
+            f"but {data} ({size} bytes) is other data: the file was replaced without its "
+            "metadata (an interrupted or concurrent write, or an edit)")
 
 
 def check_tie(tie, data: Path, where) -> None:

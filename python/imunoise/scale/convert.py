@@ -36,6 +36,7 @@ the same way (so a log of one piece converts to exactly what ``read`` gives).
 
 from __future__ import annotations
 
+import io
 import json
 import os
 import shutil
@@ -146,8 +147,9 @@ class _NpyAppender:
     The header is written first for zero rows and rewritten in place at the end
     (numpy reserves room in the header for any row count, so its length does
     not change). The rows go from the arrays given (views of the parser's
-    tables) straight into the file, gathered and written by the core with the
-    GIL released (:class:`imunoise._core.records.RecordFile`).
+    tables) straight into the file, gathered, written and hashed by the core with
+    the GIL released (:class:`imunoise._core.records.RecordFile`); :meth:`close`
+    gives the file's fingerprint, the final header hashed with them.
     """
 
     def __init__(self, path: Path, dtype: np.dtype, row_shape: tuple[int, ...]):
@@ -182,16 +184,18 @@ class _NpyAppender:
             arrays.append(a)
         self.records.append(arrays)
 
-    def close(self) -> None:
-        if self.records is None:
-            return
-        rows = self.records.rows
+    def close(self) -> dict:
+        """Write the final header; returns the file's fingerprint."""
+        head = io.BytesIO()
+        self._header(head, self.records.rows)
+        if head.tell() != self.data_start:  # pragma: no cover - numpy guarantees room
+            raise OSError(f"{self.path}: the .npy header grew when rewritten")
+        digest = self.records.digest(head.getvalue())
         self.records.close()
         self.records = None
         with open(self.path, "r+b") as f:
-            self._header(f, rows)
-            if f.tell() != self.data_start:  # pragma: no cover - numpy guarantees room
-                raise OSError(f"{self.path}: the .npy header grew when rewritten")
+            f.write(head.getvalue())
+        return _atomic.hashed_fingerprint(self.path, digest)
 
 
 class _Sink:
@@ -235,16 +239,13 @@ class _DirSink(_Sink):
         self.rows += len(cols[self.channels[0]])
 
     def close(self, meta):
-        for f in self.files.values():
-            f.close()
+        self.marks = {f"{ch}.npy": f.close() for ch, f in self.files.items()}
 
     def publish(self, out, meta):
         # each channel file's fingerprint: a directory whose files were replaced one
         # by one (below) and interrupted is refused by the reader, not mixed
-        ties = {f"{ch}.npy": _atomic.synced_fingerprint(self.staging / f"{ch}.npy")
-                for ch in self.channels}
         _atomic.write_text(self.staging / "meta.json",
-                           json.dumps({**meta, "data": ties}, indent=1))
+                           json.dumps({**meta, "data": self.marks}, indent=1))
         _atomic.sync(self.staging)
         names = [f"{ch}.npy" for ch in self.channels] + ["meta.json"]
         if not out.exists():
@@ -288,12 +289,13 @@ class _NpySink(_Sink):
         self.rows += len(cols[self.channels[0]])
 
     def close(self, meta):
-        self.file.close()
+        self.mark = self.file.close()
 
     def publish(self, out, meta):
         meta_file = metafile.meta_path(out)
         _atomic.publish_pair(self.staging, out,
-                             lambda tie: json.dumps({**meta, "data": tie}, indent=1), meta_file)
+                             lambda tie: json.dumps({**meta, "data": tie}, indent=1), meta_file,
+                             mark=self.mark)
         return [out, meta_file]
 
 
