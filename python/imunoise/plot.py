@@ -679,6 +679,12 @@ def allan(
                     rocking = np.where(curves["motion"] > 0, curves["motion"], np.nan)
                     ax.plot(grid, rocking, color="tab:brown", linewidth=0.9, linestyle="-.",
                             label="bounded motion (mount)")
+                drawn = {*TERM_STYLES, "GM1", "GM2", "GM3", "sine", "resonance", "motion",
+                         "total"}
+                for name in (n for n in curves if n not in drawn):  # a kind named by its curve
+                    if np.any(curves[name] > 0):
+                        ax.plot(grid, np.where(curves[name] > 0, curves[name], np.nan),
+                                color="0.3", linewidth=0.9, linestyle=(0, (2, 2)), label=name)
                 if marks.get("N", 0.0) > 0:
                     ax.plot([1.0], [marks["N"]], marker="s", color="crimson", ms=5,
                             linestyle="none", label="N at τ=1 s")

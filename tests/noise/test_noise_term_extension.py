@@ -121,3 +121,22 @@ def test_every_kind_writes_and_exports_through_its_class(white, monkeypatch):
     axis = export.ekf_dict(gyro=model)["gyroscope"]["axes"]["ch0"]
     assert axis["white_noise_density"] == pytest.approx(math.sqrt(5.0))
     assert axis["gauss_markov"] == []
+
+
+def test_predict_and_the_allan_panel_name_each_curve_by_its_class(monkeypatch):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import numpy as np
+
+    x = imunoise.simulate(200_000, FS, N=1e-3, gm=[(2e-3, 20.0)], seed=3)
+    r = imunoise.adev(x, FS, taus=10)
+    model = imunoise.fit(r, terms=["N", "GM"], warn_coverage=False)
+    monkeypatch.setattr(noise.GaussMarkov, "curve", lambda self, index: f"wander {index}")
+    pred = model.predict()
+    assert "wander 0" in pred.terms and "GM1" not in pred.terms
+    np.testing.assert_allclose(pred.terms["wander 0"] ** 2 + pred.terms["N"] ** 2,
+                               pred.dev**2, rtol=1e-12)
+    fig = model.plot(r)
+    labels = [line.get_label() for ax in fig.axes for line in ax.get_lines()]
+    assert "wander 0" in labels

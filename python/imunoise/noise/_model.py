@@ -4,7 +4,7 @@ exports, with the fitted components behind them under one name."""
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import asdict, dataclass, field, replace
+from dataclasses import asdict, dataclass, field
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -17,6 +17,7 @@ from imunoise._support import summary as _summary
 from imunoise._support import warn as _warn
 from imunoise._support.deprecation import old_call_forms
 from imunoise.errors import ImunoiseDeprecationWarning, ImunoiseValueError
+from imunoise.noise import _typed
 from imunoise.noise._ambiguity import Tie
 from imunoise.noise._components import (
     Components,
@@ -182,22 +183,35 @@ class NoiseModel(PerTerm):
         ``terms["resonance"]`` for the resonance and ``terms["motion"]`` for a
         bounded motion (when a channel has one).
         """
-        pred = self._arrays.predict(self.taus if taus is None else taus)
-        if not any(f is not None for f in self.filter):
-            return pred
-        # The white term through each channel's output filter, and the filter's
-        # share of the spectrum's flicker and walk, which pass it too.
-        t = np.asarray(pred.taus, dtype=float)
-        dev = np.array(pred.dev, dtype=float, ndmin=2).reshape(t.size, -1)
-        white = np.array(pred.terms["N"], dtype=float).reshape(t.size, -1)
-        for c, found in enumerate(self.filter):
+        t = np.asarray(self.taus if taus is None else taus, dtype=float)
+        if t.ndim != 1 or t.size == 0 or not np.all(np.isfinite(t)) or np.any(t <= 0):
+            raise ImunoiseValueError(
+                f"taus must be a non-empty 1-D array of finite values > 0; got {t!r}")
+        channels = len(self.terms)
+        curves = {name: np.zeros((t.size, channels)) for name in TERMS}
+        kinds = list(_typed.KINDS)
+        rank = {name: (kinds.index(_typed.IEEE[name].kind), name) for name in TERMS}
+        total = np.zeros((t.size, channels))
+        for c, terms in enumerate(self.terms):
+            var = _typed.allan_variances(terms, t, self.fs)
+            seen: dict[str, int] = {}
+            for k, term in enumerate(terms):
+                index = seen[term.kind] = seen.get(term.kind, -1) + 1
+                name = term.curve(index)
+                rank.setdefault(name, (kinds.index(term.kind), name))
+                curves.setdefault(name, np.zeros((t.size, channels)))[:, c] += var[:, k]
+            found = self.filter[c]
             if found is not None:
-                extra = white[:, c] ** 2 * (found.factor(t) - 1.0) + found.excess(t)
-                dev[:, c] = np.sqrt(np.maximum(dev[:, c] ** 2 + extra, 0.0))
-                white[:, c] *= np.sqrt(found.factor(t))
-        shape = np.shape(pred.dev)
-        return replace(pred, dev=dev.reshape(shape),
-                       terms={**pred.terms, "N": white.reshape(shape)})
+                # The white term through the channel's output filter, and the filter's
+                # share of the spectrum's flicker and walk, which pass it too.
+                curves["N"][:, c] *= found.factor(t)
+                total[:, c] += found.excess(t)
+        total = np.sqrt(np.maximum(total + sum(curves.values()), 0.0))
+        ordered = sorted(curves, key=rank.__getitem__)
+        if self.one_channel:
+            return Prediction(taus=t, dev=total[:, 0],
+                              terms={k: np.sqrt(curves[k][:, 0]) for k in ordered})
+        return Prediction(taus=t, dev=total, terms={k: np.sqrt(curves[k]) for k in ordered})
 
     def floor(self, channel: int = 0) -> tuple[float, float] | None:
         """(τ, σ(τ)) of the model's floor over the fitted taus, where ``B`` is read

@@ -68,6 +68,12 @@ class Term:
         """The term in a structure's words: ``"N"``, ``"GM(0.05 s)"``, ``"tone 13.4 Hz"``."""
         raise NotImplementedError
 
+    def curve(self, index: int) -> str:
+        """The name of this term's curve in :meth:`NoiseModel.predict`, ``index`` its
+        place among its channel's terms of the same kind (terms that share a name are
+        drawn as one curve): its kind's name."""
+        return self.kind
+
     def sample(self, n: int, fs: float, rng: np.random.Generator,
                channels: int = 1) -> np.ndarray:
         """``channels`` independent records, shape (n, channels), of this term's own
@@ -142,6 +148,9 @@ class _Ieee(Term):
         return self.kind, [self.value**2]
 
     def label(self) -> str:
+        return self.name
+
+    def curve(self, index: int) -> str:
         return self.name
 
     def describe(self, words: TermWords) -> str | None:
@@ -269,6 +278,9 @@ class GaussMarkov(_VarianceAndTime):
     def label(self) -> str:
         return f"GM({_summary.number(self.tau_c)} s)"
 
+    def curve(self, index: int) -> str:
+        return f"GM{index + 1}"
+
     def describe(self, words: TermWords) -> str:
         return (f"Gauss–Markov bias σ = {words.amount(self.sigma, self.sigma_std, 'B')}, "
                 f"τc = {words.number(self.tau_c, self.tau_c_std)} s")
@@ -328,6 +340,9 @@ class Tone(Term):
 
     def label(self) -> str:
         return f"tone {_summary.number(self.freq)} Hz"
+
+    def curve(self, index: int) -> str:
+        return "sine"  # the tones together: their sum is what the curve shows
 
     def describe(self, words: TermWords) -> str | None:
         """A line where the spectrum shows one, at the spectrum's frequency; a tone
