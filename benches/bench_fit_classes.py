@@ -1,7 +1,7 @@
 """Noise-model fit on simulated sensor classes that ../shared/data does not hold.
 
 The recordings a model is judged on are other makers, grades and rates than the
-ones it was developed on (#23). Where no public still log of a class was found,
+ones it was developed on. Where no public still log of a class was found,
 the class is simulated here (``imunoise.simulate`` plus scipy filters and
 integer counting) as its physics describes it, and the fit is scored as
 ``bench_fit_real.py`` scores real channels: the share of taus τ ≤ T/10, at 20
