@@ -10,7 +10,7 @@ import os
 import warnings
 from collections.abc import Sequence
 from concurrent.futures import ThreadPoolExecutor
-from dataclasses import fields, replace
+from dataclasses import dataclass, fields, replace
 
 import numpy as np
 
@@ -336,8 +336,9 @@ def _fit(result, *, method, terms, tau_range, uncertainty, replicates, seed, war
                                                select, filters[c], held=held))
         for c, out in enumerate(fits):
             coef[c], std[c], sup[c], gm[c], gm_std[c], sine[c], sine_std[c], osc[c], \
-                osc_std[c], moving[c], moving_std[c], stats[c], cov[c], core[c], \
-                ambiguous[c] = out
+                osc_std[c], moving[c], moving_std[c] = out.arrays
+            stats[c], cov[c], ambiguous[c] = out.stats, out.slot_cov, out.ties
+            core[c] = out.core_terms, out.cov
             markov = [(a, b) for a, b in gm[c] if np.isfinite(a)]
             tones = [tuple(p) for p in sine[c] if np.isfinite(p[0])]
             oscs = [tuple(osc[c])] if np.isfinite(osc[c, 0]) else []
@@ -535,7 +536,8 @@ def _check_spectrum(spectrum, result) -> None:
     require_linear_grid(spectrum)
 
 
-def _at_spectral_lines(out, spectrum, channel: int, refit):
+def _at_spectral_lines(out: _ChannelFit, spectrum, channel: int,
+                       refit) -> tuple[_ChannelFit, dict]:
     """One channel's fit ``out`` (:func:`_fit_wls`) with each tone the spectrum
     confirms moved to the spectrum's frequency and the variances fitted again by
     ``refit(held core terms)``, and each tone's check against ``spectrum`` by its
@@ -543,9 +545,9 @@ def _at_spectral_lines(out, spectrum, channel: int, refit):
     few per cent wide on the Allan curve: one model has the spectrum's frequency."""
     from imunoise import spectral_lines
 
-    core_terms, cov = out[13]
+    core_terms = out.core_terms
     checks = {}
-    for t in _typed.from_core(core_terms, cov):
+    for t in _typed.from_core(core_terms, out.cov):
         if isinstance(t, _typed.Tone):
             checks[t.freq] = spectral_lines.check_line(spectrum, channel, t.freq, t.amplitude,
                                                        t.freq_std)
@@ -564,7 +566,7 @@ def _at_spectral_lines(out, spectrum, channel: int, refit):
             parameters = [parameters[0], moved.get(f, f)]
         held.append((kind, list(parameters)))
     again = refit(held)
-    return again[:-1] + (out[-1],), {moved.get(f, f): line for f, line in checks.items()}
+    return replace(again, ties=out.ties), {moved.get(f, f): line for f, line in checks.items()}
 
 
 def _lines(components, spectrum, channel: int, checked) -> tuple:
@@ -686,10 +688,24 @@ def _readonly(a):
     return out
 
 
-def _fit_wls(t, v, e, fs, counts, select, found=None, held=None):
-    """One channel's core fit and its deprecated arrays; ``held``: the core terms
-    whose structure, times and frequencies are kept, their variances fitted again
-    (no search)."""
+@dataclass(frozen=True)
+class _ChannelFit:
+    """One channel's core fit: its terms in the core's form (kind, parameters) with
+    the covariance of their coordinates, the fit's statistics (discrepancy, χ²,
+    n_eff), the ties the core found, and the deprecated ``Components`` arrays and
+    slot covariance derived from them."""
+
+    core_terms: list
+    cov: np.ndarray
+    stats: tuple[float, float, float]
+    ties: list
+    arrays: tuple
+    slot_cov: np.ndarray
+
+
+def _fit_wls(t, v, e, fs, counts, select, found=None, held=None) -> _ChannelFit:
+    """One channel's core fit; ``held``: the core terms whose structure, times and
+    frequencies are kept, their variances fitted again (no search)."""
     args = [np.ascontiguousarray(t), np.ascontiguousarray(v), np.ascontiguousarray(e), fs]
     args += [list(counts.items()), select] if held is None else [held]
     core = _core_fit.fit_noise if held is None else _core_fit.fit_noise_at
@@ -701,10 +717,10 @@ def _fit_wls(t, v, e, fs, counts, select, found=None, held=None):
                      filter_level_std=float(found.white_std))
     except ValueError as exc:
         raise ImunoiseValueError(f"cannot fit the noise model to result: {exc}") from None
-    terms = _typed.from_core(r.terms, np.asarray(r.cov))
-    return _legacy_arrays(terms) + (
-        (r.discrepancy, r.chi2, r.n_eff), _slot_covariance(r.terms, np.asarray(r.cov)),
-        (r.terms, np.asarray(r.cov)), r.ambiguous)
+    cov = np.asarray(r.cov)
+    return _ChannelFit(core_terms=r.terms, cov=cov, stats=(r.discrepancy, r.chi2, r.n_eff),
+                       ties=r.ambiguous, arrays=_legacy_arrays(_typed.from_core(r.terms, cov)),
+                       slot_cov=_slot_covariance(r.terms, cov))
 
 
 def _legacy_arrays(terms):
