@@ -52,10 +52,9 @@ print(json.dumps({"wall": wall, "cpu": cpu, "rows": rows,
                   "rss": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024}))
 """
 
-CONVERT = """
-import json, os, resource, shutil, sys, time, warnings
-from imunoise import scale
-warnings.simplefilter("ignore")
+#: The output of a timed run removed first (a file, a directory, its metadata).
+CLEAR = """
+import os, shutil, sys
 out = sys.argv[2]
 shutil.rmtree(out, ignore_errors=True)
 for stale in (out, out + ".meta.json"):
@@ -63,6 +62,12 @@ for stale in (out, out + ".meta.json"):
         os.unlink(stale)
     except (FileNotFoundError, IsADirectoryError):
         pass
+"""
+
+CONVERT = CLEAR + """
+import json, resource, time, warnings
+from imunoise import scale
+warnings.simplefilter("ignore")
 c, t = time.process_time(), time.perf_counter()
 done = scale.convert(sys.argv[1], sys.argv[2], fs=800.0)
 wall, cpu = time.perf_counter() - t, time.process_time() - c
@@ -72,16 +77,9 @@ print(json.dumps({"wall": wall, "cpu": cpu, "rows": done.samples, "bytes": size,
 """
 
 
-FLOOR = """
-import json, os, resource, shutil, sys, time
+FLOOR = CLEAR + """
+import json, resource, time
 from imunoise._core import vn
-out = sys.argv[2]
-shutil.rmtree(out, ignore_errors=True)
-for stale in (out, out + ".meta.json"):
-    try:
-        os.unlink(stale)
-    except (FileNotFoundError, IsADirectoryError):
-        pass
 c, t = time.process_time(), time.perf_counter()
 r = vn.parse_vn(sys.argv[1])
 table = max((cols for cols in r.tables.values()), key=lambda cols: len(next(iter(cols.values()))))

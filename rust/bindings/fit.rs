@@ -42,6 +42,17 @@ fn output_filter(gain: Option<PyReadonlyArray1<'_, f64>>) -> PyResult<Option<Out
         .map_err(PyErr::from)
 }
 
+/// The output filter a fit passes the white term through: its gains and the
+/// relative standard uncertainty of the white level they were measured against.
+fn measured_filter(
+    gain: Option<PyReadonlyArray1<'_, f64>>,
+    level_std: f64,
+) -> PyResult<Option<OutputFilter>> {
+    Ok(output_filter(gain)?
+        .map(|f| f.with_level_std(level_std))
+        .transpose()?)
+}
+
 fn to_matrix(rows: Vec<Vec<f64>>, cols: usize) -> PyResult<Array2<f64>> {
     let n = rows.len();
     Array2::from_shape_vec((n, cols), rows.into_iter().flatten().collect())
@@ -65,9 +76,7 @@ fn fit_noise<'py>(
     filter: Option<PyReadonlyArray1<'py, f64>>,
     filter_level_std: f64,
 ) -> PyResult<PyNoiseFit> {
-    let filter = output_filter(filter)?
-        .map(|f| f.with_level_std(filter_level_std))
-        .transpose()?;
+    let filter = measured_filter(filter, filter_level_std)?;
     let kinds = (counts.iter())
         .map(|(name, n)| Ok((Kind::from_name(name)?, *n)))
         .collect::<Result<Vec<_>, crate::error::CoreError>>()?;
@@ -98,9 +107,7 @@ fn fit_noise_at<'py>(
     filter: Option<PyReadonlyArray1<'py, f64>>,
     filter_level_std: f64,
 ) -> PyResult<PyNoiseFit> {
-    let filter = output_filter(filter)?
-        .map(|f| f.with_level_std(filter_level_std))
-        .transpose()?;
+    let filter = measured_filter(filter, filter_level_std)?;
     let typed = typed_terms(&terms)?;
     let taus = taus.as_array().to_vec();
     let var = var.as_array().to_vec();

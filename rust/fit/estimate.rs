@@ -130,6 +130,16 @@ impl Data {
         self
     }
 
+    /// The same data without the white level's uncertainty: what a search judges
+    /// terms by (the level, one number for every tau, enters the reported
+    /// covariance only).
+    pub fn judged(&self) -> Data {
+        Data {
+            level_var: 0.0,
+            ..self.clone()
+        }
+    }
+
     /// Value of each IEEE basis function at tau `i`, the white one through the
     /// output filter.
     pub fn ieee(&self, i: usize) -> [f64; IEEE_TERMS] {

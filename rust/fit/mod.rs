@@ -180,13 +180,8 @@ pub fn fit_noise(
     opts.check()?;
     let (ieee, gm) = (opts.ieee(), opts.count(Kind::GaussMarkov));
     let reported = Data::new(taus, var, edf, fs)?.with_filter(filter);
-    // The search and its pruning judge terms by what the data constrain; the white
-    // level the filter was measured against, one number for every tau, enters the
-    // reported covariance only.
-    let data = Data {
-        level_var: 0.0,
-        ..reported.clone()
-    };
+    // The search and its pruning judge terms by what the data constrain.
+    let data = reported.judged();
     let chosen = if opts.select {
         choose(&data, fs, opts)?
     } else {
@@ -212,11 +207,7 @@ pub fn fit_noise_at(
     filter: Option<&OutputFilter>,
 ) -> CoreResult<NoiseFit> {
     let reported = Data::new(taus, var, edf, fs)?.with_filter(filter);
-    let data = Data {
-        level_var: 0.0,
-        ..reported.clone()
-    };
-    let held = search::held(&data, fs, terms)?;
+    let held = search::held(&reported.judged(), fs, terms)?;
     Ok(summarise(&reported, fs, &held))
 }
 

@@ -297,7 +297,7 @@ def _fit(result, *, method, terms, tau_range, uncertainty, replicates, seed, war
     stats = np.full((channels, 3), np.nan)  # discrepancy, chi2, n_eff
     cov = np.full((channels, PARAMS, PARAMS), np.nan)
     core: list = [None] * channels  # per channel: the core's terms and their covariance
-    checked: list = [None] * channels  # per channel: its tones checked against the spectrum
+    checked = [None] * channels  # per channel: its tones checked against the spectrum
     ambiguous: list = [[] for _ in range(channels)]  # per channel: the core's ties
     usable = []
     for c in range(channels):
@@ -322,18 +322,17 @@ def _fit(result, *, method, terms, tau_range, uncertainty, replicates, seed, war
         # The Rust fit releases the GIL: channels run in parallel threads.
         def fit_channel(c):
             ok = usable[c]
-            return _fit_wls(taus[ok], var[ok, c], edf[ok, c], float(result.fs), counts,
-                            select, filters[c])
+
+            def core_fit(held=None):
+                return _fit_wls(taus[ok], var[ok, c], edf[ok, c], float(result.fs), counts,
+                                select, filters[c], held=held)
+
+            if spectrum is None:
+                return core_fit(), None
+            return _at_spectral_lines(core_fit(), spectrum, c, core_fit)
 
         with ThreadPoolExecutor(max_workers=min(channels, os.cpu_count() or 1)) as pool:
-            fits = list(pool.map(fit_channel, range(channels)))
-        if spectrum is not None:
-            for c in range(channels):
-                fits[c], checked[c] = _at_spectral_lines(
-                    fits[c], spectrum, c,
-                    lambda held, c=c: _fit_wls(taus[usable[c]], var[usable[c], c],
-                                               edf[usable[c], c], float(result.fs), counts,
-                                               select, filters[c], held=held))
+            fits, checked = zip(*pool.map(fit_channel, range(channels)))
         for c, out in enumerate(fits):
             coef[c], std[c], sup[c], gm[c], gm_std[c], sine[c], sine_std[c], osc[c], \
                 osc_std[c], moving[c], moving_std[c] = out.arrays
