@@ -332,7 +332,7 @@ def _fit(result, *, method, terms, tau_range, uncertainty, replicates, seed, war
             return _at_spectral_lines(core_fit(), spectrum, c, core_fit)
 
         with ThreadPoolExecutor(max_workers=min(channels, os.cpu_count() or 1)) as pool:
-            fits, checked = zip(*pool.map(fit_channel, range(channels)))
+            fits, checked = zip(*pool.map(fit_channel, range(channels)), strict=True)
         for c, out in enumerate(fits):
             coef[c], std[c], sup[c], gm[c], gm_std[c], sine[c], sine_std[c], osc[c], \
                 osc_std[c], moving[c], moving_std[c] = out.arrays
